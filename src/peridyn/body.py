@@ -1,0 +1,188 @@
+"""The discretised body: material points, their volumes, cells and named node sets.
+
+One array layout everywhere: points are ``(n_points, 3)`` float64 in metres,
+also for 2D bodies (``dim == 2``), whose points lie in the plane ``z = 0`` and
+whose volumes are cell area times ``thickness``. Kernels therefore have a single
+3D form; 2D results are the first two columns.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from peridyn.errors import InputError, did_you_mean
+
+
+@dataclass(frozen=True, eq=False)
+class Body:
+    """Material points of a peridynamic body.
+
+    Parameters
+    ----------
+    points : (n_points, 3) float64, m
+        Reference positions (z = 0 for 2D bodies).
+    volumes : (n_points,) float64, m^3
+        Volume of each point's cell.
+    cells : (n_points, 3) float64, m
+        Side lengths of each point's (box) cell, used for partial volumes.
+        For 2D bodies the third side is the thickness.
+    dim : {2, 3}
+        Spatial dimension of the model.
+    spacing : float, m
+        Reference spacing: horizons given as a multiple refer to it (the
+        largest in-plane cell side of a grid).
+    node_sets : mapping of str to (n,) int64
+        Named sets of point indices.
+    thickness : float or None, m
+        Out-of-plane thickness of a 2D body.
+    plane : {"stress", "strain"} or None
+        Plane assumption of a 2D body.
+    layer_index : (n_points,) int64 or None
+        Through-thickness layer of each point for layered plates (0 = bottom).
+    """
+
+    points: np.ndarray
+    volumes: np.ndarray
+    cells: np.ndarray
+    dim: int
+    spacing: float
+    node_sets: Mapping[str, np.ndarray] = field(default_factory=dict)
+    thickness: float | None = None
+    plane: str | None = None
+    layer_index: np.ndarray | None = None
+
+    def __post_init__(self):
+        points = np.ascontiguousarray(self.points, dtype=np.float64)
+        if points.ndim != 2 or points.shape[1] != 3:
+            raise InputError(f"points must have shape (n_points, 3), got {points.shape}")
+        n = len(points)
+        if n == 0:
+            raise InputError("a body needs at least one point")
+        if not np.all(np.isfinite(points)):
+            bad = int(np.flatnonzero(~np.isfinite(points).all(axis=1))[0])
+            raise InputError(f"point {bad} has a non-finite coordinate {points[bad].tolist()}")
+        volumes = np.ascontiguousarray(self.volumes, dtype=np.float64)
+        if volumes.shape != (n,):
+            raise InputError(f"volumes must have shape ({n},), got {volumes.shape}")
+        if not np.all(volumes > 0):
+            bad = int(np.flatnonzero(~(volumes > 0))[0])
+            raise InputError(f"volume of point {bad} must be positive, got {volumes[bad]!r}")
+        cells = np.ascontiguousarray(np.broadcast_to(self.cells, (n, 3)), dtype=np.float64)
+        if self.dim not in (2, 3):
+            raise InputError(f"dim must be 2 or 3, got {self.dim!r}")
+        if self.dim == 2:
+            if self.thickness is None or not self.thickness > 0:
+                raise InputError(f"a 2D body needs a positive thickness, got {self.thickness!r}")
+            if self.plane not in ("stress", "strain"):
+                raise InputError(f"plane must be 'stress' or 'strain', got {self.plane!r}")
+            if np.any(points[:, 2] != 0.0):
+                raise InputError("points of a 2D body must have z = 0")
+        if not self.spacing > 0:
+            raise InputError(f"spacing must be positive, got {self.spacing!r}")
+        sets = {name: _as_index_array(name, idx, n) for name, idx in self.node_sets.items()}
+        object.__setattr__(self, "points", points)
+        object.__setattr__(self, "volumes", volumes)
+        object.__setattr__(self, "cells", cells)
+        object.__setattr__(self, "node_sets", sets)
+
+    @property
+    def n_points(self) -> int:
+        """Number of material points."""
+        return len(self.points)
+
+    def __repr__(self) -> str:
+        return (
+            f"Body(n_points={self.n_points}, dim={self.dim}, spacing={self.spacing:g} m, "
+            f"node_sets={sorted(self.node_sets)})"
+        )
+
+    def node_set(self, name: str) -> np.ndarray:
+        """Indices of the named node set; a clear error when it does not exist or is empty."""
+        if name not in self.node_sets:
+            raise InputError(
+                f"unknown node set {name!r}{did_you_mean(name, self.node_sets)}; "
+                f"defined sets: {sorted(self.node_sets)}"
+            )
+        idx = self.node_sets[name]
+        if len(idx) == 0:
+            raise InputError(f"node set {name!r} is empty: its region contains no point")
+        return idx
+
+    def with_node_set(self, name: str, selection) -> Body:
+        """A copy with one more named node set.
+
+        Parameters
+        ----------
+        selection : (n_points,) bool mask, index array, or callable
+            A callable receives ``points`` (n_points, 3) and returns a mask.
+        """
+        if callable(selection):
+            selection = selection(self.points)
+        idx = _as_index_array(name, selection, self.n_points)
+        if len(idx) == 0:
+            raise InputError(f"node set {name!r} is empty: its region contains no point")
+        return replace(self, node_sets={**self.node_sets, name: idx})
+
+    def remove(self, mask_or_predicate) -> Body:
+        """A copy without the points selected (e.g. a hole); node sets are re-indexed.
+
+        Parameters
+        ----------
+        mask_or_predicate : (n_points,) bool or callable(points) -> bool mask
+        """
+        mask = mask_or_predicate(self.points) if callable(mask_or_predicate) else mask_or_predicate
+        mask = np.asarray(mask, dtype=bool)
+        if mask.shape != (self.n_points,):
+            raise InputError(f"removal mask must have shape ({self.n_points},), got {mask.shape}")
+        keep = ~mask
+        if not keep.any():
+            raise InputError("the removal takes away every point of the body")
+        new_index = np.cumsum(keep) - 1
+        sets = {k: new_index[v[keep[v]]] for k, v in self.node_sets.items()}
+        layers = None if self.layer_index is None else self.layer_index[keep]
+        return replace(
+            self,
+            points=self.points[keep],
+            volumes=self.volumes[keep],
+            cells=self.cells[keep],
+            node_sets=sets,
+            layer_index=layers,
+        )
+
+
+def _as_index_array(name: str, selection, n: int) -> np.ndarray:
+    arr = np.asarray(selection)
+    if arr.dtype == bool:
+        if arr.shape != (n,):
+            raise InputError(f"node set {name!r}: mask must have shape ({n},), got {arr.shape}")
+        return np.flatnonzero(arr).astype(np.int64)
+    arr = arr.astype(np.int64).ravel()
+    if arr.size and (arr.min() < 0 or arr.max() >= n):
+        raise InputError(f"node set {name!r}: indices must lie in [0, {n}), got {arr.min()}..{arr.max()}")
+    return np.unique(arr)
+
+
+# -- region predicates: callables points (n, 3) -> bool mask (n,) -------------------------
+
+
+def in_box(lower, upper) -> Callable[[np.ndarray], np.ndarray]:
+    """Points inside the axis-aligned box ``lower <= x <= upper`` (m, 3 values each)."""
+    lo = np.asarray(lower, dtype=float)
+    hi = np.asarray(upper, dtype=float)
+    return lambda x: np.all((x >= lo) & (x <= hi), axis=1)
+
+
+def in_sphere(center, radius: float) -> Callable[[np.ndarray], np.ndarray]:
+    """Points within ``radius`` (m) of ``center`` (m, 3 values)."""
+    c = np.asarray(center, dtype=float)
+    return lambda x: np.einsum("ij,ij->i", x - c, x - c) <= radius**2
+
+
+def in_cylinder(center, radius: float, axis: str = "z") -> Callable[[np.ndarray], np.ndarray]:
+    """Points within ``radius`` (m) of the line through ``center`` along ``axis`` (x, y or z)."""
+    c = np.asarray(center, dtype=float)
+    keep = [a for a in range(3) if a != "xyz".index(axis)]
+    return lambda x: np.sum((x[:, keep] - c[keep]) ** 2, axis=1) <= radius**2

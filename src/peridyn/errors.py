@@ -1,0 +1,48 @@
+"""Exceptions that speak to the user: each names what is wrong and what was expected."""
+
+from __future__ import annotations
+
+import difflib
+
+
+class PeridynError(Exception):
+    """Base class of every error peridyn raises on purpose."""
+
+
+class InputError(PeridynError, ValueError):
+    """A value given by the user (argument, array, case-file entry) is invalid."""
+
+
+class CaseFileError(InputError):
+    """A case file is invalid.
+
+    Parameters
+    ----------
+    path : str
+        The case file.
+    key : str
+        Dotted key path inside the file, e.g. ``"material.E"``.
+    value : object
+        The offending value (``None`` when missing).
+    expected : str
+        What was expected instead.
+    """
+
+    def __init__(self, path: str, key: str, value, expected: str):
+        self.path, self.key, self.value, self.expected = path, key, value, expected
+        super().__init__(f"{path}: {key} = {value!r}: {expected}")
+
+
+class InstabilityError(PeridynError, RuntimeError):
+    """The explicit integration blew up (NaN/inf or runaway displacement)."""
+
+    def __init__(self, step: int, time: float, point: int, detail: str = ""):
+        self.step, self.time, self.point = step, time, point
+        msg = f"solution became unstable at step {step} (t = {time:.6g} s), point {point}"
+        super().__init__(msg + (f": {detail}" if detail else ""))
+
+
+def did_you_mean(word: str, choices) -> str:
+    """A ``" (did you mean 'x'?)"`` suffix for a misspelt ``word``, or ``""``."""
+    close = difflib.get_close_matches(word, list(choices), n=1)
+    return f" (did you mean {close[0]!r}?)" if close else ""

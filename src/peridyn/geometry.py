@@ -1,0 +1,187 @@
+"""Point generators (boxes, layered plates, 2D rectangles, text meshes) and face/layer sets.
+
+Grids put points at cell centres, ordered lexicographically with the last
+axis fastest, which keeps neighbours close in memory for the kernels.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from peridyn.body import Body
+from peridyn.errors import InputError
+
+
+def _positive_triplet(name: str, value, count: int = 3) -> np.ndarray:
+    arr = np.broadcast_to(np.asarray(value, dtype=float), (count,)).copy()
+    if not np.all(np.isfinite(arr)) or np.any(arr <= 0):
+        raise InputError(f"{name} must be positive and finite, got {np.asarray(value).tolist()}")
+    return arr
+
+
+def _cell_counts(lengths: np.ndarray, spacing: np.ndarray) -> np.ndarray:
+    counts = np.rint(lengths / spacing).astype(np.int64)
+    if np.any(counts < 1):
+        raise InputError(
+            f"spacing {spacing.tolist()} m is larger than the body {lengths.tolist()} m"
+        )
+    return counts
+
+
+def _grid(counts, spacing, origin) -> np.ndarray:
+    axes = [origin[a] + (np.arange(counts[a]) + 0.5) * spacing[a] for a in range(len(counts))]
+    mesh = np.meshgrid(*axes, indexing="ij")
+    return np.stack([m.ravel() for m in mesh], axis=1)
+
+
+def box(lengths, spacing, origin=(0.0, 0.0, 0.0)) -> Body:
+    """A 3D box of cubic (or box) cells.
+
+    Parameters
+    ----------
+    lengths : 3 floats, m
+        Edge lengths along x, y, z; rounded to a whole number of cells.
+    spacing : float or 3 floats, m
+        Cell size per axis.
+    origin : 3 floats, m
+        Lower corner of the box.
+    """
+    h = _positive_triplet("spacing", spacing)
+    lengths = _positive_triplet("lengths", lengths)
+    counts = _cell_counts(lengths, h)
+    points = _grid(counts, h, np.asarray(origin, dtype=float))
+    return Body(points=points, volumes=np.full(len(points), h.prod()), cells=h, dim=3,
+                spacing=float(h.max()))
+
+
+def plate(length, width, thickness, spacing, layers, origin=(0.0, 0.0, 0.0),
+          layer_placement: str = "cell") -> Body:
+    """A 3D plate in the x-y plane with ``layers`` layers of points through its thickness.
+
+    Parameters
+    ----------
+    length, width, thickness : float, m
+        Plate size along x, y and z; the plate spans z in [origin_z, origin_z + thickness].
+    spacing : float, m
+        In-plane spacing (x and y).
+    layers : int
+        Number of point layers through the thickness (>= 1).
+    layer_placement : {"cell", "surface"}
+        ``"cell"``: layers at the centres of ``layers`` equal slabs (dz = t / layers),
+        volumes add up to the plate volume. ``"surface"``: the first and last layers
+        lie on the faces (dz = t / (layers - 1)) and every point has volume
+        dx dy dz, as in seed 000 (3 layers 1 mm apart in a 2 mm plate).
+
+    Notes
+    -----
+    ``layer_index`` holds each point's layer (0 = bottom, ``layers - 1`` = top).
+    """
+    if int(layers) != layers or layers < 1:
+        raise InputError(f"layers must be a positive integer, got {layers!r}")
+    layers = int(layers)
+    h = float(_positive_triplet("spacing", spacing, 1)[0])
+    length, width, thickness = _positive_triplet("plate size", (length, width, thickness))
+    counts_xy = _cell_counts(np.array([length, width]), np.array([h, h]))
+    if layer_placement == "cell":
+        dz = thickness / layers
+        z = (np.arange(layers) + 0.5) * dz
+    elif layer_placement == "surface":
+        if layers < 2:
+            raise InputError("layer_placement 'surface' needs at least 2 layers")
+        dz = thickness / (layers - 1)
+        z = np.arange(layers) * dz
+    else:
+        raise InputError(f"layer_placement must be 'cell' or 'surface', got {layer_placement!r}")
+    xy = _grid(counts_xy, np.array([h, h]), np.asarray(origin[:2], dtype=float))
+    n_xy = len(xy)
+    points = np.empty((n_xy * layers, 3))
+    points[:, :2] = np.repeat(xy, layers, axis=0)
+    points[:, 2] = origin[2] + np.tile(z, n_xy)
+    layer_index = np.tile(np.arange(layers, dtype=np.int64), n_xy)
+    cell = np.array([h, h, dz])
+    return Body(points=points, volumes=np.full(len(points), cell.prod()), cells=cell, dim=3,
+                spacing=h, layer_index=layer_index)
+
+
+def rectangle(length, width, spacing, thickness, plane: str = "stress",
+              origin=(0.0, 0.0)) -> Body:
+    """A 2D rectangle (plane stress or plane strain) of square cells.
+
+    Parameters
+    ----------
+    length, width : float, m
+        Size along x and y.
+    spacing : float, m
+        Cell size.
+    thickness : float, m
+        Out-of-plane thickness (volumes are cell area times thickness).
+    plane : {"stress", "strain"}
+    """
+    h = float(_positive_triplet("spacing", spacing, 1)[0])
+    t = float(_positive_triplet("thickness", thickness, 1)[0])
+    counts = _cell_counts(_positive_triplet("rectangle size", (length, width), 2), np.array([h, h]))
+    xy = _grid(counts, np.array([h, h]), np.asarray(origin, dtype=float))
+    points = np.zeros((len(xy), 3))
+    points[:, :2] = xy
+    return Body(points=points, volumes=np.full(len(points), h * h * t), cells=np.array([h, h, t]),
+                dim=2, spacing=h, thickness=t, plane=plane)
+
+
+def from_text_mesh(path, dim: int = 3, thickness: float | None = None,
+                   plane: str | None = None) -> Body:
+    """A body from a Peridigm-style text mesh (``x y z block_id volume`` per line).
+
+    Cells are taken as cubes of the point's volume (squares times ``thickness``
+    in 2D); node sets ``block_<id>`` hold the points of each block.
+    """
+    from peridyn.io.mesh_text import read_text_mesh
+
+    points, blocks, volumes = read_text_mesh(path)
+    if dim == 2:
+        if thickness is None:
+            raise InputError("a 2D text mesh needs the thickness of the body")
+        side = np.sqrt(volumes / thickness)
+        cells = np.stack([side, side, np.full_like(side, thickness)], axis=1)
+    else:
+        side = np.cbrt(volumes)
+        cells = np.stack([side, side, side], axis=1)
+    sets = {f"block_{b}": np.flatnonzero(blocks == b) for b in np.unique(blocks)}
+    return Body(points=points, volumes=volumes, cells=cells, dim=dim,
+                spacing=float(np.median(side)), node_sets=sets, thickness=thickness, plane=plane)
+
+
+def to_text_mesh(body: Body, path, block_ids=None) -> None:
+    """Write ``body`` as a Peridigm-style text mesh (block 1 unless ``block_ids`` given)."""
+    from peridyn.io.mesh_text import write_text_mesh
+
+    blocks = np.ones(body.n_points, dtype=np.int64) if block_ids is None else block_ids
+    write_text_mesh(path, body.points, blocks, body.volumes)
+
+
+def face(body: Body, which: str, depth: float | None = None) -> np.ndarray:
+    """Mask of the points within ``depth`` (default: half a cell) of a bounding-box face.
+
+    Parameters
+    ----------
+    which : {"x-", "x+", "y-", "y+", "z-", "z+"}
+    depth : float, m
+        Thickness of the selected slab, measured from the outermost points.
+    """
+    if which not in {"x-", "x+", "y-", "y+", "z-", "z+"}:
+        raise InputError(f"face must be one of x-, x+, y-, y+, z-, z+, got {which!r}")
+    axis = "xyz".index(which[0])
+    coord = body.points[:, axis]
+    tol = 0.5 * float(np.min(body.cells[:, axis])) if depth is None else depth
+    if which[1] == "-":
+        return coord <= coord.min() + tol
+    return coord >= coord.max() - tol
+
+
+def layer(body: Body, index: int) -> np.ndarray:
+    """Mask of the points of through-thickness layer ``index`` of a plate (negative counts from the top)."""
+    if body.layer_index is None:
+        raise InputError("this body has no layers (only plates made by geometry.plate do)")
+    n_layers = int(body.layer_index.max()) + 1
+    if not -n_layers <= index < n_layers:
+        raise InputError(f"layer {index} out of range for a plate with {n_layers} layers")
+    return body.layer_index == (index % n_layers)

@@ -1,0 +1,391 @@
+"""Case files: YAML validated with pydantic, SI units, unknown keys refused.
+
+``load_case(path, overrides)`` reads a file, applies ``--set key.path=value``
+overrides and returns a :class:`Case`. Every problem is reported as a
+:class:`~peridyn.errors.CaseFileError` naming the key path, the value and what
+was expected (with "did you mean" for misspelt keys).
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+from typing import Annotated, Literal
+
+import yaml
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+
+from peridyn.errors import CaseFileError, did_you_mean
+
+
+class _Loader(yaml.SafeLoader):
+    """SafeLoader that also reads ``1e3`` and ``150.0e3`` as floats (YAML 1.2 style);
+    plain PyYAML would take them for strings."""
+
+
+_Loader.add_implicit_resolver(
+    "tag:yaml.org,2002:float",
+    re.compile(r"""^(?:[-+]?(?:[0-9][0-9_]*)(?:\.[0-9_]*)?(?:[eE][-+]?[0-9]+)
+    |[-+]?(?:[0-9][0-9_]*)\.[0-9_]*
+    |[-+]?\.[0-9_]+(?:[eE][-+]?[0-9]+)?
+    |[-+]?\.(?:inf|Inf|INF)
+    |\.(?:nan|NaN|NAN))$""", re.X),
+    list("-+0123456789."),
+)
+
+
+def parse_yaml(text: str):
+    """Parse YAML text with floats read as in YAML 1.2 (``1e-3``, ``68.9e9``)."""
+    return yaml.load(text, Loader=_Loader)
+
+
+Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
+NonNegative = Annotated[float, Field(ge=0, allow_inf_nan=False)]
+Finite = Annotated[float, Field(allow_inf_nan=False)]
+Vector3 = Annotated[list[Finite], Field(min_length=2, max_length=3)]
+
+
+class Strict(BaseModel):
+    """Base of every section: unknown keys are errors."""
+
+    model_config = ConfigDict(extra="forbid")
+
+
+class Geometry(Strict):
+    """The body's shape. ``box``: size [lx, ly, lz]; ``plate``: size [length, width, thickness]
+    and ``layers``; ``rectangle`` (2D): size [lx, ly], ``thickness``, ``plane``;
+    ``mesh``: a Peridigm-style text mesh ``file`` (x y z block_id volume)."""
+
+    type: Literal["box", "plate", "rectangle", "mesh"]
+    size: list[Positive] | None = None
+    origin: Vector3 | None = None
+    layers: Annotated[int, Field(ge=1)] | None = None
+    layer_placement: Literal["cell", "surface"] = "cell"
+    thickness: Positive | None = None
+    plane: Literal["stress", "strain"] = "stress"
+    file: str | None = None
+    dimension: Literal[2, 3] = 3
+
+    @model_validator(mode="after")
+    def _complete(self):
+        need = {"box": 3, "plate": 3, "rectangle": 2}
+        if self.type in need and (self.size is None or len(self.size) != need[self.type]):
+            raise ValueError(f"a {self.type} needs size with {need[self.type]} values (m)")
+        if self.type == "plate" and self.layers is None:
+            raise ValueError("a plate needs the number of layers through its thickness")
+        if self.type == "rectangle" and self.thickness is None:
+            raise ValueError("a rectangle (2D) needs its thickness (m)")
+        if self.type == "mesh" and not self.file:
+            raise ValueError("a mesh geometry needs the mesh file")
+        return self
+
+
+class Discretization(Strict):
+    """Spacing (m, one value or one per axis for a box), horizon as a multiple of the spacing
+    (``horizon``) or in metres (``horizon_m``), influence function and partial volumes."""
+
+    spacing: Positive | list[Positive] | None = None
+    horizon: Positive | None = None
+    horizon_m: Positive | None = None
+    influence: Literal["constant", "inverse", "gaussian", "conical"] = "constant"
+    partial_volumes: bool = True
+
+    @model_validator(mode="after")
+    def _one_horizon(self):
+        if (self.horizon is None) == (self.horizon_m is None):
+            raise ValueError("give exactly one of horizon (multiple of the spacing) or horizon_m")
+        return self
+
+
+class Damage(Strict):
+    """Bond failure: ``critical_stretch`` or ``fracture_energy`` (J/m^2), and node sets
+    where bonds never break."""
+
+    critical_stretch: Positive | None = None
+    fracture_energy: Positive | None = None
+    no_damage_sets: list[str] = []
+
+    @model_validator(mode="after")
+    def _one(self):
+        if (self.critical_stretch is None) == (self.fracture_energy is None):
+            raise ValueError("give exactly one of critical_stretch or fracture_energy")
+        return self
+
+
+class Material(Strict):
+    """Material model, elastic constants (Pa, kg/m^3) and optional damage."""
+
+    model: Literal["pmb", "lps"]
+    E: Positive
+    nu: Annotated[float, Field(gt=-1, lt=0.5)] | None = None
+    density: Positive
+    surface_correction: str = "none"
+    damage: Damage | None = None
+
+
+class Region(Strict):
+    """A region of points: box (min, max), sphere (center, radius), cylinder (center, radius,
+    axis), face (face, depth), layer (index), or all."""
+
+    type: Literal["box", "sphere", "cylinder", "face", "layer", "all"]
+    min: Vector3 | None = None
+    max: Vector3 | None = None
+    center: Vector3 | None = None
+    radius: Positive | None = None
+    axis: Literal["x", "y", "z"] = "z"
+    face: Literal["x-", "x+", "y-", "y+", "z-", "z+"] | None = None
+    depth: Positive | None = None
+    index: int | None = None
+
+    @model_validator(mode="after")
+    def _complete(self):
+        needs = {"box": ("min", "max"), "sphere": ("center", "radius"),
+                 "cylinder": ("center", "radius"), "face": ("face",), "layer": ("index",)}
+        missing = [k for k in needs.get(self.type, ()) if getattr(self, k) is None]
+        if missing:
+            raise ValueError(f"a {self.type} region needs {', '.join(missing)}")
+        return self
+
+
+class Precrack(Strict):
+    """Bonds crossing a planar rectangle (origin, edge_u, edge_v; 3D) or a segment
+    (start, end; 2D) are cut."""
+
+    type: Literal["rectangle", "segment"]
+    origin: Vector3 | None = None
+    edge_u: Vector3 | None = None
+    edge_v: Vector3 | None = None
+    start: Vector3 | None = None
+    end: Vector3 | None = None
+
+    @model_validator(mode="after")
+    def _complete(self):
+        keys = ("origin", "edge_u", "edge_v") if self.type == "rectangle" else ("start", "end")
+        missing = [k for k in keys if getattr(self, k) is None]
+        if missing:
+            raise ValueError(f"a {self.type} pre-crack needs {', '.join(missing)}")
+        return self
+
+
+class BoundaryConditionSpec(Strict):
+    """A condition on node set ``set``: kind, components ("x", "xy", ...) and a value
+    (a number or a time function mapping, see ``peridyn.timefunctions.from_spec``)."""
+
+    set: str
+    kind: Literal["displacement", "velocity", "force", "body_force"]
+    components: str | list[str] = "xyz"
+    value: float | dict = 0.0
+
+
+class InitialConditionSpec(Strict):
+    """Initial displacement (m) or velocity (m/s) of node set ``set``."""
+
+    set: str
+    kind: Literal["displacement", "velocity"]
+    components: str | list[str] = "xyz"
+    value: Finite = 0.0
+
+
+class Solver(Strict):
+    """``explicit``: ``steps`` or ``time`` (s), optional ``dt`` (s; default safety x stable),
+    damping (1/s), kernel dtype; ``static``: adaptive dynamic relaxation with ``tolerance``,
+    ``max_iterations`` and ``load_steps`` (the loads at t = 1 s, ramped linearly in steps)."""
+
+    type: Literal["explicit", "static"] = "explicit"
+    steps: Annotated[int, Field(ge=1)] | None = None
+    time: Positive | None = None
+    dt: Positive | None = None
+    safety: Annotated[float, Field(gt=0, le=1)] = 0.8
+    damping: NonNegative = 0.0
+    dtype: Literal["float64", "float32"] = "float64"
+    tolerance: Positive = 1e-6
+    max_iterations: Annotated[int, Field(ge=1)] = 200_000
+    load_steps: Annotated[int, Field(ge=1)] = 1
+
+    @model_validator(mode="after")
+    def _duration(self):
+        if self.type == "explicit" and self.steps is not None and self.time is not None:
+            raise ValueError("give steps or time, not both (they would conflict)")
+        if self.type == "explicit" and self.steps is None and self.time is None:
+            raise ValueError("an explicit run needs steps or time (s)")
+        return self
+
+
+class LineSpec(Strict):
+    """A line probe from ``start`` to ``end`` (m) sampled at ``points`` points."""
+
+    start: Vector3
+    end: Vector3
+    points: Annotated[int, Field(ge=2)]
+
+
+class Output(Strict):
+    """Where and what to write (folder default: ``peridyn-out/<case name>``)."""
+
+    directory: str | None = None
+    every: Annotated[int, Field(ge=1)] = 1
+    snapshot_every: Annotated[int, Field(ge=1)] | None = None
+    snapshot_times: list[NonNegative] = []
+    sensors: dict[str, Vector3] = {}
+    lines: dict[str, LineSpec] = {}
+    planes: dict[str, str] = {}
+    series_dtype: Literal["float64", "float32"] = "float64"
+    vtu: bool = True
+    plots: bool = True
+
+
+class Case(Strict):
+    """A whole simulation case."""
+
+    name: str
+    description: str = ""
+    geometry: Geometry
+    discretization: Discretization
+    material: Material
+    removals: list[Region] = []
+    node_sets: dict[str, Region] = {}
+    precracks: list[Precrack] = []
+    boundary_conditions: list[BoundaryConditionSpec] = []
+    initial_conditions: list[InitialConditionSpec] = []
+    solver: Solver
+    output: Output = Output()
+
+    @model_validator(mode="after")
+    def _sets_exist(self):
+        known = set(self.node_sets) | {"all"}
+        used = [(f"boundary_conditions[{i}].set", bc.set)
+                for i, bc in enumerate(self.boundary_conditions)]
+        used += [(f"initial_conditions[{i}].set", ic.set)
+                 for i, ic in enumerate(self.initial_conditions)]
+        used += [(f"output.planes.{k}", v) for k, v in self.output.planes.items()]
+        if self.material.damage:
+            used += [("material.damage.no_damage_sets", s)
+                     for s in self.material.damage.no_damage_sets]
+        for where, name in used:
+            if name not in known:
+                raise ValueError(f"{where}: unknown node set {name!r}{did_you_mean(name, known)};"
+                                 f" defined: {sorted(known)}")
+        return self
+
+
+def load_case(path, overrides=()) -> Case:
+    """Read, override and validate a case file.
+
+    Parameters
+    ----------
+    path : str or Path
+    overrides : sequence of "key.path=value"
+        Applied before validation; values are parsed as YAML (``1e-3``, ``true``, ``[1, 2]``).
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise CaseFileError(str(path), "<file>", None, "an existing YAML case file")
+    try:
+        raw = parse_yaml(path.read_text())
+    except yaml.YAMLError as exc:
+        raise CaseFileError(str(path), "<file>", None, f"valid YAML ({exc})") from exc
+    if not isinstance(raw, dict):
+        raise CaseFileError(str(path), "<root>", raw, "a mapping of sections")
+    for item in overrides:
+        apply_override(raw, item, str(path))
+    return validate_case(raw, str(path))
+
+
+def validate_case(raw: dict, source: str = "<case>") -> Case:
+    """Validate a case given as a dictionary (e.g. built in Python)."""
+    try:
+        return Case.model_validate(raw)
+    except ValidationError as exc:
+        raise _case_error(exc, source) from None
+
+
+def apply_override(raw: dict, item: str, source: str = "<case>") -> None:
+    """Set ``key.path=value`` in the nested dict ``raw`` (list items by index: ``a.0.b``)."""
+    if "=" not in item:
+        raise CaseFileError(source, item, None, "an override of the form key.path=value")
+    key, text = item.split("=", 1)
+    value = parse_yaml(text)
+    parts = key.strip().split(".")
+    node = raw
+    for depth, part in enumerate(parts[:-1]):
+        node = _child(node, part, source, ".".join(parts[: depth + 1]))
+    last = parts[-1]
+    if isinstance(node, list):
+        node[_index(node, last, source, key)] = value
+    elif isinstance(node, dict):
+        node[last] = value
+    else:
+        raise CaseFileError(source, key, node, "a mapping or a list to set a key in")
+
+
+def _child(node, part: str, source: str, where: str):
+    if isinstance(node, list):
+        return node[_index(node, part, source, where)]
+    if not isinstance(node, dict):
+        raise CaseFileError(source, where, node, "a mapping")
+    return node.setdefault(part, {})
+
+
+def _index(node: list, part: str, source: str, where: str) -> int:
+    if not part.lstrip("-").isdigit() or not -len(node) <= int(part) < len(node):
+        raise CaseFileError(source, where, part, f"a list index below {len(node)}")
+    return int(part)
+
+
+def _case_error(exc: ValidationError, source: str) -> CaseFileError:
+    lines = []
+    first = None
+    for err in exc.errors():
+        loc = _key_path(err["loc"])
+        value = err.get("input")
+        if err["type"] == "extra_forbidden":
+            allowed = _allowed_keys(err["loc"])
+            expected = f"no such key{did_you_mean(str(err['loc'][-1]), allowed)}; allowed: {allowed}"
+        elif err["type"] == "missing":
+            expected, value = "a required key that is missing", None
+        else:
+            expected = err["msg"].removeprefix("Value error, ")
+        if first is None:
+            first = (loc, value, expected)
+        lines.append(f"{loc} = {value!r}: {expected}" if loc else expected)
+    error = CaseFileError(source, first[0] or "<root>", first[1], first[2])
+    if len(lines) > 1:
+        error.args = (f"{source}: {len(lines)} problems:\n  " + "\n  ".join(lines),)
+    return error
+
+
+def _key_path(loc) -> str:
+    out = ""
+    for part in loc:
+        if isinstance(part, int):
+            out += f"[{part}]"
+        elif "[" in str(part) or part in ("function-after", "literal"):
+            continue
+        else:
+            out += f".{part}" if out else str(part)
+    return out
+
+
+def _allowed_keys(loc) -> list[str]:
+    model: type[BaseModel] = Case
+    for part in loc[:-1]:
+        if isinstance(part, int):
+            continue
+        field = model.model_fields.get(str(part))
+        if field is None:
+            break
+        inner = _model_in(field.annotation)
+        if inner is None:
+            break
+        model = inner
+    return sorted(model.model_fields)
+
+
+def _model_in(annotation):
+    if isinstance(annotation, type) and issubclass(annotation, BaseModel):
+        return annotation
+    for arg in getattr(annotation, "__args__", ()):
+        found = _model_in(arg)
+        if found is not None:
+            return found
+    return None

@@ -1,0 +1,537 @@
+"""Incremental HDF5 results files.
+
+Layout of a results file::
+
+    /                       root attributes: the run's provenance
+    /geometry/points        (n_points, dim) float64, m
+    /geometry/volumes       (n_points,) float64, m^3
+    /series/<name>/data     (n_records, *shape), resizable, chunked along time
+    /series/<name>/time     (n_records,) float64, s
+    /series/<name>/step     (n_records,) int64, strictly increasing
+    /<any>/<name>           one-off arrays, e.g. /final/damage
+
+The writer flushes after every ``flush_every`` appends, so a process that
+crashes loses at most the records appended since the last flush.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import operator
+import os
+from collections.abc import Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass
+
+import h5py
+import numpy as np
+
+from peridyn.errors import InputError, did_you_mean
+
+CHUNK_BYTES = 1 << 20
+"""Target size of one chunk of a series' data, in bytes."""
+
+MIN_INDEX_CHUNK = 1024
+"""Smallest chunk, in records, of the ``time`` and ``step`` datasets."""
+
+JSON_KEYS_ATTR = "_peridyn_json_keys"
+"""Root attribute listing the attributes stored as JSON text."""
+
+_CHUNK_CACHE_BYTES = 4 * CHUNK_BYTES
+_RESERVED_GROUPS = ("geometry", "series")
+
+
+class HDF5Writer:
+    """Write a results file incrementally.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The results file.
+    points : array_like, shape (n_points, dim)
+        Reference coordinates in m, ``dim`` 2 or 3.
+    volumes : array_like, shape (n_points,)
+        Point volumes in m^3 (m^2 times thickness in 2-D).
+    provenance : dict
+        Run metadata stored as root attributes. Values may be strings,
+        numbers, booleans or numeric arrays; dicts, lists, tuples and ``None``
+        are stored as JSON text and decoded by :func:`read_provenance`.
+    mode : {"w", "a"}
+        ``"w"`` creates the file (overwriting it). ``"a"`` continues an
+        existing file, e.g. on restart from a checkpoint; its geometry must
+        equal ``points`` and ``volumes``, and ``provenance`` updates the root
+        attributes. A missing file is created.
+    flush_every : int
+        Flush the file to the operating system after this many appends.
+
+    Raises
+    ------
+    InputError
+        Bad arguments, or in append mode a geometry that differs from the one
+        in the file.
+
+    Examples
+    --------
+    >>> with HDF5Writer("run.h5", x, vol, {"solver": "explicit"}) as out:  # doctest: +SKIP
+    ...     out.create_series("u", x.shape)
+    ...     out.append("u", step=0, time=0.0, values=u)
+    """
+
+    def __init__(
+        self,
+        path: str | os.PathLike,
+        points,
+        volumes,
+        provenance: dict,
+        mode: str = "w",
+        flush_every: int = 1,
+    ):
+        if mode not in ("w", "a"):
+            raise InputError(f"mode must be 'w' or 'a', got {mode!r}")
+        if not _is_int(flush_every) or flush_every < 1:
+            raise InputError(f"flush_every must be a positive integer, got {flush_every!r}")
+        points, volumes = _check_geometry(points, volumes)
+        self.path = os.fspath(path)
+        self.flush_every = flush_every
+        self._pending = 0
+        self._series: dict[str, _Series] = {}
+        try:
+            self._file = h5py.File(self.path, mode, rdcc_nbytes=_CHUNK_CACHE_BYTES)
+        except OSError as exc:
+            raise InputError(f"cannot open results file {self.path!r} for writing: {exc}") from None
+        try:
+            self._write_geometry(points, volumes)
+            _write_attrs(self._file.attrs, provenance, f"{self.path}: provenance")
+            self._open_existing_series()
+            self._file.flush()
+        except BaseException:
+            self._file.close()
+            raise
+
+    def __enter__(self) -> HDF5Writer:
+        return self
+
+    def __exit__(self, exc_type, exc, tb) -> None:
+        self.close()
+
+    def close(self) -> None:
+        """Flush and close the file; calling it again does nothing."""
+        if self._file.id.valid:
+            self._file.flush()
+            self._file.close()
+
+    def flush(self) -> None:
+        """Flush everything written so far to the operating system."""
+        self._file.flush()
+        self._pending = 0
+
+    def create_series(self, name: str, shape, dtype="float64", attrs: dict | None = None) -> None:
+        """Create the time series ``/series/<name>``, with no records yet.
+
+        Parameters
+        ----------
+        name : str
+            Series name, without ``/``.
+        shape : tuple of int
+            Shape of one record, e.g. ``(n_points, dim)`` for a vector field,
+            ``()`` for a scalar.
+        dtype : str or numpy dtype
+            Storage type; ``"float32"`` halves the size of big plane records.
+        attrs : dict, optional
+            Attributes of the series group (e.g. units), encoded like
+            provenance.
+
+        Raises
+        ------
+        InputError
+            Bad name, shape or dtype, or a series of that name already exists
+            with a different shape or dtype (an identical one is reused, so a
+            restarted run may create its series again).
+        """
+        _check_series_name(name)
+        shape = _check_shape(name, shape)
+        dtype = _check_dtype(name, dtype)
+        if name in self._series:
+            self._check_existing_series(name, shape, dtype)
+        else:
+            group = self._file.require_group("series").create_group(name)
+            self._series[name] = _Series.create(group, shape, dtype)
+        if attrs:
+            group = self._file["series"][name]
+            _write_attrs(group.attrs, attrs, f"{self.path}: series {name!r} attrs")
+        self.flush()
+
+    def append(self, name: str, step: int, time: float, values) -> None:
+        """Append one record to a series.
+
+        Parameters
+        ----------
+        name : str
+            A series made by :meth:`create_series`.
+        step : int
+            Time step number; must exceed the last step of the series.
+        time : float
+            Simulated time in s.
+        values : array_like, shape of the series' record
+            The record, cast to the series' dtype.
+
+        Raises
+        ------
+        InputError
+            Unknown series, non-increasing step, non-finite time or a record
+            of the wrong shape.
+        """
+        series = self._get_series(name)
+        step, time = _check_step_time(name, series.last_step, step, time)
+        values = np.asarray(values)
+        if values.shape != series.data.shape[1:]:
+            raise InputError(
+                f"series {name!r}: record has shape {values.shape}, "
+                f"expected {series.data.shape[1:]}"
+            )
+        series.append(step, time, values)
+        self._pending += 1
+        if self._pending >= self.flush_every:
+            self.flush()
+
+    def write_array(self, name: str, array, attrs: dict | None = None) -> None:
+        """Write a one-off dataset, replacing any dataset of that name.
+
+        Parameters
+        ----------
+        name : str
+            Dataset path, e.g. ``"final/damage"``; not under ``geometry`` or
+            ``series``.
+        array : array_like
+            The data, stored with its own dtype.
+        attrs : dict, optional
+            Dataset attributes, encoded like provenance.
+        """
+        key = name.strip("/") if isinstance(name, str) else ""
+        if not key or key.split("/")[0] in _RESERVED_GROUPS:
+            raise InputError(
+                f"write_array: name {name!r} must be a non-empty path outside "
+                f"{', '.join('/' + g for g in _RESERVED_GROUPS)}"
+            )
+        if key in self._file:
+            del self._file[key]
+        dataset = self._file.create_dataset(key, data=np.asarray(array))
+        if attrs:
+            _write_attrs(dataset.attrs, attrs, f"{self.path}: {key!r} attrs")
+        self.flush()
+
+    def truncate(self, step: int) -> None:
+        """Drop the records with a step greater than ``step`` in every series.
+
+        Used on restart from the checkpoint taken at ``step``, so that records
+        written after the checkpoint are not duplicated.
+        """
+        if not _is_int(step):
+            raise InputError(f"truncate: step must be an integer, got {step!r}")
+        for series in self._series.values():
+            series.resize(int(np.searchsorted(series.step[:], step, side="right")))
+        self.flush()
+
+    def _write_geometry(self, points: np.ndarray, volumes: np.ndarray) -> None:
+        if "geometry" not in self._file:
+            geometry = self._file.create_group("geometry")
+            geometry.create_dataset("points", data=points)
+            geometry.create_dataset("volumes", data=volumes)
+            return
+        old_points = self._file["geometry/points"][:]
+        old_volumes = self._file["geometry/volumes"][:]
+        if not (np.array_equal(old_points, points) and np.array_equal(old_volumes, volumes)):
+            raise InputError(
+                f"{self.path}: points/volumes differ from the geometry already in the file "
+                f"(points {old_points.shape} there, {points.shape} given); "
+                "append mode needs the same geometry"
+            )
+
+    def _open_existing_series(self) -> None:
+        for name, group in self._file.get("series", {}).items():
+            self._series[name] = _Series.open(group)
+
+    def _check_existing_series(self, name: str, shape: tuple, dtype: np.dtype) -> None:
+        data = self._series[name].data
+        if data.shape[1:] != shape or data.dtype != dtype:
+            raise InputError(
+                f"{self.path}: series {name!r} already exists with record shape "
+                f"{data.shape[1:]} and dtype {data.dtype}, not {shape} and {dtype}"
+            )
+
+    def _get_series(self, name: str) -> _Series:
+        if name not in self._series:
+            raise InputError(
+                f"series {name!r} does not exist; call create_series first"
+                + did_you_mean(name, self._series)
+            )
+        return self._series[name]
+
+
+@dataclass
+class _Series:
+    """Open handles of one series' datasets, kept for fast appends."""
+
+    data: h5py.Dataset
+    time: h5py.Dataset
+    step: h5py.Dataset
+    last_step: int | None
+
+    @classmethod
+    def create(cls, group: h5py.Group, shape: tuple, dtype: np.dtype) -> _Series:
+        record_bytes = dtype.itemsize * math.prod(shape)
+        records = max(1, CHUNK_BYTES // max(record_bytes, 1))
+        index_chunk = (max(records, MIN_INDEX_CHUNK),)
+        data = group.create_dataset(
+            "data", (0, *shape), dtype, maxshape=(None, *shape), chunks=(records, *shape)
+        )
+        time = group.create_dataset("time", (0,), np.float64, maxshape=(None,), chunks=index_chunk)
+        step = group.create_dataset("step", (0,), np.int64, maxshape=(None,), chunks=index_chunk)
+        return cls(data, time, step, None)
+
+    @classmethod
+    def open(cls, group: h5py.Group) -> _Series:
+        """Open an existing series, dropping a record half-written by a crash."""
+        series = cls(group["data"], group["time"], group["step"], None)
+        series.resize(_n_records(group))
+        return series
+
+    def append(self, step: int, time: float, values: np.ndarray) -> None:
+        """Write one record: data, then time, then step (the step marks it complete)."""
+        n = self.data.shape[0]
+        for dataset, value in ((self.data, values), (self.time, time), (self.step, step)):
+            dataset.resize(n + 1, axis=0)
+            dataset[n] = value
+        self.last_step = step
+
+    def resize(self, n: int) -> None:
+        """Keep the first ``n`` records."""
+        for dataset in (self.data, self.time, self.step):
+            dataset.resize(n, axis=0)
+        self.last_step = int(self.step[n - 1]) if n else None
+
+
+def _check_step_time(name: str, last_step: int | None, step, time) -> tuple[int, float]:
+    if not _is_int(step):
+        raise InputError(f"series {name!r}: step must be an integer, got {step!r}")
+    if last_step is not None and step <= last_step:
+        raise InputError(
+            f"series {name!r}: step {step} does not exceed the last recorded step {last_step} "
+            "(call truncate(step) after restarting from a checkpoint)"
+        )
+    try:
+        time = float(time)
+    except (TypeError, ValueError):
+        time = math.nan
+    if not math.isfinite(time):
+        raise InputError(f"series {name!r}: time must be a finite number of seconds")
+    return int(step), time
+
+
+def read_series(path: str | os.PathLike, name: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Read a whole series.
+
+    Parameters
+    ----------
+    path : str or path-like
+        A results file.
+    name : str
+        Series name.
+
+    Returns
+    -------
+    steps : ndarray, shape (n_records,), int64
+    times : ndarray, shape (n_records,), float64
+        Times in s.
+    data : ndarray, shape (n_records, *record_shape)
+        Records in the stored dtype.
+    """
+    with _open_series(path, name) as group:
+        n = _n_records(group)
+        return group["step"][:n], group["time"][:n], group["data"][:n]
+
+
+def iter_series_chunks(
+    path: str | os.PathLike, name: str, chunk_records: int
+) -> Iterator[tuple[np.ndarray, np.ndarray]]:
+    """Read a series a few records at a time, without loading it whole.
+
+    Parameters
+    ----------
+    path : str or path-like
+        A results file.
+    name : str
+        Series name.
+    chunk_records : int
+        Records per chunk (the last chunk may be shorter).
+
+    Yields
+    ------
+    times : ndarray, shape (k,), float64
+        Times in s.
+    data : ndarray, shape (k, *record_shape)
+        The records, ``k <= chunk_records``.
+    """
+    if not _is_int(chunk_records) or chunk_records < 1:
+        raise InputError(f"chunk_records must be a positive integer, got {chunk_records!r}")
+    with _open_series(path, name) as group:
+        times, data = group["time"], group["data"]
+        n = _n_records(group)
+        for start in range(0, n, chunk_records):
+            stop = min(start + chunk_records, n)
+            yield times[start:stop], data[start:stop]
+
+
+def read_array(path: str | os.PathLike, name: str) -> np.ndarray:
+    """Read one dataset, e.g. ``"final/damage"`` or ``"geometry/points"``."""
+    with _open_results(path) as f:
+        key = name.strip("/")
+        if not key or not isinstance(f.get(key), h5py.Dataset):
+            raise InputError(f"{os.fspath(path)}: no dataset {name!r}")
+        return f[key][()]
+
+
+def read_provenance(path: str | os.PathLike) -> dict:
+    """Read the root attributes of a results file, JSON entries decoded.
+
+    Returns
+    -------
+    dict
+        Provenance as given to :class:`HDF5Writer`; numbers come back as
+        Python scalars, tuples as lists.
+    """
+    with _open_results(path) as f:
+        return _read_attrs(f.attrs)
+
+
+@contextmanager
+def _open_results(path: str | os.PathLike) -> Iterator[h5py.File]:
+    path = os.fspath(path)
+    if not os.path.exists(path):
+        raise InputError(f"results file {path!r} does not exist")
+    try:
+        f = h5py.File(path, "r")
+    except OSError as exc:
+        raise InputError(f"{path}: not a readable HDF5 file ({exc})") from None
+    with f:
+        yield f
+
+
+@contextmanager
+def _open_series(path: str | os.PathLike, name: str) -> Iterator[h5py.Group]:
+    with _open_results(path) as f:
+        available = list(f.get("series", {}))
+        if name not in available:
+            raise InputError(
+                f"{os.fspath(path)}: no series {name!r}; it has {available}"
+                + did_you_mean(name, available)
+            )
+        yield f["series"][name]
+
+
+def _is_int(value) -> bool:
+    return isinstance(value, int | np.integer) and not isinstance(value, bool)
+
+
+def _check_geometry(points, volumes) -> tuple[np.ndarray, np.ndarray]:
+    points = np.asarray(points, dtype=np.float64)
+    volumes = np.asarray(volumes, dtype=np.float64)
+    if points.ndim != 2 or points.shape[1] not in (2, 3):
+        raise InputError(f"points must have shape (n_points, 2 or 3), got {points.shape}")
+    if volumes.shape != points.shape[:1]:
+        raise InputError(
+            f"volumes must have shape ({points.shape[0]},) like points, got {volumes.shape}"
+        )
+    return points, volumes
+
+
+def _check_series_name(name) -> None:
+    if not isinstance(name, str) or not name or "/" in name or name == ".":
+        raise InputError(f"series name must be a non-empty string without '/', got {name!r}")
+
+
+def _check_shape(name: str, shape) -> tuple[int, ...]:
+    if isinstance(shape, int | np.integer):
+        shape = (shape,)
+    try:
+        shape = tuple(operator.index(s) for s in shape)
+    except TypeError:
+        raise InputError(f"series {name!r}: shape must be a tuple of ints, got {shape!r}") from None
+    if any(s < 1 for s in shape):
+        raise InputError(f"series {name!r}: record dimensions must be positive, got {shape}")
+    return shape
+
+
+def _check_dtype(name: str, dtype) -> np.dtype:
+    try:
+        dtype = np.dtype(dtype)
+    except TypeError:
+        raise InputError(f"series {name!r}: unknown dtype {dtype!r}") from None
+    if dtype.kind not in "biuf":
+        raise InputError(f"series {name!r}: dtype must be numeric, got {dtype}")
+    return dtype
+
+
+def _n_records(group: h5py.Group) -> int:
+    """Number of complete records (a crash may leave data or time one longer)."""
+    return min(group[key].shape[0] for key in ("data", "time", "step"))
+
+
+def _write_attrs(attrs: h5py.AttributeManager, values: dict, where: str) -> None:
+    """Store ``values`` as HDF5 attributes, JSON-encoding containers and None."""
+    json_keys = set(json.loads(attrs.get(JSON_KEYS_ATTR, "[]")))
+    for key, value in values.items():
+        if not isinstance(key, str) or key == JSON_KEYS_ATTR:
+            raise InputError(f"{where}: invalid attribute name {key!r}")
+        if isinstance(value, dict | list | tuple) or value is None:
+            attrs[key] = _to_json(value, f"{where}: {key!r}")
+            json_keys.add(key)
+        elif isinstance(value, str | bool | int | float | np.generic | np.ndarray):
+            _set_attr(attrs, key, value, where)
+            json_keys.discard(key)
+        else:
+            raise InputError(
+                f"{where}: {key!r} has type {type(value).__name__}; expected a string, "
+                "number, boolean, numeric array, dict, list or None"
+            )
+    if json_keys:
+        attrs[JSON_KEYS_ATTR] = json.dumps(sorted(json_keys))
+    elif JSON_KEYS_ATTR in attrs:
+        del attrs[JSON_KEYS_ATTR]
+
+
+def _set_attr(attrs: h5py.AttributeManager, key: str, value, where: str) -> None:
+    try:
+        attrs[key] = value
+    except (OSError, TypeError) as exc:
+        raise InputError(
+            f"{where}: {key!r} cannot be stored as an HDF5 attribute ({exc}); "
+            "arrays over 64 KiB belong in write_array"
+        ) from None
+
+
+def _to_json(value, where: str) -> str:
+    try:
+        return json.dumps(value, default=_json_default, sort_keys=True)
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"{where} cannot be stored as JSON: {exc}") from None
+
+
+def _json_default(value):
+    if isinstance(value, np.generic | np.ndarray):
+        return value.tolist()
+    raise TypeError(f"{type(value).__name__} is not JSON serializable")
+
+
+def _read_attrs(attrs: h5py.AttributeManager) -> dict:
+    json_keys = set(json.loads(attrs.get(JSON_KEYS_ATTR, "[]")))
+    out = {}
+    for key, value in attrs.items():
+        if key == JSON_KEYS_ATTR:
+            continue
+        if key in json_keys:
+            out[key] = json.loads(value)
+        else:
+            out[key] = value.item() if isinstance(value, np.generic) else value
+    return out

@@ -1,0 +1,150 @@
+"""VTK output for ParaView: point clouds as .vtu files and .pvd time collections."""
+
+from __future__ import annotations
+
+import math
+import os
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import meshio
+import numpy as np
+
+from peridyn.errors import InputError
+
+
+def write_vtu(path: str | os.PathLike, points, point_data: dict) -> None:
+    """Write points and their fields as an unstructured grid of VTK_VERTEX cells.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The .vtu file to write (overwritten).
+    points : array_like, shape (n_points, dim)
+        Coordinates in m, ``dim`` 2 or 3; 2-D points get ``z = 0``.
+    point_data : dict of str to array_like
+        Fields of shape ``(n_points,)`` (scalars) or ``(n_points, k)``.
+        Two-component vectors are padded with a zero third component so that
+        ParaView shows them as vectors; booleans are written as uint8.
+
+    Raises
+    ------
+    InputError
+        Points of a bad shape, or a field whose first dimension is not
+        ``n_points`` or that is not numeric.
+    """
+    points = _pad_columns(np.asarray(points, dtype=np.float64))
+    if points.ndim != 2 or points.shape[1] != 3:
+        raise InputError(
+            f"write_vtu: points must have shape (n_points, 2 or 3), got {points.shape}"
+        )
+    n = points.shape[0]
+    fields = {name: _vtk_field(name, values, n) for name, values in point_data.items()}
+    cells = [("vertex", np.arange(n, dtype=np.int64).reshape(-1, 1))]
+    meshio.Mesh(points, cells, point_data=fields).write(os.fspath(path), file_format="vtu")
+
+
+class PVDCollection:
+    """A ParaView .pvd file listing .vtu files by time.
+
+    The whole file is rewritten atomically on each change, so it is valid at
+    any moment, even while a run is still writing.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The .pvd file.
+    mode : {"w", "a"}
+        ``"w"`` starts an empty collection (the file is written on the first
+        :meth:`add`); ``"a"`` keeps the entries of an existing file, e.g. on
+        restart from a checkpoint (a missing file starts empty).
+    """
+
+    def __init__(self, path: str | os.PathLike, mode: str = "w"):
+        if mode not in ("w", "a"):
+            raise InputError(f"PVDCollection: mode must be 'w' or 'a', got {mode!r}")
+        self.path = Path(path)
+        self._entries: list[tuple[float, str]] = []
+        if mode == "a" and self.path.exists():
+            self._entries = _read_pvd(self.path)
+
+    @property
+    def entries(self) -> list[tuple[float, str]]:
+        """``(time in s, file)`` of each data set, in order."""
+        return list(self._entries)
+
+    def add(self, time: float, vtu_relative_path: str | os.PathLike) -> None:
+        """List one more .vtu file and rewrite the collection.
+
+        Parameters
+        ----------
+        time : float
+            Simulated time in s; must exceed the last time listed.
+        vtu_relative_path : str or path-like
+            The .vtu file, relative to the directory of the .pvd file.
+
+        Raises
+        ------
+        InputError
+            The time is not finite or does not increase.
+        """
+        time = float(time)
+        if not math.isfinite(time):
+            raise InputError(f"{self.path}: time must be finite, got {time!r}")
+        if self._entries and time <= self._entries[-1][0]:
+            raise InputError(
+                f"{self.path}: time {time!r} s does not exceed the last listed time "
+                f"{self._entries[-1][0]!r} s (call truncate(time) after a restart)"
+            )
+        self._entries.append((time, Path(vtu_relative_path).as_posix()))
+        self._write()
+
+    def truncate(self, time: float) -> None:
+        """Drop the entries later than ``time`` (s) and rewrite the collection."""
+        self._entries = [entry for entry in self._entries if entry[0] <= time]
+        self._write()
+
+    def _write(self) -> None:
+        root = ET.Element("VTKFile", type="Collection", version="0.1", byte_order="LittleEndian")
+        collection = ET.SubElement(root, "Collection")
+        for time, file in self._entries:
+            ET.SubElement(collection, "DataSet", timestep=repr(time), group="", part="0", file=file)
+        ET.indent(root)
+        tmp = self.path.with_name(self.path.name + ".tmp")
+        ET.ElementTree(root).write(tmp, encoding="utf-8", xml_declaration=True)
+        os.replace(tmp, self.path)
+
+
+def _read_pvd(path: Path) -> list[tuple[float, str]]:
+    """``(time, file)`` entries of an existing .pvd file."""
+    try:
+        root = ET.parse(path).getroot()
+        return [
+            (float(item.attrib["timestep"]), item.attrib["file"]) for item in root.iter("DataSet")
+        ]
+    except (ET.ParseError, KeyError, ValueError) as exc:
+        raise InputError(
+            f"{path}: not a valid .pvd collection (expected DataSet elements with "
+            f"'timestep' and 'file' attributes): {exc}"
+        ) from None
+
+
+def _pad_columns(array: np.ndarray) -> np.ndarray:
+    """Pad a ``(n, 2)`` array with a zero third column; other shapes pass through."""
+    if array.ndim == 2 and array.shape[1] == 2:
+        return np.column_stack([array, np.zeros(array.shape[0], dtype=array.dtype)])
+    return array
+
+
+def _vtk_field(name: str, values, n: int) -> np.ndarray:
+    values = np.asarray(values)
+    if values.ndim not in (1, 2) or values.shape[0] != n:
+        raise InputError(
+            f"write_vtu: field {name!r} has shape {values.shape}, "
+            f"expected ({n},) or ({n}, k) for {n} points"
+        )
+    if values.dtype.kind == "b":
+        values = values.astype(np.uint8)
+    if values.dtype.kind not in "iuf":
+        raise InputError(f"write_vtu: field {name!r} must be numeric, got dtype {values.dtype}")
+    return _pad_columns(values)

@@ -1,0 +1,187 @@
+"""Boundary and initial conditions on node sets, per displacement component.
+
+Kinds of boundary condition:
+
+- ``displacement``: u[set, c] = profile * f(t) (m); the velocity follows by difference;
+- ``velocity``: v[set, c] = profile * f(t) (m/s); the displacement integrates it;
+- ``force``: a total force f(t) (N) per component, spread over the set as a uniform
+  body-force density f(t) / (sum of the set's volumes);
+- ``body_force``: body-force density b[set, c] = profile * f(t) (N/m^3).
+
+``profile`` is an optional spatial amplitude, (n_set,) or (n_set, n_components),
+e.g. the radial displacement field of a PZT patch.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from peridyn.body import Body
+from peridyn.errors import InputError, did_you_mean
+from peridyn.timefunctions import Constant, TimeFunction
+
+BC_KINDS = ("displacement", "velocity", "force", "body_force")
+IC_KINDS = ("displacement", "velocity")
+COMPONENTS = {"x": 0, "y": 1, "z": 2}
+
+
+def parse_components(components) -> tuple[int, ...]:
+    """Component indices from "x", "xy", ["x", "z"] or [0, 2]."""
+    if isinstance(components, str):
+        components = list(components)
+    out = []
+    for c in components:
+        if isinstance(c, str):
+            if c not in COMPONENTS:
+                raise InputError(f"unknown component {c!r}: use x, y or z")
+            out.append(COMPONENTS[c])
+        elif c in (0, 1, 2):
+            out.append(int(c))
+        else:
+            raise InputError(f"unknown component {c!r}: use x, y, z or 0, 1, 2")
+    if not out or len(set(out)) != len(out):
+        raise InputError(f"components must be distinct and not empty, got {components!r}")
+    return tuple(out)
+
+
+@dataclass(frozen=True)
+class BoundaryCondition:
+    """A condition on the components of a node set over time (see the module docstring)."""
+
+    node_set: str
+    kind: str
+    components: tuple = (0, 1, 2)
+    function: TimeFunction = field(default_factory=lambda: Constant(0.0))
+    profile: np.ndarray | None = None
+
+    def __post_init__(self):
+        if self.kind not in BC_KINDS:
+            raise InputError(f"unknown boundary condition kind {self.kind!r}"
+                             f"{did_you_mean(self.kind, BC_KINDS)}; choose one of {BC_KINDS}")
+        object.__setattr__(self, "components", parse_components(self.components))
+
+
+@dataclass(frozen=True)
+class InitialCondition:
+    """u or v of the components of a node set at t = 0: ``value`` (float or (n_set, n_comp))."""
+
+    node_set: str
+    kind: str
+    components: tuple = (0, 1, 2)
+    value: float | np.ndarray = 0.0
+
+    def __post_init__(self):
+        if self.kind not in IC_KINDS:
+            raise InputError(f"unknown initial condition kind {self.kind!r}; choose one of {IC_KINDS}")
+        object.__setattr__(self, "components", parse_components(self.components))
+
+
+@dataclass
+class _Bound:
+    index: np.ndarray  # (n_set,) point indices
+    components: tuple
+    function: TimeFunction
+    amplitude: np.ndarray  # (n_set, n_comp)
+
+
+class Loading:
+    """Boundary conditions bound to a body, checked for conflicts.
+
+    Attributes
+    ----------
+    constrained : (n_points, 3) bool
+        DOFs whose motion is prescribed (displacement or velocity).
+    """
+
+    def __init__(self, body: Body, conditions=(), initial=()):
+        self.body = body
+        self.displacement: list[_Bound] = []
+        self.velocity: list[_Bound] = []
+        self.body_force: list[_Bound] = []
+        self.initial = list(initial)
+        self.constrained = np.zeros((body.n_points, 3), dtype=bool)
+        owner = np.full((body.n_points, 3), -1)
+        forced = np.zeros((body.n_points, 3), dtype=bool)
+        for number, bc in enumerate(conditions):
+            bound = self._bind(bc)
+            idx, comps = bound.index, list(bound.components)
+            if bc.kind in ("displacement", "velocity"):
+                taken = owner[np.ix_(idx, comps)]
+                if np.any(taken >= 0):
+                    other = conditions[int(taken[taken >= 0][0])]
+                    raise InputError(
+                        f"boundary conditions on sets {other.node_set!r} ({other.kind}) and "
+                        f"{bc.node_set!r} ({bc.kind}) prescribe the same component of the same "
+                        "points: a point's motion can be prescribed only once"
+                    )
+                owner[np.ix_(idx, comps)] = number
+                (self.displacement if bc.kind == "displacement" else self.velocity).append(bound)
+            else:
+                forced[np.ix_(idx, comps)] = True
+                if bc.kind == "force":
+                    bound.amplitude = bound.amplitude / body.volumes[idx].sum()
+                self.body_force.append(bound)
+        self.constrained = owner >= 0
+        clash = self.constrained & forced
+        if clash.any():
+            point = int(np.flatnonzero(clash.any(axis=1))[0])
+            raise InputError(
+                f"point {point} has both a prescribed motion and an applied force on the same "
+                "component: the force would be ignored"
+            )
+
+    def _bind(self, bc: BoundaryCondition) -> _Bound:
+        idx = self.body.node_set(bc.node_set)
+        return _Bound(idx, bc.components, bc.function,
+                      _amplitude(bc.profile, len(idx), len(bc.components), bc.node_set))
+
+    @property
+    def has_loads(self) -> bool:
+        """True when any boundary condition is defined."""
+        return bool(self.displacement or self.velocity or self.body_force)
+
+    def apply_initial(self, u: np.ndarray, v: np.ndarray) -> None:
+        """Write the initial conditions into ``u`` and ``v`` (IN/OUT, (n_points, 3))."""
+        for ic in self.initial:
+            idx = self.body.node_set(ic.node_set)
+            amp = _amplitude(ic.value, len(idx), len(ic.components), ic.node_set)
+            target = u if ic.kind == "displacement" else v
+            target[np.ix_(idx, list(ic.components))] = amp
+
+    def apply_kinematics(self, t: float, dt: float, u: np.ndarray, v: np.ndarray) -> None:
+        """Impose the prescribed displacements (and their velocity) at time ``t`` (IN/OUT)."""
+        for b in self.displacement:
+            cols = list(b.components)
+            u[np.ix_(b.index, cols)] = b.amplitude * b.function(t)
+            v[np.ix_(b.index, cols)] = b.amplitude * b.function.derivative(t, dt)
+
+    def apply_velocities(self, t: float, v: np.ndarray) -> None:
+        """Impose the prescribed velocities at time ``t`` (IN/OUT ``v``)."""
+        for b in self.velocity:
+            v[np.ix_(b.index, list(b.components))] = b.amplitude * b.function(t)
+
+    def body_force_density(self, t: float, out: np.ndarray) -> np.ndarray:
+        """External body-force density at ``t``, N/m^3, written into ``out`` (n_points, 3)."""
+        out[:] = 0.0
+        for b in self.body_force:
+            out[np.ix_(b.index, list(b.components))] += b.amplitude * b.function(t)
+        return out
+
+
+def _amplitude(profile, n: int, n_comp: int, name: str) -> np.ndarray:
+    if profile is None:
+        return np.ones((n, n_comp))
+    arr = np.asarray(profile, dtype=float)
+    if arr.ndim == 0:
+        return np.full((n, n_comp), float(arr))
+    if arr.shape == (n,):
+        arr = np.repeat(arr[:, None], n_comp, axis=1)
+    if arr.shape == (n_comp,):
+        arr = np.broadcast_to(arr, (n, n_comp)).copy()
+    if arr.shape != (n, n_comp):
+        raise InputError(f"profile for set {name!r} must have shape ({n}, {n_comp}), got {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        raise InputError(f"profile for set {name!r} has non-finite values")
+    return arr

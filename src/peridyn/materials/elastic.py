@@ -1,0 +1,50 @@
+"""Isotropic elastic constants and the peridynamic integrals of influence functions."""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.integrate import quad
+
+from peridyn.bonds import influence_function
+from peridyn.errors import InputError
+
+
+def check_elastic(E: float, nu: float, rho: float) -> None:
+    """Raise InputError unless 0 < E, -1 < nu < 1/2 and 0 < rho (SI units)."""
+    for name, value in (("E", E), ("rho", rho)):
+        if not (np.isfinite(value) and value > 0):
+            raise InputError(f"material {name} must be positive and finite, got {value!r}")
+    if not (np.isfinite(nu) and -1.0 < nu < 0.5):
+        raise InputError(f"material nu must lie in (-1, 0.5), got {nu!r}")
+
+
+def bulk_modulus(E: float, nu: float) -> float:
+    """3D bulk modulus K = E / (3 (1 - 2 nu)), Pa."""
+    return E / (3.0 * (1.0 - 2.0 * nu))
+
+
+def shear_modulus(E: float, nu: float) -> float:
+    """Shear modulus mu = E / (2 (1 + nu)), Pa."""
+    return E / (2.0 * (1.0 + nu))
+
+
+def plane_bulk_modulus(E: float, nu: float, plane: str) -> float:
+    """2D (in-plane) bulk modulus, Pa: E / (2 (1 - nu)) in plane stress, lambda + mu in plane strain."""
+    if plane == "stress":
+        return E / (2.0 * (1.0 - nu))
+    if plane == "strain":
+        return E / (2.0 * (1.0 + nu) * (1.0 - 2.0 * nu))
+    raise InputError(f"plane must be 'stress' or 'strain', got {plane!r}")
+
+
+def radial_moment(influence: str, horizon: float, power: int) -> float:
+    """Integral of omega(r) r^power over [0, horizon] (m^(power+1))."""
+    omega = influence_function(influence)
+    value, _ = quad(lambda r: float(omega(np.array(r), horizon)) * r**power, 0.0, horizon,
+                    limit=200)
+    return value
+
+
+def mean_fourth_power(dim: int) -> float:
+    """Integral of n_x^4 over the unit sphere (3D: 4 pi / 5) or circle (2D: 3 pi / 4)."""
+    return 4.0 * np.pi / 5.0 if dim == 3 else 3.0 * np.pi / 4.0

@@ -1,0 +1,131 @@
+"""Linear peridynamic solid (LPS), state-based (Silling, Epton, Weckner, Xu, Askari 2007).
+
+3D: bulk modulus K and shear modulus mu from E and nu; 2D (Le, Silling and
+Bobaru 2014 form): the in-plane bulk modulus kappa (E / (2 (1 - nu)) in plane
+stress, lambda + mu in plane strain) and mu, with dilatation
+theta = (2 / m) sum w |xi| e and deviatoric coefficient 8 mu / m.
+In d dimensions the energy density of point i is
+
+    W_i = kappa theta_i^2 / 2 + (alpha_i / 2) sum_j w_ij (e_ij - theta_i |xi| / d)^2,
+
+alpha = 15 mu / m (3D), 8 mu / m (2D), w = omega beta V_j, m_i = sum_j w_ij |xi|^2 over
+the intact bonds at set-up (each point's own family, so surfaces are seen).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from peridyn.body import Body
+from peridyn.bonds import Bonds
+from peridyn.errors import InputError
+from peridyn.kernels.lps import lps_deviatoric_energy, lps_dilatation, lps_pair_force
+from peridyn.materials.base import Model
+from peridyn.materials.elastic import (
+    bulk_modulus,
+    check_elastic,
+    plane_bulk_modulus,
+    shear_modulus,
+)
+
+
+class LPSModel(Model):
+    """LPS material bound to a body and its bonds.
+
+    Parameters
+    ----------
+    body, bonds : Body, Bonds
+    E : float, Pa
+    nu : float
+    density : float, kg/m^3
+    dtype : float64 or float32
+    """
+
+    name = "lps"
+
+    def __init__(self, body: Body, bonds: Bonds, E: float, nu: float, density: float,
+                 surface_correction: str = "none", dtype=np.float64):
+        check_elastic(E, nu, density)
+        if surface_correction != "none":
+            raise InputError(
+                f"LPS surface_correction must be 'none' in this version, got {surface_correction!r}"
+            )
+        super().__init__(body, bonds, density, dtype)
+        dim = body.dim
+        self.E, self.nu, self.dim = float(E), float(nu), dim
+        self.shear = shear_modulus(E, nu)
+        self.bulk = bulk_modulus(E, nu) if dim == 3 else plane_bulk_modulus(E, nu, body.plane)
+        b = bonds
+        w = b.influence * self.bond_volume
+        self.weighted_volume = np.add.reduceat(np.where(b.intact, w * b.length**2, 0.0),
+                                               b.offsets[:-1])
+        m = self.weighted_volume
+        if np.any(m <= 0):
+            lonely = int(np.flatnonzero(m <= 0)[0])
+            raise InputError(f"point {lonely} has no intact bond: its weighted volume is zero")
+        self.alpha = (15.0 if dim == 3 else 8.0) * self.shear / m
+        self.theta_coef = dim / m
+        self.length = b.length.astype(self.dtype)
+        self.w = w.astype(self.dtype)
+        self._alpha = self.alpha.astype(self.dtype)
+        self._theta_coef = self.theta_coef.astype(self.dtype)
+        # P_i = theta_i * p_coef_i, see peridyn.kernels.lps
+        self._p_coef = (dim * self.bulk / m - self.alpha / dim).astype(self.dtype)
+        self._theta = np.empty(body.n_points, dtype=self.dtype)
+
+    def dilatation(self, u) -> np.ndarray:
+        """Dilatation theta (n_points,), dimensionless."""
+        b = self.bonds
+        return lps_dilatation(self.x, self._as_state(u), b.offsets, b.neighbours, self.length,
+                              self.w, b.intact, self._theta_coef, self._theta).copy()
+
+    def force(self, u, out=None):
+        out = np.empty_like(self.x) if out is None else out
+        b = self.bonds
+        u = self._as_state(u)
+        theta = lps_dilatation(self.x, u, b.offsets, b.neighbours, self.length, self.w,
+                               b.intact, self._theta_coef, self._theta)
+        p = theta * self._p_coef
+        return lps_pair_force(self.x, u, b.offsets, b.neighbours, self.length, self.w, b.intact,
+                              p, self._alpha, out)
+
+    def energy_density(self, u):
+        b = self.bonds
+        u64 = np.ascontiguousarray(u, dtype=np.float64)
+        x64 = self.body.points
+        w64 = self.w.astype(np.float64)
+        theta = lps_dilatation(x64, u64, b.offsets, b.neighbours, b.length, w64, b.intact,
+                               self.theta_coef, np.empty(self.body.n_points))
+        dev = lps_deviatoric_energy(x64, u64, b.offsets, b.neighbours, b.length, w64, b.intact,
+                                    theta, float(self.dim), np.empty(self.body.n_points))
+        return 0.5 * self.bulk * theta**2 + 0.5 * self.alpha * dev
+
+    def stiffness_bound(self):
+        """Block-Gershgorin bound of the LPS stiffness (see ``Model.stiffness_bound``).
+
+        The energy is bounded above by dropping the -theta |xi| / d part of the
+        deviatoric extension; the bound's Hessian has bond blocks of norm
+        w (alpha_i + alpha_j) and, for each point k's dilatation, rank-one
+        blocks kappa V_k g_k g_k^T with |g_k,j| = (d / m_k) w |xi| and
+        sum_j |g_k,j| <= 2 S_k, S_k = (d / m_k) sum_j w |xi|.
+        """
+        b = self.bonds
+        w = np.where(b.intact, b.influence * self.bond_volume, 0.0)
+        nbr = b.neighbours
+        s = self.theta_coef * np.add.reduceat(w * b.length, b.offsets[:-1])
+        pair = 2.0 * w * (self.alpha[b.owners()] + self.alpha[nbr])
+        dil = 2.0 * self.bulk * self.theta_coef[nbr] * w * b.length * s[nbr]
+        return np.add.reduceat(pair + dil, b.offsets[:-1]) + 2.0 * self.bulk * s**2
+
+    def critical_stretch(self, fracture_energy):
+        """s_c from G_c for LPS with a constant influence function (Madenci and Oterkus 2014).
+
+        3D: s_c = sqrt(G / ((3 mu + (3/4)^4 (K - 5 mu / 3)) delta));
+        2D: s_c = sqrt(G / ((6 mu / pi + 16 / (9 pi^2) (kappa - 2 mu)) delta)).
+        """
+        delta, mu, k = self.bonds.horizon, self.shear, self.bulk
+        if self.dim == 3:
+            denom = (3.0 * mu + (0.75**4) * (k - 5.0 * mu / 3.0)) * delta
+        else:
+            denom = (6.0 * mu / np.pi + 16.0 / (9.0 * np.pi**2) * (k - 2.0 * mu)) * delta
+        return float(np.sqrt(fracture_energy / denom))

@@ -1,0 +1,157 @@
+"""Bond-based prototype microelastic brittle (PMB) material.
+
+The micromodulus c(xi) = c0 omega(|xi|) is chosen so that the peridynamic
+strain energy of an isotropic expansion equals the classical one in the
+bulk (Silling and Askari 2005):
+
+- 3D: c0 = 18 K / I,  I = int_0^delta omega(r) 4 pi r^3 dr  (constant omega: 18 K / (pi delta^4));
+- 2D: c0 = 8 kappa / (t J),  J = int_0^delta omega(r) 2 pi r^2 dr  (constant omega,
+  plane stress: 9 E / (pi t delta^3)).
+
+A bond-based model has a fixed Poisson ratio: 1/4 in 3D and plane strain,
+1/3 in plane stress. K (kappa) is taken from E with that ratio, so that the
+Young's modulus is right; a different ``nu`` given by the user only draws a warning.
+
+Surface correction ``"energy"`` (Madenci and Oterkus 2014, sec. 4.2): for each
+axis a, a uniform uniaxial strain along a gives each point a strain energy
+density W_i; its factor g_a,i = W_bulk / W_i (W_bulk the continuum value).
+A bond's stiffness is scaled by the ellipsoidal mean
+G = (sum_a (n_a / g_a)^2)^(-1/2) of the two end points' averaged factors.
+"""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+
+from peridyn.body import Body
+from peridyn.bonds import Bonds
+from peridyn.errors import InputError
+from peridyn.kernels.pmb import pmb_energy, pmb_force
+from peridyn.materials.base import Model
+from peridyn.materials.elastic import (
+    bulk_modulus,
+    check_elastic,
+    mean_fourth_power,
+    plane_bulk_modulus,
+    radial_moment,
+)
+
+SURFACE_CORRECTIONS = ("none", "energy")
+
+
+def pmb_poisson_ratio(dim: int, plane: str | None) -> float:
+    """The Poisson ratio a bond-based model implies: 1/3 in plane stress, else 1/4."""
+    return 1.0 / 3.0 if (dim == 2 and plane == "stress") else 0.25
+
+
+def pmb_micromodulus(E: float, dim: int, horizon: float, influence: str,
+                     plane: str | None = None, thickness: float | None = None) -> float:
+    """c0 of c(xi) = c0 omega(|xi|), N/m^6 (3D) — see the module docstring."""
+    nu = pmb_poisson_ratio(dim, plane)
+    if dim == 3:
+        return 18.0 * bulk_modulus(E, nu) / (4.0 * np.pi * radial_moment(influence, horizon, 3))
+    kappa = plane_bulk_modulus(E, nu, plane)
+    return 8.0 * kappa / (thickness * 2.0 * np.pi * radial_moment(influence, horizon, 2))
+
+
+class PMBModel(Model):
+    """PMB material bound to a body and its bonds.
+
+    Parameters
+    ----------
+    body, bonds : Body, Bonds
+    E : float, Pa
+    density : float, kg/m^3
+    nu : float or None
+        Only checked against the model's implied Poisson ratio.
+    surface_correction : {"none", "energy"}
+    dtype : float64 or float32
+    """
+
+    name = "pmb"
+
+    def __init__(self, body: Body, bonds: Bonds, E: float, density: float,
+                 nu: float | None = None, surface_correction: str = "none",
+                 dtype=np.float64):
+        implied = pmb_poisson_ratio(body.dim, body.plane)
+        check_elastic(E, implied if nu is None else nu, density)
+        if nu is not None and abs(nu - implied) > 1e-3:
+            warnings.warn(
+                f"a bond-based PMB material has Poisson ratio {implied:.4g} here; nu = {nu} "
+                "is ignored (use LPS for another ratio)",
+                stacklevel=2,
+            )
+        if surface_correction not in SURFACE_CORRECTIONS:
+            raise InputError(
+                f"PMB surface_correction must be one of {SURFACE_CORRECTIONS}, "
+                f"got {surface_correction!r}"
+            )
+        super().__init__(body, bonds, density, dtype)
+        self.E = float(E)
+        self.c0 = pmb_micromodulus(E, body.dim, bonds.horizon, bonds.influence_name,
+                                   body.plane, body.thickness)
+        self.length = bonds.length.astype(self.dtype)
+        self.inv_length = (1.0 / bonds.length).astype(self.dtype)
+        base = self.c0 * bonds.influence * self.bond_volume
+        self.bond_stiffness = base.astype(self.dtype)
+        self.surface_factor = np.ones(bonds.n_bonds)
+        if surface_correction == "energy":
+            self.surface_factor = self._energy_surface_factor()
+            self.bond_stiffness = (base * self.surface_factor).astype(self.dtype)
+
+    def force(self, u, out=None):
+        out = np.empty_like(self.x) if out is None else out
+        b = self.bonds
+        return pmb_force(self.x, self._as_state(u), b.offsets, b.neighbours, self.inv_length,
+                         self.bond_stiffness, b.intact, out)
+
+    def energy_density(self, u):
+        b = self.bonds
+        w = np.empty(self.body.n_points)
+        return pmb_energy(self.body.points, np.ascontiguousarray(u, dtype=np.float64), b.offsets,
+                          b.neighbours, b.length, self.bond_stiffness.astype(np.float64),
+                          b.intact, w)
+
+    def stiffness_bound(self):
+        b = self.bonds
+        per_bond = np.where(b.intact, self.bond_stiffness / b.length, 0.0)
+        return 2.0 * np.add.reduceat(per_bond, b.offsets[:-1]) if b.n_bonds else np.zeros(0)
+
+    def critical_stretch(self, fracture_energy):
+        """s_c from G_c by integrating the bond energies across a crack plane.
+
+        3D: G = (c0 s^2 / 2) pi int omega r^4 dr (constant omega: s_c = sqrt(5 G / (9 K delta)),
+        Silling and Askari 2005); 2D: G = t c0 s^2 int omega r^3 dr (constant omega, plane
+        stress: s_c = sqrt(4 pi G / (9 E delta)), Ha and Bobaru 2010).
+        """
+        delta, name = self.bonds.horizon, self.bonds.influence_name
+        if self.body.dim == 3:
+            per_s2 = 0.5 * self.c0 * np.pi * radial_moment(name, delta, 4)
+        else:
+            per_s2 = self.body.thickness * self.c0 * radial_moment(name, delta, 3)
+        return float(np.sqrt(fracture_energy / per_s2))
+
+    def _energy_surface_factor(self) -> np.ndarray:
+        body, b = self.body, self.bonds
+        dim = body.dim
+        strain = 1e-3
+        # continuum energy density of a uniaxial strain: (c0/4) eps^2 int omega r^d dr * <n^4>
+        moment = radial_moment(b.influence_name, b.horizon, dim)
+        thickness = body.thickness if dim == 2 else 1.0
+        w_bulk = 0.25 * self.c0 * strain**2 * moment * mean_fourth_power(dim) * thickness
+        owners = b.owners()
+        xi = body.points[b.neighbours] - body.points[owners]
+        n = xi / b.length[:, None]
+        base = self.c0 * b.influence * self.bond_volume
+        inv_g2 = np.zeros(b.n_bonds)
+        for axis in range(dim):
+            u = np.zeros_like(body.points)
+            u[:, axis] = strain * body.points[:, axis]
+            w = pmb_energy(body.points, u, b.offsets, b.neighbours, b.length, base, b.intact,
+                           np.empty(body.n_points))
+            g = w_bulk / np.maximum(w, 1e-300)
+            g_bond = 0.5 * (g[owners] + g[b.neighbours])
+            inv_g2 += (n[:, axis] / g_bond) ** 2
+        return 1.0 / np.sqrt(inv_g2)

@@ -1,0 +1,1 @@
+"""Matplotlib figures (Agg backend, never a window): fields, signals, Lamb curves."""

@@ -1,0 +1,128 @@
+"""Figures of a run read back from its results.h5: sensor signals, B-scans, fields, damage."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import h5py
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+from matplotlib.tri import Triangulation  # noqa: E402
+
+from peridyn.body import Body  # noqa: E402
+
+COMPONENT_NAMES = ("x", "y", "z")
+
+
+def plot_run(directory, body: Body) -> list[Path]:
+    """Draw every figure the results support; returns the PNG paths written."""
+    directory = Path(directory)
+    written = []
+    with h5py.File(directory / "results.h5", "r") as f:
+        series = f.get("series", {})
+        if "sensor_u" in series:
+            written.append(plot_sensors(f, directory / "sensors.png"))
+        for key in series:
+            if key.startswith("line_"):
+                name = key.removeprefix("line_")
+                written.append(plot_bscan(f, name, directory / f"bscan_{name}.png"))
+        u = f["final/u"][...]
+        damage = f["final/damage"][...] if "final/damage" in f else None
+    if body.dim == 3:
+        written.append(plot_field(body, u[:, 2], "final u_z (m)", directory / "displacement.png",
+                                  cmap="RdBu_r", symmetric=True))
+    else:
+        written.append(plot_field(body, np.linalg.norm(u, axis=1), "final |u| (m)",
+                                  directory / "displacement.png"))
+    if damage is not None and damage.max() > 0:
+        written.append(plot_field(body, damage, "damage index", directory / "damage.png",
+                                  cmap="inferno", limits=(0.0, 1.0)))
+    return written
+
+
+def plot_sensors(f: h5py.File, path: Path) -> Path:
+    """Displacement components against time at each sensor."""
+    group = f["series/sensor_u"]
+    names = _names(group)
+    t = group["time"][...] * 1e6
+    data = group["data"][...]
+    fig, axes = plt.subplots(len(names), 1, figsize=(7, 1.8 + 1.6 * len(names)), squeeze=False,
+                             sharex=True)
+    for k, (ax, name) in enumerate(zip(axes[:, 0], names, strict=True)):
+        for c in range(3):
+            ax.plot(t, data[:, k, c], label=f"u{COMPONENT_NAMES[c]}")
+        ax.set_ylabel(f"{name}\nu (m)")
+        ax.grid(alpha=0.3)
+    axes[0, 0].legend(loc="upper right", ncol=3, fontsize=8)
+    axes[-1, 0].set_xlabel("time (us)")
+    return _save(fig, path)
+
+
+def plot_bscan(f: h5py.File, name: str, path: Path) -> Path:
+    """Space-time map (B-scan) of each displacement component along a line probe."""
+    group = f[f"series/line_{name}"]
+    t = group["time"][...] * 1e6
+    data = group["data"][...]
+    points = f["geometry/points"][...][json.loads(group.attrs["points"])]
+    distance = np.linalg.norm(points - points[0], axis=1) * 1e3
+    fig, axes = plt.subplots(1, 3, figsize=(12, 4), sharey=True)
+    for c, ax in enumerate(axes):
+        field = data[:, :, c]
+        lim = np.max(np.abs(field)) or 1.0
+        ax.imshow(field, aspect="auto", origin="lower", cmap="RdBu_r", vmin=-lim, vmax=lim,
+                  extent=(distance[0], distance[-1], t[0], t[-1]))
+        ax.set_title(f"u{COMPONENT_NAMES[c]} along line '{name}'")
+        ax.set_xlabel("distance along the line (mm)")
+    axes[0].set_ylabel("time (us)")
+    return _save(fig, path)
+
+
+def plot_field(body: Body, values: np.ndarray, label: str, path: Path, cmap="viridis",
+               limits=None, symmetric: bool = False) -> Path:
+    """Colour map of a point field: the whole body in 2D, the top layer (largest z) in 3D.
+
+    The points are triangulated; triangles longer than two spacings (holes, cracks'
+    removed points, concave outlines) are left blank.
+    """
+    x = body.points
+    sel = np.ones(body.n_points, dtype=bool)
+    if body.dim == 3:
+        sel = x[:, 2] >= x[:, 2].max() - 0.5 * np.min(body.cells[:, 2])
+    xs, ys, vs = x[sel, 0] * 1e3, x[sel, 1] * 1e3, values[sel]
+    tri = Triangulation(xs, ys)
+    edges = np.hypot(np.diff(xs[tri.triangles], axis=1, append=xs[tri.triangles][:, :1]),
+                     np.diff(ys[tri.triangles], axis=1, append=ys[tri.triangles][:, :1]))
+    tri.set_mask(edges.max(axis=1) > 2.01 * body.spacing * 1e3 * np.sqrt(2))
+    if limits is None and symmetric:
+        lim = float(np.max(np.abs(vs))) or 1.0
+        limits = (-lim, lim)
+    vmin, vmax = limits if limits is not None else (None, None)
+    fig, ax = plt.subplots(figsize=(7, 5))
+    sc = ax.tripcolor(tri, vs, cmap=cmap, vmin=vmin, vmax=vmax, shading="gouraud")
+    ax.set_aspect("equal")
+    ax.set_xlabel("x (mm)")
+    ax.set_ylabel("y (mm)")
+    ax.set_title(label + (" (top layer)" if body.dim == 3 else ""))
+    fig.colorbar(sc, ax=ax, label=label)
+    return _save(fig, path)
+
+
+def _names(group) -> list[str]:
+    raw = group.attrs.get("names")
+    if isinstance(raw, bytes | str):
+        try:
+            return list(json.loads(raw))
+        except ValueError:
+            return [str(raw)]
+    return [str(n) for n in raw]
+
+
+def _save(fig, path: Path) -> Path:
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path

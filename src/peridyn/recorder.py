@@ -1,0 +1,208 @@
+"""Recording a run: sensors, line and plane probes, field snapshots -> HDF5 and VTU/PVD.
+
+Series in ``results.h5`` (see ``peridyn.io.hdf5`` for the layout):
+
+- ``sensor_u``, ``sensor_v``: (n_sensors, 3) displacement (m) and velocity (m/s) of the
+  points nearest to the named sensor positions (names in the series attribute ``names``);
+- ``line_<name>``: (n, 3) displacement along a line probe;
+- ``plane_<name>``: (n, 3) displacement of a plane probe (a node set or a plate layer);
+- ``field_u``: (n_points, 3) displacement at every snapshot, with ``snapshots/*.vtu``
+  files and ``snapshots.pvd`` for ParaView.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import platform
+import subprocess
+import sys
+from dataclasses import dataclass, field
+from datetime import UTC, datetime
+from pathlib import Path
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from peridyn import __version__
+from peridyn.body import Body
+from peridyn.damage import damage_field
+from peridyn.errors import InputError
+from peridyn.io.hdf5 import HDF5Writer
+from peridyn.io.vtk import PVDCollection, write_vtu
+from peridyn.solvers.state import State
+
+
+@dataclass
+class LineProbe:
+    """Points nearest to ``points`` samples evenly spaced from ``start`` to ``end`` (m)."""
+
+    start: tuple
+    end: tuple
+    points: int
+
+
+@dataclass
+class RecorderSpec:
+    """What to record and how often.
+
+    Attributes
+    ----------
+    every : int
+        Steps between records of the sensor, line and plane series.
+    snapshot_every : int or None
+        Steps between field snapshots (None: only at ``snapshot_steps`` and the end).
+    snapshot_steps : list of int
+        Extra steps with a snapshot (e.g. the seed's 20, 40, 60 us).
+    sensors : dict of name -> 3 floats (m)
+    lines : dict of name -> LineProbe
+    planes : dict of name -> (n,) point indices
+    series_dtype : "float64" or "float32"
+        Storage type of the line and plane series (float32 halves big records).
+    vtu : bool
+        Write VTU snapshots and a PVD collection.
+    """
+
+    every: int = 1
+    snapshot_every: int | None = None
+    snapshot_steps: list = field(default_factory=list)
+    sensors: dict = field(default_factory=dict)
+    lines: dict = field(default_factory=dict)
+    planes: dict = field(default_factory=dict)
+    series_dtype: str = "float64"
+    vtu: bool = True
+
+
+class Recorder:
+    """Observer of an explicit run that writes ``results.h5`` (and VTU files) incrementally.
+
+    Parameters
+    ----------
+    body : Body
+    directory : path
+        Output folder (created).
+    spec : RecorderSpec
+    provenance : dict
+        Stored as attributes of the results file.
+    model : Model or None
+        Needed to write the damage index into snapshots.
+    resume : (step, time) or None
+        Reopen an existing results file and drop the records after this step and
+        time (s), for a restart from a checkpoint.
+    """
+
+    def __init__(self, body: Body, directory, spec: RecorderSpec, provenance: dict,
+                 model=None, resume: tuple[int, float] | None = None):
+        self.body = body
+        self.directory = Path(directory)
+        self.directory.mkdir(parents=True, exist_ok=True)
+        self.spec = spec
+        self.model = model
+        if spec.every < 1:
+            raise InputError(f"output.every must be at least 1, got {spec.every}")
+        tree = cKDTree(body.points)
+        self.sensor_names = list(spec.sensors)
+        self.sensor_index = (tree.query(np.array([spec.sensors[k] for k in self.sensor_names]))[1]
+                             if spec.sensors else np.zeros(0, dtype=int))
+        self.line_index = {name: tree.query(np.linspace(p.start, p.end, p.points))[1]
+                           for name, p in spec.lines.items()}
+        self.plane_index = {name: np.asarray(idx) for name, idx in spec.planes.items()}
+        mode = "a" if resume is not None else "w"
+        self.h5 = HDF5Writer(self.directory / "results.h5", body.points[:, : body.dim],
+                             body.volumes, provenance, mode=mode, flush_every=1)
+        self._create_series()
+        self.pvd = None
+        if spec.vtu:
+            (self.directory / "snapshots").mkdir(exist_ok=True)
+            self.pvd = PVDCollection(self.directory / "snapshots.pvd", mode=mode)
+        if resume is not None:
+            self.h5.truncate(resume[0])
+            if self.pvd is not None:
+                self.pvd.truncate(resume[1])
+
+    def _create_series(self) -> None:
+        h5, spec = self.h5, self.spec
+        if self.sensor_names:
+            for q in ("u", "v"):
+                h5.create_series(f"sensor_{q}", (len(self.sensor_names), 3),
+                                 attrs={"names": self.sensor_names,
+                                        "points": self.sensor_index.tolist()})
+        for name, idx in self.line_index.items():
+            h5.create_series(f"line_{name}", (len(idx), 3), spec.series_dtype,
+                             attrs={"points": idx.tolist()})
+        for name, idx in self.plane_index.items():
+            h5.create_series(f"plane_{name}", (len(idx), 3), spec.series_dtype)
+            h5.write_array(f"probes/plane_{name}", idx)
+        h5.create_series("field_u", (self.body.n_points, 3), spec.series_dtype)
+
+    def observe(self, state: State, solver) -> None:
+        """Record what is due at this step (called after every step)."""
+        if state.step % self.spec.every == 0:
+            self.record_series(state)
+        every = self.spec.snapshot_every
+        if (every and state.step % every == 0) or state.step in self.spec.snapshot_steps:
+            self.snapshot(state)
+
+    def record_series(self, state: State) -> None:
+        """Append one record to every probe series."""
+        h5, step, t = self.h5, state.step, state.time
+        if self.sensor_names:
+            h5.append("sensor_u", step, t, state.u[self.sensor_index])
+            h5.append("sensor_v", step, t, state.v[self.sensor_index])
+        for name, idx in self.line_index.items():
+            h5.append(f"line_{name}", step, t, state.u[idx])
+        for name, idx in self.plane_index.items():
+            h5.append(f"plane_{name}", step, t, state.u[idx])
+
+    def snapshot(self, state: State) -> None:
+        """Write the whole displacement field (HDF5, and VTU when enabled)."""
+        self.h5.append("field_u", state.step, state.time, state.u)
+        if self.pvd is None:
+            return
+        data = {"displacement": state.u[:, : self.body.dim],
+                "velocity": state.v[:, : self.body.dim]}
+        if self.model is not None:
+            data["damage"] = damage_field(self.model)
+        name = f"snapshots/step_{state.step:08d}.vtu"
+        write_vtu(self.directory / name, self.body.points[:, : self.body.dim], data)
+        self.pvd.add(state.time, name)
+
+    def finish(self, state: State, summary: dict) -> None:
+        """Write the final state and the run summary, then close the file."""
+        self.h5.write_array("final/u", state.u)
+        self.h5.write_array("final/v", state.v)
+        if self.model is not None:
+            self.h5.write_array("final/damage", damage_field(self.model))
+        self.h5.write_array("summary/json", np.bytes_(_json(summary)))
+        self.h5.close()
+
+
+def _json(obj) -> str:
+    return json.dumps(obj, default=lambda o: o.tolist() if hasattr(o, "tolist") else str(o))
+
+
+def provenance(case_path=None, argv=None) -> dict:
+    """Package version, git commit, case file and its SHA-256, command line, host and date."""
+    info = {
+        "peridyn_version": __version__,
+        "git_commit": _git_commit(),
+        "command_line": " ".join(sys.argv if argv is None else argv),
+        "python": platform.python_version(),
+        "machine": platform.platform(),
+        "created_utc": datetime.now(UTC).isoformat(timespec="seconds"),
+    }
+    if case_path is not None:
+        data = Path(case_path).read_bytes()
+        info["case_file"] = str(case_path)
+        info["case_sha256"] = hashlib.sha256(data).hexdigest()
+        info["case_text"] = data.decode("utf-8", errors="replace")
+    return info
+
+
+def _git_commit() -> str:
+    try:
+        out = subprocess.run(["git", "rev-parse", "HEAD"], cwd=Path(__file__).parent,
+                             capture_output=True, text=True, timeout=5, check=False)
+    except (OSError, subprocess.SubprocessError):
+        return "unknown"
+    return out.stdout.strip() or "unknown"

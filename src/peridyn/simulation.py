@@ -1,0 +1,263 @@
+"""From a validated case to results: build the body, bonds, model and loads, then run.
+
+``run_case`` is what ``peridyn run`` calls; the ``build_*`` functions are the
+same steps for Python users who want to stop half-way (e.g. to inspect the bonds).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from peridyn import geometry
+from peridyn.body import Body, in_box, in_cylinder, in_sphere
+from peridyn.bonds import Bonds, crossing_rectangle, crossing_segment, cut_bonds, find_bonds
+from peridyn.checkpoint import Checkpointer, load_checkpoint
+from peridyn.damage import BondDamage, damage_field
+from peridyn.errors import CaseFileError, InputError
+from peridyn.io.case import Case, Region
+from peridyn.loads import BoundaryCondition, InitialCondition, Loading
+from peridyn.materials import Model, make_model
+from peridyn.recorder import LineProbe, Recorder, RecorderSpec, provenance
+from peridyn.solvers import ExplicitSolver, relax
+from peridyn.solvers.state import State
+from peridyn.timefunctions import from_spec
+
+
+@dataclass
+class Setup:
+    """Everything a case builds before running."""
+
+    body: Body
+    bonds: Bonds
+    model: Model
+    loading: Loading
+    damage: BondDamage | None
+
+
+def build_body(case: Case, base_dir=".") -> Body:
+    """Points of the case geometry, minus removals, with the case's node sets (and ``all``)."""
+    g, d = case.geometry, case.discretization
+    if g.type != "mesh" and d.spacing is None:
+        raise CaseFileError(case.name, "discretization.spacing", None, "a positive spacing (m)")
+    if g.type == "box":
+        body = geometry.box(g.size, d.spacing, g.origin or (0.0, 0.0, 0.0))
+    elif g.type == "plate":
+        body = geometry.plate(*g.size, spacing=d.spacing, layers=g.layers,
+                              origin=g.origin or (0.0, 0.0, 0.0),
+                              layer_placement=g.layer_placement)
+    elif g.type == "rectangle":
+        body = geometry.rectangle(*g.size, spacing=d.spacing, thickness=g.thickness,
+                                  plane=g.plane, origin=(g.origin or (0.0, 0.0))[:2])
+    else:
+        mesh = Path(g.file) if Path(g.file).is_absolute() else Path(base_dir) / g.file
+        body = geometry.from_text_mesh(mesh, dim=g.dimension, thickness=g.thickness,
+                                       plane=g.plane if g.dimension == 2 else None)
+    for k, region in enumerate(case.removals):
+        body = body.remove(region_mask(body, region, f"removals[{k}]"))
+    body = body.with_node_set("all", np.ones(body.n_points, dtype=bool))
+    for name, region in case.node_sets.items():
+        mask = region_mask(body, region, f"node_sets.{name}")
+        if not mask.any():
+            raise CaseFileError(case.name, f"node_sets.{name}", region.model_dump(exclude_none=True),
+                                "a region that contains at least one point")
+        body = body.with_node_set(name, mask)
+    return body
+
+
+def region_mask(body: Body, region: Region, where: str) -> np.ndarray:
+    """(n_points,) bool mask of a case-file region."""
+    pad = _pad3
+    if region.type == "all":
+        return np.ones(body.n_points, dtype=bool)
+    if region.type == "box":
+        return in_box(pad(region.min), pad(region.max))(body.points)
+    if region.type == "sphere":
+        return in_sphere(pad(region.center), region.radius)(body.points)
+    if region.type == "cylinder":
+        return in_cylinder(pad(region.center), region.radius, region.axis)(body.points)
+    if region.type == "face":
+        return geometry.face(body, region.face, region.depth)
+    try:
+        return geometry.layer(body, region.index)
+    except InputError as exc:
+        raise InputError(f"{where}: {exc}") from None
+
+
+def _pad3(v) -> list:
+    """A 2- or 3-component coordinate as 3 components (z = 0 for 2D input)."""
+    return list(v) + [0.0] * (3 - len(v))
+
+
+def build_bonds(case: Case, body: Body) -> Bonds:
+    """Families of the case's discretisation, with its pre-cracks cut."""
+    d = case.discretization
+    horizon = d.horizon_m if d.horizon_m is not None else d.horizon * body.spacing
+    bonds = find_bonds(body, horizon, d.influence, d.partial_volumes)
+    for crack in case.precracks:
+        if crack.type == "rectangle":
+            def crossing(a, b, c=crack):
+                return crossing_rectangle(a, b, c.origin, c.edge_u, c.edge_v)
+        else:
+            def crossing(a, b, c=crack):
+                return crossing_segment(a, b, c.start, c.end)
+        cut_bonds(body, bonds, crossing)
+    return bonds
+
+
+def build_loading(case: Case, body: Body) -> Loading:
+    """Boundary and initial conditions of the case, checked for conflicts."""
+    bcs = [BoundaryCondition(bc.set, bc.kind, bc.components,
+                             from_spec(bc.value, f"boundary_conditions[{k}].value"))
+           for k, bc in enumerate(case.boundary_conditions)]
+    ics = [InitialCondition(ic.set, ic.kind, ic.components, ic.value)
+           for ic in case.initial_conditions]
+    return Loading(body, bcs, ics)
+
+
+def build(case: Case, base_dir=".") -> Setup:
+    """Body, bonds, model, loading and damage of a case."""
+    body = build_body(case, base_dir)
+    bonds = build_bonds(case, body)
+    mat = case.material
+    model = make_model(mat.model, body, bonds, E=mat.E, density=mat.density, nu=mat.nu,
+                       surface_correction=mat.surface_correction, dtype=case.solver.dtype)
+    damage = None
+    if mat.damage is not None:
+        damage = BondDamage(model, mat.damage.critical_stretch, mat.damage.fracture_energy,
+                            mat.damage.no_damage_sets)
+    loading = build_loading(case, body)
+    if case.solver.type == "static" and not loading.has_loads:
+        raise CaseFileError(case.name, "boundary_conditions", [], "at least one load for a static run")
+    if case.solver.type == "explicit" and not (loading.has_loads or loading.initial):
+        raise CaseFileError(case.name, "boundary_conditions", [],
+                            "a load or an initial condition: nothing would move")
+    return Setup(body, bonds, model, loading, damage)
+
+
+def recorder_spec(case: Case, body: Body, dt: float) -> RecorderSpec:
+    """What the case asks to record, with snapshot times turned into steps."""
+    out = case.output
+    planes = {name: body.node_set(set_name) for name, set_name in out.planes.items()}
+    return RecorderSpec(
+        every=out.every,
+        snapshot_every=out.snapshot_every,
+        snapshot_steps=[int(round(t / dt)) for t in out.snapshot_times],
+        sensors={k: _pad3(v) for k, v in out.sensors.items()},
+        lines={k: LineProbe(_pad3(v.start), _pad3(v.end), v.points) for k, v in out.lines.items()},
+        planes=planes,
+        series_dtype=out.series_dtype,
+        vtu=out.vtu,
+    )
+
+
+def output_directory(case: Case, override=None) -> Path:
+    """The run's output folder: the override, the case's ``output.directory`` or peridyn-out/NAME."""
+    if override is not None:
+        return Path(override)
+    return Path(case.output.directory or Path("peridyn-out") / case.name)
+
+
+def run_case(case: Case, output_dir=None, case_path=None, checkpoint_every: int | None = None,
+             restart: bool = False, progress=None, base_dir=".") -> dict:
+    """Run a case and write its results; returns the summary (also stored in results.h5).
+
+    Parameters
+    ----------
+    checkpoint_every : int or None
+        Steps between checkpoints (``<output>/checkpoint.h5``).
+    restart : bool
+        Continue from ``<output>/checkpoint.h5`` (results after it are dropped and rewritten).
+    progress : callable(total) -> bar with update(n) and close(), or None
+    """
+    start = time.perf_counter()
+    setup = build(case, base_dir)
+    out = output_directory(case, output_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    if case.solver.type == "static":
+        summary = _run_static(case, setup, out, case_path)
+    else:
+        summary = _run_explicit(case, setup, out, case_path, checkpoint_every, restart, progress)
+    summary["seconds"] = time.perf_counter() - start
+    if case.output.plots:
+        from peridyn.plotting.fields import plot_run
+
+        summary["plots"] = [str(p) for p in plot_run(out, setup.body)]
+    return summary
+
+
+def _base_summary(setup: Setup, out: Path) -> dict:
+    phi = damage_field(setup.model)
+    return {"output_dir": str(out), "points": setup.body.n_points, "bonds": setup.bonds.n_bonds,
+            "broken_bonds": int((~setup.bonds.intact).sum()), "max_damage": float(phi.max())}
+
+
+def _run_explicit(case, setup, out, case_path, checkpoint_every, restart, progress) -> dict:
+    s = case.solver
+    solver = ExplicitSolver(setup.model, setup.loading, dt=s.dt, safety=s.safety,
+                            damping=s.damping, damage=setup.damage)
+    n_steps = s.steps if s.steps is not None else int(np.ceil(s.time / solver.dt - 1e-9))
+    ckpt_path = out / "checkpoint.h5"
+    if restart:
+        state, intact = load_checkpoint(ckpt_path, setup.body.n_points, setup.bonds.n_bonds)
+        setup.bonds.intact[:] = intact
+        resume = (state.step, state.time)
+    else:
+        state, resume = solver.initial_state(), None
+    spec = recorder_spec(case, setup.body, solver.dt)
+    recorder = Recorder(setup.body, out, spec, provenance(case_path), setup.model, resume)
+    if resume is None:
+        recorder.record_series(state)
+        recorder.snapshot(state)
+    observers = [recorder]
+    if checkpoint_every:
+        observers.append(Checkpointer(ckpt_path, checkpoint_every, setup.bonds.intact))
+    remaining = n_steps - state.step
+    bar = progress(remaining) if progress is not None else None
+    try:
+        solver.run(state, remaining, observers, bar)
+    finally:
+        if bar is not None:
+            bar.close()
+    if state.step not in spec.snapshot_steps and not (
+        spec.snapshot_every and state.step % spec.snapshot_every == 0
+    ):
+        recorder.snapshot(state)
+    summary = _base_summary(setup, out)
+    summary.update({"steps": state.step, "time_s": state.time, "dt_s": solver.dt,
+                    "stable_dt_s": solver.stable_dt,
+                    "kinetic_energy_j": solver.kinetic_energy(state),
+                    "strain_energy_j": setup.model.strain_energy(state.u)})
+    recorder.finish(state, summary)
+    return summary
+
+
+def _run_static(case, setup, out, case_path) -> dict:
+    s = case.solver
+    u = None
+    iterations = 0
+    for k in range(1, s.load_steps + 1):
+        result = relax(setup.model, setup.loading, time=k / s.load_steps, u0=u,
+                       tolerance=s.tolerance, max_iterations=s.max_iterations,
+                       damage=setup.damage)
+        u, iterations = result.u, iterations + result.iterations
+        if not result.converged:
+            raise InputError(
+                f"static load step {k}/{s.load_steps} did not converge in {s.max_iterations} "
+                f"iterations (residual {result.residual:.3g} > {s.tolerance:g}): raise "
+                "solver.max_iterations or solver.load_steps"
+            )
+    state = State(u, np.zeros_like(u), np.zeros_like(u), 1.0, s.load_steps)
+    spec = recorder_spec(case, setup.body, 1.0)
+    recorder = Recorder(setup.body, out, spec, provenance(case_path), setup.model)
+    recorder.record_series(state)
+    recorder.snapshot(state)
+    summary = _base_summary(setup, out)
+    summary.update({"steps": s.load_steps, "iterations": iterations,
+                    "residual": result.residual,
+                    "strain_energy_j": setup.model.strain_energy(u)})
+    recorder.finish(state, summary)
+    return summary

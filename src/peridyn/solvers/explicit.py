@@ -1,0 +1,142 @@
+"""Explicit dynamics by velocity Verlet.
+
+One step of size dt (rho a = f(u) + b - rho c v, c the mass-proportional damping):
+
+    v <- v + dt/2 a;  u <- u + dt v;  t <- t + dt;  impose prescribed u (and its v);
+    break over-stretched bonds;  a <- (f(u) + b(t)) / rho - c v;  a <- 0 on prescribed DOFs;
+    v <- v + dt/2 a;  impose prescribed v.
+
+The step defaults to ``safety`` times the model's stable step (``Model.critical_time_step``);
+a larger step given by the user is refused.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from peridyn.damage import BondDamage
+from peridyn.errors import InputError, InstabilityError
+from peridyn.loads import Loading
+from peridyn.materials.base import Model
+from peridyn.solvers.state import State
+
+
+class ExplicitSolver:
+    """Velocity-Verlet time integration of a model under a loading.
+
+    Parameters
+    ----------
+    model : Model
+    loading : Loading or None
+    dt : float or None, s
+        Time step; ``None`` takes ``safety`` times the stable step.
+    safety : float
+        Fraction of the stable step used when ``dt`` is None (0 < safety <= 1).
+    damping : float, 1/s
+        Mass-proportional damping coefficient c (0: undamped).
+    damage : BondDamage or None
+    check_every : int
+        Steps between checks for non-finite values.
+    """
+
+    def __init__(self, model: Model, loading: Loading | None = None, dt: float | None = None,
+                 safety: float = 0.8, damping: float = 0.0, damage: BondDamage | None = None,
+                 check_every: int = 50):
+        if not 0 < safety <= 1:
+            raise InputError(f"time-step safety factor must lie in (0, 1], got {safety!r}")
+        if damping < 0:
+            raise InputError(f"damping must be non-negative, got {damping!r}")
+        self.model = model
+        self.loading = loading if loading is not None else Loading(model.body)
+        self.stable_dt = model.critical_time_step()
+        if dt is None:
+            dt = safety * self.stable_dt
+        elif not dt > 0:
+            raise InputError(f"time step must be positive, got {dt!r}")
+        elif dt > self.stable_dt:
+            raise InputError(
+                f"time step {dt:.4g} s exceeds the stable step {self.stable_dt:.4g} s of this "
+                f"model (Gershgorin bound): use dt <= {self.stable_dt:.4g} s or leave dt unset"
+            )
+        self.dt = float(dt)
+        self.damping = float(damping)
+        self.damage = damage
+        self.check_every = int(check_every)
+        n = model.body.n_points
+        self._force = np.zeros((n, 3), dtype=model.dtype)
+        self._body_force = np.zeros((n, 3))
+        self._inv_rho = (1.0 / model.density)[:, None]
+
+    def __repr__(self) -> str:
+        return f"ExplicitSolver(model={self.model!r}, dt={self.dt:.4g} s, damping={self.damping})"
+
+    def initial_state(self) -> State:
+        """The state at t = 0: initial conditions applied and accelerations computed."""
+        state = State.zeros(self.model.body.n_points)
+        self.loading.apply_initial(state.u, state.v)
+        self.loading.apply_kinematics(0.0, self.dt, state.u, state.v)
+        self.loading.apply_velocities(0.0, state.v)
+        self._acceleration(state)
+        return state
+
+    def _acceleration(self, state: State) -> None:
+        f = self.model.force(state.u, out=self._force)
+        b = self.loading.body_force_density(state.time, self._body_force)
+        a = state.a
+        np.add(f, b, out=a)
+        a *= self._inv_rho
+        if self.damping:
+            a -= self.damping * state.v
+        a[self.loading.constrained] = 0.0
+
+    def step(self, state: State) -> int:
+        """Advance ``state`` by one step in place; returns the number of bonds broken."""
+        dt = self.dt
+        state.v += 0.5 * dt * state.a
+        state.u += dt * state.v
+        state.time += dt
+        state.step += 1
+        self.loading.apply_kinematics(state.time, dt, state.u, state.v)
+        broken = self.damage.update(state.u) if self.damage is not None else 0
+        self._acceleration(state)
+        state.v += 0.5 * dt * state.a
+        self.loading.apply_velocities(state.time, state.v)
+        if state.step % self.check_every == 0:
+            check_finite(state)
+        return broken
+
+    def run(self, state: State, n_steps: int, observers: Sequence = (), progress=None) -> State:
+        """Advance ``state`` by ``n_steps`` steps.
+
+        Parameters
+        ----------
+        observers : sequence of objects with ``observe(state, solver)``
+            Called after every step (recorders, checkpoints).
+        progress : object with ``update(n)`` or None
+            E.g. a tqdm bar.
+        """
+        for _ in range(int(n_steps)):
+            self.step(state)
+            for obs in observers:
+                obs.observe(state, self)
+            if progress is not None:
+                progress.update(1)
+        check_finite(state)
+        return state
+
+    def kinetic_energy(self, state: State) -> float:
+        """Total kinetic energy, J."""
+        v2 = np.einsum("ij,ij->i", state.v, state.v)
+        return float(0.5 * np.sum(self.model.density * self.model.body.volumes * v2))
+
+
+def check_finite(state: State) -> None:
+    """Raise InstabilityError naming the first point whose u or v is not finite."""
+    bad = ~np.isfinite(state.u).all(axis=1) | ~np.isfinite(state.v).all(axis=1)
+    if bad.any():
+        point = int(np.flatnonzero(bad)[0])
+        raise InstabilityError(state.step, state.time, point,
+                               "non-finite displacement or velocity (time step too large, or a "
+                               "load too violent for the discretisation?)")

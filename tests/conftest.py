@@ -1,0 +1,48 @@
+"""Shared factories: small bodies and models used across the test folders."""
+
+import numpy as np
+import pytest
+
+from peridyn import geometry
+from peridyn.bonds import find_bonds
+from peridyn.materials import make_model
+
+#: Maraging steel of seed 001 / VALIDATION V3: rho = 8000, mu = 81.92 GPa, K = 132.77 GPa.
+STEEL_K, STEEL_MU, STEEL_RHO = 132.77e9, 81.92e9, 8000.0
+STEEL_E = 9 * STEEL_K * STEEL_MU / (3 * STEEL_K + STEEL_MU)
+STEEL_NU = (3 * STEEL_K - 2 * STEEL_MU) / (2 * (3 * STEEL_K + STEEL_MU))
+
+
+def small_body(dim: int, plane: str = "stress", n: int = 12, h: float = 1e-3):
+    """A cube (3D) or square (2D) of n points per side, spacing h."""
+    if dim == 3:
+        return geometry.box((n * h,) * 3, h)
+    return geometry.rectangle(n * h, n * h, h, thickness=h, plane=plane)
+
+
+def small_model(name: str, dim: int = 3, plane: str = "stress", n: int = 12,
+                horizon_factor: float = 3.015, partial_volumes: bool = True,
+                dtype=np.float64, nu: float = 0.25, surface_correction: str = "none"):
+    """A model on ``small_body`` with steel-like constants."""
+    body = small_body(dim, plane, n)
+    bonds = find_bonds(body, horizon_factor * body.spacing, partial_volumes=partial_volumes)
+    implied = 1 / 3 if (dim == 2 and plane == "stress") else 0.25
+    return make_model(name, body, bonds, E=200e9, density=7850.0,
+                      nu=(implied if name == "pmb" else nu),
+                      surface_correction=surface_correction, dtype=dtype)
+
+
+MODEL_CASES = [
+    pytest.param(("pmb", 3, "stress"), id="pmb-3d"),
+    pytest.param(("lps", 3, "stress"), id="lps-3d"),
+    pytest.param(("pmb", 2, "stress"), id="pmb-2d-stress"),
+    pytest.param(("pmb", 2, "strain"), id="pmb-2d-strain"),
+    pytest.param(("lps", 2, "stress"), id="lps-2d-stress"),
+    pytest.param(("lps", 2, "strain"), id="lps-2d-strain"),
+]
+
+
+@pytest.fixture
+def rng():
+    """A seeded generator (tests never use global random state)."""
+    return np.random.default_rng(20261123)

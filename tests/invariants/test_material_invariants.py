@@ -1,0 +1,124 @@
+"""Invariants every material model must satisfy (run for PMB and LPS, 2D and 3D)."""
+
+import numpy as np
+import pytest
+from conftest import MODEL_CASES, small_model
+
+from peridyn.kernels import reference
+
+
+def _model(case, **kw):
+    name, dim, plane = case
+    return small_model(name, dim, plane, **kw)
+
+
+def _rotation(angle, dim):
+    c, s = np.cos(angle), np.sin(angle)
+    if dim == 2:
+        return np.array([[c, -s, 0], [s, c, 0], [0, 0, 1.0]])
+    axis = np.array([1.0, 2.0, 3.0]) / np.sqrt(14.0)
+    k = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
+    return np.eye(3) + s * k + (1 - c) * k @ k
+
+
+@pytest.mark.parametrize("case", MODEL_CASES)
+def test_zero_force_at_rest(case):
+    """No displacement, no force (to round-off of the bond lengths: 1e-12 of E / h)."""
+    model = _model(case)
+    f = model.force(np.zeros_like(model.x))
+    assert np.max(np.abs(f)) < 1e-12 * 200e9 / model.body.spacing
+
+
+@pytest.mark.parametrize("case", MODEL_CASES)
+@pytest.mark.parametrize("angle", [1e-3, np.pi / 2])
+def test_rigid_rotation_gives_no_force(case, angle):
+    """Objectivity: a rigid rotation (small and 90 degrees) leaves every bond unstretched."""
+    model = _model(case)
+    x = model.body.points
+    u = x @ _rotation(angle, model.body.dim).T - x + np.array([1e-4, -2e-4, 0.0])
+    if model.body.dim == 2:
+        u[:, 2] = 0.0
+    f = model.force(u)
+    scale = 200e9 / model.body.spacing  # E / h: force density of a unit strain, N/m^3
+    assert np.max(np.abs(f)) < 1e-8 * scale
+
+
+@pytest.mark.parametrize("case", MODEL_CASES)
+def test_uniform_strain_interior_force_vanishes(case):
+    """Patch test: a homogeneous strain gives zero force away from the surface.
+
+    PMB forces depend on one horizon, LPS forces on two (dilatation of the neighbours).
+    """
+    name, dim, plane = case
+    model = _model(case, n=20 if dim == 3 else 24, horizon_factor=2.015)
+    x = model.body.points
+    strain = np.array([[1.0, 0.3, -0.2], [0.3, -0.5, 0.4], [-0.2, 0.4, 0.7]]) * 1e-4
+    if dim == 2:
+        strain[2, :] = strain[:, 2] = 0.0
+    u = x @ strain.T
+    f = model.force(u)
+    reach = (1 if name == "pmb" else 2) * model.bonds.horizon
+    lo, hi = x.min(axis=0), x.max(axis=0)
+    interior = np.all((x[:, :dim] - lo[:dim] > reach) & (hi[:dim] - x[:, :dim] > reach), axis=1)
+    assert interior.sum() > 0
+    surface_force = np.max(np.abs(f))
+    assert np.max(np.abs(f[interior])) < 1e-8 * surface_force
+
+
+@pytest.mark.parametrize("case", MODEL_CASES)
+def test_newtons_third_law(case, rng):
+    """Internal forces sum to zero: sum_i V_i f_i = 0 to round-off."""
+    model = _model(case)
+    u = 1e-5 * rng.standard_normal(model.x.shape)
+    if model.body.dim == 2:
+        u[:, 2] = 0.0
+    f = model.force(u)
+    total = (model.body.volumes[:, None] * f).sum(axis=0)
+    scale = np.sum(model.body.volumes[:, None] * np.abs(f))
+    assert np.max(np.abs(total)) < 1e-12 * scale
+
+
+@pytest.mark.parametrize("case", MODEL_CASES)
+def test_force_is_minus_energy_gradient(case, rng):
+    """V_i f_i = -dE/du_i: the force kernel and the energy agree (central differences)."""
+    model = _model(case, n=8)
+    u = 1e-4 * model.body.spacing * rng.standard_normal(model.x.shape)
+    if model.body.dim == 2:
+        u[:, 2] = 0.0
+    f = model.force(u)
+    h = 1e-9 * model.body.spacing
+    for point in (0, 37, model.body.n_points // 2):
+        for comp in range(model.body.dim):
+            up, um = u.copy(), u.copy()
+            up[point, comp] += h
+            um[point, comp] -= h
+            grad = (model.strain_energy(up) - model.strain_energy(um)) / (2 * h)
+            expected = -model.body.volumes[point] * f[point, comp]
+            assert grad == pytest.approx(expected, rel=2e-5, abs=1e-7 * np.abs(expected).max())
+
+
+@pytest.mark.parametrize("case", MODEL_CASES)
+def test_kernel_matches_numpy_reference(case, rng):
+    model = _model(case, n=8)
+    b = model.bonds
+    b.intact[rng.random(b.n_bonds) < 0.05] = False  # break some bonds (asymmetrically: fine)
+    u = 1e-5 * rng.standard_normal(model.x.shape)
+    if model.name == "pmb":
+        ref = reference.pmb_force(model.x, u, b.offsets, b.neighbours, model.inv_length,
+                                  model.bond_stiffness, b.intact)
+    else:
+        ref = reference.lps_force(model.x, u, b.offsets, b.neighbours, model.length, model.w,
+                                  b.intact, model.theta_coef, model._p_coef, model.alpha)
+    got = model.force(u)
+    np.testing.assert_allclose(got, ref, rtol=1e-10, atol=1e-12 * np.abs(ref).max())
+
+
+@pytest.mark.parametrize("name", ["pmb", "lps"])
+def test_float32_kernel_close_to_float64(name, rng):
+    m64 = small_model(name, 3)
+    m32 = small_model(name, 3, dtype=np.float32)
+    u = 1e-6 * rng.standard_normal(m64.x.shape)
+    f64 = m64.force(u)
+    f32 = m32.force(u)
+    assert f32.dtype == np.float32
+    assert np.max(np.abs(f32 - f64)) < 2e-3 * np.max(np.abs(f64))
