@@ -39,7 +39,7 @@ from dataclasses import asdict, dataclass
 from typing import NamedTuple
 
 import numpy as np
-from scipy.optimize import brentq
+from scipy.optimize import brentq, minimize_scalar
 
 from peridyn.errors import InputError
 
@@ -192,9 +192,7 @@ def rayleigh_speed(E: float, nu: float, rho: float) -> float:
     return ct * brentq(residual, 0.5, 1.0, xtol=1e-15, rtol=1e-15)
 
 
-def cutoff_frequencies(
-    E: float, nu: float, rho: float, thickness: float, f_max: float
-) -> dict[str, float]:
+def cutoff_frequencies(E: float, nu: float, rho: float, thickness: float, f_max: float) -> dict[str, float]:
     """Cut-off frequencies (``k = 0``) of the higher modes up to ``f_max``.
 
     At ``k = 0`` the symmetric equation reduces to ``cos(wh/cL) sin(wh/cT) = 0``
@@ -249,8 +247,10 @@ def lamb_modes(
     Roots of the Rayleigh-Lamb equations (module docstring) are bracketed by a
     sign-change scan in wavenumber, fine in the shear phase for phase
     velocities above ``cT`` and uniform in phase velocity below it, then
-    refined to 1e-13 relative by Brent's method. Two roots closer than one
-    scan step (only next to a zero-group-velocity point) can be missed.
+    refined to 1e-13 relative by Brent's method. Pairs of roots closer than
+    one scan step (near branch crossings and zero-group-velocity points) are
+    found from the dips of ``|F|`` between scan points; a pair so close that
+    it leaves no dip on the scan, or an exact double root, is missed.
 
     Parameters
     ----------
@@ -463,8 +463,7 @@ def _cross_term(p2, q2, gap, h: float, cp, sp, cq, sq):
     powers = np.arange(_N_TERMS)
     x, y = np.where(small, p2, 0.0) * h * h, np.where(small, q2, 0.0) * h * h
     integral = (
-        np.einsum("in,nm,im->i", np.power.outer(x, powers), _CROSS_TERMS, np.power.outer(y, powers))
-        * h**3
+        np.einsum("in,nm,im->i", np.power.outer(x, powers), _CROSS_TERMS, np.power.outer(y, powers)) * h**3
     )
     scale = np.exp(-np.sqrt(np.maximum(-x.real, 0.0)) - np.sqrt(np.maximum(-y.real, 0.0)))
     return np.where(small, gap * scale * integral, direct)
@@ -529,14 +528,39 @@ def _scan_grid(plate: _Plate, omega: float) -> np.ndarray:
 def _roots(plate: _Plate, omega: float, family: str) -> np.ndarray:
     """Wavenumbers (rad/m) of all propagating modes of one symmetry, descending."""
     grid = _scan_grid(plate, omega)
-    values = _lamb_function(plate, grid, omega, family)
-    brackets = np.flatnonzero(np.signbit(values[:-1]) != np.signbit(values[1:]))
 
     def f(k):
-        return float(_lamb_function(plate, np.array([k]), omega, family)[0])
+        return float(_lamb_function(plate, k, omega, family)[0])
 
-    roots = [brentq(f, grid[i], grid[i + 1], xtol=1e-300, rtol=1e-13) for i in brackets]
+    brackets = _brackets(grid, _lamb_function(plate, grid, omega, family), f)
+    roots = [brentq(f, a, b, xtol=1e-300, rtol=1e-13) for a, b in brackets]
     return np.sort(np.array(roots))[::-1]
+
+
+def _brackets(grid, values, f) -> list[tuple[float, float]]:
+    """Intervals of ``grid`` holding one sign change of ``f`` each.
+
+    Besides the sign changes between neighbours, a dip of ``|f|`` at a grid
+    point between two of the same sign may hide two roots closer than a step
+    (near crossings of branches of one symmetry): the minimum of ``|f|`` around
+    it is found, and where ``f`` changes sign there, both halves are kept.
+    """
+    sign, size = np.signbit(values), np.abs(values)
+    brackets = [(grid[i], grid[i + 1]) for i in np.flatnonzero(sign[:-1] != sign[1:])]
+    same = (sign[:-2] == sign[1:-1]) & (sign[1:-1] == sign[2:])
+    dips = np.flatnonzero(same & (size[1:-1] <= size[:-2]) & (size[1:-1] <= size[2:])) + 1
+    for i in dips:
+        polarity = -1.0 if sign[i] else 1.0
+        lo, hi = grid[i - 1], grid[i + 1]
+        bottom = minimize_scalar(
+            lambda k, p=polarity: p * f(k),
+            bounds=(lo, hi),
+            method="bounded",
+            options={"xatol": 1e-13 * hi},
+        ).x
+        if polarity * f(bottom) < 0:
+            brackets += [(lo, bottom), (bottom, hi)]
+    return brackets
 
 
 def _family_modes(plate: _Plate, frequency: float, family: str) -> list[LambMode]:

@@ -25,9 +25,7 @@ def register(subparsers) -> None:
     parser.add_argument("--nu", type=float, required=True, help="Poisson's ratio")
     parser.add_argument("--rho", type=float, required=True, help="density, kg/m^3")
     parser.add_argument("--thickness", type=float, required=True, help="plate thickness, m")
-    parser.add_argument(
-        "--freq", required=True, help="comma-separated frequencies, Hz (e.g. 110e3,150e3)"
-    )
+    parser.add_argument("--freq", required=True, help="comma-separated frequencies, Hz (e.g. 110e3,150e3)")
     parser.add_argument(
         "--max-order", type=int, default=None, metavar="N", help="list modes S0..SN, A0..AN only"
     )
@@ -75,8 +73,7 @@ def format_table(summary: dict) -> str:
     """The human-readable report of :func:`run`."""
     speeds = summary["bulk_speeds_m_s"]
     lines = [
-        f"bulk speeds: longitudinal {speeds['longitudinal']:.1f} m/s, "
-        f"shear {speeds['shear']:.1f} m/s",
+        f"bulk speeds: longitudinal {speeds['longitudinal']:.1f} m/s, shear {speeds['shear']:.1f} m/s",
         f"{'f (kHz)':>10}  {'mode':>4}  {'c (m/s)':>10}  {'cg (m/s)':>10}  {'k (rad/m)':>11}",
     ]
     for m in summary["modes"]:

@@ -28,6 +28,9 @@ from peridyn.materials.elastic import (
     shear_modulus,
 )
 
+#: ``shear-factor``: Peridigm's former "Apply Shear Correction Factor" (see ``LPSModel``).
+SURFACE_CORRECTIONS = ("none", "shear-factor")
+
 
 class LPSModel(Model):
     """LPS material bound to a body and its bonds.
@@ -38,6 +41,9 @@ class LPSModel(Model):
     E : float, Pa
     nu : float
     density : float, kg/m^3
+    surface_correction : {"none", "shear-factor"}
+        ``shear-factor`` scales each point's deviatoric coefficient alpha so that
+        its energy under the pure shears equals the bulk value mu gamma^2 / 2.
     dtype : float64 or float32
     """
 
@@ -46,9 +52,10 @@ class LPSModel(Model):
     def __init__(self, body: Body, bonds: Bonds, E: float, nu: float, density: float,
                  surface_correction: str = "none", dtype=np.float64):
         check_elastic(E, nu, density)
-        if surface_correction != "none":
+        if surface_correction not in SURFACE_CORRECTIONS:
             raise InputError(
-                f"LPS surface_correction must be 'none' in this version, got {surface_correction!r}"
+                f"LPS surface_correction must be one of {SURFACE_CORRECTIONS}, "
+                f"got {surface_correction!r}"
             )
         super().__init__(body, bonds, density, dtype)
         dim = body.dim
@@ -65,6 +72,10 @@ class LPSModel(Model):
             raise InputError(f"point {lonely} has no intact bond: its weighted volume is zero")
         self.alpha = (15.0 if dim == 3 else 8.0) * self.shear / m
         self.theta_coef = dim / m
+        self.shear_factor = np.ones(body.n_points)
+        if surface_correction == "shear-factor":
+            self.shear_factor = self._shear_correction_factor(w)
+            self.alpha = self.alpha * self.shear_factor
         self.length = b.length.astype(self.dtype)
         self.w = w.astype(self.dtype)
         self._alpha = self.alpha.astype(self.dtype)
@@ -72,6 +83,31 @@ class LPSModel(Model):
         # P_i = theta_i * p_coef_i, see peridyn.kernels.lps
         self._p_coef = (dim * self.bulk / m - self.alpha / dim).astype(self.dtype)
         self._theta = np.empty(body.n_points, dtype=self.dtype)
+
+    def _shear_correction_factor(self, w: np.ndarray) -> np.ndarray:
+        """Per-point factor on alpha making the energy of each pure shear the bulk value.
+
+        For the pure shears gamma in the planes xy, xz, yz (xy only in 2D),
+        u_a = gamma x_b / 2, u_b = gamma x_a / 2, the classical energy density is
+        mu gamma^2 / 2; the factor is the ratio of the summed classical energies to
+        the summed deviatoric energies of the point (the pure shears have no
+        dilatation in the bulk).
+        """
+        body, b = self.body, self.bonds
+        x = body.points
+        gamma = 1e-6
+        planes = [(0, 1), (0, 2), (1, 2)] if self.dim == 3 else [(0, 1)]
+        deviatoric = np.zeros(body.n_points)
+        for a, c in planes:
+            u = np.zeros_like(x)
+            u[:, a] = 0.5 * gamma * x[:, c]
+            u[:, c] = 0.5 * gamma * x[:, a]
+            theta = lps_dilatation(x, u, b.offsets, b.neighbours, b.length, w, b.intact,
+                                   self.theta_coef, np.empty(body.n_points))
+            dev = lps_deviatoric_energy(x, u, b.offsets, b.neighbours, b.length, w, b.intact,
+                                        theta, float(self.dim), np.empty(body.n_points))
+            deviatoric += 0.5 * self.alpha * dev
+        return len(planes) * 0.5 * self.shear * gamma**2 / deviatoric
 
     def dilatation(self, u) -> np.ndarray:
         """Dilatation theta (n_points,), dimensionless."""

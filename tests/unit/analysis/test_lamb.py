@@ -60,8 +60,9 @@ def test_bulk_speeds_match_v1():
 def test_fundamental_modes_match_v1_table(frequency, s0, a0):
     modes = lamb_modes(*PLATE, frequency)
     assert [m.mode for m in modes] == ["S0", "A0"]
-    assert _triple(_mode(modes, "S0")) == pytest.approx(s0, rel=1e-3)
-    assert _triple(_mode(modes, "A0")) == pytest.approx(a0, rel=1e-3)
+    # Asked for: 0.1 %. Held to 1e-4, above the table's rounding (< 4e-5 relative).
+    assert _triple(_mode(modes, "S0")) == pytest.approx(s0, rel=1e-4)
+    assert _triple(_mode(modes, "A0")) == pytest.approx(a0, rel=1e-4)
 
 
 def test_low_frequency_limits_plate_and_kirchhoff_speeds():
@@ -70,26 +71,26 @@ def test_low_frequency_limits_plate_and_kirchhoff_speeds():
     assert _mode(modes, "S0").phase_velocity_m_s == pytest.approx(PLATE_VELOCITY, rel=5e-3)
     assert _mode(modes, "A0").phase_velocity_m_s == pytest.approx(_kirchhoff_speed(1e3), rel=5e-3)
     # Kirchhoff: c ~ sqrt(omega), so cg = 2 c.
-    assert _mode(modes, "A0").group_velocity_m_s == pytest.approx(
-        2.0 * _kirchhoff_speed(1e3), rel=5e-3
-    )
+    assert _mode(modes, "A0").group_velocity_m_s == pytest.approx(2.0 * _kirchhoff_speed(1e3), rel=5e-3)
+
+
+def _log_slope(x, y):
+    return np.polyfit(np.log(x), np.log(y), 1)[0]
 
 
 def test_low_frequency_corrections_scale_as_kh_squared():
-    # The first corrections to both limits are O((k h)^2): relative errors grow
-    # as f for A0 (k ~ sqrt(f)) and as f^2 for S0 (k ~ f).
+    # The first corrections to both limits are O((k h)^2): relative deviations
+    # grow as f for A0 (k ~ sqrt(f)) and as f^2 for S0 (k ~ f). Down to
+    # f * thickness = 2e-4 Hz m for A0, where a plain Rayleigh-Lamb function
+    # loses every digit to cancellation; S0's deviation is at round-off there.
+    freqs = np.geomspace(0.1, 1e3, 5)
+    a0 = [m for m in lamb_modes(*PLATE, freqs) if m.mode == "A0"]
+    a0_gap = [1.0 - m.phase_velocity_m_s / _kirchhoff_speed(m.frequency_hz) for m in a0]
+    assert abs(_log_slope(freqs, a0_gap) - 1.0) < 0.01, f"A0: f^{_log_slope(freqs, a0_gap):.3f}"
     freqs = np.geomspace(10.0, 1e3, 5)
-    modes = lamb_modes(*PLATE, freqs)
-    a0 = [
-        1.0 - m.phase_velocity_m_s / _kirchhoff_speed(m.frequency_hz)
-        for m in modes
-        if m.mode == "A0"
-    ]
-    s0 = [1.0 - m.phase_velocity_m_s / PLATE_VELOCITY for m in modes if m.mode == "S0"]
-    a0_rate = np.polyfit(np.log(freqs), np.log(a0), 1)[0]
-    s0_rate = np.polyfit(np.log(freqs), np.log(s0), 1)[0]
-    assert abs(a0_rate - 1.0) < 0.02, f"A0 correction grows as f^{a0_rate:.3f}"
-    assert abs(s0_rate - 2.0) < 0.02, f"S0 correction grows as f^{s0_rate:.3f}"
+    s0 = [m for m in lamb_modes(*PLATE, freqs) if m.mode == "S0"]
+    s0_gap = [1.0 - m.phase_velocity_m_s / PLATE_VELOCITY for m in s0]
+    assert abs(_log_slope(freqs, s0_gap) - 2.0) < 0.01, f"S0: f^{_log_slope(freqs, s0_gap):.3f}"
 
 
 def _rayleigh_root(cl, ct):
@@ -192,8 +193,10 @@ def test_mode_shapes_have_their_symmetry():
     z, ux, uz = mode_shape(*PLATE, _mode(modes, "S0"))
     assert z[0] == pytest.approx(-THICKNESS / 2) and z[-1] == pytest.approx(THICKNESS / 2)
     assert _is_even(ux) and _is_odd(uz) and ux.max() == pytest.approx(1.0)
+    assert np.abs(uz).max() > 0.05  # Poisson contraction, ~ nu k h / (1 - nu)
     z, ux, uz = mode_shape(*PLATE, _mode(modes, "A0"))
     assert _is_odd(ux) and _is_even(uz) and uz.max() == pytest.approx(1.0)
+    assert np.abs(ux).max() > 0.3  # rotation of the normals, ~ k h
 
 
 def test_long_wave_mode_shapes_follow_plate_kinematics():
@@ -220,6 +223,19 @@ def test_dispersion_branches_are_continuous():
         assert jumps.max() <= 2.01 * step, label
         assert np.all(np.diff(branch.wavenumber_rad_m) > 0), label
     assert curves["S0"].frequency_hz.size == curves["A0"].frequency_hz.size == 80
+
+
+def test_close_roots_near_a_branch_crossing_are_found():
+    # nu = 0.01: the plane P wave k = omega / cL nearly solves the S equation
+    # (exactly at nu = 0, where lambda = 0) and the S branches cross it in
+    # near-degenerate pairs; at 6.32 MHz two roots (k ~ 7.8e3 rad/m) lie within
+    # one scan step. With no backward wave there, the S modes are S0 plus one
+    # per cut-off below f.
+    plate, f = (70e9, 0.01, 2700.0, 0.002), 6.32e6
+    s_modes = [m for m in lamb_modes(*plate, f) if m.mode.startswith("S")]
+    n_cutoffs = sum(label.startswith("S") for label in cutoff_frequencies(*plate, f))
+    assert all(m.group_velocity_m_s > 0 for m in s_modes)
+    assert [m.mode for m in s_modes] == [f"S{n}" for n in range(n_cutoffs + 1)]
 
 
 @pytest.mark.parametrize(

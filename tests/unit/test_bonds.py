@@ -1,0 +1,137 @@
+"""Family search, influence functions, partial volumes and pre-cracks."""
+
+import itertools
+
+import numpy as np
+import pytest
+
+from peridyn import geometry
+from peridyn.bonds import (
+    cell_fraction_in_ball,
+    crossing_rectangle,
+    crossing_segment,
+    cut_bonds,
+    find_bonds,
+)
+from peridyn.errors import InputError
+
+
+def _lattice_count(radius: float, dim: int) -> int:
+    """Lattice points (integer vectors, not 0) within ``radius`` grid units: a closed form count."""
+    r = int(np.ceil(radius))
+    rng = range(-r, r + 1)
+    pts = itertools.product(*([rng] * dim))
+    return sum(1 for p in pts if 0 < sum(c * c for c in p) <= radius**2)
+
+
+@pytest.mark.parametrize("factor, expected", [(1.4143, 18), (2.015, 32), (3.015, 122)])
+def test_interior_family_size_3d(factor, expected):
+    body = geometry.box((0.011,) * 3, 1e-3)
+    bonds = find_bonds(body, factor * 1e-3, partial_volumes=False)
+    centre = np.argmin(np.linalg.norm(body.points - 0.0055, axis=1))
+    assert np.diff(bonds.offsets)[centre] == expected == _lattice_count(factor, 3)
+
+
+def test_interior_family_size_2d():
+    body = geometry.rectangle(0.011, 0.011, 1e-3, thickness=1e-3)
+    bonds = find_bonds(body, 3.015e-3, partial_volumes=False)
+    centre = np.argmin(np.linalg.norm(body.points[:, :2] - 0.0055, axis=1))
+    assert np.diff(bonds.offsets)[centre] == _lattice_count(3.015, 2) == 28
+
+
+def test_families_are_symmetric_and_sorted():
+    body = geometry.plate(0.008, 0.006, 0.002, spacing=1e-3, layers=3)
+    bonds = find_bonds(body, 2.5e-3)
+    rev = bonds.reverse()
+    owners = bonds.owners()
+    np.testing.assert_array_equal(owners[rev], bonds.neighbours)
+    np.testing.assert_array_equal(bonds.neighbours[rev], owners)
+    np.testing.assert_allclose(bonds.volume_factor[rev], bonds.volume_factor, rtol=1e-12)
+    for i in range(body.n_points):
+        fam = bonds.neighbours[bonds.offsets[i]:bonds.offsets[i + 1]]
+        assert np.all(np.diff(fam) > 0)
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_partial_volumes_fill_the_horizon(dim):
+    """The family's volume with partial volumes equals the ball's (disc's) to 0.5%."""
+    h, delta = 1e-3, 3.015e-3
+    if dim == 3:
+        body = geometry.box((0.011,) * 3, h)
+        target = 4 / 3 * np.pi * delta**3 - h**3  # ball minus the point's own cell
+    else:
+        body = geometry.rectangle(0.011, 0.011, h, thickness=h)
+        target = (np.pi * delta**2 - h**2) * h
+    bonds = find_bonds(body, delta, partial_volumes=True)
+    centre = np.argmin(np.linalg.norm(body.points[:, :dim] - 0.0055, axis=1))
+    fam = slice(bonds.offsets[centre], bonds.offsets[centre + 1])
+    volume = np.sum(body.volumes[bonds.neighbours[fam]] * bonds.volume_factor[fam])
+    # the own cell is (almost) whole inside the ball; the rest of the ball is covered by neighbours
+    assert volume == pytest.approx(target, rel=5e-3)
+
+
+def test_cell_fraction_simple_cases():
+    cell = np.array([[1.0, 1.0, 1.0]])
+    assert cell_fraction_in_ball(np.array([[0.0, 0.0, 0.0]]), cell, 2.0)[0] == 1.0
+    assert cell_fraction_in_ball(np.array([[5.0, 0.0, 0.0]]), cell, 2.0)[0] == 0.0
+    # a plane through the cell centre: a huge ball's surface cuts the cell in half
+    big = 1e6
+    half = cell_fraction_in_ball(np.array([[big, 0.0, 0.0]]), cell, big, quadrature_points=8)[0]
+    assert half == pytest.approx(0.5, abs=1e-6)
+
+
+@pytest.mark.parametrize("name, at_horizon", [("constant", 1.0), ("inverse", 1.0),
+                                              ("gaussian", np.exp(-1.0)), ("conical", 0.0)])
+def test_influence_functions(name, at_horizon):
+    body = geometry.box((0.007,) * 3, 1e-3)
+    bonds = find_bonds(body, 3.0e-3 * (1 + 1e-9), influence=name, partial_volumes=False)
+    far = np.isclose(bonds.length, 3.0e-3)
+    np.testing.assert_allclose(bonds.influence[far], at_horizon, atol=1e-8)
+
+
+def test_isolated_points_are_refused():
+    body = geometry.box((0.004, 0.004, 0.004), 1e-3)
+    with pytest.raises(InputError, match="horizon"):
+        find_bonds(body, 0.4e-3)
+
+
+def test_unknown_influence_function():
+    body = geometry.box((0.004, 0.004, 0.004), 1e-3)
+    with pytest.raises(InputError, match="did you mean 'gaussian'"):
+        find_bonds(body, 2e-3, influence="gausian")
+
+
+def test_rectangle_precrack_cuts_exactly_the_crossing_bonds():
+    """Count checked against a brute-force loop over all point pairs."""
+    body = geometry.box((0.010, 0.006, 0.004), 1e-3)
+    bonds = find_bonds(body, 3.015e-3, partial_volumes=False)
+    origin, eu, ev = (0.005, 0.0, 0.0), (0.0, 0.0032, 0.0), (0.0, 0.0, 0.004)  # x = 5 mm, y < 3.2 mm
+    cut = cut_bonds(body, bonds, lambda a, b: crossing_rectangle(a, b, origin, eu, ev))
+    x = body.points
+    brute = 0
+    for i in range(body.n_points):
+        for j in range(body.n_points):
+            if i == j or np.linalg.norm(x[j] - x[i]) > bonds.horizon * (1 + 1e-12):
+                continue
+            xa, xb = x[i], x[j]
+            if (xa[0] - 0.005) * (xb[0] - 0.005) < 0:
+                t = (0.005 - xa[0]) / (xb[0] - xa[0])
+                hit = xa + t * (xb - xa)
+                if 0 <= hit[1] <= 0.0032 and 0 <= hit[2] <= 0.004:
+                    brute += 1
+    assert cut == brute > 0
+    assert int((~bonds.intact).sum()) == cut
+
+
+def test_segment_precrack_2d():
+    body = geometry.rectangle(0.010, 0.010, 1e-3, thickness=1e-3)
+    bonds = find_bonds(body, 2.015e-3, partial_volumes=False)
+    cut = cut_bonds(body, bonds, lambda a, b: crossing_segment(a, b, (0.005, 0.0), (0.005, 0.004)))
+    owners = bonds.owners()
+    xa, xb = body.points[owners], body.points[bonds.neighbours]
+    crosses = ((xa[:, 0] - 0.005) * (xb[:, 0] - 0.005) < 0)
+    y_hit = xa[:, 1] + (0.005 - xa[:, 0]) / np.where(crosses, xb[:, 0] - xa[:, 0], 1) * (
+        xb[:, 1] - xa[:, 1])
+    expected = crosses & (y_hit > 0) & (y_hit < 0.004)
+    assert cut == int(expected.sum()) > 0
+    np.testing.assert_array_equal(~bonds.intact, expected)
