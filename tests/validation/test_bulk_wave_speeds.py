@@ -53,9 +53,10 @@ def plane_wave_speed(component: str, speed: float) -> float:
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("component, classical", [
-    ("x", np.sqrt((STEEL_K + 4 * STEEL_MU / 3) / STEEL_RHO)),
-    ("y", np.sqrt(STEEL_MU / STEEL_RHO)),
+@pytest.mark.parametrize("component, classical, tolerance", [
+    ("x", np.sqrt((STEEL_K + 4 * STEEL_MU / 3) / STEEL_RHO), 0.02),  # measured -0.9%
+    ("y", np.sqrt(STEEL_MU / STEEL_RHO), 0.03),                      # measured -0.4%
 ])
-def test_plane_waves_travel_at_classical_speeds(component, classical):
-    assert plane_wave_speed(component, classical) == pytest.approx(classical, rel=0.03)
+def test_plane_waves_travel_at_classical_speeds(component, classical, tolerance):
+    """Longitudinal within 2%, shear within 3% (the core issue's bands)."""
+    assert plane_wave_speed(component, classical) == pytest.approx(classical, rel=tolerance)

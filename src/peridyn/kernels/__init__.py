@@ -9,8 +9,50 @@ Layout expected by every kernel (the drivers in ``peridyn.materials`` and
 - ``intact``: (n_bonds,) bool.
 
 ``reference.py`` holds plain NumPy versions used by the tests.
+
+How the force kernels are written (what makes them fast, see ``benchmarks/RESULTS.md``):
+
+- the family of point ``i`` is taken as slices ``nbr[lo:hi]``, ``k[lo:hi]``... indexed
+  from 0 and the neighbour index is read as unsigned, so that numba emits no
+  negative-index wraparound code and LLVM sees unit-stride per-bond loads: the inner
+  loop then vectorises (4 bonds per AVX2 register in float64, 8 in float32), the
+  neighbours' coordinates being loaded lane by lane;
+- ``x`` and ``u`` are read through flat views (``x.reshape(3 n)``), so the address
+  of ``x[j, a]`` is ``3 j + a`` with a compile-time stride;
+- broken bonds are masked by a select on ``intact`` (no branch in the loop);
+- every constant has the kernel's dtype (``f.dtype.type(...)``): a Python ``0 * r`` or
+  ``1 / r`` turns a float32 kernel into float64 arithmetic;
+- the bond vector differences come from :func:`bond_differences`, compiled without
+  fast-math, so ``Y_ij = -Y_ji`` holds exactly whatever the optimiser does with the rest.
+
+Two forms of the stretch are used:
+
+- float64, "length form": ``|Y| - |xi|`` with ``|xi|`` (or ``1 / |xi|``) read from a
+  stored per-bond array, as in the reference;
+- float32, "cancellation-free form" (kernels named ``*_cf``): ``|xi|`` is recomputed from
+  ``x`` and the extension is ``|Y| - |xi| = du . (Y + xi) / (|Y| + |xi|)``,
+  ``du = u_j - u_i``, which has no cancellation: in float32 ``|Y| - |xi|`` loses
+  everything below ~1e-7 |xi| (strain 1e-6 waves would be noise), and the float32
+  rounding of ``x`` (~1e-6 of a millimetre bond) would otherwise show up as a strain.
+  It also reads one per-bond float fewer.
 """
+
+import numba
 
 #: Fast-math flags used by the force kernels: reassociation lets LLVM vectorise
 #: the per-point sums; NaN/inf semantics are kept so blow-ups are still detected.
 FASTMATH = {"reassoc", "contract", "nsz", "arcp"}
+
+
+@numba.njit(cache=True)
+def bond_differences(xj, xi, uj, ui):
+    """One component of a bond: ``(xi_a, du_a, Y_a)`` = ``(xj - xi, uj - ui, xi_a + du_a)``.
+
+    Compiled without fast-math: LLVM inlines it into the fast-math kernels but keeps
+    these three roundings as written, so swapping i and j negates all three exactly
+    (Newton's third law to the last bit) and ``du`` keeps its full precision next to
+    the much larger coordinates.
+    """
+    d = xj - xi
+    du = uj - ui
+    return d, du, d + du
