@@ -23,6 +23,8 @@ COMMAND_MODULES = (
     "peridyn.cli.demo_cmd",
     "peridyn.cli.bench_cmd",
     "peridyn.cli.lamb_cmd",
+    "peridyn.cli.dispersion_cmd",
+    "peridyn.cli.plot_cmd",
 )
 
 

@@ -7,30 +7,92 @@ Force density on point i (N/m^3):
 which is c s Y/|Y| V_j with stretch s = |Y|/|xi| - 1, folded so that each
 bond costs one square root and one division. ``k_ij = c omega beta V_j g``
 (micromodulus, influence, volume factor, neighbour volume, surface factor).
+
+``pmb_force`` (float64) and ``pmb_force_cf`` (float32) compute the same force; see
+``peridyn.kernels`` for the two forms and what makes them fast. ``pmb_force_baseline``
+is the straightforward loop kept as the reference row of ``peridyn bench``.
 """
 
 import numba
 import numpy as np
 
-from peridyn.kernels import FASTMATH
+from peridyn.kernels import FASTMATH, bond_differences
 
 
 @numba.njit(parallel=True, fastmath=FASTMATH, cache=True)
 def pmb_force(x, u, offsets, nbr, inv_len, k, intact, f):
-    """Internal force density ``f`` (OUT, overwritten) of the PMB model."""
+    """Internal force density ``f`` (OUT, overwritten) of the PMB model ("length form").
+
+    ``s = k (1/|xi| - 1/|Y|)`` with the stored ``inv_len = 1/|xi|``: one square root
+    and one division per bond. Used for float64 (see the package docstring).
+    """
     n = x.shape[0]
+    zero = f.dtype.type(0.0)
+    one = f.dtype.type(1.0)
+    xf = x.reshape(3 * n)
+    uf = u.reshape(3 * n)
     for i in numba.prange(n):
-        xi0, xi1, xi2 = x[i, 0], x[i, 1], x[i, 2]
-        f0 = f.dtype.type(0.0)
-        f1 = f.dtype.type(0.0)
-        f2 = f.dtype.type(0.0)
-        for b in range(offsets[i], offsets[i + 1]):
-            j = nbr[b]
-            y0 = (x[j, 0] - xi0) + (u[j, 0] - u[i, 0])
-            y1 = (x[j, 1] - xi1) + (u[j, 1] - u[i, 1])
-            y2 = (x[j, 2] - xi2) + (u[j, 2] - u[i, 2])
+        xi0, xi1, xi2 = xf[3 * i], xf[3 * i + 1], xf[3 * i + 2]
+        ui0, ui1, ui2 = uf[3 * i], uf[3 * i + 1], uf[3 * i + 2]
+        lo = offsets[i]
+        hi = offsets[i + 1]
+        fam = nbr[lo:hi]
+        il = inv_len[lo:hi]
+        kb = k[lo:hi]
+        ok = intact[lo:hi]
+        f0 = zero
+        f1 = zero
+        f2 = zero
+        for q in range(hi - lo):
+            j = 3 * np.uint64(np.uint32(fam[q]))
+            _, _, y0 = bond_differences(xf[j], xi0, uf[j], ui0)
+            _, _, y1 = bond_differences(xf[j + 1], xi1, uf[j + 1], ui1)
+            _, _, y2 = bond_differences(xf[j + 2], xi2, uf[j + 2], ui2)
+            s = kb[q] * (il[q] - one / np.sqrt(y0 * y0 + y1 * y1 + y2 * y2))
+            s = s if ok[q] else zero
+            f0 += s * y0
+            f1 += s * y1
+            f2 += s * y2
+        f[i, 0] = f0
+        f[i, 1] = f1
+        f[i, 2] = f2
+    return f
+
+
+@numba.njit(parallel=True, fastmath=FASTMATH, cache=True)
+def pmb_force_cf(x, u, offsets, nbr, k, intact, f):
+    """PMB force density ``f`` (OUT), cancellation-free form (used for float32).
+
+    Same force as :func:`pmb_force`, written
+    ``s = k (|Y|^2 - |xi|^2) / (|Y| |xi| (|Y| + |xi|))`` with
+    ``|Y|^2 - |xi|^2 = du . (Y + xi)`` and ``|xi|`` recomputed from ``x``: no per-bond
+    length is read and the stretch keeps full relative precision however small it is.
+    """
+    n = x.shape[0]
+    zero = f.dtype.type(0.0)
+    xf = x.reshape(3 * n)
+    uf = u.reshape(3 * n)
+    for i in numba.prange(n):
+        xi0, xi1, xi2 = xf[3 * i], xf[3 * i + 1], xf[3 * i + 2]
+        ui0, ui1, ui2 = uf[3 * i], uf[3 * i + 1], uf[3 * i + 2]
+        lo = offsets[i]
+        hi = offsets[i + 1]
+        fam = nbr[lo:hi]
+        kb = k[lo:hi]
+        ok = intact[lo:hi]
+        f0 = zero
+        f1 = zero
+        f2 = zero
+        for q in range(hi - lo):
+            j = 3 * np.uint64(np.uint32(fam[q]))
+            d0, e0, y0 = bond_differences(xf[j], xi0, uf[j], ui0)
+            d1, e1, y1 = bond_differences(xf[j + 1], xi1, uf[j + 1], ui1)
+            d2, e2, y2 = bond_differences(xf[j + 2], xi2, uf[j + 2], ui2)
             r = np.sqrt(y0 * y0 + y1 * y1 + y2 * y2)
-            s = k[b] * (inv_len[b] - 1 / r) if intact[b] else 0 * r
+            length = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+            ext2 = e0 * (y0 + d0) + e1 * (y1 + d1) + e2 * (y2 + d2)
+            s = kb[q] * ext2 / (r * length * (r + length))
+            s = s if ok[q] else zero
             f0 += s * y0
             f1 += s * y1
             f2 += s * y2
