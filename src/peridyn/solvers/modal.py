@@ -1,0 +1,111 @@
+"""Free vibration: K x = lambda M x, f = sqrt(lambda) / (2 pi).
+
+Shift-invert Lanczos (``scipy.sparse.linalg.eigsh``) with a negative shift
+``sigma = -s`` so that ``K + s M`` is positive definite even for a free body
+(whose K is singular), factorised once with a sparse LU. Rigid-body modes
+(six for a free 3D body, three in 2D) come out with |f| near zero and are
+counted and reported separately.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.linalg import eigsh, splu
+
+from peridyn.errors import InputError
+from peridyn.materials.base import Model
+from peridyn.stiffness import assemble_stiffness, mass_matrix
+
+#: Modes whose frequency is below this fraction of the highest computed one are rigid.
+RIGID_FRACTION = 1e-4
+
+
+@dataclass
+class ModalResult:
+    """Eigenpairs of a body.
+
+    Attributes
+    ----------
+    frequencies : (n_modes,) float64, Hz
+        Signed: sqrt(lambda) / 2 pi, negative when lambda < 0 (round-off of rigid modes).
+    shapes : (n_modes, n_points, 3) float64
+        Mass-normalised mode shapes (x^T M x = 1).
+    residuals : (n_modes,) float64
+        ||K x - lambda M x|| / ||K x|| (rigid modes: / (max K_ii ||x||)).
+    rigid : (n_modes,) bool
+        Rigid-body modes.
+    """
+
+    frequencies: np.ndarray
+    shapes: np.ndarray
+    residuals: np.ndarray
+    rigid: np.ndarray
+
+    @property
+    def n_rigid(self) -> int:
+        """Number of rigid-body modes found."""
+        return int(self.rigid.sum())
+
+    def elastic(self) -> ModalResult:
+        """The elastic modes only."""
+        keep = ~self.rigid
+        return ModalResult(self.frequencies[keep], self.shapes[keep], self.residuals[keep],
+                           self.rigid[keep])
+
+
+def free_dofs(model: Model, fixed: np.ndarray | None = None) -> np.ndarray:
+    """Indices of the free dofs: all but the z dofs of a 2D body and the ``fixed`` ones."""
+    n = model.body.n_points
+    free = np.ones((n, 3), dtype=bool)
+    if model.body.dim == 2:
+        free[:, 2] = False
+    if fixed is not None:
+        free &= ~fixed
+    return np.flatnonzero(free.ravel())
+
+
+def modal_analysis(model: Model, n_modes: int = 12, fixed: np.ndarray | None = None,
+                   shift: float | None = None, tol: float = 1e-10) -> ModalResult:
+    """The ``n_modes`` lowest modes of ``model`` (free-free unless ``fixed`` dofs are given).
+
+    Parameters
+    ----------
+    n_modes : int
+        Number of modes, rigid ones included.
+    fixed : (n_points, 3) bool or None
+        Dofs held at zero.
+    shift : float or None, 1/s^2
+        Magnitude s of the negative shift; default: 1e-3 of the largest K_ii / M_ii
+        estimate scaled to the low end of the spectrum (see code).
+    """
+    if n_modes < 1:
+        raise InputError(f"number of modes must be positive, got {n_modes}")
+    dofs = free_dofs(model, fixed)
+    if n_modes >= len(dofs):
+        raise InputError(f"asked for {n_modes} modes of a model with {len(dofs)} free dofs")
+    K = assemble_stiffness(model)[dofs][:, dofs].tocsc()
+    m = mass_matrix(model).diagonal()[dofs]
+    M = sp.diags(m).tocsc()
+    if shift is None:
+        # a fraction of the lowest diagonal frequency estimate keeps K + s M well conditioned
+        shift = 1e-6 * float(np.median(K.diagonal() / m))
+    lu = splu((K + shift * M).tocsc())
+    op = sp.linalg.LinearOperator(K.shape, matvec=lu.solve, dtype=np.float64)
+    lam, vecs = eigsh(K, k=n_modes, M=M, sigma=-shift, which="LM", OPinv=op, tol=tol)
+    order = np.argsort(lam)
+    lam, vecs = lam[order], vecs[:, order]
+    kx = K @ vecs
+    mx = M @ vecs
+    freqs = np.sign(lam) * np.sqrt(np.abs(lam)) / (2 * np.pi)
+    rigid = np.abs(freqs) < RIGID_FRACTION * np.abs(freqs).max()
+    resid = np.linalg.norm(kx - mx * lam, axis=0)
+    # elastic modes: relative to ||K x||; rigid ones (K x ~ 0): relative to max K_ii ||x||
+    k_scale = np.abs(K.diagonal()).max() * np.linalg.norm(vecs, axis=0)
+    scale = np.where(rigid, k_scale, np.linalg.norm(kx, axis=0))
+    shapes = np.zeros((n_modes, model.body.n_points * 3))
+    shapes[:, dofs] = vecs.T
+    return ModalResult(freqs, shapes.reshape(n_modes, -1, 3), resid / np.maximum(scale, 1e-300),
+                       rigid)
