@@ -6,6 +6,7 @@ Series in ``results.h5`` (see ``peridyn.io.hdf5`` for the layout):
   points nearest to the named sensor positions (names in the series attribute ``names``);
 - ``line_<name>``: (n, 3) displacement along a line probe;
 - ``plane_<name>``: (n, 3) displacement of a plane probe (a node set or a plate layer);
+- ``pzt_signal``: (n_pzt,) mean in-plane strain under each PZT sensor patch;
 - ``field_u``: (n_points, 3) displacement at every snapshot, with ``snapshots/*.vtu``
   files and ``snapshots.pvd`` for ParaView.
 """
@@ -13,7 +14,6 @@ Series in ``results.h5`` (see ``peridyn.io.hdf5`` for the layout):
 from __future__ import annotations
 
 import hashlib
-import json
 import platform
 import subprocess
 import sys
@@ -57,6 +57,9 @@ class RecorderSpec:
     sensors : dict of name -> 3 floats (m)
     lines : dict of name -> LineProbe
     planes : dict of name -> (n,) point indices
+    pzt_sensors : dict of name -> ((n,) point indices, (n, 2) weights)
+        The signal is sum(weights * u[indices, :2]): the mean in-plane strain under a patch
+        (see ``peridyn.transducers.pzt_sensor_weights``).
     series_dtype : "float64" or "float32"
         Storage type of the line and plane series (float32 halves big records).
     vtu : bool
@@ -69,6 +72,7 @@ class RecorderSpec:
     sensors: dict = field(default_factory=dict)
     lines: dict = field(default_factory=dict)
     planes: dict = field(default_factory=dict)
+    pzt_sensors: dict = field(default_factory=dict)
     series_dtype: str = "float64"
     vtu: bool = True
 
@@ -133,6 +137,9 @@ class Recorder:
         for name, idx in self.plane_index.items():
             h5.create_series(f"plane_{name}", (len(idx), 3), spec.series_dtype)
             h5.write_array(f"probes/plane_{name}", idx)
+        if spec.pzt_sensors:
+            h5.create_series("pzt_signal", (len(spec.pzt_sensors),),
+                             attrs={"names": list(spec.pzt_sensors)})
         h5.create_series("field_u", (self.body.n_points, 3), spec.series_dtype)
 
     def observe(self, state: State, solver) -> None:
@@ -153,6 +160,9 @@ class Recorder:
             h5.append(f"line_{name}", step, t, state.u[idx])
         for name, idx in self.plane_index.items():
             h5.append(f"plane_{name}", step, t, state.u[idx])
+        if self.spec.pzt_sensors:
+            signals = [np.sum(w * state.u[idx, :2]) for idx, w in self.spec.pzt_sensors.values()]
+            h5.append("pzt_signal", step, t, np.array(signals))
 
     def snapshot(self, state: State) -> None:
         """Write the whole displacement field (HDF5, and VTU when enabled)."""
@@ -167,18 +177,13 @@ class Recorder:
         write_vtu(self.directory / name, self.body.points[:, : self.body.dim], data)
         self.pvd.add(state.time, name)
 
-    def finish(self, state: State, summary: dict) -> None:
-        """Write the final state and the run summary, then close the file."""
+    def finish(self, state: State) -> None:
+        """Write the final state, then close the file."""
         self.h5.write_array("final/u", state.u)
         self.h5.write_array("final/v", state.v)
         if self.model is not None:
             self.h5.write_array("final/damage", damage_field(self.model))
-        self.h5.write_array("summary/json", np.bytes_(_json(summary)))
         self.h5.close()
-
-
-def _json(obj) -> str:
-    return json.dumps(obj, default=lambda o: o.tolist() if hasattr(o, "tolist") else str(o))
 
 
 def provenance(case_path=None, argv=None) -> dict:

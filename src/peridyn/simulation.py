@@ -6,6 +6,7 @@ same steps for Python users who want to stop half-way (e.g. to inspect the bonds
 
 from __future__ import annotations
 
+import json
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -19,12 +20,15 @@ from peridyn.checkpoint import Checkpointer, load_checkpoint
 from peridyn.damage import BondDamage, damage_field
 from peridyn.errors import CaseFileError, InputError
 from peridyn.io.case import Case, Region
+from peridyn.io.hdf5 import HDF5Writer
 from peridyn.loads import BoundaryCondition, InitialCondition, Loading
 from peridyn.materials import Model, make_model
+from peridyn.postprocess import analyse
 from peridyn.recorder import LineProbe, Recorder, RecorderSpec, provenance
 from peridyn.solvers import ExplicitSolver, relax
 from peridyn.solvers.state import State
 from peridyn.timefunctions import from_spec
+from peridyn.transducers import pin_force_actuator, pzt_radial_actuator, pzt_sensor_weights
 
 
 @dataclass
@@ -108,19 +112,34 @@ def build_bonds(case: Case, body: Body) -> Bonds:
     return bonds
 
 
-def build_loading(case: Case, body: Body) -> Loading:
-    """Boundary and initial conditions of the case, checked for conflicts."""
+def add_actuators(case: Case, body: Body) -> tuple[Body, list[BoundaryCondition]]:
+    """The body with a node set per actuator, and the actuators' boundary conditions."""
+    conditions = []
+    for name, a in case.actuators.items():
+        signal = from_spec(a.signal, f"actuators.{name}.signal")
+        if a.type == "pzt_radial":
+            body, bcs = pzt_radial_actuator(body, a.center, a.size, signal, shape=a.shape,
+                                            layer=a.layer, amplitude=a.amplitude, name=name)
+        else:
+            body, bcs = pin_force_actuator(body, a.center, a.size, signal, shape=a.shape,
+                                           layer=a.layer, line_force=a.line_force, name=name)
+        conditions += bcs
+    return body, conditions
+
+
+def build_loading(case: Case, body: Body, extra=()) -> Loading:
+    """Boundary and initial conditions of the case (plus ``extra`` ones), checked for conflicts."""
     bcs = [BoundaryCondition(bc.set, bc.kind, bc.components,
                              from_spec(bc.value, f"boundary_conditions[{k}].value"))
            for k, bc in enumerate(case.boundary_conditions)]
     ics = [InitialCondition(ic.set, ic.kind, ic.components, ic.value)
            for ic in case.initial_conditions]
-    return Loading(body, bcs, ics)
+    return Loading(body, [*extra, *bcs], ics)
 
 
 def build(case: Case, base_dir=".") -> Setup:
     """Body, bonds, model, loading and damage of a case."""
-    body = build_body(case, base_dir)
+    body, actuation = add_actuators(case, build_body(case, base_dir))
     bonds = build_bonds(case, body)
     mat = case.material
     model = make_model(mat.model, body, bonds, E=mat.E, density=mat.density, nu=mat.nu,
@@ -129,7 +148,7 @@ def build(case: Case, base_dir=".") -> Setup:
     if mat.damage is not None:
         damage = BondDamage(model, mat.damage.critical_stretch, mat.damage.fracture_energy,
                             mat.damage.no_damage_sets)
-    loading = build_loading(case, body)
+    loading = build_loading(case, body, actuation)
     if case.solver.type == "static" and not loading.has_loads:
         raise CaseFileError(case.name, "boundary_conditions", [], "at least one load for a static run")
     if case.solver.type == "explicit" and not (loading.has_loads or loading.initial):
@@ -149,9 +168,18 @@ def recorder_spec(case: Case, body: Body, dt: float) -> RecorderSpec:
         sensors={k: _pad3(v) for k, v in out.sensors.items()},
         lines={k: LineProbe(_pad3(v.start), _pad3(v.end), v.points) for k, v in out.lines.items()},
         planes=planes,
+        pzt_sensors={k: _pzt_weights(body, v) for k, v in out.pzt_sensors.items()},
         series_dtype=out.series_dtype,
         vtu=out.vtu,
     )
+
+
+def _pzt_weights(body: Body, sensor) -> tuple[np.ndarray, np.ndarray]:
+    """Point indices and (n, 2) weights of a PZT sensor patch on its layer."""
+    idx = np.flatnonzero(geometry.layer(body, sensor.layer))
+    weights = pzt_sensor_weights(body.points[idx], sensor.center, sensor.size, sensor.shape)
+    used = np.any(weights != 0, axis=1)
+    return idx[used], weights[used]
 
 
 def output_directory(case: Case, override=None) -> Path:
@@ -181,12 +209,25 @@ def run_case(case: Case, output_dir=None, case_path=None, checkpoint_every: int 
         summary = _run_static(case, setup, out, case_path)
     else:
         summary = _run_explicit(case, setup, out, case_path, checkpoint_every, restart, progress)
-    summary["seconds"] = time.perf_counter() - start
+    analysis, figures = analyse(case, setup.body, out, plots=case.output.plots)
+    summary.update(analysis)
     if case.output.plots:
         from peridyn.plotting.fields import plot_run
 
-        summary["plots"] = [str(p) for p in plot_run(out, setup.body)]
+        summary["plots"] = [str(p) for p in [*plot_run(out, setup.body), *figures]]
+    summary["seconds"] = time.perf_counter() - start
+    store_summary(out / "results.h5", setup.body, summary)
     return summary
+
+
+def store_summary(results, body: Body, summary: dict) -> None:
+    """(Re)write the run summary as JSON in ``/summary/json`` of a results file."""
+    with HDF5Writer(results, body.points[:, : body.dim], body.volumes, {}, mode="a") as h5:
+        h5.write_array("summary/json", np.bytes_(json.dumps(summary, default=_json_default)))
+
+
+def _json_default(obj):
+    return obj.tolist() if hasattr(obj, "tolist") else str(obj)
 
 
 def _base_summary(setup: Setup, out: Path) -> dict:
@@ -231,7 +272,7 @@ def _run_explicit(case, setup, out, case_path, checkpoint_every, restart, progre
                     "stable_dt_s": solver.stable_dt,
                     "kinetic_energy_j": solver.kinetic_energy(state),
                     "strain_energy_j": setup.model.strain_energy(state.u)})
-    recorder.finish(state, summary)
+    recorder.finish(state)
     return summary
 
 
@@ -259,5 +300,5 @@ def _run_static(case, setup, out, case_path) -> dict:
     summary.update({"steps": s.load_steps, "iterations": iterations,
                     "residual": result.residual,
                     "strain_energy_j": setup.model.strain_energy(u)})
-    recorder.finish(state, summary)
+    recorder.finish(state)
     return summary

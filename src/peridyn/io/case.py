@@ -186,6 +186,58 @@ class InitialConditionSpec(Strict):
     value: Finite = 0.0
 
 
+class Actuator(Strict):
+    """A surface-bonded PZT patch: ``pzt_radial`` (seed 000: radial in-plane displacement, zero at
+    the centre, ``amplitude`` on the perimeter) or ``pin_force`` (outward line forces of
+    ``line_force`` N/m along the edges); driven by the time function ``signal``."""
+
+    type: Literal["pzt_radial", "pin_force"]
+    center: Annotated[list[Finite], Field(min_length=2, max_length=2)]
+    size: Positive
+    shape: Literal["square", "circular"] = "square"
+    layer: int | None = -1
+    amplitude: Positive = 1e-6
+    line_force: Positive = 1.0
+    signal: dict
+
+
+class PZTSensor(Strict):
+    """A PZT patch used as a sensor: the mean in-plane strain (eps_xx + eps_yy) under it."""
+
+    center: Annotated[list[Finite], Field(min_length=2, max_length=2)]
+    size: Positive
+    shape: Literal["square", "circular"] = "square"
+    layer: int = -1
+
+
+class FKAnalysis(Strict):
+    """Frequency-wavenumber analysis of a line probe: wavenumbers of the named modes at
+    ``frequency`` (default: the first actuator's centre frequency), each read from one
+    displacement component."""
+
+    line: str
+    frequency: Positive | None = None
+    components: dict[str, Literal["x", "y", "z"]] = {"S0": "x", "A0": "z"}
+    window: Literal["hann", "none"] = "hann"
+    pad: Annotated[float, Field(ge=1)] = 2.0
+    tolerance: Annotated[float, Field(gt=0, lt=1)] = 0.2
+
+
+class KxKyAnalysis(Strict):
+    """(kx, ky) maps of a plane probe at chosen frequencies, with ring radii per mode."""
+
+    plane: str
+    frequencies: list[Positive]
+    component: Literal["x", "y", "z"] = "z"
+
+
+class Analysis(Strict):
+    """Post-processing run after the simulation."""
+
+    fk: FKAnalysis | None = None
+    kxky: KxKyAnalysis | None = None
+
+
 class Solver(Strict):
     """``explicit``: ``steps`` or ``time`` (s), optional ``dt`` (s; default safety x stable),
     damping (1/s), kernel dtype; ``static``: adaptive dynamic relaxation with ``tolerance``,
@@ -229,6 +281,7 @@ class Output(Strict):
     sensors: dict[str, Vector3] = {}
     lines: dict[str, LineSpec] = {}
     planes: dict[str, str] = {}
+    pzt_sensors: dict[str, PZTSensor] = {}
     series_dtype: Literal["float64", "float32"] = "float64"
     vtu: bool = True
     plots: bool = True
@@ -245,14 +298,19 @@ class Case(Strict):
     removals: list[Region] = []
     node_sets: dict[str, Region] = {}
     precracks: list[Precrack] = []
+    actuators: dict[str, Actuator] = {}
     boundary_conditions: list[BoundaryConditionSpec] = []
     initial_conditions: list[InitialConditionSpec] = []
     solver: Solver
     output: Output = Output()
+    analysis: Analysis | None = None
 
     @model_validator(mode="after")
     def _sets_exist(self):
-        known = set(self.node_sets) | {"all"}
+        clash = set(self.actuators) & (set(self.node_sets) | {"all"})
+        if clash:
+            raise ValueError(f"actuators: name {sorted(clash)[0]!r} is already a node set")
+        known = set(self.node_sets) | {"all"} | set(self.actuators)
         used = [(f"boundary_conditions[{i}].set", bc.set)
                 for i, bc in enumerate(self.boundary_conditions)]
         used += [(f"initial_conditions[{i}].set", ic.set)
@@ -265,6 +323,17 @@ class Case(Strict):
             if name not in known:
                 raise ValueError(f"{where}: unknown node set {name!r}{did_you_mean(name, known)};"
                                  f" defined: {sorted(known)}")
+        a = self.analysis
+        if a is not None and self.geometry.type != "plate":
+            raise ValueError("analysis: Lamb-wave analyses need a plate geometry")
+        if a is not None and a.fk is not None and a.fk.line not in self.output.lines:
+            raise ValueError(f"analysis.fk.line: {a.fk.line!r} is not one of output.lines "
+                             f"{sorted(self.output.lines)}")
+        if a is not None and a.kxky is not None and a.kxky.plane not in self.output.planes:
+            raise ValueError(f"analysis.kxky.plane: {a.kxky.plane!r} is not one of output.planes "
+                             f"{sorted(self.output.planes)}")
+        if a is not None and a.fk is not None and a.fk.frequency is None and not self.actuators:
+            raise ValueError("analysis.fk.frequency: give it, or an actuator whose signal has one")
         return self
 
 
