@@ -9,6 +9,7 @@ from tqdm import tqdm
 
 from peridyn.cli import add_json_flag
 from peridyn.io.case import load_case
+from peridyn.recorder import provenance
 
 
 def add_case_arguments(parser) -> None:
@@ -39,6 +40,9 @@ def run(args) -> dict:
     from peridyn.simulation import run_case
 
     case = load_case(args.case, args.overrides)
+    info = provenance()
+    print(f"peridyn {info['peridyn_version']} (commit {info['git_commit'][:12]}): case "
+          f"{case.name!r} from {args.case}", file=sys.stderr)
     progress = None
     if not args.no_progress:
         def progress(total):

@@ -63,12 +63,23 @@ def plot_sensors(f: h5py.File, path: Path) -> Path:
 
 
 def plot_bscan(f: h5py.File, name: str, path: Path) -> Path:
-    """Space-time map (B-scan) of each displacement component along a line probe."""
+    """Space-time map (B-scan) of each displacement component along a line probe (a profile
+    plot when the line holds a single record, as after a static solve)."""
     group = f[f"series/line_{name}"]
     t = group["time"][...] * 1e6
     data = group["data"][...]
     points = f["geometry/points"][...][json.loads(group.attrs["points"])]
     distance = np.linalg.norm(points - points[0], axis=1) * 1e3
+    if len(t) < 2:  # a static result: the displacement profile along the line
+        fig, ax = plt.subplots(figsize=(7, 4))
+        for c in range(3):
+            ax.plot(distance, data[-1, :, c], label=f"u{COMPONENT_NAMES[c]}")
+        ax.set_xlabel("distance along the line (mm)")
+        ax.set_ylabel("u (m)")
+        ax.set_title(f"displacement along line '{name}'")
+        ax.legend()
+        ax.grid(alpha=0.3)
+        return _save(fig, path)
     fig, axes = plt.subplots(1, 3, figsize=(12, 4), sharey=True)
     for c, ax in enumerate(axes):
         field = data[:, :, c]
