@@ -1,0 +1,171 @@
+"""Peridynamic dispersion curves: omega(k), phase and group velocity of each branch."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+
+from peridyn.analysis.dispersion import DispersionRelation, Study
+
+#: The three panels of a row: (attribute of Branch, axis label, scale to the plotted unit).
+_PANELS = (
+    ("frequency", "angular frequency (Mrad/s)", 1e-6),
+    ("phase_velocity", "phase velocity (m/s)", 1.0),
+    ("group_velocity", "group velocity (m/s)", 1.0),
+)
+_SWEEPS = ("influence", "horizon", "spacing")
+
+
+def plot_dispersion(relations, path=None, title: str | None = None) -> Figure:
+    """Draw omega(k), phase and group velocity, one row per branch.
+
+    A row is drawn for the longitudinal branch and for each shear branch that
+    differs from the first one (e.g. shear_2 along xy on a lattice). Classical
+    speeds are dashed grey lines; the group-velocity panels mark zero. Drawn on
+    an Agg canvas, never in a window.
+
+    Parameters
+    ----------
+    relations : DispersionRelation or dict of str to DispersionRelation
+        One relation, or several labelled curves drawn on the same axes.
+    path : str or os.PathLike, optional
+        Where to save the figure as PNG.
+    title : str, optional
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    if isinstance(relations, DispersionRelation):
+        title = title or _describe(relations)
+        relations = {_describe(relations): relations}
+    names = _branches_to_draw(relations.values())
+    fig = Figure(figsize=(13.0, 3.3 * len(names) + 0.6), layout="constrained")
+    FigureCanvasAgg(fig)
+    axes = fig.subplots(len(names), len(_PANELS), squeeze=False)
+    for row, name in zip(axes, names, strict=True):
+        for i, (label, rel) in enumerate(relations.items()):
+            branch = rel.branches[name]
+            for ax, (attr, _, scale) in zip(row, _PANELS, strict=True):
+                ax.plot(branch.wavenumber, getattr(branch, attr) * scale, color=f"C{i % 10}",
+                        label=label)
+        _decorate(row, name, next(iter(relations.values())))
+    if len(relations) > 1:
+        axes[0, -1].legend(fontsize="small", loc="upper right")
+    if title:
+        fig.suptitle(title)
+    if path is not None:
+        fig.savefig(path, format="png", dpi=120)
+    return fig
+
+
+def plot_study(study: Study, directory, prefix: str = "dispersion") -> list[Path]:
+    """Write one figure per sweep of a study (``<prefix>_influence.png``, ``_horizon``,
+    ``_spacing``: seed 001 figures 4-6 and 10-12); returns the paths written."""
+    directory = Path(directory)
+    directory.mkdir(parents=True, exist_ok=True)
+    written = []
+    for parameter in _SWEEPS:
+        curves = study.sweep(parameter)
+        if len(curves) > 1:
+            path = directory / f"{prefix}_{parameter}.png"
+            plot_dispersion(curves, path,
+                            title=f"{_kind(next(iter(curves.values())))}: {parameter} sweep")
+            written.append(path)
+    return written
+
+
+def _branches_to_draw(relations) -> list[str]:
+    """Longitudinal, shear_1, and shear_2 where it differs from shear_1."""
+    relations = list(relations)
+    names = [n for n in ("longitudinal", "shear_1") if n in relations[0].branches]
+    if "shear_2" in relations[0].branches and any(
+        not np.allclose(r.branches["shear_2"].frequency, r.branches["shear_1"].frequency,
+                        rtol=1e-9) for r in relations):
+        names.append("shear_2")
+    return names
+
+
+def _decorate(row, name: str, relation: DispersionRelation) -> None:
+    classical = relation.classical[0 if name == "longitudinal" else 1]
+    for ax, (attr, ylabel, _) in zip(row, _PANELS, strict=True):
+        ax.set(xlabel="wavenumber k (rad/m)", ylabel=ylabel, title=name.replace("_", " "))
+        ax.set_xlim(left=0.0)
+        ax.grid(alpha=0.3)
+        if attr != "frequency":
+            ax.axhline(classical, color="0.5", linestyle="--", linewidth=0.8)
+    row[-1].axhline(0.0, color="k", linewidth=0.6)
+
+
+def _kind(rel: DispersionRelation) -> str:
+    """E.g. ``LPS 3D (discrete, partial volumes)``."""
+    if rel.discrete:
+        kind = "discrete, partial volumes" if rel.partial_volumes else "discrete, centre distance"
+    else:
+        kind = "continuous"
+    return f"{rel.model.upper()} {rel.dim}D ({kind})"
+
+
+def _describe(rel: DispersionRelation) -> str:
+    return (f"{_kind(rel)}, {rel.influence}, delta = {rel.horizon * 1e3:g} mm, "
+            f"h = {rel.spacing * 1e3:g} mm")
+
+
+def plot_mid_planes(results, path, times=None, component: str = "x",
+                    planes=("mid_z", "mid_y"), near: float = 5e-3, clip: float = 0.3) -> Figure:
+    """Displacement on the mid planes of a point-excitation run: the ellipsoidal front.
+
+    One row per plane probe (``plane_<name>`` series of ``results.h5``, a single
+    layer of lattice points), one column per time; colours clipped at ``clip``
+    times the largest magnitude farther than ``near`` (m) from the plane's
+    centre, so that neither the source nor the S wave swamps the weaker P front.
+
+    Parameters
+    ----------
+    results : path
+    path : path or None
+        Where to save the PNG.
+    times : sequence of float, s, optional
+        Default: 30%, 50% and 70% of the record.
+    component : {"x", "y", "z"}
+    planes : names of the plane probes
+    near : float, m
+    clip : float
+    """
+    from peridyn.io.hdf5 import read_array, read_series
+
+    points = read_array(results, "geometry/points")
+    fig = Figure(figsize=(4.2 * (3 if times is None else len(times)) + 1, 4.0 * len(planes)),
+                 layout="constrained")
+    FigureCanvasAgg(fig)
+    axes = None
+    for row, name in enumerate(planes):
+        x = points[read_array(results, f"probes/plane_{name}")]
+        _, t, data = read_series(results, f"plane_{name}")
+        chosen = [0.3 * t[-1], 0.5 * t[-1], 0.7 * t[-1]] if times is None else list(times)
+        if axes is None:
+            axes = fig.subplots(len(planes), len(chosen), squeeze=False)
+        spread = np.ptp(x, axis=0)
+        a, b = np.argsort(spread)[::-1][:2]  # the plane's two in-plane axes
+        a, b = sorted((a, b))
+        grid_a, ia = np.unique(np.round(x[:, a], 12), return_inverse=True)
+        grid_b, ib = np.unique(np.round(x[:, b], 12), return_inverse=True)
+        far = np.hypot(x[:, a] - grid_a.mean(), x[:, b] - grid_b.mean()) > near
+        values = data[:, :, "xyz".index(component)]
+        for ax, when in zip(axes[row], chosen, strict=True):
+            k = int(np.argmin(np.abs(t - when)))
+            image = np.full((len(grid_b), len(grid_a)), np.nan)
+            image[ib, ia] = values[k]
+            lim = clip * float(np.max(np.abs(values[k][far]))) or 1.0
+            extent = (grid_a[0] * 1e3, grid_a[-1] * 1e3, grid_b[0] * 1e3, grid_b[-1] * 1e3)
+            shown = ax.imshow(image, origin="lower", extent=extent, cmap="RdBu_r", vmin=-lim,
+                              vmax=lim)
+            ax.set(xlabel=f"{'xyz'[a]} (mm)", ylabel=f"{'xyz'[b]} (mm)",
+                   title=f"u{component} on {name}, t = {t[k] * 1e6:.1f} us")
+            fig.colorbar(shown, ax=ax, shrink=0.8, label="m")
+    if path is not None:
+        fig.savefig(path, format="png", dpi=110)
+    return fig
