@@ -52,6 +52,9 @@ def bond_differences(xj, xi, uj, ui):
     these three roundings as written, so swapping i and j negates all three exactly
     (Newton's third law to the last bit) and ``du`` keeps its full precision next to
     the much larger coordinates.
+
+    numba's on-disk cache of a kernel does not notice edits to this function (it is
+    keyed on the kernel's own file): after changing it, touch ``pmb.py`` and ``lps.py``.
     """
     d = xj - xi
     du = uj - ui

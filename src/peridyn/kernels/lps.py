@@ -8,51 +8,163 @@ force on i is (t_ij + t_ji) Y/|Y| beta V_j, which the kernel writes as
 
     sum_j w_ij [ |xi| (P_i + P_j) + (alpha_i + alpha_j) e_ij ] Y / |Y|,
     P_i = theta_i (d kappa_i / m_i - alpha_i / d).
+
+The force takes two passes over the bonds (the pair force needs the neighbours'
+dilatations). ``lps_dilatation`` / ``lps_pair_force`` (float64) and the ``*_cf``
+versions (float32) compute the same quantities; see ``peridyn.kernels`` for the two
+forms of the extension.
 """
 
 import numba
 import numpy as np
 
-from peridyn.kernels import FASTMATH
+from peridyn.kernels import FASTMATH, bond_differences
 
 
 @numba.njit(parallel=True, fastmath=FASTMATH, cache=True)
 def lps_dilatation(x, u, offsets, nbr, length, w, intact, theta_coef, theta):
-    """Dilatation ``theta`` (OUT): theta_i = theta_coef_i sum_j w_ij |xi| e_ij, coef = d / m_i."""
+    """Dilatation ``theta`` (OUT): theta_i = theta_coef_i sum_j w_ij |xi| e_ij, coef = d / m_i.
+
+    Length form, e = |Y| - |xi| with the stored ``length`` (float64; see ``peridyn.kernels``).
+    """
     n = x.shape[0]
+    zero = theta.dtype.type(0.0)
+    xf = x.reshape(3 * n)
+    uf = u.reshape(3 * n)
     for i in numba.prange(n):
-        acc = theta.dtype.type(0.0)
-        for b in range(offsets[i], offsets[i + 1]):
-            j = nbr[b]
-            y0 = (x[j, 0] - x[i, 0]) + (u[j, 0] - u[i, 0])
-            y1 = (x[j, 1] - x[i, 1]) + (u[j, 1] - u[i, 1])
-            y2 = (x[j, 2] - x[i, 2]) + (u[j, 2] - u[i, 2])
+        xi0, xi1, xi2 = xf[3 * i], xf[3 * i + 1], xf[3 * i + 2]
+        ui0, ui1, ui2 = uf[3 * i], uf[3 * i + 1], uf[3 * i + 2]
+        lo = offsets[i]
+        hi = offsets[i + 1]
+        fam = nbr[lo:hi]
+        lb = length[lo:hi]
+        wb = w[lo:hi]
+        ok = intact[lo:hi]
+        acc = zero
+        for q in range(hi - lo):
+            j = 3 * np.uint64(np.uint32(fam[q]))
+            _, _, y0 = bond_differences(xf[j], xi0, uf[j], ui0)
+            _, _, y1 = bond_differences(xf[j + 1], xi1, uf[j + 1], ui1)
+            _, _, y2 = bond_differences(xf[j + 2], xi2, uf[j + 2], ui2)
             r = np.sqrt(y0 * y0 + y1 * y1 + y2 * y2)
-            e = r - length[b]
-            acc += w[b] * length[b] * e if intact[b] else 0 * e
+            t = wb[q] * lb[q] * (r - lb[q])
+            acc += t if ok[q] else zero
         theta[i] = theta_coef[i] * acc
     return theta
 
 
 @numba.njit(parallel=True, fastmath=FASTMATH, cache=True)
 def lps_pair_force(x, u, offsets, nbr, length, w, intact, p, alpha, f):
-    """Force density ``f`` (OUT) from the per-point ``p`` = P_i and ``alpha`` (see module)."""
+    """Force density ``f`` (OUT) from the per-point ``p`` = P_i and ``alpha`` (see module).
+
+    Length form (float64).
+    """
     n = x.shape[0]
+    zero = f.dtype.type(0.0)
+    xf = x.reshape(3 * n)
+    uf = u.reshape(3 * n)
     for i in numba.prange(n):
-        f0 = f.dtype.type(0.0)
-        f1 = f.dtype.type(0.0)
-        f2 = f.dtype.type(0.0)
+        xi0, xi1, xi2 = xf[3 * i], xf[3 * i + 1], xf[3 * i + 2]
+        ui0, ui1, ui2 = uf[3 * i], uf[3 * i + 1], uf[3 * i + 2]
+        lo = offsets[i]
+        hi = offsets[i + 1]
+        fam = nbr[lo:hi]
+        lb = length[lo:hi]
+        wb = w[lo:hi]
+        ok = intact[lo:hi]
         pi = p[i]
         ai = alpha[i]
-        for b in range(offsets[i], offsets[i + 1]):
-            j = nbr[b]
-            y0 = (x[j, 0] - x[i, 0]) + (u[j, 0] - u[i, 0])
-            y1 = (x[j, 1] - x[i, 1]) + (u[j, 1] - u[i, 1])
-            y2 = (x[j, 2] - x[i, 2]) + (u[j, 2] - u[i, 2])
+        f0 = zero
+        f1 = zero
+        f2 = zero
+        for q in range(hi - lo):
+            jp = np.uint32(fam[q])
+            j = 3 * np.uint64(jp)
+            _, _, y0 = bond_differences(xf[j], xi0, uf[j], ui0)
+            _, _, y1 = bond_differences(xf[j + 1], xi1, uf[j + 1], ui1)
+            _, _, y2 = bond_differences(xf[j + 2], xi2, uf[j + 2], ui2)
             r = np.sqrt(y0 * y0 + y1 * y1 + y2 * y2)
-            L = length[b]
-            t = w[b] * (L * (pi + p[j]) + (ai + alpha[j]) * (r - L)) / r
-            t = t if intact[b] else 0 * t
+            L = lb[q]
+            t = wb[q] * (L * (pi + p[jp]) + (ai + alpha[jp]) * (r - L)) / r
+            t = t if ok[q] else zero
+            f0 += t * y0
+            f1 += t * y1
+            f2 += t * y2
+        f[i, 0] = f0
+        f[i, 1] = f1
+        f[i, 2] = f2
+    return f
+
+
+@numba.njit(parallel=True, fastmath=FASTMATH, cache=True)
+def lps_dilatation_cf(x, u, offsets, nbr, w, intact, theta_coef, theta):
+    """:func:`lps_dilatation` in the cancellation-free form (float32).
+
+    ``|xi|`` is recomputed from ``x`` and e = du . (Y + xi) / (|Y| + |xi|); no per-bond
+    length is read.
+    """
+    n = x.shape[0]
+    zero = theta.dtype.type(0.0)
+    xf = x.reshape(3 * n)
+    uf = u.reshape(3 * n)
+    for i in numba.prange(n):
+        xi0, xi1, xi2 = xf[3 * i], xf[3 * i + 1], xf[3 * i + 2]
+        ui0, ui1, ui2 = uf[3 * i], uf[3 * i + 1], uf[3 * i + 2]
+        lo = offsets[i]
+        hi = offsets[i + 1]
+        fam = nbr[lo:hi]
+        wb = w[lo:hi]
+        ok = intact[lo:hi]
+        acc = zero
+        for q in range(hi - lo):
+            j = 3 * np.uint64(np.uint32(fam[q]))
+            d0, e0, y0 = bond_differences(xf[j], xi0, uf[j], ui0)
+            d1, e1, y1 = bond_differences(xf[j + 1], xi1, uf[j + 1], ui1)
+            d2, e2, y2 = bond_differences(xf[j + 2], xi2, uf[j + 2], ui2)
+            r = np.sqrt(y0 * y0 + y1 * y1 + y2 * y2)
+            L = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+            ext2 = e0 * (y0 + d0) + e1 * (y1 + d1) + e2 * (y2 + d2)
+            t = wb[q] * L * ext2 / (r + L)
+            acc += t if ok[q] else zero
+        theta[i] = theta_coef[i] * acc
+    return theta
+
+
+@numba.njit(parallel=True, fastmath=FASTMATH, cache=True)
+def lps_pair_force_cf(x, u, offsets, nbr, w, intact, p, alpha, f):
+    """:func:`lps_pair_force` in the cancellation-free form (float32), one division per bond:
+
+    t = w [ |xi| (|Y| + |xi|) (P_i + P_j) + (alpha_i + alpha_j) du . (Y + xi) ] / (|Y| (|Y| + |xi|)).
+    """
+    n = x.shape[0]
+    zero = f.dtype.type(0.0)
+    xf = x.reshape(3 * n)
+    uf = u.reshape(3 * n)
+    for i in numba.prange(n):
+        xi0, xi1, xi2 = xf[3 * i], xf[3 * i + 1], xf[3 * i + 2]
+        ui0, ui1, ui2 = uf[3 * i], uf[3 * i + 1], uf[3 * i + 2]
+        lo = offsets[i]
+        hi = offsets[i + 1]
+        fam = nbr[lo:hi]
+        wb = w[lo:hi]
+        ok = intact[lo:hi]
+        pi = p[i]
+        ai = alpha[i]
+        f0 = zero
+        f1 = zero
+        f2 = zero
+        for q in range(hi - lo):
+            jp = np.uint32(fam[q])
+            j = 3 * np.uint64(jp)
+            d0, e0, y0 = bond_differences(xf[j], xi0, uf[j], ui0)
+            d1, e1, y1 = bond_differences(xf[j + 1], xi1, uf[j + 1], ui1)
+            d2, e2, y2 = bond_differences(xf[j + 2], xi2, uf[j + 2], ui2)
+            r = np.sqrt(y0 * y0 + y1 * y1 + y2 * y2)
+            L = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+            ext2 = e0 * (y0 + d0) + e1 * (y1 + d1) + e2 * (y2 + d2)
+            rl = r + L
+            t = wb[q] * (L * rl * (pi + p[jp]) + (ai + alpha[jp]) * ext2) / (r * rl)
+            t = t if ok[q] else zero
             f0 += t * y0
             f1 += t * y1
             f2 += t * y2

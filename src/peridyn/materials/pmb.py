@@ -28,7 +28,7 @@ import numpy as np
 from peridyn.body import Body
 from peridyn.bonds import Bonds
 from peridyn.errors import InputError
-from peridyn.kernels.pmb import pmb_energy, pmb_force
+from peridyn.kernels.pmb import pmb_energy, pmb_force, pmb_force_cf
 from peridyn.materials.base import Model
 from peridyn.materials.elastic import (
     bulk_modulus,
@@ -102,8 +102,17 @@ class PMBModel(Model):
             self.bond_stiffness = (base * self.surface_factor).astype(self.dtype)
 
     def force(self, u, out=None):
+        """Internal force density (see ``Model.force``).
+
+        float64 uses the stored ``inv_length``; float32 the cancellation-free kernel,
+        which recomputes |xi| from ``x`` (see ``peridyn.kernels``). Both read
+        ``bonds.intact`` on every call, so broken bonds need no notification.
+        """
         out = np.empty_like(self.x) if out is None else out
         b = self.bonds
+        if self.dtype == np.float32:
+            return pmb_force_cf(self.x, self._as_state(u), b.offsets, b.neighbours,
+                                self.bond_stiffness, b.intact, out)
         return pmb_force(self.x, self._as_state(u), b.offsets, b.neighbours, self.inv_length,
                          self.bond_stiffness, b.intact, out)
 

@@ -1,0 +1,224 @@
+"""Force-kernel throughput: what ``peridyn bench`` and ``benchmarks/bench_kernels.py`` measure.
+
+The grid is a cube of ``points_per_side**3`` points (``geometry.box``), spacing 1 mm,
+horizon 3.015 spacings, constant influence function; by default **without** partial
+volumes (every neighbour with |xi| <= delta is a full-volume bond: 122 neighbours in
+the bulk, 11.0 M directed bonds for the default 46^3 = 97,336 points), with
+``partial_volumes=True`` with them (more, fractional neighbours: 19.4 M bonds).
+
+Each row times one explicit-step internal-force evaluation over all directed bonds
+and reports ``bond_updates_per_s`` = directed bonds / seconds (for LPS, both of its
+passes count as one update of each bond):
+
+- ``pmb-baseline`` float64: ``kernels.pmb.pmb_force_baseline``, the straightforward
+  loop (reference row, ``speedup_vs_baseline`` = 1);
+- ``pmb`` and ``lps`` in float64 and float32, through ``model.force(u, out)``, i.e. what
+  the solvers run.
+
+Timing: every row is called once first (JIT compilation or cache load, excluded); then
+``repeat`` rounds each call every row once, in turn, and a row's time is its best
+round. Interleaving the rows makes their ratios robust to a machine whose load drifts.
+
+Memory bandwidth: a STREAM-like triad ``a[:] = b + s c`` (numba ``prange``, float64
+arrays of ``triad_elements`` items, 128 MiB each by default, far beyond any L3),
+counted as STREAM does, 24 bytes per element (two reads, one write; the
+write-allocate read is not counted), best of ``max(repeat, 5)`` runs.
+
+``bytes_per_bond`` is what one bond update must stream from memory: the per-bond
+arrays the kernel reads, summed over its passes (:func:`bytes_per_bond`):
+
+- baseline: neighbour index (int32, 4) + reference length (8) + micromodulus (8) +
+  intact flag (bool, 1) = 21;
+- pmb float64: index 4 + 1/|xi| 8 + stiffness 8 + intact 1 = 21;
+  pmb float32 (cancellation-free kernel, |xi| recomputed): 4 + 4 + 1 = 9;
+- lps float64: 2 passes x (index 4 + length 8 + weight 8 + intact 1) = 42;
+  lps float32: 2 x (4 + 4 + 1) = 18.
+
+Not counted: the neighbours' coordinates, displacements and per-point coefficients
+(gathered, but neighbours are close in index on a grid, so they come from cache), the
+CSR offsets and the force written (per point, amortised over ~100 bonds).
+``roofline_fraction`` = bond_updates_per_s x bytes_per_bond / bandwidth: the share of
+the triad bandwidth that this streaming alone uses (1 would be memory bound).
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+
+import numba
+import numpy as np
+
+from peridyn import geometry
+from peridyn.bonds import find_bonds
+from peridyn.errors import InputError
+from peridyn.kernels.pmb import pmb_force_baseline
+from peridyn.materials import make_model
+
+#: Default grid: 46^3 = 97,336 points.
+DEFAULT_POINTS_PER_SIDE = 46
+DEFAULT_POINTS = DEFAULT_POINTS_PER_SIDE**3
+SPACING = 1e-3  # m
+HORIZON_FACTOR = 3.015
+#: Triad array length: 2^24 float64 = 128 MiB per array.
+DEFAULT_TRIAD_ELEMENTS = 1 << 24
+#: Rows in table order: (model, dtype).
+ROWS = (
+    ("pmb-baseline", "float64"),
+    ("pmb", "float64"),
+    ("pmb", "float32"),
+    ("lps", "float64"),
+    ("lps", "float32"),
+)
+#: Steel-like constants of the benchmark material (do not affect the timings).
+E, NU, DENSITY = 200e9, 0.25, 7850.0
+
+
+@numba.njit(parallel=True, cache=True)
+def _triad(a, b, c, s):
+    for i in numba.prange(a.shape[0]):
+        a[i] = b[i] + s * c[i]
+
+
+def triad_bandwidth(elements: int = DEFAULT_TRIAD_ELEMENTS, repeat: int = 10) -> float:
+    """Memory bandwidth (bytes/s) of the triad ``a = b + s c``, STREAM's count (24 B per element)."""
+    b = np.full(elements, 1.0)
+    c = np.full(elements, 2.0)
+    a = np.zeros(elements)
+    _triad(a, b, c, 3.0)  # compile (or load) and touch the pages
+    best = np.inf
+    for _ in range(max(1, repeat)):
+        t0 = time.perf_counter()
+        _triad(a, b, c, 3.0)
+        best = min(best, time.perf_counter() - t0)
+    return 3 * a.itemsize * elements / best
+
+
+def side_for(points: int) -> int:
+    """Points per side of the cube closest to ``points`` points in total."""
+    if points < 8:
+        raise InputError(f"the benchmark grid needs at least 8 points (2 per side), got {points}")
+    return max(2, round(points ** (1.0 / 3.0)))
+
+
+def benchmark_grid(points_per_side: int = DEFAULT_POINTS_PER_SIDE, partial_volumes: bool = False):
+    """The benchmark body and bonds: a cube, 1 mm spacing, horizon 3.015 spacings."""
+    body = geometry.box((points_per_side * SPACING,) * 3, SPACING)
+    bonds = find_bonds(body, HORIZON_FACTOR * SPACING, partial_volumes=partial_volumes)
+    return body, bonds
+
+
+def bytes_per_bond(model: str, dtype: str) -> int:
+    """Bytes of per-bond arrays one bond update streams (see the module docstring)."""
+    index, flag = np.dtype(np.int32).itemsize, np.dtype(bool).itemsize
+    real = np.dtype(dtype).itemsize
+    if model == "pmb-baseline":
+        return index + 2 * real + flag  # neighbour, length, micromodulus, intact
+    if model == "pmb":
+        # float64: inv_length and stiffness; float32 (cancellation-free): stiffness only
+        return index + (2 if dtype == "float64" else 1) * real + flag
+    if model == "lps":
+        # two passes; float64: length and weight; float32 (cancellation-free): weight only
+        return 2 * (index + (2 if dtype == "float64" else 1) * real + flag)
+    raise InputError(f"unknown benchmark row {model!r}")
+
+
+def _row_callables(body, bonds, u64: np.ndarray) -> dict[tuple[str, str], Callable[[], np.ndarray]]:
+    """One zero-argument callable per row, each computing a full force evaluation."""
+    calls = {}
+    models = {}
+    for name, dtype in ROWS:
+        if name == "pmb-baseline":
+            continue
+        models[name, dtype] = make_model(name, body, bonds, E=E, nu=NU, density=DENSITY,
+                                         dtype=np.dtype(dtype))
+    # the baseline computes the PMB force with c = the PMB bond stiffness (k (1/|xi| - 1/|Y|) Y)
+    c = models["pmb", "float64"].bond_stiffness.astype(np.float64)
+    out64 = np.empty_like(body.points)
+
+    def baseline():
+        return pmb_force_baseline(body.points, u64, bonds.offsets, bonds.neighbours, bonds.length,
+                                  c, bonds.intact, out64)
+
+    calls["pmb-baseline", "float64"] = baseline
+    for key, model in models.items():
+        u = np.ascontiguousarray(u64, dtype=model.dtype)
+        out = np.empty_like(model.x)
+        calls[key] = lambda model=model, u=u, out=out: model.force(u, out)
+    return calls
+
+
+def run_benchmark(points: int = DEFAULT_POINTS, repeat: int = 10, partial_volumes: bool = False,
+                  triad_elements: int = DEFAULT_TRIAD_ELEMENTS, seed: int = 0,
+                  log: Callable[[str], None] | None = None) -> dict:
+    """Measure every row and the triad bandwidth; returns the ``peridyn bench --json`` dict.
+
+    Parameters
+    ----------
+    points : int
+        Approximate number of grid points (rounded to a cube, see :func:`side_for`).
+    repeat : int
+        Timed rounds after the warm-up; each row keeps its best.
+    partial_volumes : bool
+        Build the bonds with partial volumes (default False: full-volume bonds).
+    triad_elements : int
+        Length of the triad arrays (keep it far beyond the L3 cache).
+    seed : int
+        Seed of the random displacement field (amplitude 1e-4 spacing).
+    log : callable or None
+        Receives progress messages (the CLI sends them to stderr).
+    """
+    if repeat < 1:
+        raise InputError(f"repeat must be at least 1, got {repeat}")
+    say = log or (lambda msg: None)
+    side = side_for(points)
+    say(f"building a {side}^3 grid (partial volumes {'on' if partial_volumes else 'off'})")
+    body, bonds = benchmark_grid(side, partial_volumes)
+    rng = np.random.default_rng(seed)
+    u64 = 1e-4 * SPACING * rng.standard_normal(body.points.shape)
+    calls = _row_callables(body, bonds, u64)
+    say(f"{body.n_points} points, {bonds.n_bonds} directed bonds; warming up (JIT)")
+    for call in calls.values():
+        call()
+    best = dict.fromkeys(calls, np.inf)
+    for r in range(repeat):
+        say(f"round {r + 1}/{repeat}")
+        for key, call in calls.items():
+            t0 = time.perf_counter()
+            call()
+            best[key] = min(best[key], time.perf_counter() - t0)
+    say("triad bandwidth")
+    bandwidth = triad_bandwidth(triad_elements, max(repeat, 5))
+    base_rate = bonds.n_bonds / best["pmb-baseline", "float64"]
+    results = []
+    for name, dtype in ROWS:
+        rate = bonds.n_bonds / best[name, dtype]
+        nbytes = bytes_per_bond(name, dtype)
+        results.append({
+            "model": name,
+            "dtype": dtype,
+            "points": int(body.n_points),
+            "bonds": int(bonds.n_bonds),
+            "bond_updates_per_s": float(rate),
+            "bytes_per_bond": int(nbytes),
+            "roofline_fraction": float(rate * nbytes / bandwidth),
+            "speedup_vs_baseline": float(rate / base_rate),
+        })
+    return {"bandwidth_bytes_per_s": float(bandwidth), "threads": int(numba.get_num_threads()),
+            "results": results}
+
+
+def format_table(result: dict) -> str:
+    """Readable table of a :func:`run_benchmark` result."""
+    rows = result["results"]
+    head = (f"{rows[0]['points']} points, {rows[0]['bonds']} directed bonds, "
+            f"{result['threads']} numba threads, triad bandwidth "
+            f"{result['bandwidth_bytes_per_s'] / 1e9:.1f} GB/s")
+    lines = [head, "",
+             f"{'model':<13} {'dtype':<8} {'M bond/s':>9} {'x baseline':>10} {'B/bond':>7} "
+             f"{'roofline':>8}"]
+    for r in rows:
+        lines.append(f"{r['model']:<13} {r['dtype']:<8} {r['bond_updates_per_s'] / 1e6:>9.1f} "
+                     f"{r['speedup_vs_baseline']:>10.2f} {r['bytes_per_bond']:>7d} "
+                     f"{r['roofline_fraction']:>8.2f}")
+    return "\n".join(lines)
