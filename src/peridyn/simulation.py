@@ -207,11 +207,15 @@ def run_case(case: Case, output_dir=None, case_path=None, checkpoint_every: int 
     out.mkdir(parents=True, exist_ok=True)
     if case.solver.type == "static":
         summary = _run_static(case, setup, out, case_path)
+    elif case.solver.type == "modal":
+        from peridyn.modal_run import run_modal
+
+        summary = run_modal(case, setup, out, case_path)
     else:
         summary = _run_explicit(case, setup, out, case_path, checkpoint_every, restart, progress)
     analysis, figures = analyse(case, setup.body, out, plots=case.output.plots)
     summary.update(analysis)
-    if case.output.plots:
+    if case.output.plots and case.solver.type != "modal":  # a modal run draws its own
         from peridyn.plotting.fields import plot_run
 
         summary["plots"] = [str(p) for p in [*plot_run(out, setup.body), *figures]]

@@ -12,6 +12,7 @@ CASES = sorted((ROOT / "cases").glob("*.yaml"))
 SHORTEN = {
     "explicit": ["--set", "solver.time=0.3e-6"],
     "static": ["--set", "solver.tolerance=1e-3"],
+    "modal": ["--set", "solver.modes=8"],
 }
 
 

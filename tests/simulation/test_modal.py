@@ -51,6 +51,36 @@ def test_modes_are_mass_orthonormal(coarse):
     assert np.max(off[6:, 6:]) < 1e-8
 
 
+def test_modal_command_json_and_outputs(tmp_path, capsys):
+    """`peridyn modal CASE --json` gives the VALIDATION.md keys and writes tables and shapes."""
+    import json
+    from pathlib import Path
+
+    from peridyn.cli import main
+
+    case = Path(__file__).resolve().parents[2] / "cases" / "pmma_plate.yaml"
+    assert main(["modal", str(case), "--modes", "8", "--json", "-o", str(tmp_path),
+                 "--set", "output.plots=false"]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["rigid_modes"] == 6 and len(summary["modes"]) == 8
+    assert {"index", "frequency_hz", "type", "order"} <= set(summary["modes"][6])
+    assert summary["modes"][6]["type"] == "bending" and summary["modes"][7]["type"] == "torsional"
+    assert summary["points"] == 5000 and summary["peak_memory_bytes"] > 0
+    assert (tmp_path / "modes.csv").is_file() and (tmp_path / "modes" / "mode_07.vtu").is_file()
+
+
+def test_too_large_lps_matrix_is_refused_before_assembly(tmp_path, capsys):
+    from pathlib import Path
+
+    from peridyn.cli import main
+
+    case = Path(__file__).resolve().parents[2] / "cases" / "pmma_plate.yaml"
+    code = main(["modal", str(case), "-o", str(tmp_path), "--set", "discretization.spacing=0.001",
+                 "--set", "discretization.horizon=4.001"])
+    assert code == 1
+    assert "billion entries" in capsys.readouterr().err
+
+
 @pytest.mark.slow
 def test_40k_points_match_the_independent_lps_assembly():
     """V4: 40 000 points, horizon 1.4143 h, no correction: 1772.86, 2196.50, 4690.93,

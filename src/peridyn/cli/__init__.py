@@ -24,6 +24,7 @@ COMMAND_MODULES = (
     "peridyn.cli.bench_cmd",
     "peridyn.cli.lamb_cmd",
     "peridyn.cli.dispersion_cmd",
+    "peridyn.cli.modal_cmd",
     "peridyn.cli.plot_cmd",
 )
 

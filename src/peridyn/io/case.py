@@ -241,9 +241,12 @@ class Analysis(Strict):
 class Solver(Strict):
     """``explicit``: ``steps`` or ``time`` (s), optional ``dt`` (s; default safety x stable),
     damping (1/s), kernel dtype; ``static``: adaptive dynamic relaxation with ``tolerance``,
-    ``max_iterations`` and ``load_steps`` (the loads at t = 1 s, ramped linearly in steps)."""
+    ``max_iterations`` and ``load_steps`` (the loads at t = 1 s, ramped linearly in steps);
+    ``modal``: the ``modes`` lowest free-vibration modes (zero displacement conditions fix
+    their dofs; free-free otherwise)."""
 
-    type: Literal["explicit", "static"] = "explicit"
+    type: Literal["explicit", "static", "modal"] = "explicit"
+    modes: Annotated[int, Field(ge=1)] = 12
     steps: Annotated[int, Field(ge=1)] | None = None
     time: Positive | None = None
     dt: Positive | None = None

@@ -1,0 +1,38 @@
+"""``peridyn modal CASE.yaml``: free-vibration modes of a case, classified by type."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from peridyn.cli import add_json_flag
+from peridyn.cli.run_cmd import add_case_arguments
+from peridyn.io.case import load_case
+
+
+def register(sub) -> None:
+    """Add the ``modal`` subcommand."""
+    p = sub.add_parser("modal", help="modal analysis of a case", description=__doc__)
+    add_case_arguments(p)
+    p.add_argument("--modes", type=int, default=None, help="number of modes (rigid included)")
+    p.add_argument("--output", "-o", help="output folder")
+    add_json_flag(p)
+    p.set_defaults(func=run)
+
+
+def run(args) -> dict:
+    """Solve and print the frequency table unless --json."""
+    from peridyn.simulation import run_case
+
+    overrides = [*args.overrides, "solver.type=modal"]
+    if args.modes is not None:
+        overrides.append(f"solver.modes={args.modes}")
+    case = load_case(args.case, overrides)
+    summary = run_case(case, args.output, case_path=args.case, base_dir=Path(args.case).parent)
+    if not args.json:
+        print(f"{summary['points']} points, {summary['rigid_modes']} rigid modes, "
+              f"{summary['seconds']:.1f} s")
+        for m in summary["modes"]:
+            label = m["type"] if m["order"] == 0 else f"{m['order']} {m['type']}"
+            print(f"  {m['index']:3d}  {m['frequency_hz']:12.2f} Hz  {label}")
+        print(f"results written to {summary['output_dir']}")
+    return summary
