@@ -10,15 +10,16 @@ from pathlib import Path
 import h5py
 import numpy as np
 import pytest
+from scipy.signal import hilbert
 
 from peridyn.io.case import load_case
 from peridyn.io.hdf5 import read_series
 from peridyn.simulation import run_case
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
-#: V1, 150 kHz: S0 and A0 wavenumbers (rad/m) and the S0 group velocity (m/s).
+#: V1, 150 kHz: S0 and A0 wavenumbers (rad/m) and group velocities (m/s).
 K_S0, K_A0 = 176.34, 612.41
-CG_S0 = 5330.9
+CG_S0, CG_A0 = 5330.9, 2582.2
 
 
 @pytest.fixture(scope="module")
@@ -88,3 +89,36 @@ def test_hole_scatters_only_after_the_fastest_path(pristine, holed):
     earliest = 0.065 / CG_S0
     assert np.abs(scattered[t < earliest]).max() < 0.02 * np.abs(scattered).max()
     assert np.abs(scattered).max() > 0.10 * np.abs(without).max()
+
+
+@pytest.fixture(scope="module")
+def converged(tmp_path_factory):
+    out = tmp_path_factory.mktemp("lamb_plate_converged")
+    summary = run_case(load_case(CASES / "lamb_plate_converged.yaml", ["output.plots=false"]), out)
+    return out, summary
+
+
+def _envelope_peak_time(times, signal, start, end):
+    """Time of the largest Hilbert envelope of ``signal`` within [start, end] (s)."""
+    envelope = np.abs(hilbert(signal))
+    window = (times >= start) & (times <= end)
+    return times[window][np.argmax(envelope[window])]
+
+
+@pytest.mark.slow
+def test_converged_preset_arrival_times_and_a0_wavenumber(converged):
+    """The converged preset (5 layers, 0.4 mm, 1.5 dx; VALIDATION V2): the S0 and A0 packets,
+    separated by mirror symmetry ((top + bottom)/2 of u_x and of u_z), reach the sensors 50 mm
+    from the PZT at the V1 group velocities within 5%, taking the burst's envelope centre as
+    the emission time; the f-k A0 wavenumber at 150 kHz is within 5% of V1."""
+    out, summary = converged
+    assert summary["fk_peaks_rad_m"]["A0"] == pytest.approx(K_A0, rel=0.05)
+    t, ux_top = _sensor(out, "s50_top", "x")
+    _, ux_bottom = _sensor(out, "s50_bottom", "x")
+    _, uz_top = _sensor(out, "s50_top", "z")
+    _, uz_bottom = _sensor(out, "s50_bottom", "z")
+    emitted = 0.5 * 3.5 / 150e3
+    t_s0 = _envelope_peak_time(t, 0.5 * (ux_top + ux_bottom), 0.0, 28e-6)
+    t_a0 = _envelope_peak_time(t, 0.5 * (uz_top + uz_bottom), 20e-6, 45e-6)
+    assert 0.050 / (t_s0 - emitted) == pytest.approx(CG_S0, rel=0.05)
+    assert 0.050 / (t_a0 - emitted) == pytest.approx(CG_A0, rel=0.05)
