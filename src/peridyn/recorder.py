@@ -186,8 +186,10 @@ class Recorder:
         self.h5.close()
 
 
-def provenance(case_path=None, argv=None) -> dict:
-    """Package version, git commit, case file and its SHA-256, command line, host and date."""
+def provenance(case_path=None, argv=None, case=None) -> dict:
+    """Package version, git commit, case file and its SHA-256, command line, host and date;
+    with ``case``, also the validated case (overrides applied) as JSON, which
+    ``peridyn plot`` uses to redraw a run."""
     info = {
         "peridyn_version": __version__,
         "git_commit": _git_commit(),
@@ -201,6 +203,8 @@ def provenance(case_path=None, argv=None) -> dict:
         info["case_file"] = str(case_path)
         info["case_sha256"] = hashlib.sha256(data).hexdigest()
         info["case_text"] = data.decode("utf-8", errors="replace")
+    if case is not None:
+        info["case_json"] = case.model_dump_json()
     return info
 
 

@@ -20,7 +20,7 @@ from peridyn.checkpoint import Checkpointer, load_checkpoint
 from peridyn.damage import BondDamage, damage_field
 from peridyn.errors import CaseFileError, InputError
 from peridyn.io.case import Case, Region
-from peridyn.io.hdf5 import HDF5Writer
+from peridyn.io.hdf5 import HDF5Writer, read_series
 from peridyn.loads import BoundaryCondition, InitialCondition, Loading
 from peridyn.materials import Model, make_model
 from peridyn.postprocess import analyse
@@ -216,12 +216,27 @@ def run_case(case: Case, output_dir=None, case_path=None, checkpoint_every: int 
     analysis, figures = analyse(case, setup.body, out, plots=case.output.plots)
     summary.update(analysis)
     if case.output.plots and case.solver.type != "modal":  # a modal run draws its own
-        from peridyn.plotting.fields import plot_run
-
-        summary["plots"] = [str(p) for p in [*plot_run(out, setup.body), *figures]]
+        summary["plots"] = [str(p) for p in [*draw_run_figures(case, setup.body, out), *figures]]
     summary["seconds"] = time.perf_counter() - start
     store_summary(out / "results.h5", setup.body, summary)
     return summary
+
+
+def draw_run_figures(case: Case, body: Body, out: Path) -> list[Path]:
+    """The figures of a finished explicit or static run (not its analyses): sensor signals,
+    B-scans, final fields, damage and, for plates with snapshot times, the wavefield per layer."""
+    from peridyn.plotting.fields import plot_run
+
+    figures = plot_run(out, body)
+    if case.geometry.type == "plate" and case.output.snapshot_times:
+        from peridyn.plotting.lamb_wavefield import plot_wavefield_snapshots
+
+        _, times, _ = read_series(out / "results.h5", "field_u")
+        reached = [t for t in case.output.snapshot_times if t <= times[-1] * (1 + 1e-9)]
+        if reached:
+            figures.append(plot_wavefield_snapshots(out / "results.h5", out / "wavefield.png",
+                                                    reached))
+    return figures
 
 
 def store_summary(results, body: Body, summary: dict) -> None:
@@ -253,7 +268,7 @@ def _run_explicit(case, setup, out, case_path, checkpoint_every, restart, progre
     else:
         state, resume = solver.initial_state(), None
     spec = recorder_spec(case, setup.body, solver.dt)
-    recorder = Recorder(setup.body, out, spec, provenance(case_path), setup.model, resume)
+    recorder = Recorder(setup.body, out, spec, provenance(case_path, case=case), setup.model, resume)
     if resume is None:
         recorder.record_series(state)
         recorder.snapshot(state)
@@ -297,7 +312,7 @@ def _run_static(case, setup, out, case_path) -> dict:
             )
     state = State(u, np.zeros_like(u), np.zeros_like(u), 1.0, s.load_steps)
     spec = recorder_spec(case, setup.body, 1.0)
-    recorder = Recorder(setup.body, out, spec, provenance(case_path), setup.model)
+    recorder = Recorder(setup.body, out, spec, provenance(case_path, case=case), setup.model)
     recorder.record_series(state)
     recorder.snapshot(state)
     summary = _base_summary(setup, out)

@@ -139,3 +139,20 @@ def test_static_case_runs(tmp_path):
     pull_on_clamp = f[setup.body.node_set("start")].sum(axis=0)
     assert pull_on_clamp[0] == pytest.approx(16.0, rel=1e-5)
     assert u[:, 0].max() > 0
+
+
+def test_plot_command_redraws_a_run(tmp_path, capsys):
+    """`peridyn plot DIR` rebuilds the case from the results' provenance and redraws."""
+    run_case(_case(output__plots=True), tmp_path)
+    for png in tmp_path.glob("*.png"):
+        png.unlink()
+    assert main(["plot", str(tmp_path), "--json"]) == 0
+    plots = json.loads(capsys.readouterr().out)["plots"]
+    assert {p.split("/")[-1] for p in plots} == {"sensors.png", "bscan_axis.png",
+                                                 "displacement.png"}
+    assert all((tmp_path / p.split("/")[-1]).stat().st_size > 0 for p in plots)
+
+
+def test_plot_command_refuses_a_folder_without_results(tmp_path, capsys):
+    assert main(["plot", str(tmp_path)]) == 1
+    assert "results.h5" in capsys.readouterr().err
