@@ -236,6 +236,31 @@ def draw_run_figures(case: Case, body: Body, out: Path) -> list[Path]:
         if reached:
             figures.append(plot_wavefield_snapshots(out / "results.h5", out / "wavefield.png",
                                                     reached))
+        figures += _actuator_figures(case, out, reached)
+    return figures
+
+
+def _actuator_figures(case: Case, out: Path, snapshot_times) -> list[Path]:
+    """Through-thickness field under each actuator's cut (+-50 mm along x, at the middle
+    snapshot) and the PZT sensor signals under the first actuator's excitation."""
+    from peridyn.plotting.lamb_wavefield import plot_sensor_signals, plot_through_thickness
+
+    figures = []
+    length = case.geometry.size[0]
+    for name, actuator in case.actuators.items():
+        if snapshot_times:
+            cx = actuator.center[0]
+            x_range = (max(0.0, cx - 0.050), min(length, cx + 0.050))
+            figures.append(plot_through_thickness(
+                out / "results.h5", out / f"cut_{name}.png",
+                snapshot_times[len(snapshot_times) // 2], actuator.center, x_range))
+    if case.output.pzt_sensors and case.actuators:
+        _, times, data = read_series(out / "results.h5", "pzt_signal")
+        first = next(iter(case.actuators.values()))
+        excitation = from_spec(first.signal, "actuators.signal")(times)
+        signals = {n: data[:, k] for k, n in enumerate(case.output.pzt_sensors)}
+        figures.append(plot_sensor_signals(times, signals, out / "pzt_sensors.png",
+                                           excitation=excitation))
     return figures
 
 
