@@ -125,3 +125,24 @@ def test_float32_kernel_close_to_float64(name, amplitude, rng):
     f32 = m32.force(u)
     assert f32.dtype == np.float32
     assert np.max(np.abs(f32 - f64)) < 1e-5 * np.max(np.abs(f64))
+
+
+@pytest.mark.parametrize("dim, factor, partial, bulk_is_one", [
+    (3, 1.4143, False, True),   # the 18-neighbour lattice is isotropic to 4th order
+    (3, 2.015, True, False),    # elsewhere the factor also absorbs the lattice's anisotropy
+    (2, 2.015, True, False),
+])
+def test_shear_factor_in_the_bulk_and_at_surfaces(dim, factor, partial, bulk_is_one):
+    """The shear-correction factor compares each point's stiffest pure-shear response with
+    the continuum value 4 gamma^2 m / 15 (3D) or / 8 (2D): the same for every interior point
+    (exactly 1 on the isotropic 18-neighbour lattice), different near a surface."""
+    model = small_model("lps", dim, n=16, horizon_factor=factor, partial_volumes=partial,
+                        surface_correction="shear-factor")
+    x = model.body.points[:, :dim]
+    depth = np.minimum(x - x.min(axis=0), x.max(axis=0) - x).min(axis=1)
+    interior = depth > model.bonds.horizon + model.body.spacing
+    bulk = model.shear_factor[interior]
+    np.testing.assert_allclose(bulk, bulk[0], rtol=1e-8)
+    if bulk_is_one:
+        assert bulk[0] == pytest.approx(1.0, rel=1e-6)
+    assert np.max(np.abs(model.shear_factor[depth < model.body.spacing] / bulk[0] - 1.0)) > 0.05
