@@ -10,13 +10,16 @@ LPS: the energy of point p is V_p [c_p theta_p^2 + (alpha_p / 2) sum_j w e^2] wi
 c_p = kappa / 2 - alpha_p m_p / (2 d^2) (since sum w (e^d)^2 = sum w e^2 - m theta^2 / d^2);
 theta_p = g_p . u couples p with its whole family, so each point adds a dense
 block 2 c_p V_p g_p g_p^T over its family: the matrix reaches two horizons
-(about (n_family + 1)^2 blocks per point). For large families use
-``stiffness_operator``, which applies K without storing it.
+(about (n_family + 1)^2 blocks per point). ``stiffness_parts`` keeps it factored
+as K = K_pair + G^T diag(2 c V) G, with G (n, 3 n) as sparse as the bonds: the
+eigensolver factorises the augmented matrix built from it instead of K. For
+large families ``stiffness_operator`` applies K without storing it.
 """
 
 from __future__ import annotations
 
-import numba
+from dataclasses import dataclass
+
 import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import LinearOperator
@@ -57,28 +60,90 @@ def stiffness_operator(model: Model) -> LinearOperator:
     return LinearOperator((3 * n, 3 * n), matvec=matvec, rmatvec=matvec, dtype=np.float64)
 
 
-def assemble_stiffness(model: Model) -> sp.csr_matrix:
-    """Assembled stiffness (3 n, 3 n), N/m, symmetric for equal cells (grids)."""
+@dataclass
+class StiffnessParts:
+    """The stiffness split as ``K = pair + G^T diag(dilatation) G`` (all N/m, dofs point-major).
+
+    Attributes
+    ----------
+    pair : (3 n, 3 n) csr_matrix
+        Bond-pair part: sum over bonds of coef (n n^T) on the ii, jj, -ij, -ji blocks.
+    G : (n, 3 n) csr_matrix or None
+        LPS dilatation gradients, theta_p = (G u)_p; None for PMB.
+    dilatation : (n,) float64 or None, J
+        2 c_p V_p: the second derivative of each point's energy V_p c_p theta_p^2.
+    """
+
+    pair: sp.csr_matrix
+    G: sp.csr_matrix | None = None
+    dilatation: np.ndarray | None = None
+
+    def diagonal(self) -> np.ndarray:
+        """diag(K) (3 n,), N/m, without assembling K."""
+        d = self.pair.diagonal()
+        if self.G is not None:
+            d = d + self.G.multiply(self.G).T @ self.dilatation
+        return d
+
+    def restricted(self, dofs: np.ndarray) -> LinearOperator:
+        """K on the ``dofs`` (K[dofs][:, dofs]) as an operator, without assembling K."""
+        pair = self.pair[dofs][:, dofs]
+        G = None if self.G is None else self.G[:, dofs].tocsr()
+
+        def matvec(v):
+            out = pair @ v
+            if G is not None:
+                gv = G @ v
+                out += G.T @ (self.dilatation.reshape(-1, *[1] * (gv.ndim - 1)) * gv)
+            return out
+
+        n = len(dofs)
+        return LinearOperator((n, n), matvec=matvec, rmatvec=matvec, dtype=np.float64)
+
+    def assemble(self) -> sp.csr_matrix:
+        """The full stiffness (3 n, 3 n)."""
+        if self.G is None:
+            return self.pair
+        return (self.pair + self.G.T @ sp.diags(self.dilatation) @ self.G).tocsr()
+
+
+def stiffness_parts(model: Model, energy_of: np.ndarray | None = None) -> StiffnessParts:
+    """The two sparse parts of the stiffness; see :class:`StiffnessParts`.
+
+    ``energy_of`` ((n,) bool, default all points): the Hessian of the energy of these
+    points only (``sum_p V_p W_p`` over them), e.g. one periodic cell's share.
+    """
     b = model.bonds
     x = model.body.points
     owners = b.owners()
     n_vec = (x[b.neighbours] - x[owners]) / b.length[:, None]
     vol = model.body.volumes
+    if energy_of is not None:
+        vol = np.where(energy_of, vol, 0.0)
+    counted = b.intact & (vol[owners] > 0)
+    n = model.body.n_points
     if isinstance(model, PMBModel):
         pair = vol[owners] * model.bond_stiffness.astype(np.float64) / b.length  # W = k e^2 / 4L
-        return _pair_matrix(owners, b.neighbours, n_vec, np.where(b.intact, pair, 0.0),
-                            model.body.n_points)
+        return StiffnessParts(_pair_matrix(owners[counted], b.neighbours[counted], n_vec[counted],
+                                           pair[counted], n))
     if isinstance(model, LPSModel):
-        w = np.where(b.intact, model.w.astype(np.float64), 0.0)
+        w = np.where(counted, model.w.astype(np.float64), 0.0)
         pair = 2.0 * vol[owners] * model.alpha[owners] * w  # (V alpha w / 2) e^2 per bond
-        k_pair = _pair_matrix(owners, b.neighbours, n_vec, pair, model.body.n_points)
+        k_pair = _pair_matrix(owners[counted], b.neighbours[counted], n_vec[counted], pair[counted], n)
         d = model.dim
         c = 0.5 * model.bulk - model.alpha * model.weighted_volume / (2 * d * d)
         a = model.theta_coef[owners] * w * b.length  # d theta_p / d e_pj
-        rows, cols, vals = _dilatation_blocks(b.offsets, b.neighbours, n_vec, a, 2.0 * c * vol)
-        k_dil = sp.coo_matrix((vals, (rows, cols)), shape=k_pair.shape).tocsr()
-        return (k_pair + k_dil).tocsr()
+        return StiffnessParts(k_pair, _dilatation_gradients(owners, b.neighbours, n_vec, a, n),
+                              2.0 * c * vol)
     raise TypeError(f"no stiffness for {type(model).__name__}")
+
+
+def assemble_stiffness(model: Model, energy_of: np.ndarray | None = None) -> sp.csr_matrix:
+    """Assembled stiffness (3 n, 3 n), N/m, symmetric for equal cells (grids).
+
+    ``energy_of``: see :func:`stiffness_parts`.
+    """
+    return stiffness_parts(model, energy_of).assemble()
 
 
 def _pair_matrix(i, j, n_vec, coef, n_points) -> sp.csr_matrix:
@@ -97,35 +162,11 @@ def _pair_matrix(i, j, n_vec, coef, n_points) -> sp.csr_matrix:
                          shape=shape).tocsr()
 
 
-@numba.njit(cache=True)
-def _dilatation_blocks(offsets, nbr, n_vec, a, scale):
-    """COO triplets of sum_p scale_p g_p g_p^T, g_p = sum_j a_pj n_pj (e_j - e_p)."""
-    n = offsets.shape[0] - 1
-    total = 0
-    for p in range(n):
-        m = offsets[p + 1] - offsets[p] + 1
-        total += 9 * m * m
-    rows = np.empty(total, dtype=np.int64)
-    cols = np.empty(total, dtype=np.int64)
-    vals = np.empty(total)
-    pos = 0
-    for p in range(n):
-        lo, hi = offsets[p], offsets[p + 1]
-        m = hi - lo + 1
-        nodes = np.empty(m, dtype=np.int64)
-        g = np.zeros((m, 3))
-        nodes[0] = p
-        for k in range(lo, hi):
-            nodes[k - lo + 1] = nbr[k]
-            for c in range(3):
-                g[k - lo + 1, c] = a[k] * n_vec[k, c]
-                g[0, c] -= a[k] * n_vec[k, c]
-        for r in range(m):
-            for s in range(m):
-                for c1 in range(3):
-                    for c2 in range(3):
-                        rows[pos] = 3 * nodes[r] + c1
-                        cols[pos] = 3 * nodes[s] + c2
-                        vals[pos] = scale[p] * g[r, c1] * g[s, c2]
-                        pos += 1
-    return rows, cols, vals
+def _dilatation_gradients(owners, nbr, n_vec, a, n_points) -> sp.csr_matrix:
+    """G (n, 3 n): row p holds g_p = sum_j a_pj n_pj (e_j - e_p), so theta_p = g_p . u."""
+    g = a[:, None] * n_vec  # (nb, 3)
+    comp = np.arange(3)
+    rows = np.concatenate([np.repeat(owners, 3), np.repeat(owners, 3)])
+    cols = np.concatenate([(3 * nbr[:, None] + comp).ravel(), (3 * owners[:, None] + comp).ravel()])
+    vals = np.concatenate([g.ravel(), -g.ravel()])
+    return sp.coo_matrix((vals, (rows, cols)), shape=(n_points, 3 * n_points)).tocsr()

@@ -2,7 +2,17 @@
 
 Shift-invert Lanczos (``scipy.sparse.linalg.eigsh``) with a negative shift
 ``sigma = -s`` so that ``K + s M`` is positive definite even for a free body
-(whose K is singular), factorised once with a sparse LU. Rigid-body modes
+(whose K is singular), factorised once with a sparse LU. For LPS, K = P + G^T D G
+(``stiffness.StiffnessParts``) reaches two horizons, but the augmented system
+
+    [ P + s M    G^T   ] [x]   [b]
+    [    G     -D^-1   ] [y] = [0]      (y = D G x)
+
+is as sparse as the bonds and gives (K + s M) x = b; it is quasi-definite (D > 0 on
+usual materials), so a symmetric fill-reducing order (geometric nested dissection,
+``solvers.ordering``) with little pivoting factorises it
+at a fraction of the memory and time of K itself (D < 0, as for a 2D plane-stress LPS
+with nu < 1/3, only needs more pivoting). Rigid-body modes
 (six for a free 3D body, three in 2D) come out with |f| near zero and are
 counted and reported separately.
 """
@@ -13,11 +23,12 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.sparse.linalg import eigsh, splu
+from scipy.sparse.linalg import LinearOperator, eigsh, splu
 
 from peridyn.errors import InputError
 from peridyn.materials.base import Model
-from peridyn.stiffness import assemble_stiffness, mass_matrix
+from peridyn.solvers.ordering import order_unknowns
+from peridyn.stiffness import StiffnessParts, mass_matrix, stiffness_parts
 
 #: Modes whose frequency is below this fraction of the highest computed one are rigid.
 RIGID_FRACTION = 1e-4
@@ -86,14 +97,14 @@ def modal_analysis(model: Model, n_modes: int = 12, fixed: np.ndarray | None = N
     dofs = free_dofs(model, fixed)
     if n_modes >= len(dofs):
         raise InputError(f"asked for {n_modes} modes of a model with {len(dofs)} free dofs")
-    K = assemble_stiffness(model)[dofs][:, dofs].tocsc()
+    parts = stiffness_parts(model)
+    K = parts.restricted(dofs)
     m = mass_matrix(model).diagonal()[dofs]
     M = sp.diags(m).tocsc()
     if shift is None:
         # a fraction of the lowest diagonal frequency estimate keeps K + s M well conditioned
-        shift = 1e-6 * float(np.median(K.diagonal() / m))
-    lu = splu((K + shift * M).tocsc())
-    op = sp.linalg.LinearOperator(K.shape, matvec=lu.solve, dtype=np.float64)
+        shift = 1e-6 * float(np.median(parts.diagonal()[dofs] / m))
+    op = shifted_inverse(parts, dofs, shift * m, model.body.points, model.bonds.horizon)
     lam, vecs = eigsh(K, k=n_modes, M=M, sigma=-shift, which="LM", OPinv=op, tol=tol)
     order = np.argsort(lam)
     lam, vecs = lam[order], vecs[:, order]
@@ -103,9 +114,44 @@ def modal_analysis(model: Model, n_modes: int = 12, fixed: np.ndarray | None = N
     rigid = np.abs(freqs) < RIGID_FRACTION * np.abs(freqs).max()
     resid = np.linalg.norm(kx - mx * lam, axis=0)
     # elastic modes: relative to ||K x||; rigid ones (K x ~ 0): relative to max K_ii ||x||
-    k_scale = np.abs(K.diagonal()).max() * np.linalg.norm(vecs, axis=0)
+    k_scale = np.abs(parts.diagonal()[dofs]).max() * np.linalg.norm(vecs, axis=0)
     scale = np.where(rigid, k_scale, np.linalg.norm(kx, axis=0))
     shapes = np.zeros((n_modes, model.body.n_points * 3))
     shapes[:, dofs] = vecs.T
     return ModalResult(freqs, shapes.reshape(n_modes, -1, 3), resid / np.maximum(scale, 1e-300),
                        rigid)
+
+
+def shifted_inverse(parts: StiffnessParts, dofs: np.ndarray, shift_mass: np.ndarray,
+                    points: np.ndarray, reach: float) -> LinearOperator:
+    """(K + s M)^-1 on the ``dofs`` as an operator, factorised once.
+
+    ``shift_mass`` ((len(dofs),) N/m) is s M on those dofs; ``points`` (n, 3) m and
+    ``reach`` (m, the horizon) give the nested-dissection order of the unknowns
+    (``solvers.ordering``). With a dilatation part the augmented system of the module
+    docstring is factorised instead of K + s M.
+    """
+    P = parts.pair[dofs][:, dofs] + sp.diags(shift_mass)
+    n = len(dofs)
+    unknown_points = dofs // 3
+    if parts.G is None:
+        A = P
+    else:
+        active = np.flatnonzero(parts.dilatation != 0.0)
+        # scale the multipliers so that both diagonal blocks have the size of P's diagonal
+        scale = np.sqrt(np.median(P.diagonal()) * np.abs(parts.dilatation[active]))
+        SG = sp.diags(scale) @ parts.G[active][:, dofs]  # unknowns y' = y / scale
+        A = sp.bmat([[P, SG.T], [SG, sp.diags(-(scale**2) / parts.dilatation[active])]])
+        unknown_points = np.concatenate([unknown_points, active])
+    perm = order_unknowns(unknown_points, points, reach)
+    lu = splu(A.tocsr()[perm][:, perm].tocsc(), permc_spec="NATURAL", diag_pivot_thresh=0.1,
+              options={"SymmetricMode": True})
+    rhs = np.zeros(A.shape[0])
+    inverse = np.empty_like(perm)
+    inverse[perm] = np.arange(len(perm))
+
+    def solve(b):
+        rhs[:n] = b
+        return lu.solve(rhs[perm])[inverse[:n]]
+
+    return LinearOperator((n, n), matvec=solve, dtype=np.float64)

@@ -1,0 +1,5 @@
+"""``python -m peridyn ...``: the same as the ``peridyn`` command."""
+
+from peridyn.cli import main
+
+raise SystemExit(main())
