@@ -57,21 +57,29 @@ def stiffness_operator(model: Model) -> LinearOperator:
     return LinearOperator((3 * n, 3 * n), matvec=matvec, rmatvec=matvec, dtype=np.float64)
 
 
-def assemble_stiffness(model: Model) -> sp.csr_matrix:
-    """Assembled stiffness (3 n, 3 n), N/m, symmetric for equal cells (grids)."""
+def assemble_stiffness(model: Model, energy_of: np.ndarray | None = None) -> sp.csr_matrix:
+    """Assembled stiffness (3 n, 3 n), N/m, symmetric for equal cells (grids).
+
+    ``energy_of`` ((n,) bool, default all points): assemble the Hessian of the energy
+    of these points only (``sum_p V_p W_p`` over them), e.g. one periodic cell's share.
+    """
     b = model.bonds
     x = model.body.points
     owners = b.owners()
     n_vec = (x[b.neighbours] - x[owners]) / b.length[:, None]
     vol = model.body.volumes
+    if energy_of is not None:
+        vol = np.where(energy_of, vol, 0.0)
+    counted = b.intact & (vol[owners] > 0)
     if isinstance(model, PMBModel):
         pair = vol[owners] * model.bond_stiffness.astype(np.float64) / b.length  # W = k e^2 / 4L
-        return _pair_matrix(owners, b.neighbours, n_vec, np.where(b.intact, pair, 0.0),
+        return _pair_matrix(owners[counted], b.neighbours[counted], n_vec[counted], pair[counted],
                             model.body.n_points)
     if isinstance(model, LPSModel):
         w = np.where(b.intact, model.w.astype(np.float64), 0.0)
         pair = 2.0 * vol[owners] * model.alpha[owners] * w  # (V alpha w / 2) e^2 per bond
-        k_pair = _pair_matrix(owners, b.neighbours, n_vec, pair, model.body.n_points)
+        k_pair = _pair_matrix(owners[counted], b.neighbours[counted], n_vec[counted], pair[counted],
+                              model.body.n_points)
         d = model.dim
         c = 0.5 * model.bulk - model.alpha * model.weighted_volume / (2 * d * d)
         a = model.theta_coef[owners] * w * b.length  # d theta_p / d e_pj
@@ -103,6 +111,8 @@ def _dilatation_blocks(offsets, nbr, n_vec, a, scale):
     n = offsets.shape[0] - 1
     total = 0
     for p in range(n):
+        if scale[p] == 0.0:
+            continue
         m = offsets[p + 1] - offsets[p] + 1
         total += 9 * m * m
     rows = np.empty(total, dtype=np.int64)
@@ -110,6 +120,8 @@ def _dilatation_blocks(offsets, nbr, n_vec, a, scale):
     vals = np.empty(total)
     pos = 0
     for p in range(n):
+        if scale[p] == 0.0:
+            continue
         lo, hi = offsets[p], offsets[p + 1]
         m = hi - lo + 1
         nodes = np.empty(m, dtype=np.int64)
