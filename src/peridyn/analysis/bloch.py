@@ -173,22 +173,31 @@ def _tiles(disc: Discretisation) -> int:
     return int(math.ceil(reach / disc.spacing))
 
 
-def tiled_model(disc: Discretisation):
-    """(model, central mask, cell index of each tiled point) on (2 t + 1)^d tiles."""
+def tiled_model(disc: Discretisation, repeat: int = 1):
+    """The solver's model on enough tiles around a central row of ``repeat`` cells along x.
+
+    Returns (model, central, cell_index): ``central`` ((n,) bool) marks the points of the
+    ``repeat`` central cells; ``cell_index`` ((n,) int64) numbers every tiled point by its
+    image in a periodic supercell of ``repeat`` cells (layer + layers * (x tile mod repeat)
+    for plates, x tile mod repeat for blocks).
+    """
     _check(disc)
     t = _tiles(disc)
     n = 2 * t + 1
     h = disc.spacing
     if disc.kind == "plate":
-        body = geometry.plate(n * h, n * h, disc.thickness, h, disc.layers,
+        body = geometry.plate((n + repeat - 1) * h, n * h, disc.thickness, h, disc.layers,
                               layer_placement=disc.layer_placement)
-        cell_index = body.layer_index.copy()
+        per_cell = disc.layers
+        layer = body.layer_index
         tile = np.rint(body.points[:, :2] / h - 0.5).astype(np.int64)
     else:
-        body = geometry.box((n * h,) * 3, h)
-        cell_index = np.zeros(body.n_points, dtype=np.int64)
+        body = geometry.box(((n + repeat - 1) * h, n * h, n * h), h)
+        per_cell = 1
+        layer = np.zeros(body.n_points, dtype=np.int64)
         tile = np.rint(body.points / h - 0.5).astype(np.int64)
-    central = np.all(tile == t, axis=1)
+    central = (tile[:, 0] >= t) & (tile[:, 0] < t + repeat) & np.all(tile[:, 1:] == t, axis=1)
+    cell_index = layer + per_cell * np.mod(tile[:, 0] - t, repeat)
     bonds = find_bonds(body, disc.horizon, disc.influence, disc.partial_volumes)
     model = make_model(disc.model, body, bonds, E=disc.E, nu=disc.nu, density=disc.density,
                        surface_correction=disc.surface_correction)
