@@ -70,7 +70,7 @@ def _check_frequencies(frequencies) -> np.ndarray:
 #: Default sweep of the study: layers, spacing (m), horizon (multiple of dx), correction.
 STUDY_LAYERS = (3, 4, 5, 6, 7)
 STUDY_SPACINGS = (1.2e-3, 0.8e-3, 0.6e-3, 0.4e-3, 0.3e-3)
-STUDY_HORIZONS = (1.5, 2.015, 3.015)
+STUDY_HORIZONS = (1.5, 3.015)
 STUDY_CORRECTIONS = ("none", "shear-factor")
 
 
