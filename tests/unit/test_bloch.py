@@ -17,7 +17,6 @@ import scipy.sparse as sp
 from peridyn.analysis.bloch import Discretisation, bloch_cell, plate_basis, tiled_model
 from peridyn.analysis.bloch_study import format_study, predict, study
 from peridyn.cli import main
-from peridyn.errors import InputError
 from peridyn.stiffness import assemble_stiffness
 
 # maraging steel of V3
@@ -122,7 +121,7 @@ def test_plate_mirror_separates_s_a_and_sh():
     h = full.T @ cell.mass_normalised((700.0, 0, 0)) @ full
     sizes = np.cumsum([0] + [b.shape[1] for b in bases])
     off = h.copy()
-    for lo, hi in zip(sizes[:-1], sizes[1:]):
+    for lo, hi in zip(sizes[:-1], sizes[1:], strict=True):
         off[lo:hi, lo:hi] = 0
     assert np.abs(off).max() < 1e-12 * np.abs(h).max()
 
@@ -232,15 +231,22 @@ def test_cli_bad_input(argv, message, capsys):
     assert message in capsys.readouterr().err
 
 
-def test_non_grid_case_is_refused():
-    """Only box and plate cases have a periodic lattice."""
-    class Geometry:
-        type = "rectangle"
+@pytest.mark.parametrize("argv, message", [
+    (["dispersion", "cases/plate2d_precrack_pull.yaml", "--frequencies", "50e3"], "box or plate"),
+    (["dispersion", "cases/cube_point.yaml", "--frequencies", "50e3", "--set",
+      "discretization.spacing=[1e-3,2e-3,1e-3]"], "one grid spacing"),
+])
+def test_cases_without_a_cubic_lattice_are_refused(argv, message, capsys):
+    """Only box and plate cases with one spacing have the periodic lattice Bloch needs."""
+    assert main(argv) == 1
+    assert message in capsys.readouterr().err
 
-    class Case:
-        geometry = Geometry()
-        discretization = None
-        material = None
 
-    with pytest.raises(InputError, match="box or plate"):
-        Discretisation.from_case(Case())
+def test_block_case_from_the_cli_is_near_classical_at_long_waves(capsys):
+    """cases/cube_point.yaml (LPS, 1.4143 dx, 1 mm): P and S at 50 kHz (k dx = 0.06) within
+    0.1 % of omega / cL and omega / cT (exact long-wave limits, weak dispersion)."""
+    assert main(["dispersion", "cases/cube_point.yaml", "--frequencies", "50e3", "--json"]) == 0
+    modes = json.loads(capsys.readouterr().out)["modes"]
+    assert [m["mode"] for m in modes] == ["P", "S"]
+    for m in modes:
+        assert abs(m["error"]) < 1e-3

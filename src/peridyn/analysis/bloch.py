@@ -73,11 +73,13 @@ class Discretisation:
         if g.type not in ("box", "plate"):
             raise InputError(f"Bloch analysis needs a box or plate case, got geometry.type "
                              f"{g.type!r}")
-        if d.spacing is None:
-            raise InputError("Bloch analysis needs discretization.spacing")
-        horizon = d.horizon_m if d.horizon_m is not None else d.horizon * d.spacing
+        spacing = np.atleast_1d(np.asarray(d.spacing if d.spacing is not None else [], float))
+        if spacing.size == 0 or np.ptp(spacing) > 1e-12 * spacing.max():
+            raise InputError(f"Bloch analysis needs one grid spacing (a cubic lattice), got "
+                             f"discretization.spacing = {d.spacing!r}")
+        horizon = d.horizon_m if d.horizon_m is not None else d.horizon * spacing[0]
         plate = g.type == "plate"
-        return cls(spacing=float(d.spacing), horizon=float(horizon), model=mat.model, E=mat.E,
+        return cls(spacing=float(spacing[0]), horizon=float(horizon), model=mat.model, E=mat.E,
                    nu=mat.nu, density=mat.density, kind=g.type if plate else "block",
                    influence=d.influence, partial_volumes=bool(d.partial_volumes),
                    surface_correction=mat.surface_correction,

@@ -16,8 +16,8 @@ import numpy as np
 from peridyn.analysis.bloch import (
     BlochCell,
     Discretisation,
-    block_wavenumbers,
     bloch_cell,
+    block_wavenumbers,
     plate_wavenumbers,
 )
 from peridyn.analysis.lamb import bulk_speeds, lamb_modes

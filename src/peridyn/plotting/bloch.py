@@ -53,7 +53,7 @@ def plot_bloch(disc: Discretisation, path=None, frequencies=(), f_max: float | N
         colour = f"C{n}"
         ax.plot(k, f_disc / 1e3, color=colour, label=f"{name} discrete")
         k0 = [theory.get((name, float(f))) for f in f_theory]
-        pts = [(kk, f) for kk, f in zip(k0, f_theory) if kk is not None]
+        pts = [(kk, f) for kk, f in zip(k0, f_theory, strict=True) if kk is not None]
         if pts:
             ax.plot([p[0] for p in pts], [p[1] / 1e3 for p in pts], "--", color=colour,
                     label=f"{name} theory")
