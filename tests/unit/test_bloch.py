@@ -250,3 +250,23 @@ def test_block_case_from_the_cli_is_near_classical_at_long_waves(capsys):
     assert [m["mode"] for m in modes] == ["P", "S"]
     for m in modes:
         assert abs(m["error"]) < 1e-3
+
+
+def test_group_velocity_is_the_slope_of_the_branches():
+    """Hellmann-Feynman group velocities equal the central difference of omega(k) (to 1e-7;
+    its truncation error at dk = 1e-4 k is ~1e-8), tend to the long-wave speeds at small k, and
+    the discrete 3 mm horizon lattice (V3: negative group velocity for horizons above about
+    3 spacings) turns back before the zone edge while the 18-neighbour one does not."""
+    cell = bloch_cell(steel_lattice(3.015, False))
+    k, dk = 1500.0, 0.15
+    omega, group = cell.branches((k, 0, 0))
+    slope = (cell.frequencies((k + dk, 0, 0)) - cell.frequencies((k - dk, 0, 0))) / (2 * dk)
+    assert group == pytest.approx(slope, rel=1e-7)
+    assert cell.branches((1.0, 0, 0))[1] == pytest.approx(cell.long_wave_speeds((1, 0, 0)),
+                                                          rel=1e-6)
+    from peridyn.analysis.bloch import negative_group_velocity_from
+
+    onset = negative_group_velocity_from(cell, np.eye(3)[:, [0]])
+    assert onset is not None and onset < np.pi / 1e-3
+    assert negative_group_velocity_from(bloch_cell(steel_lattice(1.4143, False)),
+                                        np.eye(3)[:, [0]]) is None

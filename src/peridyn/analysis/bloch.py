@@ -148,6 +148,37 @@ class BlochCell:
         lam = np.linalg.eigvalsh(0.5 * (h + h.conj().T))
         return np.sqrt(np.clip(lam, 0.0, None))
 
+    def dynamical_matrix_derivative(self, k, direction) -> np.ndarray:
+        """dD/dk along the unit vector ``direction`` at ``k`` (3 m, 3 m) complex, N rad^-1."""
+        n = np.asarray(direction, dtype=np.float64)
+        n = n / np.linalg.norm(n)
+        weights = 1j * (self.shifts @ n) * self.values * np.exp(
+            1j * (self.shifts @ np.asarray(k, dtype=np.float64)))
+        idx = self.rows * self.n_dofs + self.cols
+        size = self.n_dofs**2
+        flat = (np.bincount(idx, weights=weights.real, minlength=size)
+                + 1j * np.bincount(idx, weights=weights.imag, minlength=size))
+        return flat.reshape(self.n_dofs, self.n_dofs)
+
+    def branches(self, k, direction=(1.0, 0.0, 0.0), basis: np.ndarray | None = None):
+        """(omega (rad/s), group velocity (m/s)) of all branches at ``k`` (3,), ascending.
+
+        Group velocity d omega / dk along ``direction`` by the Hellmann-Feynman theorem:
+        2 omega d omega = v^H (dH/dk) v for the unit eigenvector v of H = M^-1/2 D M^-1/2
+        (exact for simple eigenvalues; a degenerate pair gets the pair's mean).
+        """
+        s = 1.0 / np.sqrt(np.repeat(self.mass, 3))
+        h = s[:, None] * self.dynamical_matrix(k) * s[None, :]
+        dh = s[:, None] * self.dynamical_matrix_derivative(k, direction) * s[None, :]
+        if basis is not None:
+            h, dh = basis.T @ h @ basis, basis.T @ dh @ basis
+        lam, vec = np.linalg.eigh(0.5 * (h + h.conj().T))
+        omega = np.sqrt(np.clip(lam, 0.0, None))
+        slope = np.einsum("ib,ij,jb->b", vec.conj(), dh, vec).real
+        with np.errstate(divide="ignore", invalid="ignore"):
+            group = np.where(omega > 0, slope / (2.0 * omega), 0.0)
+        return omega, group
+
     def long_wave_tensor(self, direction) -> np.ndarray:
         """(3, 3) N/m: -sum_terms K (n . shift)^2 / 2; omega^2 = k^2 eig / mass (one-point cells).
 
@@ -296,6 +327,16 @@ def branch_wavenumber(cell: BlochCell, omega: float, basis: np.ndarray | None = 
         if f_lo < 0 <= f_k:
             return float(brentq(f, lo, k, xtol=1e-12 * k, rtol=1e-12))
         lo, f_lo = k, f_k
+    return None
+
+
+def negative_group_velocity_from(cell: BlochCell, basis: np.ndarray | None = None,
+                                 branch: int = 0, points: int = 400) -> float | None:
+    """First wavenumber (rad/m, along x, sampled on ``points`` up to the zone edge) where
+    branch ``branch`` of the subspace has a negative group velocity; None if it never has."""
+    for k in np.linspace(0.0, zone_edge(cell), points + 1)[1:]:
+        if cell.branches((k, 0.0, 0.0), basis=basis)[1][branch] < 0:
+            return float(k)
     return None
 
 
