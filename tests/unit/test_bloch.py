@@ -246,10 +246,18 @@ def test_block_case_from_the_cli_is_near_classical_at_long_waves(capsys):
     """cases/cube_point.yaml (LPS, 1.4143 dx, 1 mm): P and S at 50 kHz (k dx = 0.06) within
     0.1 % of omega / cL and omega / cT (exact long-wave limits, weak dispersion)."""
     assert main(["dispersion", "cases/cube_point.yaml", "--frequencies", "50e3", "--json"]) == 0
-    modes = json.loads(capsys.readouterr().out)["modes"]
+    out = json.loads(capsys.readouterr().out)
+    modes = out["modes"]
     assert [m["mode"] for m in modes] == ["P", "S"]
     for m in modes:
         assert abs(m["error"]) < 1e-3
+    # exact long-wave limits of the 18-neighbour lattice: the classical speeds of the case
+    classical = {name: 2 * np.pi * 50e3 / m["theory_wavenumber_rad_m"]
+                 for name, m in zip(("longitudinal", "shear"), modes, strict=True)}
+    for name, c in out["long_wave_limit_m_s"].items():
+        assert c == pytest.approx(classical[name], rel=1e-10)
+    assert out["negative_group_velocity_from_rad_m"] == {"longitudinal": None, "shear": None}
+    assert out["zone_edge_rad_m"] == pytest.approx(np.pi / 1e-3)
 
 
 def test_group_velocity_is_the_slope_of_the_branches():

@@ -6,6 +6,8 @@ import argparse
 import math
 import sys
 
+import numpy as np
+
 from peridyn.analysis.dispersion import MODELS, Medium, dispersion_relation, parse_direction
 from peridyn.bonds import INFLUENCE_FUNCTIONS
 from peridyn.cli import add_json_flag
@@ -86,7 +88,12 @@ def run(args: argparse.Namespace) -> dict:
 
 def run_case_file(args: argparse.Namespace) -> dict:
     """Bloch-wave wavenumbers of a case's discrete model against theory (``{"modes": [...]}``)."""
-    from peridyn.analysis.bloch import Discretisation
+    from peridyn.analysis.bloch import (
+        Discretisation,
+        bloch_cell,
+        negative_group_velocity_from,
+        zone_edge,
+    )
     from peridyn.analysis.bloch_study import predict
     from peridyn.io.case import load_case
 
@@ -95,7 +102,16 @@ def run_case_file(args: argparse.Namespace) -> dict:
     freqs = [_positive("--frequencies", item) for item in args.frequencies.split(",")]
     case = load_case(args.case, args.overrides)
     disc = Discretisation.from_case(case)
-    summary = {"case": case.name, "modes": predict(disc, freqs)}
+    cell = bloch_cell(disc)
+    summary = {"case": case.name, "modes": predict(disc, freqs, cell),
+               "zone_edge_rad_m": zone_edge(cell)}
+    if disc.kind == "block":  # one-point lattice: exact long-wave limits along x
+        speeds = cell.long_wave_speeds((1.0, 0.0, 0.0))
+        summary["long_wave_limit_m_s"] = {"longitudinal": float(speeds[2]),
+                                          "shear": float(speeds[0])}
+        summary["negative_group_velocity_from_rad_m"] = {
+            name: negative_group_velocity_from(cell, np.eye(3)[:, [axis]])
+            for name, axis in (("longitudinal", 0), ("shear", 1))}
     if args.plot:
         from peridyn.plotting.bloch import plot_bloch  # matplotlib only when asked
 
@@ -108,7 +124,8 @@ def run_case_file(args: argparse.Namespace) -> dict:
 
 def format_modes(summary: dict) -> str:
     """The human-readable report of :func:`run_case_file`."""
-    lines = [f"{summary['case']}: Bloch-wave wavenumbers of the discrete model",
+    lines = [f"{summary['case']}: Bloch-wave wavenumbers of the discrete model (zone edge "
+             f"{summary['zone_edge_rad_m']:.1f} rad/m)",
              f"{'mode':>5} {'f (kHz)':>9} {'k (rad/m)':>11} {'theory (rad/m)':>15} {'error':>8}"]
     for m in summary["modes"]:
         k, k0, err = m["wavenumber_rad_m"], m["theory_wavenumber_rad_m"], m["error"]
@@ -116,6 +133,12 @@ def format_modes(summary: dict) -> str:
                      f"{'-' if k is None else f'{k:11.2f}':>11} "
                      f"{'-' if k0 is None else f'{k0:15.2f}':>15} "
                      f"{'-' if err is None else f'{100 * err:+7.2f}%':>8}")
+    if "long_wave_limit_m_s" in summary:
+        lines.append("long-wave limits along x: " + ", ".join(
+            f"{k} {v:.1f} m/s" for k, v in summary["long_wave_limit_m_s"].items()))
+        lines.append("negative group velocity from: " + ", ".join(
+            f"{k} {'none' if v is None else f'{v:.1f} rad/m'}"
+            for k, v in summary["negative_group_velocity_from_rad_m"].items()))
     return "\n".join(lines)
 
 
