@@ -6,6 +6,8 @@ import argparse
 import math
 import sys
 
+import numpy as np
+
 from peridyn.analysis.dispersion import MODELS, Medium, dispersion_relation, parse_direction
 from peridyn.bonds import INFLUENCE_FUNCTIONS
 from peridyn.cli import add_json_flag
@@ -25,8 +27,13 @@ def register(subparsers) -> None:
         "(integral over the horizon) or, with --discrete, the lattice sum of a simple cubic "
         "(square) grid as a simulation uses it. Numbers are SI: Pa, kg/m^3, m.",
     )
-    parser.add_argument("case", nargs="?", help="(not yet supported) a case file whose "
-                        "discrete model to analyse")
+    parser.add_argument("case", nargs="?", help="a box or plate case file: Bloch-wave "
+                        "dispersion of its discrete model (see docs/bloch.md); needs --frequencies")
+    parser.add_argument("--frequencies", metavar="F1,F2,...",
+                        help="with a case: frequencies in Hz, e.g. 110e3,150e3,225e3")
+    parser.add_argument("--set", dest="overrides", action="append", default=[],
+                        metavar="KEY=VALUE", help="with a case: override a case entry, e.g. "
+                        "discretization.spacing=0.0004 (repeatable)")
     parser.add_argument("--model", help=f"material model: {' or '.join(MODELS)}")
     parser.add_argument("--rho", help="density, kg/m^3")
     parser.add_argument("--bulk-modulus", help="bulk modulus K, Pa (with --shear-modulus)")
@@ -57,8 +64,7 @@ def register(subparsers) -> None:
 def run(args: argparse.Namespace) -> dict:
     """Compute the relation; print a report unless ``--json``."""
     if args.case is not None:
-        raise InputError(f"CASE = {args.case!r}: the dispersion of a case file's discrete model "
-                         "is not yet supported; give --model, the material and the grid instead")
+        return run_case_file(args)
     dim = _choice("--dimension", args.dimension, ("1", "2", "3"))
     relation = dispersion_relation(
         _choice("--model", args.model, MODELS), medium_from_args(args),
@@ -78,6 +84,62 @@ def run(args: argparse.Namespace) -> dict:
     if not args.json:
         print(format_report(summary))
     return summary
+
+
+def run_case_file(args: argparse.Namespace) -> dict:
+    """Bloch-wave wavenumbers of a case's discrete model against theory (``{"modes": [...]}``)."""
+    from peridyn.analysis.bloch import (
+        Discretisation,
+        bloch_cell,
+        negative_group_velocity_from,
+        zone_edge,
+    )
+    from peridyn.analysis.bloch_study import predict
+    from peridyn.io.case import load_case
+
+    if args.frequencies is None:
+        raise InputError("--frequencies is required with a case file, e.g. --frequencies 150e3")
+    freqs = [_positive("--frequencies", item) for item in args.frequencies.split(",")]
+    case = load_case(args.case, args.overrides)
+    disc = Discretisation.from_case(case)
+    cell = bloch_cell(disc)
+    summary = {"case": case.name, "modes": predict(disc, freqs, cell),
+               "zone_edge_rad_m": zone_edge(cell)}
+    if disc.kind == "block":  # one-point lattice: exact long-wave limits along x
+        speeds = cell.long_wave_speeds((1.0, 0.0, 0.0))
+        summary["long_wave_limit_m_s"] = {"longitudinal": float(speeds[2]),
+                                          "shear": float(speeds[0])}
+        summary["negative_group_velocity_from_rad_m"] = {
+            name: negative_group_velocity_from(cell, np.eye(3)[:, [axis]])
+            for name, axis in (("longitudinal", 0), ("shear", 1))}
+    if args.plot:
+        from peridyn.plotting.bloch import plot_bloch  # matplotlib only when asked
+
+        plot_bloch(disc, path=args.plot, frequencies=freqs)
+        print(f"wrote {args.plot}", file=sys.stderr)
+    if not args.json:
+        print(format_modes(summary))
+    return summary
+
+
+def format_modes(summary: dict) -> str:
+    """The human-readable report of :func:`run_case_file`."""
+    lines = [f"{summary['case']}: Bloch-wave wavenumbers of the discrete model (zone edge "
+             f"{summary['zone_edge_rad_m']:.1f} rad/m)",
+             f"{'mode':>5} {'f (kHz)':>9} {'k (rad/m)':>11} {'theory (rad/m)':>15} {'error':>8}"]
+    for m in summary["modes"]:
+        k, k0, err = m["wavenumber_rad_m"], m["theory_wavenumber_rad_m"], m["error"]
+        lines.append(f"{m['mode']:>5} {m['frequency_hz'] / 1e3:9.1f} "
+                     f"{'-' if k is None else f'{k:11.2f}':>11} "
+                     f"{'-' if k0 is None else f'{k0:15.2f}':>15} "
+                     f"{'-' if err is None else f'{100 * err:+7.2f}%':>8}")
+    if "long_wave_limit_m_s" in summary:
+        lines.append("long-wave limits along x: " + ", ".join(
+            f"{k} {v:.1f} m/s" for k, v in summary["long_wave_limit_m_s"].items()))
+        lines.append("negative group velocity from: " + ", ".join(
+            f"{k} {'none' if v is None else f'{v:.1f} rad/m'}"
+            for k, v in summary["negative_group_velocity_from_rad_m"].items()))
+    return "\n".join(lines)
 
 
 def medium_from_args(args: argparse.Namespace) -> Medium:

@@ -333,5 +333,5 @@ def test_cli_missing_model_and_case_form():
     with pytest.raises(InputError, match="--model"):
         args.func(args)
     args = build_parser().parse_args(["dispersion", "case.yaml"])
-    with pytest.raises(InputError, match="not yet supported"):
+    with pytest.raises(InputError, match="--frequencies"):
         args.func(args)
