@@ -1,8 +1,11 @@
 """Harmonic content of a sensor signal (nonlinear ultrasonics).
 
 The amplitude spectrum is |FFT| of the Hann-windowed record, zero-padded ``pad`` times.
-A_n is its largest value within +-20 % of n f0; the second-harmonic ratio A2/A1 measures
+A_n is its largest value within n f0 +- 0.2 f0; the second-harmonic ratio A2/A1 measures
 the nonlinearity met by a tone burst of centre frequency f0 (e.g. a clapping crack).
+The band has the same half-width (0.2 f0) around every harmonic: a band of +-20 % of
+2 f0 would reach down to 1.6 f0, into the skirt of the fundamental itself (the main lobe of
+a 5-cycle Hann burst spans f0 +- 0.4 f0), and would then measure the linear signal.
 """
 
 from __future__ import annotations
@@ -11,7 +14,7 @@ import numpy as np
 
 from peridyn.errors import InputError
 
-#: Half-width of the band searched around each harmonic, as a fraction of its frequency.
+#: Half-width of the band searched around each harmonic, as a fraction of f0.
 BAND = 0.2
 
 
@@ -37,9 +40,9 @@ def amplitude_spectrum(signal: np.ndarray, dt: float, pad: int = 8) -> tuple[np.
 
 
 def harmonic_amplitude(freq: np.ndarray, spectrum: np.ndarray, f0: float, order: int) -> float:
-    """Largest spectrum value within +-BAND of ``order`` x ``f0`` (Hz)."""
+    """Largest spectrum value within ``order`` f0 +- BAND f0 (Hz)."""
     target = order * f0
-    band = (freq > (1 - BAND) * target) & (freq < (1 + BAND) * target)
+    band = (freq > target - BAND * f0) & (freq < target + BAND * f0)
     if not band.any():
         raise InputError(f"harmonic {order} of {f0:g} Hz lies above the Nyquist frequency "
                          f"{freq[-1]:g} Hz of the signal")
