@@ -2,16 +2,20 @@
 Verlet-list correctness and input checks. Model: Silling's short-range force as in Peridigm
 (Parks et al.), f_i = -c_sr (d_c - |Y|) / delta V_j Y / |Y| for |Y| < d_c."""
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
 from peridyn import geometry
 from peridyn.bonds import crossing_segment, cut_bonds, find_bonds
 from peridyn.contact import Contact
-from peridyn.errors import InputError
+from peridyn.errors import CaseFileError, InputError
+from peridyn.io.case import load_case
 from peridyn.loads import InitialCondition, Loading
 from peridyn.materials import make_model
 from peridyn.materials.pmb import pmb_micromodulus
+from peridyn.simulation import build
 from peridyn.solvers import ExplicitSolver
 
 H = 1e-3
@@ -163,3 +167,24 @@ def test_contact_lowers_the_stable_step_by_its_stiffness_bound():
 def test_bad_contact_input(kwargs, message):
     with pytest.raises(InputError, match=message):
         Contact(cut_square(n=6), **kwargs)
+
+
+def breathing_case(**contact):
+    """The breathing-crack case file, its contact block replaced by ``contact`` if given."""
+    path = Path(__file__).resolve().parents[2] / "cases" / "lamb_breathing_crack.yaml"
+    overrides = [f"contact={contact}"] if contact else []
+    return load_case(path, overrides)
+
+
+def test_case_contact_block_builds_contact_in_metres():
+    setup = build(breathing_case())
+    assert isinstance(setup.contact, Contact)
+    assert setup.contact.radius == pytest.approx(1.0e-3)  # radius: 1.0 spacing of 1 mm
+    assert setup.contact.stiffness_factor == 15.0
+
+
+def test_case_contact_block_errors():
+    with pytest.raises(CaseFileError, match="exactly one of radius"):
+        breathing_case(stiffness_factor=10.0)
+    with pytest.raises(CaseFileError, match="larger than the horizon"):
+        build(breathing_case(radius=4.0))
