@@ -17,6 +17,7 @@ from peridyn import geometry
 from peridyn.body import Body, in_box, in_cylinder, in_sphere
 from peridyn.bonds import Bonds, crossing_rectangle, crossing_segment, cut_bonds, find_bonds
 from peridyn.checkpoint import Checkpointer, load_checkpoint
+from peridyn.contact import Contact
 from peridyn.damage import BondDamage, damage_field
 from peridyn.errors import CaseFileError, InputError
 from peridyn.io.case import Case, Region
@@ -40,6 +41,7 @@ class Setup:
     model: Model
     loading: Loading
     damage: BondDamage | None
+    contact: Contact | None = None
 
 
 def build_body(case: Case, base_dir=".") -> Body:
@@ -154,7 +156,19 @@ def build(case: Case, base_dir=".") -> Setup:
     if case.solver.type == "explicit" and not (loading.has_loads or loading.initial):
         raise CaseFileError(case.name, "boundary_conditions", [],
                             "a load or an initial condition: nothing would move")
-    return Setup(body, bonds, model, loading, damage)
+    return Setup(body, bonds, model, loading, damage, build_contact(case, model))
+
+
+def build_contact(case: Case, model: Model) -> Contact | None:
+    """The case's short-range contact forces, or None without a ``contact`` block."""
+    c = case.contact
+    if c is None:
+        return None
+    radius = c.radius_m if c.radius_m is not None else c.radius * model.body.spacing
+    try:
+        return Contact(model, radius, c.stiffness_factor)
+    except InputError as exc:
+        raise CaseFileError(case.name, "contact", c.model_dump(exclude_none=True), str(exc)) from None
 
 
 def recorder_spec(case: Case, body: Body, dt: float) -> RecorderSpec:
@@ -283,7 +297,7 @@ def _base_summary(setup: Setup, out: Path) -> dict:
 def _run_explicit(case, setup, out, case_path, checkpoint_every, restart, progress) -> dict:
     s = case.solver
     solver = ExplicitSolver(setup.model, setup.loading, dt=s.dt, safety=s.safety,
-                            damping=s.damping, damage=setup.damage)
+                            damping=s.damping, damage=setup.damage, contact=setup.contact)
     n_steps = s.steps if s.steps is not None else int(np.ceil(s.time / solver.dt - 1e-9))
     ckpt_path = out / "checkpoint.h5"
     if restart:
@@ -316,6 +330,8 @@ def _run_explicit(case, setup, out, case_path, checkpoint_every, restart, progre
                     "stable_dt_s": solver.stable_dt,
                     "kinetic_energy_j": solver.kinetic_energy(state),
                     "strain_energy_j": setup.model.strain_energy(state.u)})
+    if setup.contact is not None:
+        summary["contact_rebuilds"] = setup.contact.rebuilds
     recorder.finish(state)
     return summary
 
@@ -327,7 +343,7 @@ def _run_static(case, setup, out, case_path) -> dict:
     for k in range(1, s.load_steps + 1):
         result = relax(setup.model, setup.loading, time=k / s.load_steps, u0=u,
                        tolerance=s.tolerance, max_iterations=s.max_iterations,
-                       damage=setup.damage)
+                       damage=setup.damage, contact=setup.contact)
         u, iterations = result.u, iterations + result.iterations
         if not result.converged:
             raise InputError(

@@ -290,6 +290,23 @@ class Output(Strict):
     plots: bool = True
 
 
+class ContactSpec(Strict):
+    """Short-range contact forces between unbonded points (``peridyn.contact``): contact
+    distance as a multiple of the spacing (``radius``) or in metres (``radius_m``), and the
+    short-range constant as a multiple of the PMB micromodulus (``stiffness_factor``,
+    Peridigm's 15 by default)."""
+
+    radius: Positive | None = None
+    radius_m: Positive | None = None
+    stiffness_factor: Positive = 15.0
+
+    @model_validator(mode="after")
+    def _one_radius(self):
+        if (self.radius is None) == (self.radius_m is None):
+            raise ValueError("give exactly one of radius (multiple of the spacing) or radius_m")
+        return self
+
+
 class Case(Strict):
     """A whole simulation case."""
 
@@ -307,6 +324,7 @@ class Case(Strict):
     solver: Solver
     output: Output = Output()
     analysis: Analysis | None = None
+    contact: ContactSpec | None = None
 
     @model_validator(mode="after")
     def _sets_exist(self):

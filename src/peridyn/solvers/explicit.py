@@ -3,11 +3,13 @@
 One step of size dt (rho a = f(u) + b - rho c v, c the mass-proportional damping):
 
     v <- v + dt/2 a;  u <- u + dt v;  t <- t + dt;  impose prescribed u (and its v);
-    break over-stretched bonds;  a <- (f(u) + b(t)) / rho - c v;  a <- 0 on prescribed DOFs;
+    break over-stretched bonds;  a <- (f(u) + f_c(u) + b(t)) / rho - c v;  a <- 0 on prescribed DOFs;
     v <- v + dt/2 a;  impose prescribed v.
 
 The step defaults to ``safety`` times the model's stable step (``Model.critical_time_step``);
-a larger step given by the user is refused.
+a larger step given by the user is refused. With contact (``f_c``, the short-range
+forces of ``peridyn.contact``) the stable step comes from the sum of the model's and the
+contact's stiffness bounds, 2 / sqrt(max((s_model + s_contact) / rho)) (Gershgorin).
 """
 
 from __future__ import annotations
@@ -16,6 +18,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from peridyn.contact import Contact
 from peridyn.damage import BondDamage
 from peridyn.errors import InputError, InstabilityError
 from peridyn.loads import Loading
@@ -39,18 +42,21 @@ class ExplicitSolver:
     damage : BondDamage or None
     check_every : int
         Steps between checks for non-finite values.
+    contact : Contact or None
+        Short-range forces added to the model's force; their stiffness lowers the stable step.
     """
 
     def __init__(self, model: Model, loading: Loading | None = None, dt: float | None = None,
                  safety: float = 0.8, damping: float = 0.0, damage: BondDamage | None = None,
-                 check_every: int = 50):
+                 check_every: int = 50, contact: Contact | None = None):
         if not 0 < safety <= 1:
             raise InputError(f"time-step safety factor must lie in (0, 1], got {safety!r}")
         if damping < 0:
             raise InputError(f"damping must be non-negative, got {damping!r}")
         self.model = model
         self.loading = loading if loading is not None else Loading(model.body)
-        self.stable_dt = model.critical_time_step()
+        self.contact = contact
+        self.stable_dt = stable_time_step(model, contact)
         if dt is None:
             dt = safety * self.stable_dt
         elif not dt > 0:
@@ -83,6 +89,8 @@ class ExplicitSolver:
 
     def _acceleration(self, state: State) -> None:
         f = self.model.force(state.u, out=self._force)
+        if self.contact is not None:
+            self.contact.add_force(state.u, f)
         b = self.loading.body_force_density(state.time, self._body_force)
         a = state.a
         np.add(f, b, out=a)
@@ -130,6 +138,14 @@ class ExplicitSolver:
         """Total kinetic energy, J."""
         v2 = np.einsum("ij,ij->i", state.v, state.v)
         return float(0.5 * np.sum(self.model.density * self.model.body.volumes * v2))
+
+
+def stable_time_step(model: Model, contact: Contact | None = None) -> float:
+    """Largest stable velocity-Verlet step, s, of a model with optional contact."""
+    if contact is None:
+        return model.critical_time_step()
+    bound = model.stiffness_bound() + contact.stiffness_bound()
+    return float(2.0 / np.sqrt(np.max(bound / model.density)))
 
 
 def check_finite(state: State) -> None:

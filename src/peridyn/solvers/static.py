@@ -11,7 +11,8 @@ fictitious explicit integration stable. Each iteration n:
 
 the damping c tracking the lowest frequency of the current state. Converged
 when the out-of-balance force on the free DOFs is below ``tolerance`` times
-the larger of the applied load and the reactions.
+the larger of the applied load and the reactions. With contact, f includes the
+short-range forces and s_i their stiffness bound (``Contact.stiffness_bound``).
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from peridyn.contact import Contact
 from peridyn.damage import BondDamage
 from peridyn.errors import InputError
 from peridyn.loads import Loading
@@ -49,7 +51,8 @@ class RelaxationResult:
 
 def relax(model: Model, loading: Loading, time: float = 0.0, u0: np.ndarray | None = None,
           tolerance: float = 1e-6, max_iterations: int = 200_000,
-          damage: BondDamage | None = None, check_every: int = 20) -> RelaxationResult:
+          damage: BondDamage | None = None, check_every: int = 20,
+          contact: Contact | None = None) -> RelaxationResult:
     """Find the static equilibrium under the loads evaluated at ``time`` (s).
 
     Parameters
@@ -60,6 +63,8 @@ def relax(model: Model, loading: Loading, time: float = 0.0, u0: np.ndarray | No
         Relative residual force to reach.
     damage : BondDamage or None
         If given, bonds break as the body relaxes.
+    contact : Contact or None
+        Short-range forces between unbonded points, added to the model's force.
     """
     if not tolerance > 0:
         raise InputError(f"relaxation tolerance must be positive, got {tolerance!r}")
@@ -72,9 +77,17 @@ def relax(model: Model, loading: Loading, time: float = 0.0, u0: np.ndarray | No
     v[:] = 0.0
     free = ~loading.constrained
     free[:, model.body.dim:] = False
-    lam = np.repeat((0.25 * model.stiffness_bound())[:, None], 3, axis=1)
+    bound = model.stiffness_bound()
+    if contact is not None:
+        bound = bound + contact.stiffness_bound()
+    lam = np.repeat((0.25 * bound)[:, None], 3, axis=1)
+
+    def internal_force(u):
+        f = np.asarray(model.force(u), dtype=float)
+        return contact.add_force(u, f) if contact is not None else f
+
     b = loading.body_force_density(time, np.zeros((n, 3)))
-    f = np.asarray(model.force(u), dtype=float)
+    f = internal_force(u)
     f_prev = f.copy()
     c = 0.0
     broken = 0
@@ -90,7 +103,7 @@ def relax(model: Model, loading: Loading, time: float = 0.0, u0: np.ndarray | No
         u += v
         if damage is not None:
             broken += damage.update(u)
-        f_prev, f = f, np.asarray(model.force(u), dtype=float)
+        f_prev, f = f, internal_force(u)
         moving = np.abs(v) > 0
         k_loc = np.zeros_like(u)
         k_loc[moving] = -(f[moving] - f_prev[moving]) / (lam[moving] * v[moving])
