@@ -14,17 +14,20 @@ def break_stretched_bonds(x, u, offsets, nbr, length, critical_stretch, breakabl
     n = x.shape[0]
     count = np.zeros(n, dtype=np.int64)
     for i in numba.prange(n):
+        x0, x1, x2 = x[i, 0], x[i, 1], x[i, 2]
+        u0, u1, u2 = u[i, 0], u[i, 1], u[i, 2]
+        broken = 0
         for b in range(offsets[i], offsets[i + 1]):
-            if not (intact[b] and breakable[b]):
-                continue
             j = nbr[b]
-            r2 = 0.0
-            for a in range(3):
-                d = (x[j, a] - x[i, a]) + (u[j, a] - u[i, a])
-                r2 += d * d
-            if np.sqrt(r2) > length[b] * (1.0 + critical_stretch[b]):
+            d0 = (x[j, 0] - x0) + (u[j, 0] - u0)
+            d1 = (x[j, 1] - x1) + (u[j, 1] - u1)
+            d2 = (x[j, 2] - x2) + (u[j, 2] - u2)
+            limit = length[b] * (1.0 + critical_stretch[b])
+            # squared lengths: no square root, and the cheap test first
+            if d0 * d0 + d1 * d1 + d2 * d2 > limit * limit and intact[b] and breakable[b]:
                 intact[b] = False
-                count[i] += 1
+                broken += 1
+        count[i] = broken
     return count.sum()
 
 
