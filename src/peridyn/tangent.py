@@ -27,6 +27,7 @@ The first bracket is the bond block B: a stretch term along n and a geometric
 
 from __future__ import annotations
 
+import numba
 import numpy as np
 import scipy.sparse as sp
 
@@ -48,7 +49,7 @@ def tangent_stiffness(model: Model, u: np.ndarray) -> sp.csr_matrix:
     if isinstance(model, PMBModel):
         k = np.where(b.intact, model.bond_stiffness.astype(np.float64), 0.0)
         force = k * (r / length - 1.0)
-        jacobian = _bond_blocks(owners, nbr, n_vec, k / length, force / r, n)
+        jacobian = _bond_blocks(b.offsets, nbr, n_vec, k / length, force / r)
     elif isinstance(model, LPSModel):
         w = np.where(b.intact, model.w.astype(np.float64), 0.0)
         e = r - length
@@ -57,7 +58,7 @@ def tangent_stiffness(model: Model, u: np.ndarray) -> sp.csr_matrix:
         p = theta * p_coef
         a_sum = model.alpha[owners] + model.alpha[nbr]
         force = w * (length * (p[owners] + p[nbr]) + a_sum * e)
-        jacobian = _bond_blocks(owners, nbr, n_vec, w * a_sum, force / r, n)
+        jacobian = _bond_blocks(b.offsets, nbr, n_vec, w * a_sum, force / r)
         jacobian = jacobian + _dilatation_jacobian(model, owners, nbr, n_vec, w, p_coef)
     else:
         raise TypeError(f"no tangent for {type(model).__name__}")
@@ -65,20 +66,50 @@ def tangent_stiffness(model: Model, u: np.ndarray) -> sp.csr_matrix:
     return (-(vol @ jacobian)).tocsr()
 
 
-def _bond_blocks(owners, nbr, n_vec, stretch, geometric, n_points) -> sp.csr_matrix:
+def _bond_blocks(offsets, nbr, n_vec, stretch, geometric) -> sp.csr_matrix:
     """df/du of f_i = sum_j T n: block B = stretch n n^T + geometric (I - n n^T) per bond,
     +B on (i, j) and -B on (i, i). Shapes: (n_bonds,) and (n_bonds, 3)."""
-    nn = n_vec[:, :, None] * n_vec[:, None, :]
-    blocks = (stretch - geometric)[:, None, None] * nn + geometric[:, None, None] * np.eye(3)
-    a = np.arange(3)
-    rows = (3 * owners[:, None, None] + a[None, :, None]).repeat(3, axis=2).ravel()
-    cols_j = (3 * nbr[:, None, None] + a[None, None, :]).repeat(3, axis=1).ravel()
-    cols_i = (3 * owners[:, None, None] + a[None, None, :]).repeat(3, axis=1).ravel()
-    vals = blocks.ravel()
-    shape = (3 * n_points, 3 * n_points)
-    return sp.coo_matrix((np.concatenate([vals, -vals]),
-                          (np.concatenate([rows, rows]), np.concatenate([cols_j, cols_i]))),
-                         shape=shape).tocsr()
+    n = len(offsets) - 1
+    indptr, indices, data = _bond_blocks_csr(offsets, nbr, n_vec, stretch, geometric)
+    return sp.csr_matrix((data, indices, indptr), shape=(3 * n, 3 * n))
+
+
+@numba.njit(cache=True)
+def _bond_blocks_csr(offsets, nbr, n_vec, stretch, geometric):
+    """CSR arrays of ``_bond_blocks``: row 3 i + a holds the dofs of i and its family,
+    in increasing order (families are sorted by neighbour)."""
+    n = offsets.shape[0] - 1
+    nnz = 9 * (offsets[n] + n)
+    indptr = np.empty(3 * n + 1, dtype=np.int64)
+    indices = np.empty(nnz, dtype=np.int64)
+    data = np.zeros(nnz)
+    indptr[0] = 0
+    pos = 0
+    for i in range(n):
+        lo, hi = offsets[i], offsets[i + 1]
+        width = 3 * (hi - lo + 1)
+        # slot of point i among its sorted family
+        self_slot = 0
+        for b in range(lo, hi):
+            if nbr[b] < i:
+                self_slot += 1
+        for a in range(3):
+            row = 3 * i + a
+            start = pos + a * width
+            for b in range(lo, hi):
+                slot = b - lo + (1 if b - lo >= self_slot else 0)
+                for c in range(3):
+                    indices[start + 3 * slot + c] = 3 * nbr[b] + c
+                    block = (stretch[b] - geometric[b]) * n_vec[b, a] * n_vec[b, c]
+                    if a == c:
+                        block += geometric[b]
+                    data[start + 3 * slot + c] += block
+                    data[start + 3 * self_slot + c] -= block
+            for c in range(3):
+                indices[start + 3 * self_slot + c] = 3 * i + c
+            indptr[row + 1] = start + width
+        pos += 3 * width
+    return indptr, indices, data
 
 
 def _dilatation_jacobian(model: LPSModel, owners, nbr, n_vec, w, p_coef) -> sp.csr_matrix:
