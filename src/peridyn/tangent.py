@@ -45,7 +45,6 @@ def tangent_stiffness(model: Model, u: np.ndarray) -> sp.csr_matrix:
     r = np.linalg.norm(y, axis=1)
     n_vec = y / r[:, None]
     length = b.length
-    n = model.body.n_points
     if isinstance(model, PMBModel):
         k = np.where(b.intact, model.bond_stiffness.astype(np.float64), 0.0)
         force = k * (r / length - 1.0)

@@ -116,8 +116,8 @@ def _notched_plate():
 
 def test_bond_breaking_reequilibrates_until_no_bond_breaks():
     """Notched plate, top and bottom pulled by +-10 um (mean strain 1e-3), critical stretch
-    1.5e-3, damage disabled within 3.5 mm of the pulled edges
-    (as the thesis of seed 002 does near loaded ends): the notch tip concentrates the stretch, bonds there break and the body is
+    1.5e-3, damage disabled within 3.5 mm of the pulled edges (as the thesis of seed 002 does
+    near loaded ends): the notch tip concentrates the stretch, bonds there break and the body is
     re-equilibrated until none is over-stretched. At the end equilibrium holds (residual below
     the tolerance), no intact breakable bond exceeds s_c, and every broken bond lies near the
     notch's line (the crack grows from the tip along y = 10 mm)."""

@@ -243,9 +243,13 @@ class Solver(Strict):
     damping (1/s), kernel dtype; ``static``: adaptive dynamic relaxation with ``tolerance``,
     ``max_iterations`` and ``load_steps`` (the loads at t = 1 s, ramped linearly in steps);
     ``modal``: the ``modes`` lowest free-vibration modes (zero displacement conditions fix
-    their dofs; free-free otherwise)."""
+    their dofs; free-free otherwise); ``newton``: Newton-Raphson equilibrium with ``tolerance``
+    (relative residual), ``load_steps``, ``newton_iterations`` per solve and ``breaking_rounds``
+    (re-equilibrations per step after bonds break); ``newmark``: implicit dynamics (average
+    acceleration) with ``steps`` or ``time``, ``dt`` (s, required), ``displacement_tolerance``
+    (m, Newton increment; seed 004: 0.1 nm), ``newton_iterations`` and ``damping``."""
 
-    type: Literal["explicit", "static", "modal"] = "explicit"
+    type: Literal["explicit", "static", "modal", "newton", "newmark"] = "explicit"
     modes: Annotated[int, Field(ge=1)] = 12
     steps: Annotated[int, Field(ge=1)] | None = None
     time: Positive | None = None
@@ -256,6 +260,19 @@ class Solver(Strict):
     tolerance: Positive = 1e-6
     max_iterations: Annotated[int, Field(ge=1)] = 200_000
     load_steps: Annotated[int, Field(ge=1)] = 1
+    newton_iterations: Annotated[int, Field(ge=1)] = 30
+    breaking_rounds: Annotated[int, Field(ge=1)] = 100
+    displacement_tolerance: Positive = 1e-10
+
+    @model_validator(mode="after")
+    def _newmark(self):
+        if self.type == "newmark":
+            if (self.steps is None) == (self.time is None):
+                raise ValueError("a newmark run needs exactly one of steps or time (s)")
+            if self.dt is None:
+                raise ValueError("a newmark run needs dt (s): the implicit step is not bounded "
+                                 "by the explicit stable step, so no default is taken")
+        return self
 
     @model_validator(mode="after")
     def _duration(self):

@@ -115,7 +115,9 @@ class NewmarkSolver:
         mass = self.mass
         shift = (4.0 / dt**2 + 2.0 * c / dt) * mass[free]
         uf, u0f, v0f, a0f = u.reshape(-1), u_star.reshape(-1), state.v.reshape(-1), state.a.reshape(-1)
-        for it in range(1, self.max_iterations + 1):
+        taken = 0
+        for _ in range(self.max_iterations):
+            taken += 1
             a1 = 4.0 * (uf[free] - u0f[free]) / dt**2
             v1 = v0f[free] + 0.5 * dt * (a0f[free] + a1)
             r = self._out_of_balance(u, t1).reshape(-1)[free] - mass[free] * (a1 + c * v1)
@@ -131,7 +133,7 @@ class NewmarkSolver:
                 f"{self.max_iterations} Newton iterations (last increment "
                 f"{np.max(np.abs(du)):.3g} m > tolerance {self.tolerance:g} m): reduce dt"
             )
-        self.iterations.append(it)
+        self.iterations.append(taken)
         a_new = np.zeros_like(state.a)
         a_new.reshape(-1)[free] = 4.0 * (uf[free] - u0f[free]) / dt**2
         v_new.reshape(-1)[free] = v0f[free] + 0.5 * dt * (a0f[free] + a_new.reshape(-1)[free])
