@@ -151,6 +151,9 @@ def build(case: Case, base_dir=".") -> Setup:
     loading = build_loading(case, body, actuation)
     if case.solver.type == "static" and not loading.has_loads:
         raise CaseFileError(case.name, "boundary_conditions", [], "at least one load for a static run")
+    if case.solver.type == "newmark" and not (loading.has_loads or loading.initial):
+        raise CaseFileError(case.name, "boundary_conditions", [],
+                            "a load or an initial condition: nothing would move")
     if case.solver.type == "newton" and not loading.has_loads:
         raise CaseFileError(case.name, "boundary_conditions", [], "at least one load for a newton run")
     if case.solver.type == "explicit" and not (loading.has_loads or loading.initial):

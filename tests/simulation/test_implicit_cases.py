@@ -14,7 +14,7 @@ BAR = {
     "name": "bar",
     "geometry": {"type": "box", "size": [0.012, 0.004, 0.004]},
     "discretization": {"spacing": 1e-3, "horizon": 2.015},
-    "material": {"model": "lps", "E": 70e9, "nu": 0.3, "density": 2700},
+    "material": {"model": "pmb", "E": 70e9, "nu": 0.25, "density": 2700},
     "node_sets": {"clamp": {"type": "face", "face": "x-"}, "end": {"type": "face", "face": "x+"}},
     "boundary_conditions": [{"set": "end", "kind": "displacement", "components": "x",
                              "value": {"type": "ramp", "start": 0, "end": 1e-6,
@@ -36,7 +36,7 @@ def _case(solver, bcs=None):
 def test_newmark_case_records_like_the_explicit_one(tmp_path):
     """A bar whose end is pulled by a displacement ramp: the Newmark run (dt = 20 ns, below the
     explicit limit) writes the same sensor series as velocity Verlet at the same dt, within 2%
-    of the peak (measured 0.1%; both are second order in time)."""
+    of the peak (measured 0.3%; both are second order in time)."""
     explicit = run_case(_case({"type": "explicit", "steps": 60, "dt": 2e-8}), tmp_path / "e")
     implicit = run_case(_case({"type": "newmark", "steps": 60, "dt": 2e-8}), tmp_path / "i")
     assert implicit["steps"] == explicit["steps"] == 60
