@@ -368,7 +368,7 @@ def _newmark_solver(case, setup):
     s = case.solver
     return NewmarkSolver(setup.model, setup.loading, dt=s.dt, tolerance=s.displacement_tolerance,
                          max_iterations=s.newton_iterations, damping=s.damping,
-                         damage=setup.damage)
+                         damage=setup.damage, linear_solver=s.linear_solver)
 
 
 def _run_newton(case, setup, out, case_path) -> dict:
@@ -378,7 +378,7 @@ def _run_newton(case, setup, out, case_path) -> dict:
     s = case.solver
     result = newton(setup.model, setup.loading, load_steps=s.load_steps, tolerance=s.tolerance,
                     max_iterations=s.newton_iterations, damage=setup.damage,
-                    max_breaking_rounds=s.breaking_rounds)
+                    max_breaking_rounds=s.breaking_rounds, linear_solver=s.linear_solver)
     if not result.converged:
         step = len(result.steps)
         raise InputError(

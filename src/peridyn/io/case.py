@@ -247,7 +247,8 @@ class Solver(Strict):
     (relative residual), ``load_steps``, ``newton_iterations`` per solve and ``breaking_rounds``
     (re-equilibrations per step after bonds break); ``newmark``: implicit dynamics (average
     acceleration) with ``steps`` or ``time``, ``dt`` (s, required), ``displacement_tolerance``
-    (m, Newton increment; seed 004: 0.1 nm), ``newton_iterations`` and ``damping``."""
+    (m, Newton increment; seed 004: 0.1 nm), ``newton_iterations`` and ``damping``; both take
+    ``linear_solver`` (``lu``, or ``cg`` for large 3D bodies)."""
 
     type: Literal["explicit", "static", "modal", "newton", "newmark"] = "explicit"
     modes: Annotated[int, Field(ge=1)] = 12
@@ -263,6 +264,7 @@ class Solver(Strict):
     newton_iterations: Annotated[int, Field(ge=1)] = 30
     breaking_rounds: Annotated[int, Field(ge=1)] = 100
     displacement_tolerance: Positive = 1e-10
+    linear_solver: Literal["lu", "cg"] = "lu"
 
     @model_validator(mode="after")
     def _newmark(self):

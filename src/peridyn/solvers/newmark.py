@@ -30,7 +30,7 @@ from peridyn.loads import Loading
 from peridyn.materials.base import Model
 from peridyn.solvers.explicit import check_finite
 from peridyn.solvers.modal import free_dofs
-from peridyn.solvers.newton import solve_held
+from peridyn.solvers.newton import check_linear_solver, solve_held
 from peridyn.solvers.state import State
 from peridyn.stiffness import mass_matrix
 from peridyn.tangent import tangent_stiffness
@@ -53,11 +53,14 @@ class NewmarkSolver:
         Mass-proportional damping coefficient c.
     damage : BondDamage or None
         Over-stretched bonds break after each converged step.
+    linear_solver : {"lu", "cg"}
+        Sparse LU, or Jacobi-preconditioned conjugate gradients (the mass term makes the
+        effective tangent well conditioned, so CG needs few iterations on large bodies).
     """
 
     def __init__(self, model: Model, loading: Loading | None = None, dt: float = 20e-9,
                  tolerance: float = 1e-10, max_iterations: int = 20, damping: float = 0.0,
-                 damage: BondDamage | None = None):
+                 damage: BondDamage | None = None, linear_solver: str = "lu"):
         if not dt > 0:
             raise InputError(f"time step must be positive, got {dt!r}")
         if not tolerance > 0:
@@ -67,6 +70,8 @@ class NewmarkSolver:
                              f"{max_iterations!r}")
         if damping < 0:
             raise InputError(f"damping must be non-negative, got {damping!r}")
+        check_linear_solver(linear_solver)
+        self.linear_solver = linear_solver
         self.model = model
         self.loading = loading if loading is not None else Loading(model.body)
         self.dt = float(dt)
@@ -123,7 +128,7 @@ class NewmarkSolver:
             r = self._out_of_balance(u, t1).reshape(-1)[free] - mass[free] * (a1 + c * v1)
             k_eff = tangent_stiffness(self.model, u)[free][:, free]
             k_eff.setdiag(k_eff.diagonal() + shift)
-            du = solve_held(k_eff, r)
+            du = solve_held(k_eff, r, self.linear_solver)
             uf[free] += du
             if np.max(np.abs(du), initial=0.0) < self.tolerance:
                 break

@@ -6,7 +6,8 @@ out-of-balance force (N) is
     r(u) = V f(u) + V b,
 
 and each iteration solves ``K(u) du = r(u)`` with the consistent tangent
-``K = -d(V f)/du`` (``peridyn.tangent``) by a sparse LU factorisation, the
+``K = -d(V f)/du`` (``peridyn.tangent``) by a sparse LU factorisation (or
+Jacobi-preconditioned conjugate gradients to 1e-12 for large 3D systems), the
 prescribed dofs held at their values (elimination). Near the solution the
 residual falls quadratically, r_(k+1) ~ C r_k^2. Converged when
 ``|r| / max(|V b|, |reactions|) < tolerance`` (the reactions are the internal
@@ -31,7 +32,7 @@ import scipy.sparse as sp
 from scipy.sparse.linalg import splu
 
 from peridyn.damage import BondDamage
-from peridyn.errors import InputError
+from peridyn.errors import InputError, did_you_mean
 from peridyn.loads import Loading
 from peridyn.materials.base import Model
 from peridyn.solvers.modal import free_dofs
@@ -86,7 +87,8 @@ class NewtonResult:
 
 def newton(model: Model, loading: Loading, load_steps: int = 1, time: float = 1.0,
            u0: np.ndarray | None = None, tolerance: float = 1e-8, max_iterations: int = 30,
-           damage: BondDamage | None = None, max_breaking_rounds: int = 100) -> NewtonResult:
+           damage: BondDamage | None = None, max_breaking_rounds: int = 100,
+           linear_solver: str = "lu") -> NewtonResult:
     """Equilibrium under the loads ramped in ``load_steps`` steps up to ``time`` (s).
 
     Parameters
@@ -101,6 +103,8 @@ def newton(model: Model, loading: Loading, load_steps: int = 1, time: float = 1.
         Break over-stretched bonds after each converged step and re-equilibrate.
     max_breaking_rounds : int
         Re-equilibrations allowed per load step.
+    linear_solver : {"lu", "cg"}
+        Sparse LU, or Jacobi-preconditioned conjugate gradients for large systems.
     """
     if not tolerance > 0:
         raise InputError(f"Newton tolerance must be positive, got {tolerance!r}")
@@ -108,6 +112,7 @@ def newton(model: Model, loading: Loading, load_steps: int = 1, time: float = 1.
                         ("max_breaking_rounds", max_breaking_rounds)):
         if int(value) != value or value < 1:
             raise InputError(f"Newton {name} must be a positive integer, got {value!r}")
+    check_linear_solver(linear_solver)
     if not time > 0:
         raise InputError(f"Newton end time must be positive, got {time!r}")
     n = model.body.n_points
@@ -124,7 +129,7 @@ def newton(model: Model, loading: Loading, load_steps: int = 1, time: float = 1.
         step = NewtonStep(t)
         for _ in range(max_breaking_rounds + 1):
             u, history, converged = equilibrate(model, u, b, loading.constrained, tolerance,
-                                                max_iterations)
+                                                max_iterations, linear_solver)
             step.residuals.append(history)
             iterations += len(history) - 1
             residual = history[-1]
@@ -144,7 +149,8 @@ def newton(model: Model, loading: Loading, load_steps: int = 1, time: float = 1.
 
 
 def equilibrate(model: Model, u: np.ndarray, b: np.ndarray, constrained: np.ndarray,
-                tolerance: float, max_iterations: int) -> tuple[np.ndarray, list, bool]:
+                tolerance: float, max_iterations: int,
+                linear_solver: str = "lu") -> tuple[np.ndarray, list, bool]:
     """Newton iterations at fixed loads from ``u`` (n, 3), m; ``b`` body force density N/m^3.
 
     Returns the displacement, the relative residual before each iteration and at the
@@ -169,20 +175,64 @@ def equilibrate(model: Model, u: np.ndarray, b: np.ndarray, constrained: np.ndar
             return u, history, True
         if it == max_iterations:
             break
-        du = solve_held(tangent_stiffness(model, u)[free][:, free], r)
+        du = solve_held(tangent_stiffness(model, u)[free][:, free], r, linear_solver)
         u.ravel()[free] += du
     return u, history, False
 
 
-def solve_held(k_ff: sp.spmatrix, rhs: np.ndarray) -> np.ndarray:
-    """x with ``k_ff x = rhs`` by sparse LU; rows and columns with a zero diagonal
-    (dofs without stiffness, e.g. of a point whose bonds all broke) get x = 0."""
-    k_ff = k_ff.tocsc()
+#: Linear solvers for the Newton systems: sparse LU, or conjugate gradients with a Jacobi
+#: preconditioner (for large 3D systems, where the LU fill-in grows fast).
+LINEAR_SOLVERS = ("lu", "cg")
+
+#: Relative residual at which the conjugate gradients stop (Newton needs accurate solves).
+CG_RTOL = 1e-12
+
+
+def check_linear_solver(name: str) -> None:
+    """Raise InputError unless ``name`` is one of ``LINEAR_SOLVERS``."""
+    if name not in LINEAR_SOLVERS:
+        raise InputError(f"unknown linear solver {name!r}{did_you_mean(name, LINEAR_SOLVERS)}; "
+                         f"choose one of {LINEAR_SOLVERS}")
+
+
+def solve_held(k_ff: sp.spmatrix, rhs: np.ndarray, method: str = "lu") -> np.ndarray:
+    """x with ``k_ff x = rhs`` by sparse LU or Jacobi-preconditioned CG (``method``); rows and
+    columns with a zero diagonal (dofs without stiffness, e.g. of a point whose bonds all
+    broke) get x = 0."""
+    k_ff = k_ff.tocsc() if method == "lu" else k_ff.tocsr()
     active = np.flatnonzero(k_ff.diagonal() != 0)
     x = np.zeros(len(rhs))
-    if len(active):
-        x[active] = splu(k_ff[active][:, active].tocsc()).solve(rhs[active])
+    if len(active) == 0:
+        return x
+    k_aa = k_ff[active][:, active]
+    if method == "lu":
+        x[active] = splu(k_aa.tocsc()).solve(rhs[active])
+    else:
+        x[active] = _jacobi_cg(k_aa, rhs[active])
     return x
+
+
+def _jacobi_cg(a: sp.csr_matrix, rhs: np.ndarray) -> np.ndarray:
+    """Conjugate gradients with the diagonal of ``a`` as preconditioner, to ``CG_RTOL``."""
+    inv_diag = 1.0 / a.diagonal()
+    x = np.zeros_like(rhs)
+    r = rhs.copy()
+    z = inv_diag * r
+    p = z.copy()
+    rz = r @ z
+    target = CG_RTOL * np.linalg.norm(rhs)
+    for _ in range(10 * len(rhs)):
+        if np.linalg.norm(r) <= target:
+            return x
+        ap = a @ p
+        step = rz / (p @ ap)
+        x += step * p
+        r -= step * ap
+        z = inv_diag * r
+        rz, rz_old = r @ z, rz
+        p = z + (rz / rz_old) * p
+    raise InputError(f"conjugate gradients did not reach {CG_RTOL:g} in {10 * len(rhs)} "
+                     "iterations (is the tangent indefinite?): use linear_solver 'lu'")
 
 
 def rigid_support(model: Model) -> np.ndarray:
