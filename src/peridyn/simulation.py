@@ -153,6 +153,11 @@ def build(case: Case, base_dir=".") -> Setup:
     loading = build_loading(case, body, actuation)
     if case.solver.type == "static" and not loading.has_loads:
         raise CaseFileError(case.name, "boundary_conditions", [], "at least one load for a static run")
+    if case.solver.type == "newmark" and not (loading.has_loads or loading.initial):
+        raise CaseFileError(case.name, "boundary_conditions", [],
+                            "a load or an initial condition: nothing would move")
+    if case.solver.type == "newton" and not loading.has_loads:
+        raise CaseFileError(case.name, "boundary_conditions", [], "at least one load for a newton run")
     if case.solver.type == "explicit" and not (loading.has_loads or loading.initial):
         raise CaseFileError(case.name, "boundary_conditions", [],
                             "a load or an initial condition: nothing would move")
@@ -221,6 +226,11 @@ def run_case(case: Case, output_dir=None, case_path=None, checkpoint_every: int 
     out.mkdir(parents=True, exist_ok=True)
     if case.solver.type == "static":
         summary = _run_static(case, setup, out, case_path)
+    elif case.solver.type == "newton":
+        summary = _run_newton(case, setup, out, case_path)
+    elif case.solver.type == "newmark":
+        summary = _run_explicit(case, setup, out, case_path, checkpoint_every, restart, progress,
+                                solver=_newmark_solver(case, setup))
     elif case.solver.type == "modal":
         from peridyn.modal_run import run_modal
 
@@ -294,10 +304,13 @@ def _base_summary(setup: Setup, out: Path) -> dict:
             "broken_bonds": int((~setup.bonds.intact).sum()), "max_damage": float(phi.max())}
 
 
-def _run_explicit(case, setup, out, case_path, checkpoint_every, restart, progress) -> dict:
+def _run_explicit(case, setup, out, case_path, checkpoint_every, restart, progress,
+                  solver=None) -> dict:
+    """Time integration by ``solver`` (default: velocity Verlet from the case) with recording."""
     s = case.solver
-    solver = ExplicitSolver(setup.model, setup.loading, dt=s.dt, safety=s.safety,
-                            damping=s.damping, damage=setup.damage, contact=setup.contact)
+    if solver is None:
+        solver = ExplicitSolver(setup.model, setup.loading, dt=s.dt, safety=s.safety,
+                                damping=s.damping, damage=setup.damage, contact=setup.contact)
     n_steps = s.steps if s.steps is not None else int(np.ceil(s.time / solver.dt - 1e-9))
     ckpt_path = out / "checkpoint.h5"
     if restart:
@@ -359,6 +372,47 @@ def _run_static(case, setup, out, case_path) -> dict:
     summary = _base_summary(setup, out)
     summary.update({"steps": s.load_steps, "iterations": iterations,
                     "residual": result.residual,
+                    "strain_energy_j": setup.model.strain_energy(u)})
+    recorder.finish(state)
+    return summary
+
+
+def _newmark_solver(case, setup):
+    """The implicit Newmark solver of a ``newmark`` case."""
+    from peridyn.solvers.newmark import NewmarkSolver
+
+    s = case.solver
+    return NewmarkSolver(setup.model, setup.loading, dt=s.dt, tolerance=s.displacement_tolerance,
+                         max_iterations=s.newton_iterations, damping=s.damping,
+                         damage=setup.damage, linear_solver=s.linear_solver)
+
+
+def _run_newton(case, setup, out, case_path) -> dict:
+    """Newton-Raphson equilibrium of a ``newton`` case, recorded as one state at t = 1 s."""
+    from peridyn.solvers.newton import newton
+
+    s = case.solver
+    result = newton(setup.model, setup.loading, load_steps=s.load_steps, tolerance=s.tolerance,
+                    max_iterations=s.newton_iterations, damage=setup.damage,
+                    max_breaking_rounds=s.breaking_rounds, linear_solver=s.linear_solver)
+    if not result.converged:
+        step = len(result.steps)
+        raise InputError(
+            f"Newton load step {step}/{s.load_steps} did not converge (residual "
+            f"{result.residual:.3g}, tolerance {s.tolerance:g}, {s.newton_iterations} iterations, "
+            f"{s.breaking_rounds} breaking rounds): raise solver.load_steps or "
+            "solver.newton_iterations"
+        )
+    u = result.u
+    state = State(u, np.zeros_like(u), np.zeros_like(u), 1.0, s.load_steps)
+    spec = recorder_spec(case, setup.body, 1.0)
+    recorder = Recorder(setup.body, out, spec, provenance(case_path, case=case), setup.model)
+    recorder.record_series(state)
+    recorder.snapshot(state)
+    summary = _base_summary(setup, out)
+    summary.update({"steps": s.load_steps, "iterations": result.iterations,
+                    "residual": result.residual,
+                    "residual_history": [step.residuals for step in result.steps],
                     "strain_energy_j": setup.model.strain_energy(u)})
     recorder.finish(state)
     return summary

@@ -188,3 +188,10 @@ def test_case_contact_block_errors():
         breathing_case(stiffness_factor=10.0)
     with pytest.raises(CaseFileError, match="larger than the horizon"):
         build(breathing_case(radius=4.0))
+
+
+def test_contact_with_an_implicit_solver_is_refused():
+    """Newton and Newmark have no contact forces: the case must say so, not drop them."""
+    path = Path(__file__).resolve().parents[2] / "cases" / "lamb_breathing_crack.yaml"
+    with pytest.raises(CaseFileError, match="newmark solver has no contact forces"):
+        load_case(path, ["solver.type=newmark", "solver.dt=2e-8"])

@@ -243,9 +243,14 @@ class Solver(Strict):
     damping (1/s), kernel dtype; ``static``: adaptive dynamic relaxation with ``tolerance``,
     ``max_iterations`` and ``load_steps`` (the loads at t = 1 s, ramped linearly in steps);
     ``modal``: the ``modes`` lowest free-vibration modes (zero displacement conditions fix
-    their dofs; free-free otherwise)."""
+    their dofs; free-free otherwise); ``newton``: Newton-Raphson equilibrium with ``tolerance``
+    (relative residual), ``load_steps``, ``newton_iterations`` per solve and ``breaking_rounds``
+    (re-equilibrations per step after bonds break); ``newmark``: implicit dynamics (average
+    acceleration) with ``steps`` or ``time``, ``dt`` (s, required), ``displacement_tolerance``
+    (m, Newton increment; seed 004: 0.1 nm), ``newton_iterations`` and ``damping``; both take
+    ``linear_solver`` (``lu``, or ``cg`` for large 3D bodies)."""
 
-    type: Literal["explicit", "static", "modal"] = "explicit"
+    type: Literal["explicit", "static", "modal", "newton", "newmark"] = "explicit"
     modes: Annotated[int, Field(ge=1)] = 12
     steps: Annotated[int, Field(ge=1)] | None = None
     time: Positive | None = None
@@ -256,6 +261,20 @@ class Solver(Strict):
     tolerance: Positive = 1e-6
     max_iterations: Annotated[int, Field(ge=1)] = 200_000
     load_steps: Annotated[int, Field(ge=1)] = 1
+    newton_iterations: Annotated[int, Field(ge=1)] = 30
+    breaking_rounds: Annotated[int, Field(ge=1)] = 100
+    displacement_tolerance: Positive = 1e-10
+    linear_solver: Literal["lu", "cg"] = "lu"
+
+    @model_validator(mode="after")
+    def _newmark(self):
+        if self.type == "newmark":
+            if (self.steps is None) == (self.time is None):
+                raise ValueError("a newmark run needs exactly one of steps or time (s)")
+            if self.dt is None:
+                raise ValueError("a newmark run needs dt (s): the implicit step is not bounded "
+                                 "by the explicit stable step, so no default is taken")
+        return self
 
     @model_validator(mode="after")
     def _duration(self):
@@ -344,6 +363,9 @@ class Case(Strict):
             if name not in known:
                 raise ValueError(f"{where}: unknown node set {name!r}{did_you_mean(name, known)};"
                                  f" defined: {sorted(known)}")
+        if self.contact is not None and self.solver.type not in ("explicit", "static"):
+            raise ValueError(f"contact: the {self.solver.type} solver has no contact forces; "
+                             "contact works with solver.type explicit or static")
         a = self.analysis
         if a is not None and self.geometry.type != "plate":
             raise ValueError("analysis: Lamb-wave analyses need a plate geometry")

@@ -1,0 +1,260 @@
+"""Quasi-static equilibrium by Newton-Raphson with load stepping and bond breaking.
+
+At the free dofs (not prescribed, and not the z dofs of a 2D body) the
+out-of-balance force (N) is
+
+    r(u) = V f(u) + V b,
+
+and each iteration solves ``K(u) du = r(u)`` with the consistent tangent
+``K = -d(V f)/du`` (``peridyn.tangent``) by a sparse LU factorisation (or
+Jacobi-preconditioned conjugate gradients to 1e-12 for large 3D systems), the
+prescribed dofs held at their values (elimination). Near the solution the
+residual falls quadratically, r_(k+1) ~ C r_k^2. Converged when
+``|r| / max(|V b|, |reactions|) < tolerance`` (the reactions are the internal
+forces on the prescribed dofs), the criterion of ``relax`` with integrated forces.
+
+Load stepping: step k of n evaluates the loads at ``time * k / n`` and starts
+from step k-1's solution. With a ``BondDamage``, each converged step breaks the
+over-stretched bonds and re-equilibrates, repeatedly, until no bond breaks.
+Dofs whose tangent has no diagonal entry (points left without any bond) are held.
+A body with no prescribed motion at all gets a statically determinate support
+(``rigid_support``: 3-2-1 dofs in 3D, 2-1 in 2D) that removes its rigid-body modes
+and carries no reaction when the loads balance; partly supported bodies must be
+held against rigid motion by their own conditions.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.linalg import splu
+
+from peridyn.damage import BondDamage
+from peridyn.errors import InputError, did_you_mean
+from peridyn.loads import Loading
+from peridyn.materials.base import Model
+from peridyn.solvers.modal import free_dofs
+from peridyn.tangent import tangent_stiffness
+
+
+@dataclass
+class NewtonStep:
+    """One load step.
+
+    Attributes
+    ----------
+    time : float, s
+        Time at which the loads were evaluated.
+    residuals : list of list of float
+        Relative residual before each Newton iteration and at the end, one list per
+        equilibrium solve (the first, then one per round of bond breaking).
+    bonds_broken : int
+    converged : bool
+    """
+
+    time: float
+    residuals: list = field(default_factory=list)
+    bonds_broken: int = 0
+    converged: bool = False
+
+
+@dataclass
+class NewtonResult:
+    """Outcome of a Newton-Raphson solve (compare ``RelaxationResult``).
+
+    Attributes
+    ----------
+    u : (n_points, 3) float64, m
+    residual : float
+        Relative residual at the end of the last step.
+    iterations : int
+        Newton iterations (linear solves) over all steps.
+    converged : bool
+        Every step converged and stopped breaking bonds.
+    bonds_broken : int
+    steps : list of NewtonStep
+    """
+
+    u: np.ndarray
+    residual: float
+    iterations: int
+    converged: bool
+    bonds_broken: int
+    steps: list
+
+
+def newton(model: Model, loading: Loading, load_steps: int = 1, time: float = 1.0,
+           u0: np.ndarray | None = None, tolerance: float = 1e-8, max_iterations: int = 30,
+           damage: BondDamage | None = None, max_breaking_rounds: int = 100,
+           linear_solver: str = "lu") -> NewtonResult:
+    """Equilibrium under the loads ramped in ``load_steps`` steps up to ``time`` (s).
+
+    Parameters
+    ----------
+    u0 : (n_points, 3) float64 or None
+        Starting displacement, m.
+    tolerance : float
+        Relative residual to reach (see the module docstring).
+    max_iterations : int
+        Newton iterations per equilibrium solve.
+    damage : BondDamage or None
+        Break over-stretched bonds after each converged step and re-equilibrate.
+    max_breaking_rounds : int
+        Re-equilibrations allowed per load step.
+    linear_solver : {"lu", "cg"}
+        Sparse LU, or Jacobi-preconditioned conjugate gradients for large systems.
+    """
+    if not tolerance > 0:
+        raise InputError(f"Newton tolerance must be positive, got {tolerance!r}")
+    for name, value in (("load_steps", load_steps), ("max_iterations", max_iterations),
+                        ("max_breaking_rounds", max_breaking_rounds)):
+        if int(value) != value or value < 1:
+            raise InputError(f"Newton {name} must be a positive integer, got {value!r}")
+    check_linear_solver(linear_solver)
+    if not time > 0:
+        raise InputError(f"Newton end time must be positive, got {time!r}")
+    n = model.body.n_points
+    u = np.zeros((n, 3)) if u0 is None else np.array(u0, dtype=float)
+    if u.shape != (n, 3):
+        raise InputError(f"u0 must have shape ({n}, 3), got {u.shape}")
+    v = np.zeros((n, 3))
+    loading.apply_initial(u, v)
+    steps, iterations, broken_total, residual = [], 0, 0, np.inf
+    for k in range(1, load_steps + 1):
+        t = time * k / load_steps
+        loading.apply_kinematics(t, 1.0, u, v)
+        b = loading.body_force_density(t, np.zeros((n, 3)))
+        step = NewtonStep(t)
+        for _ in range(max_breaking_rounds + 1):
+            u, history, converged = equilibrate(model, u, b, loading.constrained, tolerance,
+                                                max_iterations, linear_solver)
+            step.residuals.append(history)
+            iterations += len(history) - 1
+            residual = history[-1]
+            if not converged:
+                break
+            broken = damage.update(u) if damage is not None else 0
+            step.bonds_broken += broken
+            if broken == 0:
+                step.converged = True
+                break
+        broken_total += step.bonds_broken
+        steps.append(step)
+        if not step.converged:
+            break
+    converged = len(steps) == load_steps and steps[-1].converged
+    return NewtonResult(u, float(residual), iterations, converged, broken_total, steps)
+
+
+def equilibrate(model: Model, u: np.ndarray, b: np.ndarray, constrained: np.ndarray,
+                tolerance: float, max_iterations: int,
+                linear_solver: str = "lu") -> tuple[np.ndarray, list, bool]:
+    """Newton iterations at fixed loads from ``u`` (n, 3), m; ``b`` body force density N/m^3.
+
+    Returns the displacement, the relative residual before each iteration and at the
+    end, and whether it converged.
+    """
+    u = u.copy()
+    vol = np.repeat(model.body.volumes, 3)
+    support = constrained if constrained.any() else rigid_support(model)
+    free = free_dofs(model, support)
+    held = np.flatnonzero(constrained.ravel())
+    load = np.linalg.norm(vol * b.ravel())
+    history = []
+    for it in range(max_iterations + 1):
+        force = vol * (np.asarray(model.force(u), dtype=float) + b).ravel()
+        scale = max(load, np.linalg.norm(force[held]))
+        r = force[free]
+        residual = float(np.linalg.norm(r) / scale) if scale > 0 else float(np.linalg.norm(r))
+        history.append(residual)
+        if not np.isfinite(residual):
+            return u, history, False
+        if residual < tolerance:
+            return u, history, True
+        if it == max_iterations:
+            break
+        du = solve_held(tangent_stiffness(model, u)[free][:, free], r, linear_solver)
+        u.ravel()[free] += du
+    return u, history, False
+
+
+#: Linear solvers for the Newton systems: sparse LU, or conjugate gradients with a Jacobi
+#: preconditioner (for large 3D systems, where the LU fill-in grows fast).
+LINEAR_SOLVERS = ("lu", "cg")
+
+#: Relative residual at which the conjugate gradients stop (Newton needs accurate solves).
+CG_RTOL = 1e-12
+
+
+def check_linear_solver(name: str) -> None:
+    """Raise InputError unless ``name`` is one of ``LINEAR_SOLVERS``."""
+    if name not in LINEAR_SOLVERS:
+        raise InputError(f"unknown linear solver {name!r}{did_you_mean(name, LINEAR_SOLVERS)}; "
+                         f"choose one of {LINEAR_SOLVERS}")
+
+
+def solve_held(k_ff: sp.spmatrix, rhs: np.ndarray, method: str = "lu") -> np.ndarray:
+    """x with ``k_ff x = rhs`` by sparse LU or Jacobi-preconditioned CG (``method``); rows and
+    columns with a zero diagonal (dofs without stiffness, e.g. of a point whose bonds all
+    broke) get x = 0."""
+    k_ff = k_ff.tocsc() if method == "lu" else k_ff.tocsr()
+    active = np.flatnonzero(k_ff.diagonal() != 0)
+    x = np.zeros(len(rhs))
+    if len(active) == 0:
+        return x
+    k_aa = k_ff[active][:, active]
+    if method == "lu":
+        x[active] = splu(k_aa.tocsc()).solve(rhs[active])
+    else:
+        x[active] = _jacobi_cg(k_aa, rhs[active])
+    return x
+
+
+def _jacobi_cg(a: sp.csr_matrix, rhs: np.ndarray) -> np.ndarray:
+    """Conjugate gradients with the diagonal of ``a`` as preconditioner, to ``CG_RTOL``."""
+    inv_diag = 1.0 / a.diagonal()
+    x = np.zeros_like(rhs)
+    r = rhs.copy()
+    z = inv_diag * r
+    p = z.copy()
+    rz = r @ z
+    target = CG_RTOL * np.linalg.norm(rhs)
+    for _ in range(10 * len(rhs)):
+        if np.linalg.norm(r) <= target:
+            return x
+        ap = a @ p
+        step = rz / (p @ ap)
+        x += step * p
+        r -= step * ap
+        z = inv_diag * r
+        rz, rz_old = r @ z, rz
+        p = z + (rz / rz_old) * p
+    raise InputError(f"conjugate gradients did not reach {CG_RTOL:g} in {10 * len(rhs)} "
+                     "iterations (is the tangent indefinite?): use linear_solver 'lu'")
+
+
+def rigid_support(model: Model) -> np.ndarray:
+    """(n_points, 3) bool: dofs of a statically determinate support (3-2-1 rule).
+
+    Point A (nearest the centroid) is held in every in-plane direction; point B (farthest
+    from A) across the line AB; in 3D, point C (farthest from that line) across the plane ABC.
+    Each direction is the coordinate axis closest to it.
+    """
+    x = model.body.points
+    dim = model.body.dim
+    held = np.zeros((len(x), 3), dtype=bool)
+    a = int(np.argmin(np.linalg.norm(x - x.mean(axis=0), axis=1)))
+    held[a, :dim] = True
+    along = x - x[a]
+    b = int(np.argmax(np.linalg.norm(along, axis=1)))
+    ab = along[b] / np.linalg.norm(along[b])
+    across = np.argsort(np.abs(ab[:dim]))[: dim - 1]  # the axes least along AB
+    held[b, across] = True
+    if dim == 3:
+        off_line = along - np.outer(along @ ab, ab)
+        c = int(np.argmax(np.linalg.norm(off_line, axis=1)))
+        normal = np.cross(ab, along[c])
+        held[c, int(np.argmax(np.abs(normal)))] = True
+    return held
