@@ -364,15 +364,21 @@ def _run_static(case, setup, out, case_path) -> dict:
                 f"iterations (residual {result.residual:.3g} > {s.tolerance:g}): raise "
                 "solver.max_iterations or solver.load_steps"
             )
-    state = State(u, np.zeros_like(u), np.zeros_like(u), 1.0, s.load_steps)
+    return _record_equilibrium(case, setup, out, case_path, u,
+                               {"steps": s.load_steps, "iterations": iterations,
+                                "residual": result.residual})
+
+
+def _record_equilibrium(case, setup, out, case_path, u, results: dict) -> dict:
+    """Record a quasi-static solution ``u`` as one state at t = 1 s; the run's summary."""
+    state = State(u, np.zeros_like(u), np.zeros_like(u), 1.0, results["steps"])
     spec = recorder_spec(case, setup.body, 1.0)
     recorder = Recorder(setup.body, out, spec, provenance(case_path, case=case), setup.model)
     recorder.record_series(state)
     recorder.snapshot(state)
     summary = _base_summary(setup, out)
-    summary.update({"steps": s.load_steps, "iterations": iterations,
-                    "residual": result.residual,
-                    "strain_energy_j": setup.model.strain_energy(u)})
+    summary.update(results)
+    summary["strain_energy_j"] = setup.model.strain_energy(u)
     recorder.finish(state)
     return summary
 
@@ -403,16 +409,7 @@ def _run_newton(case, setup, out, case_path) -> dict:
             f"{s.breaking_rounds} breaking rounds): raise solver.load_steps or "
             "solver.newton_iterations"
         )
-    u = result.u
-    state = State(u, np.zeros_like(u), np.zeros_like(u), 1.0, s.load_steps)
-    spec = recorder_spec(case, setup.body, 1.0)
-    recorder = Recorder(setup.body, out, spec, provenance(case_path, case=case), setup.model)
-    recorder.record_series(state)
-    recorder.snapshot(state)
-    summary = _base_summary(setup, out)
-    summary.update({"steps": s.load_steps, "iterations": result.iterations,
-                    "residual": result.residual,
-                    "residual_history": [step.residuals for step in result.steps],
-                    "strain_energy_j": setup.model.strain_energy(u)})
-    recorder.finish(state)
-    return summary
+    return _record_equilibrium(case, setup, out, case_path, result.u,
+                               {"steps": s.load_steps, "iterations": result.iterations,
+                                "residual": result.residual,
+                                "residual_history": [step.residuals for step in result.steps]})
