@@ -345,17 +345,17 @@ def plate_wavenumbers(cell: BlochCell, frequencies) -> list[dict]:
     frequency_hz and wavenumber_rad_m (None above the zone edge)."""
     bases = {"S0": plate_basis(cell, "S"), "A0": plate_basis(cell, "A"),
              "SH0": plate_basis(cell, "SH", 1)}
-    out = []
-    for f in np.atleast_1d(np.asarray(frequencies, dtype=np.float64)):
-        for mode, basis in bases.items():
-            out.append({"mode": mode, "frequency_hz": float(f),
-                        "wavenumber_rad_m": branch_wavenumber(cell, 2 * np.pi * f, basis)})
-    return out
+    return _mode_wavenumbers(cell, frequencies, bases)
 
 
 def block_wavenumbers(cell: BlochCell, frequencies) -> list[dict]:
     """Discrete wavenumbers along x of the P (u_x) and S (u_y) bulk waves at each frequency (Hz)."""
     bases = {"P": np.eye(3)[:, [0]], "S": np.eye(3)[:, [1]]}
+    return _mode_wavenumbers(cell, frequencies, bases)
+
+
+def _mode_wavenumbers(cell: BlochCell, frequencies, bases: dict) -> list[dict]:
+    """For each frequency (Hz) and each named polarisation basis, the branch's wavenumber."""
     out = []
     for f in np.atleast_1d(np.asarray(frequencies, dtype=np.float64)):
         for mode, basis in bases.items():
