@@ -6,10 +6,12 @@ share of the horizon disc across the crack line, 0.39 for a horizon of 3 spacing
 0.5 on the line itself), while a point ahead of a crack tip stays below ~0.3; 0.35
 separates the two. Cracked points closer than ``link`` (1.5 spacings) form clusters.
 
-Each cluster gives one main path: the longest path (tree diameter) of the cluster's
-minimum spanning tree, every vertex then replaced by the centroid of the cracked points
-within one ``link`` of it (this folds the two damaged rows of a crack onto its mid-line)
-and the polyline thinned to vertices one spacing apart. Cracked points farther than two
+Each cluster gives one main path, its mid-line by geodesic level sets: along the graph
+of links, find the point farthest from an arbitrary one (one end of the crack), sort the
+cluster's points by their link-path distance from that end into bins one spacing wide,
+and join the bins' centroids. This folds the damaged band of a crack (two rows wide in the
+bulk, up to about a horizon wide where it meets a free edge or branches) onto its mid-line;
+a path's ends lie up to about half a spacing inside the band's ends. Cracked points farther than two
 spacings from the main path that are themselves a cluster of at least ``min_points``
 give further paths (branches), reported after the main one.
 
@@ -25,7 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import connected_components, minimum_spanning_tree, shortest_path
+from scipy.sparse.csgraph import connected_components, shortest_path
 from scipy.spatial import cKDTree
 
 from peridyn.errors import InputError
@@ -127,30 +129,26 @@ def _paths_of_cluster(xy, spacing, lines, min_points) -> list[CrackPath]:
 
 
 def _main_polyline(xy: np.ndarray, link: float, spacing: float) -> np.ndarray:
-    """Mid-line polyline of the longest path of the cluster's minimum spanning tree."""
+    """Mid-line polyline of a connected cluster (module docstring)."""
     if len(xy) == 1:
         return xy.copy()
-    # link the whole cluster (a cluster is connected at ``link``)
-    tree = minimum_spanning_tree(_link_graph(xy, link))
-    far = _farthest(tree, 0)[0]
-    end, predecessors = _farthest(tree, far)
-    order = [end]
-    while order[-1] != far:
-        order.append(predecessors[order[-1]])
-    vertices = xy[order]
-    # fold the damaged rows onto the mid-line: centroid of the cracked points near each vertex
-    near = cKDTree(xy).query_ball_point(vertices, link)
-    mid = np.array([xy[idx].mean(axis=0) for idx in near])
+    graph = _link_graph(xy, link)
+    end = int(np.argmax(_geodesic(graph, 0)))
+    level = np.floor(_geodesic(graph, end) / spacing).astype(np.int64)
+    counts = np.bincount(level)
+    used = counts > 0
+    mid = np.stack([np.bincount(level, weights=xy[:, a])[used] / counts[used] for a in (0, 1)],
+                   axis=1)
     mid = _thin(mid, spacing)
     if mid[-1, 0] < mid[0, 0] or (mid[-1, 0] == mid[0, 0] and mid[-1, 1] < mid[0, 1]):
         mid = mid[::-1]
     return mid
 
 
-def _farthest(tree, source: int):
-    dist, pred = shortest_path(tree, directed=False, indices=source, return_predecessors=True)
-    dist = np.where(np.isfinite(dist), dist, -1.0)
-    return int(np.argmax(dist)), pred
+def _geodesic(graph, source: int) -> np.ndarray:
+    """Link-path distance (m) of every point of a connected cluster from ``source``."""
+    dist = shortest_path(graph, directed=False, indices=source)
+    return np.where(np.isfinite(dist), dist, 0.0)
 
 
 def _thin(polyline: np.ndarray, step: float) -> np.ndarray:
