@@ -7,7 +7,7 @@ from pathlib import Path
 import pytest
 
 sys.path.insert(0, str(Path(__file__).parents[1] / "examples"))
-from test_seed004_stretch import check_straight_crack_from_both_tips, run_stretch  # noqa: E402
+from test_seed004_short import check_straight_crack_from_both_tips, run_stretch  # noqa: E402
 
 
 @pytest.mark.slow
