@@ -6,12 +6,15 @@ share of the horizon disc across the crack line, 0.39 for a horizon of 3 spacing
 0.5 on the line itself), while a point ahead of a crack tip stays below ~0.3; 0.35
 separates the two. Cracked points closer than ``link`` (1.5 spacings) form clusters.
 
-Each cluster gives one main path, its mid-line by geodesic level sets: along the graph
-of links, find the point farthest from an arbitrary one (one end of the crack), sort the
-cluster's points by their link-path distance from that end into bins one spacing wide,
-and join the bins' centroids. This folds the damaged band of a crack (two rows wide in the
-bulk, up to about a horizon wide where it meets a free edge or branches) onto its mid-line;
-a path's ends lie up to about half a spacing inside the band's ends. Cracked points farther than two
+Each cluster gives one main path, its mid-line: in the graph linking cracked points closer
+than 2.5 spacings, find the point farthest from an arbitrary one (one end, e1), the point
+farthest from e1 (the other end, e2) and the shortest route between them. Every cracked
+point within three spacings of the route takes the arc length of its nearest route vertex;
+points are binned by it two spacings wide and the bins' centroids joined (this folds the
+damaged band, two rows wide in the bulk and up to about a horizon wide where a crack meets
+a free edge or branches, onto its mid-line, while the points of a branch stay out of it).
+The two end vertices move outwards along the end segments to the farthest point of their
+bins, and the polyline is thinned to vertices at least a spacing apart. Cracked points farther than two
 spacings from the main path that are themselves a cluster of at least ``min_points``
 give further paths (branches), reported after the main one.
 
@@ -33,6 +36,9 @@ from scipy.spatial import cKDTree
 from peridyn.errors import InputError
 
 DEFAULT_THRESHOLD = 0.35
+GEODESIC_LINK = 2.5  # spacings: links of the graph for path distances (near-Euclidean)
+BIN_WIDTH = 2.0      # spacings: width of the level-set bins along a crack
+BAND = 3.0           # spacings: half-width of the band of points around a route
 
 
 @dataclass
@@ -132,23 +138,47 @@ def _main_polyline(xy: np.ndarray, link: float, spacing: float) -> np.ndarray:
     """Mid-line polyline of a connected cluster (module docstring)."""
     if len(xy) == 1:
         return xy.copy()
-    graph = _link_graph(xy, link)
-    end = int(np.argmax(_geodesic(graph, 0)))
-    level = np.floor(_geodesic(graph, end) / spacing).astype(np.int64)
+    graph = _link_graph(xy, GEODESIC_LINK * spacing)
+    first = int(np.argmax(_geodesic(graph, 0)[0]))
+    from_first, predecessors = _geodesic(graph, first)
+    order = [int(np.argmax(from_first))]
+    while order[-1] != first:
+        order.append(int(predecessors[order[-1]]))
+    route = xy[order]
+    arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(route, axis=0), axis=1))])
+    dist, nearest = cKDTree(route).query(xy)
+    near = dist <= BAND * spacing
+    xy = xy[near]
+    level = np.floor(arc[nearest[near]] / (BIN_WIDTH * spacing)).astype(np.int64)
     counts = np.bincount(level)
     used = counts > 0
     mid = np.stack([np.bincount(level, weights=xy[:, a])[used] / counts[used] for a in (0, 1)],
                    axis=1)
+    if len(mid) > 1:
+        mid[0] = _extended_end(mid[0], mid[1], xy[level == level.min()])
+        mid[-1] = _extended_end(mid[-1], mid[-2], xy[level == level.max()])
     mid = _thin(mid, spacing)
     if mid[-1, 0] < mid[0, 0] or (mid[-1, 0] == mid[0, 0] and mid[-1, 1] < mid[0, 1]):
         mid = mid[::-1]
     return mid
 
 
-def _geodesic(graph, source: int) -> np.ndarray:
-    """Link-path distance (m) of every point of a connected cluster from ``source``."""
-    dist = shortest_path(graph, directed=False, indices=source)
-    return np.where(np.isfinite(dist), dist, 0.0)
+def _extended_end(end: np.ndarray, inner: np.ndarray, end_points: np.ndarray) -> np.ndarray:
+    """``end`` moved outwards along the last segment to the farthest of its bin's points."""
+    direction = end - inner
+    norm = np.linalg.norm(direction)
+    if norm == 0:
+        return end
+    direction /= norm
+    reach = float(np.max((end_points - end) @ direction))
+    return end + max(reach, 0.0) * direction
+
+
+def _geodesic(graph, source: int):
+    """Link-path distance (m) of every point of a connected cluster from ``source``, and the
+    predecessors along the shortest paths."""
+    dist, pred = shortest_path(graph, directed=False, indices=source, return_predecessors=True)
+    return np.where(np.isfinite(dist), dist, 0.0), pred
 
 
 def _thin(polyline: np.ndarray, step: float) -> np.ndarray:
