@@ -216,12 +216,13 @@ def run_case(case: Case, output_dir=None, case_path=None, checkpoint_every: int 
         summary = _run_explicit(case, setup, out, case_path, checkpoint_every, restart, progress)
     analysis, figures = analyse(case, setup.body, out, plots=case.output.plots)
     summary.update(analysis)
-    if setup.damage is not None:
-        summary["crack_paths"] = [p.summary() for p in final_crack_paths(case, setup)]
+    paths = final_crack_paths(case, setup) if setup.damage is not None else None
+    if paths is not None:
+        summary["crack_paths"] = [p.summary() for p in paths]
     if case.output.plots and case.solver.type != "modal":  # a modal run draws its own
         summary["plots"] = [str(p) for p in [*draw_run_figures(case, setup.body, out), *figures]]
-        if setup.damage is not None:
-            summary["plots"] += [str(p) for p in draw_crack_figures(case, setup, out, summary)]
+        if paths is not None:
+            summary["plots"] += [str(p) for p in draw_crack_figures(setup, out, paths, summary)]
     summary["seconds"] = time.perf_counter() - start
     store_summary(out / "results.h5", setup.body, summary)
     return summary
@@ -353,15 +354,15 @@ def final_crack_paths(case: Case, setup: Setup):
                        reference_lines=lines)
 
 
-def draw_crack_figures(case: Case, setup: Setup, out: Path, summary: dict) -> list[Path]:
-    """Damage map on the deformed configuration (x50, as seed 004) with the crack paths,
-    and the crack length against time when it was sampled."""
+def draw_crack_figures(setup: Setup, out: Path, paths, summary: dict) -> list[Path]:
+    """Damage map on the deformed configuration (x50, as seed 004, or less) with the crack
+    ``paths``, and the crack length against time when it was sampled."""
     from peridyn.io.hdf5 import read_array
     from peridyn.plotting.crack import plot_crack_length, plot_damage_map
 
     u = read_array(out / "results.h5", "final/u")
-    figures = [plot_damage_map(setup.body.points, u, damage_field(setup.model),
-                               final_crack_paths(case, setup), out / "crack_paths.png")]
+    figures = [plot_damage_map(setup.body.points, u, damage_field(setup.model), paths,
+                               out / "crack_paths.png")]
     history = summary.get("crack_length_history")
     if history and len(history["time_s"]) > 1:
         figures.append(plot_crack_length(history["time_s"], history["length_m"],

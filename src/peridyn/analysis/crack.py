@@ -33,6 +33,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components, shortest_path
 from scipy.spatial import cKDTree
 
+from peridyn.damage import damage_field
 from peridyn.errors import InputError
 
 DEFAULT_THRESHOLD = 0.35
@@ -253,8 +254,6 @@ class CrackLengthObserver:
 
     def sample(self, time: float) -> None:
         """Record the crack length of the current damage at ``time`` (s)."""
-        from peridyn.damage import damage_field
-
         body = self.model.body
         self.times.append(float(time))
         self.lengths.append(total_crack_length(body.points, damage_field(self.model),
