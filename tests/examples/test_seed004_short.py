@@ -6,7 +6,6 @@ from pathlib import Path
 
 import numpy as np
 
-from peridyn.analysis.crack import crack_paths
 from peridyn.damage import damage_field
 from peridyn.io.case import load_case
 from peridyn.simulation import build
@@ -52,5 +51,3 @@ def test_fast_stretch_grows_straight_crack_from_both_tips():
     body, phi = run_stretch([ramp.format(0), ramp.format(1), "solver.time=20.0e-6"])
     rows = check_straight_crack_from_both_tips(body, phi)
     assert rows.min() < 0.5e-3 and rows.max() > 3.5e-3  # it has run through most of the height
-    path = crack_paths(body.points, phi, body.spacing)[0]
-    assert abs(abs(path.angle_deg) - 90.0) < 10.0  # the extracted path is across the load

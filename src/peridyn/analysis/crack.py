@@ -13,8 +13,9 @@ point within three spacings of the route takes the arc length of its nearest rou
 points are binned by it two spacings wide and the bins' centroids joined (this folds the
 damaged band, two rows wide in the bulk and up to about a horizon wide where a crack meets
 a free edge or branches, onto its mid-line, while the points of a branch stay out of it).
-The two end vertices move outwards along the end segments to the farthest point of their
-bins, and the polyline is thinned to vertices at least a spacing apart. Cracked points farther than two
+The two end vertices move outwards (along the line from the centroid three bins in, so that
+the fanned damage where a crack meets an edge does not tilt them) to the farthest point of
+their bins, and the polyline is thinned to vertices at least a spacing apart. Cracked points farther than two
 spacings from the main path that are themselves a cluster of at least ``min_points``
 give further paths (branches), reported after the main one.
 
@@ -40,6 +41,7 @@ DEFAULT_THRESHOLD = 0.35
 GEODESIC_LINK = 2.5  # spacings: links of the graph for path distances (near-Euclidean)
 BIN_WIDTH = 2.0      # spacings: width of the level-set bins along a crack
 BAND = 3.0           # spacings: half-width of the band of points around a route
+END_SPAN = 3         # bins: the direction in which an end vertex moves out is over this many
 
 
 @dataclass
@@ -156,8 +158,9 @@ def _main_polyline(xy: np.ndarray, link: float, spacing: float) -> np.ndarray:
     mid = np.stack([np.bincount(level, weights=xy[:, a])[used] / counts[used] for a in (0, 1)],
                    axis=1)
     if len(mid) > 1:
-        mid[0] = _extended_end(mid[0], mid[1], xy[level == level.min()])
-        mid[-1] = _extended_end(mid[-1], mid[-2], xy[level == level.max()])
+        inner = min(END_SPAN, len(mid) - 1)
+        mid[0] = _extended_end(mid[0], mid[inner], xy[level == level.min()])
+        mid[-1] = _extended_end(mid[-1], mid[-1 - inner], xy[level == level.max()])
     mid = _thin(mid, spacing)
     if mid[-1, 0] < mid[0, 0] or (mid[-1, 0] == mid[0, 0] and mid[-1, 1] < mid[0, 1]):
         mid = mid[::-1]
@@ -165,7 +168,8 @@ def _main_polyline(xy: np.ndarray, link: float, spacing: float) -> np.ndarray:
 
 
 def _extended_end(end: np.ndarray, inner: np.ndarray, end_points: np.ndarray) -> np.ndarray:
-    """``end`` moved outwards along the last segment to the farthest of its bin's points."""
+    """``end`` moved outwards, along the direction from ``inner`` to it, to the farthest of its
+    bin's points."""
     direction = end - inner
     norm = np.linalg.norm(direction)
     if norm == 0:
