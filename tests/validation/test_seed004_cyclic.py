@@ -16,7 +16,6 @@ from peridyn.solvers import ExplicitSolver
 CASE = Path(__file__).parents[2] / "cases" / "plate2d_cyclic.yaml"
 
 
-@pytest.mark.slow
 @pytest.mark.parametrize("spacing", [0.125e-3, 0.0625e-3])
 def test_cyclic_case_gives_skew_branches(spacing):
     """Skew: paths at least 1 mm long whose start-end line is 45-80 degrees from the load
