@@ -149,7 +149,8 @@ def build(case: Case, base_dir=".") -> Setup:
     damage = None
     if mat.damage is not None:
         damage = BondDamage(model, mat.damage.critical_stretch, mat.damage.fracture_energy,
-                            mat.damage.no_damage_sets)
+                            mat.damage.no_damage_sets,
+                            critical_bond_stress=mat.damage.critical_bond_stress)
     loading = build_loading(case, body, actuation)
     if case.solver.type == "static" and not loading.has_loads:
         raise CaseFileError(case.name, "boundary_conditions", [], "at least one load for a static run")
@@ -239,8 +240,13 @@ def run_case(case: Case, output_dir=None, case_path=None, checkpoint_every: int 
         summary = _run_explicit(case, setup, out, case_path, checkpoint_every, restart, progress)
     analysis, figures = analyse(case, setup.body, out, plots=case.output.plots)
     summary.update(analysis)
+    paths = final_crack_paths(case, setup) if setup.damage is not None else None
+    if paths is not None:
+        summary["crack_paths"] = [p.summary() for p in paths]
     if case.output.plots and case.solver.type != "modal":  # a modal run draws its own
         summary["plots"] = [str(p) for p in [*draw_run_figures(case, setup.body, out), *figures]]
+        if paths is not None:
+            summary["plots"] += [str(p) for p in draw_crack_figures(setup, out, paths, summary)]
     summary["seconds"] = time.perf_counter() - start
     store_summary(out / "results.h5", setup.body, summary)
     return summary
@@ -325,6 +331,9 @@ def _run_explicit(case, setup, out, case_path, checkpoint_every, restart, progre
         recorder.record_series(state)
         recorder.snapshot(state)
     observers = [recorder]
+    cracks = _crack_observer(case, setup, n_steps)
+    if cracks is not None:
+        observers.append(cracks)
     if checkpoint_every:
         observers.append(Checkpointer(ckpt_path, checkpoint_every, setup.bonds.intact))
     remaining = n_steps - state.step
@@ -345,8 +354,49 @@ def _run_explicit(case, setup, out, case_path, checkpoint_every, restart, progre
                     "strain_energy_j": setup.model.strain_energy(state.u)})
     if setup.contact is not None:
         summary["contact_rebuilds"] = setup.contact.rebuilds
+    if cracks is not None:
+        summary["crack_length_history"] = cracks.history()
     recorder.finish(state)
     return summary
+
+
+def _crack_observer(case, setup, n_steps):
+    """Crack length against time, sampled at the snapshots (or 100 times a run) of a case
+    with damage; None without damage."""
+    if setup.damage is None:
+        return None
+    from peridyn.analysis.crack import CrackLengthObserver
+
+    every = case.output.snapshot_every or max(1, n_steps // 100)
+    return CrackLengthObserver(setup.model, every)
+
+
+def final_crack_paths(case: Case, setup: Setup):
+    """Crack paths of the final damage field (pre-cracks as reference lines; 2D bodies or
+    the x-y projection of 3D ones)."""
+    from peridyn.analysis.crack import crack_paths
+
+    lines = [(c.start, c.end) for c in case.precracks if c.type == "segment"]
+    lines += [(c.origin, np.add(c.origin, c.edge_u)) for c in case.precracks
+              if c.type == "rectangle"]
+    return crack_paths(setup.body.points, damage_field(setup.model), setup.body.spacing,
+                       reference_lines=lines)
+
+
+def draw_crack_figures(setup: Setup, out: Path, paths, summary: dict) -> list[Path]:
+    """Damage map on the deformed configuration (x50, as seed 004, or less) with the crack
+    ``paths``, and the crack length against time when it was sampled."""
+    from peridyn.io.hdf5 import read_array
+    from peridyn.plotting.crack import plot_crack_length, plot_damage_map
+
+    u = read_array(out / "results.h5", "final/u")
+    figures = [plot_damage_map(setup.body.points, u, damage_field(setup.model), paths,
+                               out / "crack_paths.png")]
+    history = summary.get("crack_length_history")
+    if history and len(history["time_s"]) > 1:
+        figures.append(plot_crack_length(history["time_s"], history["length_m"],
+                                         out / "crack_length.png"))
+    return figures
 
 
 def _run_static(case, setup, out, case_path) -> dict:

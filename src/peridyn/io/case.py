@@ -98,17 +98,21 @@ class Discretization(Strict):
 
 
 class Damage(Strict):
-    """Bond failure: ``critical_stretch`` or ``fracture_energy`` (J/m^2), and node sets
+    """Bond failure: ``critical_stretch``, ``fracture_energy`` (J/m^2) or
+    ``critical_bond_stress`` (Pa; bond stress E s, see ``peridyn.damage``), and node sets
     where bonds never break."""
 
     critical_stretch: Positive | None = None
     fracture_energy: Positive | None = None
+    critical_bond_stress: Positive | None = None
     no_damage_sets: list[str] = []
 
     @model_validator(mode="after")
     def _one(self):
-        if (self.critical_stretch is None) == (self.fracture_energy is None):
-            raise ValueError("give exactly one of critical_stretch or fracture_energy")
+        given = [self.critical_stretch, self.fracture_energy, self.critical_bond_stress]
+        if sum(v is not None for v in given) != 1:
+            raise ValueError("give exactly one of critical_stretch, fracture_energy or "
+                             "critical_bond_stress")
         return self
 
 
