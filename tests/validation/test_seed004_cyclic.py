@@ -26,7 +26,7 @@ def test_cyclic_case_gives_skew_branches(spacing):
                             f"node_sets.left.depth={grip}", f"node_sets.right.depth={grip}"])
     setup = build(case)
     solver = ExplicitSolver(setup.model, setup.loading, safety=case.solver.safety,
-                            damage=setup.damage)
+                            damage=setup.damage, contact=setup.contact)
     state = solver.initial_state()
     solver.run(state, int(np.ceil(case.solver.time / solver.dt)))
     paths = crack_paths(setup.body.points, damage_field(setup.model), spacing)
