@@ -4,8 +4,14 @@ import numpy as np
 import pytest
 
 from peridyn.errors import InputError
-from peridyn.fatigue.calibration import (calibrate_A_II, fit_phase_one, geometry_factor,
-                                         growth_rates, paris_fit, stress_intensity)
+from peridyn.fatigue.calibration import (
+    calibrate_A_II,
+    fit_phase_one,
+    geometry_factor,
+    growth_rates,
+    paris_fit,
+    stress_intensity,
+)
 
 
 def test_phase_one_fit_recovers_the_parameters_of_exact_strain_life_data():
