@@ -1,6 +1,7 @@
 """The fatigue loop: equilibrium at the maximum load, remaining life, broken bonds, more cycles.
 
-Each step: solve the linear static equilibrium with the bonds intact now, take the cyclic bond
+Each step: solve the linear static equilibrium with the bonds intact now (only after steps that
+broke bonds: otherwise it has not changed), take the cyclic bond
 strain from the load ratio, spend the step's cycles (``CycleMapping``) on every bond's remaining
 life, break the bonds whose life ran out, switch families to phase II where the damage reached
 phi_c, and track the crack tip.
@@ -78,15 +79,18 @@ def run_fatigue(model: Model, loading: Loading, params: FatigueParameters, mappi
     lengths.append(crack_tip(points, damage_field(model), spacing, tip_axis, depth_axis, tip_damage))
     n_cycles = 0.0
     u = None
+    changed = True
     for dn in mapping.cycles_per_step():
-        u = statics.solve()
-        eps = cyclic_bond_strain(model, u, load_ratio)
+        if changed:  # equilibrium only moves when bonds broke
+            u = statics.solve()
+            eps = cyclic_bond_strain(model, u, load_ratio)
         if mapping.adaptive:
             dn = min(dn, life.cycles_to_next_break(eps) * (1.0 + 1e-12))
         before = model.bonds.intact.copy()
         life.advance(eps, dn)
         n_cycles += dn
         lost = before & ~model.bonds.intact
+        changed = bool(lost.any())
         hit = np.zeros(model.body.n_points, dtype=bool)
         hit[owners[lost]] = True
         first_break[hit & np.isinf(first_break)] = n_cycles
@@ -98,5 +102,5 @@ def run_fatigue(model: Model, loading: Loading, params: FatigueParameters, mappi
         if progress is not None:
             progress.update(1)
     return FatigueResult(np.array(cycles), np.array(lengths), np.array(broken, dtype=np.int64),
-                         statics.solve() if u is not None else np.zeros_like(points),
+                         (statics.solve() if changed else u) if u is not None else np.zeros_like(points),
                          damage_field(model), first_break)
