@@ -65,8 +65,8 @@ def classify_mode(points: np.ndarray, shape: np.ndarray, masses: np.ndarray,
             return ModeType("torsional", _sign_changes(twist))
         along_x = _sign_changes(sym.mean(axis=1))
         along_y = _sign_changes(sym[np.argmax(np.abs(sym).max(axis=1))])
-        variation_x = np.sum(np.diff(sym, axis=0) ** 2) / grid.dx**2
-        variation_y = np.sum(np.diff(sym, axis=1) ** 2) / grid.dy**2
+        variation_x = grid.variation(sym, axis=0)
+        variation_y = grid.variation(sym, axis=1)
         if variation_x >= variation_y and along_x >= 2:
             return ModeType("bending", along_x - 1)
         if along_y >= 2:
@@ -103,6 +103,16 @@ class _Grid:
         self.shape = (len(xs), len(ys))
         self.dx = float(np.median(np.diff(xs))) if len(xs) > 1 else 1.0
         self.dy = float(np.median(np.diff(ys))) if len(ys) > 1 else 1.0
+        self.occupied = np.zeros(self.shape, dtype=bool)
+        self.occupied[self.ix, self.iy] = True
+
+    def variation(self, field: np.ndarray, axis: int) -> float:
+        """Sum of squared differences of a mid-surface field along ``axis`` over pairs of occupied
+        columns (empty columns of non-rectangular bodies do not count), divided by the spacing^2."""
+        pairs = np.diff(self.occupied.astype(np.int8), axis=axis) == 0
+        pairs &= np.take(self.occupied, range(self.shape[axis] - 1), axis=axis)
+        step = self.dx if axis == 0 else self.dy
+        return float(np.sum(np.where(pairs, np.diff(field, axis=axis), 0.0) ** 2) / step**2)
 
     def mid_surface(self, values: np.ndarray) -> np.ndarray:
         """(n_x, n_y) through-thickness mean of ``values`` on each column (0 where empty)."""

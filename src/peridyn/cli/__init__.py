@@ -26,6 +26,7 @@ COMMAND_MODULES = (
     "peridyn.cli.dispersion_cmd",
     "peridyn.cli.modal_cmd",
     "peridyn.cli.plot_cmd",
+    "peridyn.cli.fatigue_cmd",
 )
 
 

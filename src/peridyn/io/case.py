@@ -348,6 +348,7 @@ class Case(Strict):
     output: Output = Output()
     analysis: Analysis | None = None
     contact: ContactSpec | None = None
+    fatigue: Fatigue | None = None
 
     @model_validator(mode="after")
     def _sets_exist(self):
@@ -505,3 +506,67 @@ def _model_in(annotation):
         if found is not None:
             return found
     return None
+
+
+class FatigueBlock(Strict):
+    """``steps`` fatigue steps of 1 / ``tau`` cycles each (the thesis's linear cycle mapping)."""
+
+    steps: Annotated[int, Field(ge=1)]
+    tau: Positive
+
+
+class FatigueTip(Strict):
+    """Crack tip: largest coordinate along ``axis`` whose points through ``depth_axis`` all have
+    damage >= ``damage`` (thesis: 0.385); crack length measured from the low edge of ``axis``."""
+
+    axis: Literal["x", "y", "z"] = "x"
+    depth_axis: Literal["x", "y", "z"] = "z"
+    damage: Annotated[float, Field(gt=0, le=1)] = 0.385
+
+
+class FatigueModal(Strict):
+    """Free-free modal analyses before and after the fatigue run: ``modes`` modes, rigid included."""
+
+    modes: Annotated[int, Field(ge=7)] = 12
+
+
+class ParisSpecimen(Strict):
+    """Single-edge-notch geometry for K_I = sigma sqrt(pi a) F(a/b) (thesis eqs. 7.12-7.13):
+    ``stress`` (Pa, maximum remote stress) and ``width`` b (m)."""
+
+    stress: Positive
+    width: Positive
+
+
+class Fatigue(Strict):
+    """Remaining-life fatigue (thesis seed 002 ch. 7): phase I (A_I, m_I, eps_inf), phase II
+    (A_II, m_II; A_II given at ``A_II_horizon`` m and scaled to the case's horizon by eq. 7.15),
+    phi_c, load ratio R in [-1, 1), the boundary conditions' value at ``max_load_time`` (s) as the
+    maximum load, cycle ``mapping`` blocks (``adaptive``: cut a step where the next bond breaks),
+    no-damage node sets, crack ``tip``, linear ``solver`` and optional ``modal_after``."""
+
+    A_I: Positive
+    m_I: Positive
+    eps_inf: NonNegative
+    A_II: Positive
+    m_II: Positive
+    A_II_horizon: Positive | None = None
+    phi_c: Annotated[float, Field(gt=0, le=1)] = 0.385
+    load_ratio: Annotated[float, Field(ge=-1, lt=1)] = 0.0
+    max_load_time: NonNegative = 1.0
+    mapping: Annotated[list[FatigueBlock], Field(min_length=1)]
+    adaptive: bool = False
+    no_damage_sets: list[str] = []
+    tip: FatigueTip = FatigueTip()
+    solver: Literal["auto", "direct", "cg"] = "auto"
+    modal_after: FatigueModal | None = None
+    paris: ParisSpecimen | None = None
+
+    @model_validator(mode="after")
+    def _axes(self):
+        if self.tip.axis == self.tip.depth_axis:
+            raise ValueError("tip.axis and tip.depth_axis must differ")
+        return self
+
+
+Case.model_rebuild()

@@ -1,0 +1,106 @@
+"""The fatigue loop: equilibrium at the maximum load, remaining life, broken bonds, more cycles.
+
+Each step: solve the linear static equilibrium with the bonds intact now (only after steps that
+broke bonds: otherwise it has not changed), take the cyclic bond
+strain from the load ratio, spend the step's cycles (``CycleMapping``) on every bond's remaining
+life, break the bonds whose life ran out, switch families to phase II where the damage reached
+phi_c, and track the crack tip.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from peridyn.damage import damage_field
+from peridyn.errors import InputError
+from peridyn.fatigue.mapping import CycleMapping
+from peridyn.fatigue.model import FatigueParameters, RemainingLife, cyclic_bond_strain
+from peridyn.fatigue.statics import LinearStatics
+from peridyn.fatigue.tip import TIP_DAMAGE, crack_tip
+from peridyn.loads import Loading
+from peridyn.materials.base import Model
+
+
+@dataclass
+class FatigueResult:
+    """History of a fatigue run.
+
+    Attributes
+    ----------
+    cycles : (n_steps + 1,) float64, cycles at the end of each step (0 first)
+    crack_length : (n_steps + 1,) float64, m
+    broken : (n_steps + 1,) int64, bonds broken so far
+    u_max : (n_points, 3) float64, m, displacement at the maximum load after the last step
+    damage : (n_points,) float64, final damage index
+    first_break : (n_points,) float64, cycle at which each point first lost a bond (inf if none)
+    """
+
+    cycles: np.ndarray
+    crack_length: np.ndarray
+    broken: np.ndarray
+    u_max: np.ndarray
+    damage: np.ndarray
+    first_break: np.ndarray = field(repr=False)
+
+
+def breakable_bonds(model: Model, no_damage_sets=()) -> np.ndarray:
+    """(n_bonds,) bool: bonds with neither end in a no-damage node set."""
+    protected = np.zeros(model.body.n_points, dtype=bool)
+    for name in no_damage_sets:
+        protected[model.body.node_set(name)] = True
+    b = model.bonds
+    return ~(protected[b.owners()] | protected[b.neighbours])
+
+
+def run_fatigue(model: Model, loading: Loading, params: FatigueParameters, mapping: CycleMapping,
+                load_ratio: float = 0.0, max_load_time: float = 1.0, no_damage_sets=(),
+                tip_axis: str = "x", depth_axis: str = "z", tip_damage: float = TIP_DAMAGE,
+                solver: str = "auto", progress=None) -> FatigueResult:
+    """Run the fatigue loop on ``model`` (its ``bonds.intact`` is updated in place).
+
+    Parameters
+    ----------
+    loading : the case's loads; their value at ``max_load_time`` (s) is the maximum load
+    load_ratio : R = min load / max load, in [-1, 1)
+    progress : object with update(n) (e.g. a tqdm bar) or None
+    """
+    if not -1.0 <= load_ratio < 1.0:
+        raise InputError(f"load ratio R must be in [-1, 1), got {load_ratio!r}")
+    statics = LinearStatics(model, loading, max_load_time, solver)
+    life = RemainingLife(model, params, breakable_bonds(model, no_damage_sets))
+    points, spacing = model.body.points, model.body.spacing
+    owners = model.bonds.owners()
+    n_broken0 = int((~model.bonds.intact).sum()) // 2
+    first_break = np.full(model.body.n_points, np.inf)
+    life.update_phase(damage_field(model))  # pre-cracks may start families in phase II
+    cycles, lengths, broken = [0.0], [], [0]
+    lengths.append(crack_tip(points, damage_field(model), spacing, tip_axis, depth_axis, tip_damage))
+    n_cycles = 0.0
+    u = None
+    changed = True
+    for dn in mapping.cycles_per_step():
+        if changed:  # equilibrium only moves when bonds broke
+            u = statics.solve()
+            eps = cyclic_bond_strain(model, u, load_ratio)
+        if mapping.adaptive:
+            dn = min(dn, life.cycles_to_next_break(eps) * (1.0 + 1e-12))
+        before = model.bonds.intact.copy()
+        life.advance(eps, dn)
+        n_cycles += dn
+        lost = before & ~model.bonds.intact
+        changed = bool(lost.any())
+        hit = np.zeros(model.body.n_points, dtype=bool)
+        hit[owners[lost]] = True
+        first_break[hit & np.isinf(first_break)] = n_cycles
+        phi = damage_field(model)
+        life.update_phase(phi)
+        cycles.append(n_cycles)
+        lengths.append(crack_tip(points, phi, spacing, tip_axis, depth_axis, tip_damage))
+        broken.append(int((~model.bonds.intact).sum()) // 2 - n_broken0)
+        if progress is not None:
+            progress.update(1)
+    return FatigueResult(np.array(cycles), np.array(lengths), np.array(broken, dtype=np.int64),
+                         (statics.solve() if changed else u) if u is not None else np.zeros_like(points),
+                         damage_field(model), first_break)

@@ -1,0 +1,113 @@
+"""Remaining-life fatigue model: closed forms of thesis seed 002 eqs. 7.3-7.6 and 7.15 (V5)."""
+
+import numpy as np
+import pytest
+
+from peridyn import geometry
+from peridyn.bonds import find_bonds
+from peridyn.errors import InputError
+from peridyn.fatigue import CycleMapping, FatigueParameters, crack_tip, run_fatigue, scale_A_II
+from peridyn.loads import BoundaryCondition, Loading
+from peridyn.materials import make_model
+from peridyn.timefunctions import Constant
+
+#: V5 steel parameters (VALIDATION.md V5, thesis table 7.1).
+V5 = FatigueParameters(A_I=426.0, m_I=2.77, eps_inf=0.00186, A_II=25237.48, m_II=4.0, phi_c=0.385)
+SPACING = 1e-3
+
+
+def _bar(strain, n=20):
+    """A one-point-thick bar along x whose every point is held at u_x = strain x (uniform strain)."""
+    body = geometry.box((n * SPACING, SPACING, SPACING), SPACING)
+    body = body.with_node_set("all", np.ones(body.n_points, dtype=bool))
+    bonds = find_bonds(body, 3.001 * SPACING)
+    model = make_model("pmb", body, bonds, E=189.9e9, density=7850.0)
+    profile = np.column_stack([strain * body.points[:, 0], np.zeros((body.n_points, 2))])
+    loading = Loading(body, [BoundaryCondition("all", "displacement", "xyz", Constant(1.0), profile)])
+    return model, loading
+
+
+@pytest.mark.parametrize("strain", [0.004, 0.006])
+def test_bar_loses_all_bonds_at_the_closed_form_life(strain):
+    """Eq. 7.4 integrated at constant strain: every bond breaks at N = 1 / (A_I (eps - eps_inf)^m_I),
+    within one cycle-mapping step (R = 0, so the cyclic strain is the bond strain)."""
+    model, loading = _bar(strain)
+    n_life = V5.phase_one_life(strain)
+    step = n_life / 37.3  # steps not aligned with the life
+    mapping = CycleMapping(((60, 1.0 / step),))
+    result = run_fatigue(model, loading, V5, mapping, load_ratio=0.0)
+    all_bonds = model.bonds.n_bonds // 2
+    done = np.flatnonzero(result.broken == all_bonds)
+    assert done.size and not model.bonds.intact.any()
+    n_break = result.cycles[done[0]]
+    assert 0.0 <= n_break - n_life < step
+    assert result.broken[done[0] - 1] == 0  # none before: uniform strain, one life for all
+
+
+def test_no_bond_breaks_at_or_below_the_fatigue_limit():
+    """Eq. 7.4: d lambda / dN = 0 for eps <= eps_inf, however many cycles."""
+    model, loading = _bar(V5.eps_inf)
+    result = run_fatigue(model, loading, V5, CycleMapping(((10, 1e-9),)), load_ratio=0.0)
+    assert result.cycles[-1] == pytest.approx(1e10)
+    assert result.broken[-1] == 0 and model.bonds.intact.all()
+
+
+def test_load_ratio_scales_the_cyclic_strain():
+    """Eq. 7.1 for proportional loading: eps = (1 - R) |s+|; R = 0.5 at s+ = 0.008 is eps = 0.004."""
+    model, loading = _bar(0.008)
+    n_life = V5.phase_one_life(0.004)
+    step = n_life / 20.5
+    result = run_fatigue(model, loading, V5, CycleMapping(((30, 1.0 / step),)), load_ratio=0.5)
+    first = result.cycles[np.argmax(result.broken > 0)]
+    assert 0.0 <= first - n_life < step
+
+
+def test_adaptive_mapping_breaks_at_the_life_itself():
+    """With adaptive steps the break lands on the closed-form life (relative 1e-9)."""
+    model, loading = _bar(0.005)
+    n_life = V5.phase_one_life(0.005)
+    result = run_fatigue(model, loading, V5, CycleMapping(((5, 1.0 / (3 * n_life)),), adaptive=True))
+    first = result.cycles[np.argmax(result.broken > 0)]
+    assert first == pytest.approx(n_life, rel=1e-9)
+
+
+def test_A_II_horizon_scaling_reproduces_the_thesis_value():
+    """Eq. 7.15: 16 823 863 * 0.0015001^((4 - 2) / 2) = 25 237.48 (thesis table 7.1)."""
+    hat = 16823863.0
+    assert scale_A_II(hat, 1.0, 0.0015001, 4.0) == pytest.approx(25237.48, rel=1e-6)
+    assert scale_A_II(25237.48, 0.0015001, 0.0006001, 4.0) == pytest.approx(hat * 0.0006001, rel=1e-6)
+
+
+def test_crack_tip_needs_damage_through_the_whole_depth():
+    """Section 7.2: the tip is the largest x whose whole column through z has phi >= 0.385."""
+    body = geometry.box((0.010, 0.004, 0.003), SPACING)
+    x, y, z = body.points.T
+    phi = np.where((x < 0.006) & (y < 0.001), 0.5, 0.0)  # columns at x = 0.5 ... 5.5 mm
+    assert crack_tip(body.points, phi, SPACING) == pytest.approx(0.0055, abs=1e-12)
+    phi[(x > 0.004) & (x < 0.005) & (z < 0.001)] = 0.1  # a weak point behind the tip: no change
+    assert crack_tip(body.points, phi, SPACING) == pytest.approx(0.0055, abs=1e-12)
+    phi[(x > 0.005) & (z < 0.001)] = 0.1  # the 5.5 mm column is no longer cracked through
+    assert crack_tip(body.points, phi, SPACING) == pytest.approx(0.0035, abs=1e-12)
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    ({"A_I": -1.0}, "A_I must be positive"),
+    ({"m_II": 0.0}, "m_II must be positive"),
+    ({"eps_inf": -1e-3}, "eps_inf must be >= 0"),
+    ({"phi_c": 1.5}, "phi_c must be in (0, 1]"),
+])
+def test_bad_parameters_are_refused(kwargs, message):
+    values = dict(A_I=426.0, m_I=2.77, eps_inf=0.00186, A_II=25237.48, m_II=4.0) | kwargs
+    with pytest.raises(InputError, match=message.replace("(", r"\(").replace(")", r"\)")):
+        FatigueParameters(**values)
+
+
+def test_bad_load_ratio_and_zero_load_are_refused():
+    model, loading = _bar(0.004)
+    with pytest.raises(InputError, match=r"load ratio R must be in \[-1, 1\), got 1.0"):
+        run_fatigue(model, loading, V5, CycleMapping(((1, 1.0),)), load_ratio=1.0)
+    model, loading = _bar(0.0)
+    with pytest.raises(InputError, match="needs a cyclic load"):
+        run_fatigue(model, loading, V5, CycleMapping(((1, 1.0),)))
+    with pytest.raises(InputError, match="tau > 0"):
+        CycleMapping(((3, 0.0),))
