@@ -124,15 +124,35 @@ def modal_analysis(model: Model, n_modes: int = 12, fixed: np.ndarray | None = N
 
 def shifted_inverse(parts: StiffnessParts, dofs: np.ndarray, shift_mass: np.ndarray,
                     points: np.ndarray, reach: float) -> LinearOperator:
-    """(K + s M)^-1 on the ``dofs`` as an operator, factorised once.
+    """(K + s M)^-1 on the ``dofs`` as an operator, factorised once (``factorise_shifted``)."""
+    lu, perm = factorise_shifted(parts, dofs, shift_mass, points, reach)
+    n = len(dofs)
+    rhs = np.zeros(len(perm))
+    inverse = np.empty_like(perm)
+    inverse[perm] = np.arange(len(perm))
+
+    def solve(b):
+        rhs[:n] = b
+        return lu.solve(rhs[perm])[inverse[:n]]
+
+    return LinearOperator((n, n), matvec=solve, dtype=np.float64)
+
+
+def factorise_shifted(parts: StiffnessParts, dofs: np.ndarray, shift_mass: np.ndarray,
+                      points: np.ndarray, reach: float):
+    """Sparse LU of K + s M on the ``dofs`` (or of the augmented system), and its order.
 
     ``shift_mass`` ((len(dofs),) N/m) is s M on those dofs; ``points`` (n, 3) m and
     ``reach`` (m, the horizon) give the nested-dissection order of the unknowns
     (``solvers.ordering``). With a dilatation part the augmented system of the module
-    docstring is factorised instead of K + s M.
+    docstring is factorised instead of K + s M; its first len(dofs) unknowns are the dofs.
+
+    Returns
+    -------
+    lu : scipy SuperLU of the permuted matrix A[perm][:, perm]
+    perm : (n_unknowns,) int64
     """
     P = parts.pair[dofs][:, dofs] + sp.diags(shift_mass)
-    n = len(dofs)
     unknown_points = dofs // 3
     if parts.G is None:
         A = P
@@ -146,12 +166,4 @@ def shifted_inverse(parts: StiffnessParts, dofs: np.ndarray, shift_mass: np.ndar
     perm = order_unknowns(unknown_points, points, reach)
     lu = splu(A.tocsr()[perm][:, perm].tocsc(), permc_spec="NATURAL", diag_pivot_thresh=0.1,
               options={"SymmetricMode": True})
-    rhs = np.zeros(A.shape[0])
-    inverse = np.empty_like(perm)
-    inverse[perm] = np.arange(len(perm))
-
-    def solve(b):
-        rhs[:n] = b
-        return lu.solve(rhs[perm])[inverse[:n]]
-
-    return LinearOperator((n, n), matvec=solve, dtype=np.float64)
+    return lu, perm

@@ -26,7 +26,11 @@ def nested_dissection(points: np.ndarray, reach: float, leaf: int = LEAF_POINTS)
     reach : float, m
         Largest distance between two coupled points (the horizon).
     """
-    order: list[np.ndarray] = []
+    return np.concatenate(list(dissection_parts(points, reach, leaf)))
+
+
+def dissection_parts(points: np.ndarray, reach: float, leaf: int = LEAF_POINTS):
+    """The leaves and separators of the dissection in elimination order (index arrays)."""
     stack = [(np.arange(len(points)), False)]
     # iterative post-order: a part is replaced by (separator, done) and its two halves
     while stack:
@@ -35,7 +39,7 @@ def nested_dissection(points: np.ndarray, reach: float, leaf: int = LEAF_POINTS)
         extent = np.ptp(p, axis=0) if len(idx) else np.zeros(3)
         axis = int(np.argmax(extent))
         if is_separator or len(idx) <= leaf or extent[axis] <= 2 * reach:
-            order.append(idx)
+            yield idx
             continue
         middle = np.median(p[:, axis])
         coordinate = p[:, axis]
@@ -44,9 +48,22 @@ def nested_dissection(points: np.ndarray, reach: float, leaf: int = LEAF_POINTS)
         stack.append((idx[~below & ~above], True))
         stack.append((idx[above], False))
         stack.append((idx[below], False))
-    return np.concatenate(order)
 
 
+#: Factor entries per squared part size (unknowns), measured on the PMMA plate of V4 with
+#: SuperLU (L + U): 2.9 at 5 000 and 19 200 points, 4.0 at 5 000 points and 3 h.
+FILL_PER_PART_SQUARED = 4.0
+
+
+def estimated_factor_entries(points: np.ndarray, reach: float, unknowns_per_point: int) -> float:
+    """Entries of the sparse LU factors (L + U) in nested-dissection order, estimated.
+
+    Each leaf or separator of s unknowns becomes a dense front of about s^2 entries;
+    the sum, times ``FILL_PER_PART_SQUARED`` (fronts also hold their coupling to the
+    enclosing separators), predicts the measured fill within a factor 1.4.
+    """
+    sizes = np.array([len(part) for part in dissection_parts(points, reach)], dtype=np.float64)
+    return FILL_PER_PART_SQUARED * float(np.sum((unknowns_per_point * sizes) ** 2))
 def order_unknowns(unknown_points: np.ndarray, points: np.ndarray, reach: float) -> np.ndarray:
     """Permutation of unknowns (m,) int64 following the nested-dissection rank of their point.
 
