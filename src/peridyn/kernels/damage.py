@@ -3,29 +3,39 @@
 import numba
 import numpy as np
 
+from peridyn.kernels import FASTMATH, bond_differences
 
-@numba.njit(parallel=True, cache=True)
+
+@numba.njit(parallel=True, fastmath=FASTMATH, cache=True)
 def break_stretched_bonds(x, u, offsets, nbr, length, critical_stretch, breakable, intact):
     """Break (IN/OUT ``intact``) every breakable bond whose stretch exceeds its critical value.
 
     Both directed copies of a bond see the same stretch, so they break in the
-    same call. Returns the number of directed bonds broken.
+    same call. Returns the number of directed bonds broken. Laid out like the force
+    kernels (flat arrays, per-family slices, squared lengths) so that the stretch test
+    vectorises; the rare write is the only branch.
     """
     n = x.shape[0]
+    xf = x.reshape(3 * n)
+    uf = u.reshape(3 * n)
     count = np.zeros(n, dtype=np.int64)
     for i in numba.prange(n):
-        x0, x1, x2 = x[i, 0], x[i, 1], x[i, 2]
-        u0, u1, u2 = u[i, 0], u[i, 1], u[i, 2]
+        xi0, xi1, xi2 = xf[3 * i], xf[3 * i + 1], xf[3 * i + 2]
+        ui0, ui1, ui2 = uf[3 * i], uf[3 * i + 1], uf[3 * i + 2]
+        lo = offsets[i]
+        hi = offsets[i + 1]
+        fam = nbr[lo:hi]
+        ln = length[lo:hi]
+        sc = critical_stretch[lo:hi]
         broken = 0
-        for b in range(offsets[i], offsets[i + 1]):
-            j = nbr[b]
-            d0 = (x[j, 0] - x0) + (u[j, 0] - u0)
-            d1 = (x[j, 1] - x1) + (u[j, 1] - u1)
-            d2 = (x[j, 2] - x2) + (u[j, 2] - u2)
-            limit = length[b] * (1.0 + critical_stretch[b])
-            # squared lengths: no square root, and the cheap test first
-            if d0 * d0 + d1 * d1 + d2 * d2 > limit * limit and intact[b] and breakable[b]:
-                intact[b] = False
+        for q in range(hi - lo):
+            j = 3 * np.uint64(np.uint32(fam[q]))
+            _, _, y0 = bond_differences(xf[j], xi0, uf[j], ui0)
+            _, _, y1 = bond_differences(xf[j + 1], xi1, uf[j + 1], ui1)
+            _, _, y2 = bond_differences(xf[j + 2], xi2, uf[j + 2], ui2)
+            limit = ln[q] * (1.0 + sc[q])
+            if y0 * y0 + y1 * y1 + y2 * y2 > limit * limit and intact[lo + q] and breakable[lo + q]:
+                intact[lo + q] = False
                 broken += 1
         count[i] = broken
     return count.sum()
