@@ -12,8 +12,6 @@ import json
 import resource
 from pathlib import Path
 
-import numpy as np
-
 from peridyn.analysis.modes import classify_modes
 from peridyn.errors import InputError
 from peridyn.io.hdf5 import HDF5Writer
