@@ -72,6 +72,37 @@ def test_modal_command_json_and_outputs(tmp_path, capsys):
     assert (tmp_path / "modes.csv").is_file() and (tmp_path / "modes" / "mode_07.vtu").is_file()
 
 
+def test_edge_crack_lowers_most_the_mode_whose_bending_stress_it_cuts(coarse):
+    """Seed 002 (thesis ch. 5, T cracks): a through-thickness edge crack at mid-length lowers
+    every frequency, and most the mode whose bending stress it cuts. An edge crack (13.5 mm
+    into the 50 mm width) cuts the fibres of largest in-plane bending stress, so the 1st
+    in-plane bending mode falls most (here 21 %, the others 2-7 %) and drops below the 1st
+    transverse bending mode: the classifier must follow the swap, which the MAC with the
+    healthy modes confirms."""
+    from peridyn.bonds import crossing_rectangle, cut_bonds
+
+    healthy_model, healthy = coarse
+    model = _plate_model(2e-3)
+    cut = cut_bonds(model.body, model.bonds, lambda a, b: crossing_rectangle(
+        a, b, (0.0501, -0.001, -0.001), (0.0, 0.0135, 0.0), (0.0, 0.0, 0.010)))
+    assert cut > 0
+    cracked = modal_analysis(model, 12)
+    masses = model.density * model.body.volumes
+    types_h = [str(t) for t in classify_modes(healthy_model.body.points, healthy.shapes, masses,
+                                              healthy.rigid)][6:]
+    types_c = [str(t) for t in classify_modes(model.body.points, cracked.shapes, masses,
+                                              cracked.rigid)][6:]
+    mac = mac_matrix(healthy.shapes[6:], cracked.shapes[6:], masses)
+    partner = mac.argmax(axis=0)  # healthy mode most like each cracked one
+    assert np.all(mac.max(axis=0) > 0.85)
+    assert [types_h[p] for p in partner] == types_c
+    assert types_c[4:] == ["1st in-plane bending", "1st transverse bending"]
+    drop = 1.0 - cracked.frequencies[6:] / healthy.frequencies[6:][partner]
+    assert np.all(drop > 0)
+    assert types_c[int(np.argmax(drop))] == "1st in-plane bending"
+    assert np.sort(drop)[-1] > 2 * np.sort(drop)[-2]
+
+
 def test_too_large_factorisation_is_refused_with_its_size(monkeypatch):
     """The guard compares the estimated factor with the machine's memory (here made 64 MiB)."""
     import os
