@@ -12,7 +12,9 @@ import json
 import resource
 from pathlib import Path
 
-from peridyn.analysis.modes import classify_modes
+import numpy as np
+
+from peridyn.analysis.modes import classify_modes, mac_matrix
 from peridyn.errors import InputError
 from peridyn.io.hdf5 import HDF5Writer
 from peridyn.io.vtk import write_vtu
@@ -27,15 +29,8 @@ MEMORY_SHARE = 0.7
 
 def run_modal(case, setup, out: Path, case_path=None) -> dict:
     """Modal analysis of a built case; returns the summary (VALIDATION.md JSON keys)."""
-    check_assembly_fits(setup.model)
     fixed = setup.loading.constrained if setup.loading.has_loads else None
-    result = modal_analysis(setup.model, case.solver.modes, fixed=fixed)
-    masses = setup.model.density * setup.body.volumes
-    types = classify_modes(setup.body.points, result.shapes, masses, result.rigid)
-    modes = [{"index": i, "frequency_hz": float(f), "type": t.type, "order": t.order,
-              "residual": float(r)}
-             for i, (f, t, r) in enumerate(zip(result.frequencies, types, result.residuals,
-                                                strict=True))]
+    result, types, modes = modal_table(setup.model, case.solver.modes, fixed=fixed)
     _write_tables(out, modes)
     body = setup.body
     with HDF5Writer(out / "results.h5", body.points[:, : body.dim], body.volumes,
@@ -55,6 +50,89 @@ def run_modal(case, setup, out: Path, case_path=None) -> dict:
 
         summary["plots"] = [str(plot_mode_shapes(body, result, types, out / "modes.png"))]
     return summary
+
+
+def modal_table(model, n_modes: int, fixed=None):
+    """Modes of ``model`` (memory checked first), classified: (ModalResult, types, rows), the
+    rows being the JSON/CSV dicts index, frequency_hz, type, order, residual."""
+    check_assembly_fits(model)
+    result = modal_analysis(model, n_modes, fixed=fixed)
+    masses = model.density * model.body.volumes
+    types = classify_modes(model.body.points, result.shapes, masses, result.rigid)
+    rows = [{"index": i, "frequency_hz": float(f), "type": t.type, "order": t.order,
+             "residual": float(r)}
+            for i, (f, t, r) in enumerate(zip(result.frequencies, types, result.residuals,
+                                               strict=True))]
+    return result, types, rows
+
+
+def match_modes(before, after, masses) -> tuple[np.ndarray, list[dict]]:
+    """MAC matrix of the elastic modes (before x after) and, for each mode before, the mode after
+    with the largest MAC (types can swap order when frequencies shift, thesis table 7.2).
+
+    ``before``, ``after``: ModalResult of the same points; ``masses`` (n_points,) kg.
+    """
+    b, a = before.elastic(), after.elastic()
+    mac = mac_matrix(b.shapes, a.shapes, masses)
+    pairs = []
+    for i in range(mac.shape[0]):
+        j = int(np.argmax(mac[i]))
+        pairs.append({"before": i, "after": j, "mac": float(mac[i, j]),
+                      "frequency_change": float(a.frequencies[j] / b.frequencies[i] - 1.0)})
+    return mac, pairs
+
+
+def compare_with_run(run_dir: Path, reference_dir: Path) -> list[dict]:
+    """Frequency-shift table of the modal run in ``run_dir`` against ``reference_dir``.
+
+    Each elastic mode of the reference is paired with this run's elastic mode of largest
+    MAC (so types are compared like with like when damage changes the order); written to
+    ``run_dir / "frequency_shift.csv"``. Both runs must have the same points.
+    """
+    from peridyn.io.hdf5 import read_array
+
+    runs = []
+    for d in (reference_dir, run_dir):
+        h5 = d / "results.h5"
+        if not h5.is_file():
+            raise InputError(f"--compare: {h5} not found (give the folder of a modal run)")
+        runs.append({"points": read_array(h5, "geometry/points"),
+                     "volumes": read_array(h5, "geometry/volumes"),
+                     "frequencies": read_array(h5, "modes/frequencies"),
+                     "shapes": read_array(h5, "modes/shapes"),
+                     "rigid": read_array(h5, "modes/rigid").astype(bool),
+                     "types": json.loads((d / "modes.json").read_text())})
+    ref, new = runs
+    if ref["points"].shape != new["points"].shape or not np.allclose(ref["points"], new["points"]):
+        raise InputError(f"--compare: {reference_dir} has other points than this run "
+                         f"({len(ref['points'])} against {len(new['points'])}): MAC needs the "
+                         "same grid")
+    keep_r, keep_n = ~ref["rigid"], ~new["rigid"]
+    # uniform density: the volumes weigh the MAC as the masses would
+    mac = mac_matrix(ref["shapes"][keep_r], new["shapes"][keep_n], new["volumes"])
+    ref_rows = [m for m, r in zip(ref["types"], ref["rigid"], strict=True) if not r]
+    new_rows = [m for m, r in zip(new["types"], new["rigid"], strict=True) if not r]
+    rows = []
+    for i, ref_row in enumerate(ref_rows):
+        j = int(np.argmax(mac[i]))
+        rows.append({"reference_index": ref_row["index"],
+                     "reference_type": mode_label(ref_row),
+                     "reference_frequency_hz": ref_row["frequency_hz"],
+                     "index": new_rows[j]["index"], "type": mode_label(new_rows[j]),
+                     "frequency_hz": new_rows[j]["frequency_hz"], "mac": float(mac[i, j]),
+                     "frequency_change": new_rows[j]["frequency_hz"] / ref_row["frequency_hz"] - 1})
+    with open(run_dir / "frequency_shift.csv", "w", newline="") as f:
+        writer = csv.DictWriter(f, fieldnames=list(rows[0]))
+        writer.writeheader()
+        writer.writerows(rows)
+    return rows
+
+
+def mode_label(row: dict) -> str:
+    """'1st bending' from a mode row (the type alone for order 0)."""
+    from peridyn.analysis.modes import ModeType
+
+    return str(ModeType(row["type"], row["order"]))
 
 
 def check_assembly_fits(model) -> None:

@@ -15,12 +15,16 @@ def register(sub) -> None:
     add_case_arguments(p)
     p.add_argument("--modes", type=int, default=None, help="number of modes (rigid included)")
     p.add_argument("--output", "-o", help="output folder")
+    p.add_argument("--compare", metavar="RUN_DIR",
+                   help="a modal run of the same grid (e.g. the healthy body): frequency-shift "
+                        "table of this run's modes against it, matched by MAC")
     add_json_flag(p)
     p.set_defaults(func=run)
 
 
 def run(args) -> dict:
     """Solve and print the frequency table unless --json."""
+    from peridyn.modal_run import mode_label
     from peridyn.simulation import run_case
 
     overrides = [*args.overrides, "solver.type=modal"]
@@ -28,11 +32,18 @@ def run(args) -> dict:
         overrides.append(f"solver.modes={args.modes}")
     case = load_case(args.case, overrides)
     summary = run_case(case, args.output, case_path=args.case, base_dir=Path(args.case).parent)
+    if args.compare:
+        from peridyn.modal_run import compare_with_run
+
+        summary["comparison"] = compare_with_run(Path(summary["output_dir"]), Path(args.compare))
     if not args.json:
         print(f"{summary['points']} points, {summary['rigid_modes']} rigid modes, "
               f"{summary['seconds']:.1f} s")
         for m in summary["modes"]:
-            label = m["type"] if m["order"] == 0 else f"{m['order']} {m['type']}"
-            print(f"  {m['index']:3d}  {m['frequency_hz']:12.2f} Hz  {label}")
+            print(f"  {m['index']:3d}  {m['frequency_hz']:12.2f} Hz  {mode_label(m)}")
+        for row in summary.get("comparison", []):
+            print(f"  {row['reference_type']:>28s} {row['reference_frequency_hz']:10.2f} Hz -> "
+                  f"{row['frequency_hz']:10.2f} Hz ({100 * row['frequency_change']:+.2f} %, "
+                  f"MAC {row['mac']:.2f}, now {row['type']})")
         print(f"results written to {summary['output_dir']}")
     return summary

@@ -16,7 +16,6 @@ from pathlib import Path
 
 import numpy as np
 
-from peridyn.analysis.modes import classify_modes, mac_matrix
 from peridyn.errors import CaseFileError, did_you_mean
 from peridyn.fatigue.calibration import growth_rates, paris_fit, stress_intensity
 from peridyn.fatigue.mapping import CycleMapping
@@ -24,6 +23,7 @@ from peridyn.fatigue.model import FatigueParameters, scale_A_II
 from peridyn.fatigue.run import FatigueResult, run_fatigue
 from peridyn.io.case import Case
 from peridyn.io.vtk import write_vtu
+from peridyn.modal_run import match_modes, modal_table
 from peridyn.simulation import build, output_directory
 
 
@@ -47,34 +47,6 @@ def fatigue_parameters(case: Case, horizon: float) -> FatigueParameters:
     a2 = f.A_II if f.A_II_horizon is None else scale_A_II(f.A_II, f.A_II_horizon, horizon, f.m_II)
     return FatigueParameters(A_I=f.A_I, m_I=f.m_I, eps_inf=f.eps_inf, A_II=a2, m_II=f.m_II,
                              phi_c=f.phi_c)
-
-
-def modal_table(setup, n_modes: int):
-    """Free-free modes of the body as it is now: (ModalResult, list of row dicts)."""
-    from peridyn.modal_run import check_assembly_fits
-    from peridyn.solvers.modal import modal_analysis
-
-    check_assembly_fits(setup.model)
-    result = modal_analysis(setup.model, n_modes)
-    masses = setup.model.density * setup.body.volumes
-    types = classify_modes(setup.body.points, result.shapes, masses, result.rigid)
-    rows = [{"index": i, "frequency_hz": float(f), "type": t.type, "order": t.order,
-             "residual": float(r)}
-            for i, (f, t, r) in enumerate(zip(result.frequencies, types, result.residuals, strict=True))]
-    return result, rows
-
-
-def match_modes(before, after, masses) -> tuple[np.ndarray, list[dict]]:
-    """MAC matrix of the elastic modes (before x after) and, for each mode before, the mode after
-    with the largest MAC (types can swap order when frequencies shift, thesis table 7.2)."""
-    b, a = before.elastic(), after.elastic()
-    mac = mac_matrix(b.shapes, a.shapes, masses)
-    pairs = []
-    for i in range(mac.shape[0]):
-        j = int(np.argmax(mac[i]))
-        pairs.append({"before": i, "after": j, "mac": float(mac[i, j]),
-                      "frequency_change": float(a.frequencies[j] / b.frequencies[i] - 1.0)})
-    return mac, pairs
 
 
 def paris_slope(case: Case, result: FatigueResult) -> float | None:
@@ -102,7 +74,7 @@ def run_fatigue_case(case: Case, output_dir=None, base_dir=".", modal: bool | No
     do_modal = f.modal_after is not None if modal is None else modal
     before = setup_rows = None
     if do_modal:
-        before, setup_rows = modal_table(setup, n_modes)
+        before, _, setup_rows = modal_table(setup.model, n_modes)
     mapping = CycleMapping(tuple((b.steps, b.tau) for b in f.mapping), f.adaptive)
     if progress is not None:
         progress = progress(mapping.n_steps)
@@ -116,7 +88,7 @@ def run_fatigue_case(case: Case, output_dir=None, base_dir=".", modal: bool | No
                "points": setup.body.n_points, "bonds": setup.bonds.n_bonds // 2,
                "output_dir": str(out)}
     if do_modal:
-        after, after_rows = modal_table(setup, n_modes)
+        after, _, after_rows = modal_table(setup.model, n_modes)
         masses = setup.model.density * setup.body.volumes
         mac, pairs = match_modes(before, after, masses)
         summary["modal"] = {"before": setup_rows, "after": after_rows, "mac": mac.tolist(),
