@@ -131,7 +131,10 @@ class Contact:
         is smaller while r > d_c / 2). Every point within d_c of i in the reference
         configuration is counted as a possible contact partner (bonded ones too, as their
         bonds may break), so the bound is 2 c_sr / delta sum_{|x_j - x_i| <= d_c} V_j. Added
-        to the material's bound it keeps the explicit step stable (Gershgorin).
+        to the material's bound it keeps the explicit step stable (Gershgorin) while the
+        body stays near its reference configuration; it does not count partners that come
+        from farther away (a closing gap, an impact) nor the transverse stiffness of pairs
+        pressed closer than d_c / 2, so such runs may need a smaller ``safety``.
         """
         tree = cKDTree(self.x)
         pairs = tree.query_pairs(self.radius * (1 + 1e-9), output_type="ndarray")

@@ -52,7 +52,7 @@ def tangent_stiffness(model: Model, u: np.ndarray) -> sp.csr_matrix:
     elif isinstance(model, LPSModel):
         w = np.where(b.intact, model.w.astype(np.float64), 0.0)
         e = r - length
-        theta = model.theta_coef * np.add.reduceat(w * length * e, b.offsets[:-1])
+        theta = model.theta_coef * np.bincount(owners, weights=w * length * e, minlength=len(x))
         p_coef = model._p_coef.astype(np.float64)
         p = theta * p_coef
         a_sum = model.alpha[owners] + model.alpha[nbr]

@@ -43,11 +43,6 @@ class CycleMapping:
         """Number of steps of the whole schedule."""
         return sum(int(s) for s, _ in self.schedule)
 
-    @property
-    def total_cycles(self) -> float:
-        """Cycles the schedule covers without adaptive cuts."""
-        return float(sum(int(s) / tau for s, tau in self.schedule))
-
     def cycles_per_step(self) -> np.ndarray:
         """(n_steps,) cycles per step, 1 / tau of each step's block."""
         return np.concatenate([np.full(int(s), 1.0 / tau) for s, tau in self.schedule])

@@ -129,7 +129,12 @@ class RemainingLife:
         return int(dead.sum()) // 2
 
     def update_phase(self, phi: np.ndarray) -> int:
-        """Switch points with a family member at phi >= phi_c to phase II (eq. 7.6); returns how many."""
+        """Switch points with a family member at phi >= phi_c to phase II (eq. 7.6); returns how many.
+
+        Phase and restart are per directed bond half, by its owner: the halves owned by a
+        switched point restart at life 1 with the phase-II rate, the reverse halves keep
+        their owner's phase; a bond breaks when either half's life runs out (``advance``).
+        """
         b = self.model.bonds
         hit = (phi[b.neighbours] >= self.params.phi_c).astype(np.float64)
         near = np.bincount(self._owners, weights=hit, minlength=len(phi)) > 0

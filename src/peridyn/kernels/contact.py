@@ -50,7 +50,7 @@ def add_contact_force(y, first, second, bond, intact, volumes, stiffness, radius
         Directed bond index of each pair or -1.
     intact : (n_bonds,) bool
     volumes : (n_points,) float64, m^3
-    stiffness : float, N/m^6
+    stiffness : float, N/m^7 (3D)
         c_sr / delta.
     radius : float, m
         Contact distance d_c.

@@ -147,6 +147,8 @@ class NewmarkSolver:
         state.a[:] = a_new
         state.time = t1
         state.step += 1
+        # bonds broken here act from the next step on: the stored acceleration is the
+        # converged one of this step (a lag of one step; the explicit solver breaks first)
         broken = self.damage.update(state.u) if self.damage is not None else 0
         check_finite(state)
         return broken

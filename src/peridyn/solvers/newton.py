@@ -221,7 +221,7 @@ def _jacobi_cg(a: sp.csr_matrix, rhs: np.ndarray) -> np.ndarray:
     p = z.copy()
     rz = r @ z
     target = CG_RTOL * np.linalg.norm(rhs)
-    for _ in range(10 * len(rhs)):
+    for _ in range(10 * len(rhs) + 1):
         if np.linalg.norm(r) <= target:
             return x
         ap = a @ p
