@@ -150,6 +150,13 @@ class Loading:
             target = u if ic.kind == "displacement" else v
             target[np.ix_(idx, list(ic.components))] = amp
 
+    def apply_start(self, dt: float, u: np.ndarray, v: np.ndarray) -> None:
+        """The state of a dynamic run at t = 0 (IN/OUT): initial conditions, then the
+        prescribed displacements and velocities at t = 0 (``dt``: step, for derivatives)."""
+        self.apply_initial(u, v)
+        self.apply_kinematics(0.0, dt, u, v)
+        self.apply_velocities(0.0, v)
+
     def apply_kinematics(self, t: float, dt: float, u: np.ndarray, v: np.ndarray) -> None:
         """Impose the prescribed displacements (and their velocity) at time ``t`` (IN/OUT)."""
         for b in self.displacement:

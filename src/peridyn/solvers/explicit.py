@@ -81,9 +81,7 @@ class ExplicitSolver:
     def initial_state(self) -> State:
         """The state at t = 0: initial conditions applied and accelerations computed."""
         state = State.zeros(self.model.body.n_points)
-        self.loading.apply_initial(state.u, state.v)
-        self.loading.apply_kinematics(0.0, self.dt, state.u, state.v)
-        self.loading.apply_velocities(0.0, state.v)
+        self.loading.apply_start(self.dt, state.u, state.v)
         self._acceleration(state)
         return state
 

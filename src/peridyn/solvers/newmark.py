@@ -92,9 +92,7 @@ class NewmarkSolver:
     def initial_state(self) -> State:
         """The state at t = 0: initial conditions applied and M a = V (f + b) - c M v solved."""
         state = State.zeros(self.model.body.n_points)
-        self.loading.apply_initial(state.u, state.v)
-        self.loading.apply_kinematics(0.0, self.dt, state.u, state.v)
-        self.loading.apply_velocities(0.0, state.v)
+        self.loading.apply_start(self.dt, state.u, state.v)
         state.a[:] = self._out_of_balance(state.u, state.time) / self.mass.reshape(-1, 3)
         state.a -= self.damping * state.v
         state.a[self.loading.constrained] = 0.0
