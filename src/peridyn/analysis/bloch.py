@@ -256,11 +256,10 @@ def bloch_cell(disc: Discretisation) -> BlochCell:
     points = x[central][order]
     density = np.broadcast_to(model.density, (model.body.n_points,))
     mass = (density * model.body.volumes)[central][order]
-    bound = model.stiffness_bound()[central] / density[central]
     return BlochCell(points=points, mass=mass, rows=unique[keep, 0], cols=unique[keep, 1],
                      values=values[keep], shifts=unique[keep, 2:] * quantum,
                      bonds_per_point=float(np.mean(np.diff(model.bonds.offsets)[central])),
-                     critical_time_step=float(2.0 / np.sqrt(np.max(bound))))
+                     critical_time_step=model.critical_time_step(points=central))
 
 
 def _check(disc: Discretisation) -> None:

@@ -71,6 +71,16 @@ class Model:
         """Critical bond stretch for a fracture energy ``fracture_energy`` (J/m^2)."""
         raise NotImplementedError
 
-    def critical_time_step(self) -> float:
-        """Largest stable velocity-Verlet step, s: 2 / sqrt(max stiffness_bound / density)."""
-        return float(2.0 / np.sqrt(np.max(self.stiffness_bound() / self.density)))
+    def critical_time_step(self, extra_bound: np.ndarray | None = None,
+                           points: np.ndarray | None = None) -> float:
+        """Largest stable velocity-Verlet step, s: 2 / sqrt(max stiffness_bound / density).
+
+        ``extra_bound`` ((n_points,) N/m^4): stiffness added to the material's (e.g. contact);
+        ``points``: take the maximum over these point indices only (e.g. a periodic cell).
+        """
+        bound = self.stiffness_bound() / self.density
+        if extra_bound is not None:
+            bound = bound + extra_bound / self.density
+        if points is not None:
+            bound = bound[points]
+        return float(2.0 / np.sqrt(np.max(bound)))
