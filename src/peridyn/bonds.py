@@ -94,6 +94,10 @@ class Bonds:
         """(n_bonds,) int64: the point whose family holds each directed bond."""
         return np.repeat(np.arange(len(self.offsets) - 1), np.diff(self.offsets))
 
+    def family_sum(self, values: np.ndarray) -> np.ndarray:
+        """(n_points,) sum of a per-bond quantity over each point's family (0 for an empty one)."""
+        return family_sums(self.offsets, values)
+
     def reverse(self) -> np.ndarray:
         """(n_bonds,) int64: index of the opposite directed bond j->i of each bond i->j."""
         owners = self.owners()
@@ -164,7 +168,7 @@ def find_bonds(body: Body, horizon: float, influence: str = "constant",
                                     partial_volumes, quadrature_points)
     if partial_volumes:  # drop neighbours whose cell lies wholly outside the sphere
         keep = factor > 0
-        counts = np.add.reduceat(keep.astype(np.int64), offsets[:-1]) if len(j) else keep
+        counts = family_sums(offsets, keep).astype(np.int64)
         offsets = np.concatenate([[0], np.cumsum(counts)])
         j, length, factor = j[keep], length[keep], factor[keep]
     counts = np.diff(offsets)
@@ -341,3 +345,13 @@ def cut_bonds(body: Body, bonds: Bonds, crossing) -> int:
     mask = crossing(body.points[owners], body.points[bonds.neighbours])
     bonds.intact[mask] = False
     return int(mask.sum())
+
+
+def family_sums(offsets: np.ndarray, values: np.ndarray) -> np.ndarray:
+    """(n_points,) float64 sums of ``values`` (n_bonds,) over the CSR families ``offsets``.
+
+    Unlike ``np.add.reduceat``, an empty family sums to 0.
+    """
+    sizes = np.diff(offsets)
+    owners = np.repeat(np.arange(len(sizes)), sizes)
+    return np.bincount(owners, weights=np.asarray(values, dtype=np.float64), minlength=len(sizes))

@@ -135,3 +135,12 @@ def test_segment_precrack_2d():
     expected = crosses & (y_hit > 0) & (y_hit < 0.004)
     assert cut == int(expected.sum()) > 0
     np.testing.assert_array_equal(~bonds.intact, expected)
+
+
+def test_family_sums_gives_zero_for_an_empty_family():
+    """An empty CSR family sums to 0 (np.add.reduceat would return the next family's first value)."""
+    from peridyn.bonds import family_sums
+
+    offsets = np.array([0, 2, 2, 5])
+    sums = family_sums(offsets, np.array([1.0, 2.0, 3.0, 4.0, 5.0]))
+    np.testing.assert_array_equal(sums, [3.0, 0.0, 12.0])

@@ -126,7 +126,7 @@ class PMBModel(Model):
     def stiffness_bound(self):
         b = self.bonds
         per_bond = np.where(b.intact, self.bond_stiffness / b.length, 0.0)
-        return 2.0 * np.add.reduceat(per_bond, b.offsets[:-1]) if b.n_bonds else np.zeros(0)
+        return 2.0 * b.family_sum(per_bond)
 
     def critical_stretch(self, fracture_energy):
         """s_c from G_c by integrating the bond energies across a crack plane.
