@@ -55,7 +55,7 @@ def plot_convergence(runs, fits, path=None, title: str | None = None) -> Figure:
         if reference is not None:
             ax.axhline(reference, color="k", ls=":", lw=1, label=f"reference {reference:.1f} Hz")
         ax.set_title(label)
-        ax.set_xlim(left=0.0)
+        ax.set_xlim(left=-0.03 * h_max * 1e3)
         ax.set_xlabel("spacing h (mm)")
         ax.set_ylabel("frequency (Hz)")
         ax.legend(fontsize="x-small")
