@@ -139,15 +139,20 @@ def _geometry_notes(case, body) -> list[str]:
             "so this run models another body"]
 
 
-def fit_series(runs: list[StudyRun], series=("delta-m",), references=None) -> list[dict]:
+def fit_series(runs: list[StudyRun], series=("delta-m",), references=None,
+               finest: int | None = None) -> list[dict]:
     """Richardson fits of every mode over every series of runs.
 
     Returns one dict per (series, group, mode): ``series``, ``group`` (what is held fixed),
     ``variable`` (``spacing_m`` or ``horizon_m``), ``x`` and ``frequencies_hz`` (finest
     first), and either ``value_hz``, ``order``, ``gci``, ``rms_residual_hz`` or ``error``.
     With ``references`` (label -> Hz), ``reference_hz`` and the relative errors of the
-    extrapolated and of the finest value are added.
+    extrapolated and of the finest value are added. With ``finest``, only that many of the
+    finest runs of each series enter the fit (the asymptotic range, seed 002 section 6.1);
+    ``fitted_runs`` says how many did.
     """
+    if finest is not None and finest < 3:
+        raise InputError(f"finest = {finest}: a Richardson fit needs at least three runs")
     unknown = [s for s in series if s not in SERIES]
     if unknown:
         raise InputError(f"unknown convergence series {unknown}: expected some of {', '.join(SERIES)}")
@@ -166,14 +171,15 @@ def fit_series(runs: list[StudyRun], series=("delta-m",), references=None) -> li
                 row = {"series": kind, "group": group, "mode": label, "variable": variable,
                        "x": x[order].tolist(), "frequencies_hz": f[order].tolist()}
                 try:
-                    fit = richardson(x, f)
+                    fit = richardson(x[order][:finest], f[order][:finest])
                 except ConvergenceError as exc:
                     row["error"] = str(exc)
                 except InputError as exc:
                     row["error"] = f"{len(having)} run(s) with this mode: {exc}"
                 else:
-                    row.update(value_hz=fit.value, order=fit.order, gci=fit.gci,
-                               coefficient=fit.coefficient, rms_residual_hz=fit.rms_residual)
+                    row.update(fitted_runs=len(fit.spacings), value_hz=fit.value, order=fit.order,
+                               gci=fit.gci, coefficient=fit.coefficient,
+                               rms_residual_hz=fit.rms_residual)
                 if references and label in references:
                     ref = references[label]
                     row["reference_hz"] = ref
@@ -223,8 +229,8 @@ def write_study(out: Path, runs: list[StudyRun], fits: list[dict], meta: dict) -
             for label, freq in (r.modes.items() if r.modes else [("", "")]):
                 writer.writerow([r.spacing, r.horizon_factor, r.horizon, r.points,
                                  round(r.seconds, 3), label, freq, r.skipped or ""])
-    columns = ["series", "group", "mode", "variable", "x", "frequencies_hz", "value_hz", "order",
-               "gci", "coefficient", "rms_residual_hz", "reference_hz", "finest_error",
+    columns = ["series", "group", "mode", "variable", "x", "frequencies_hz", "fitted_runs",
+               "value_hz", "order", "gci", "coefficient", "rms_residual_hz", "reference_hz", "finest_error",
                "value_error", "error"]
     with open(out / "study.csv", "w", newline="") as fh:
         writer = csv.DictWriter(fh, fieldnames=columns)

@@ -29,6 +29,9 @@ def register(sub) -> None:
     p.add_argument("--series", default="delta-m", metavar="S1,S2",
                    help="series to fit: delta-m (horizon factor fixed, spacing -> 0; default), "
                         "delta (spacing fixed, horizon -> 0), m (horizon in m fixed, spacing -> 0)")
+    p.add_argument("--finest", type=int, default=None, metavar="K",
+                   help="fit only the K finest runs of each series (K >= 3; default all): "
+                        "leave coarse runs outside the asymptotic range out of the fit")
     p.add_argument("--reference", action="append", default=[], metavar="MODE=HZ",
                    help="a reference frequency, e.g. '1st bending=1706.1' (repeatable): "
                         "errors of the finest run and of the extrapolation against it")
@@ -54,13 +57,15 @@ def run(args) -> dict:
     if args.modes is not None and args.modes < 1:
         raise InputError(f"--modes = {args.modes}: expected a positive integer")
     references = _references(args.reference)
+    if args.finest is not None and args.finest < 3:
+        raise InputError(f"--finest = {args.finest}: a Richardson fit needs at least three runs")
     case = load_case(args.case, args.overrides)  # fail early on a bad case or override
     out = Path(args.out or Path("peridyn-out") / f"{case.name}-study")
     runs = run_grid(args.case, spacings, factors, args.modes, args.overrides,
                     progress=lambda line: print(line, file=sys.stderr, flush=True))
-    fits = fit_series(runs, series, references)
+    fits = fit_series(runs, series, references, args.finest)
     meta = {"case": case.name, "spacings_m": spacings, "horizon_factors": factors,
-            "series": series}
+            "series": series, "finest": args.finest}
     summary = write_study(out, runs, fits, meta)
     plots = [out / "study.png", *([Path(args.plot)] if args.plot else [])]
     figure = plot_convergence(runs, fits, title=f"{case.name}: delta-m convergence")
@@ -87,7 +92,8 @@ def format_table(summary: dict) -> str:
             xs = sorted({x for f in summary["fits"] if (f["series"], f["group"]) == previous
                          for x in f["x"]})
             lines.append(f"\n{fit['series']} convergence, {fit['group']}; {unit}: "
-                         + ", ".join(f"{x * 1e3:g}" for x in xs))
+                         + ", ".join(f"{x * 1e3:g}" for x in xs)
+                         + (f" (fits on the {summary['finest']} finest)" if summary["finest"] else ""))
             lines.append(f"  {'mode':<26}{'frequencies (Hz), finest first':>34} {'f_inf (Hz)':>11} "
                          f"{'p':>6} {'GCI':>7}")
         freqs = " ".join(f"{f:8.1f}" for f in fit["frequencies_hz"])
