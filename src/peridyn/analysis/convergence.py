@@ -13,12 +13,12 @@ convergence and C a constant (eq. 6.4: C = |f_inf - f(h)| / h^p).
       (f3 - f2) / (f2 - f1) = (h3^p - h2^p) / (h2^p - h1^p),
 
   which for a constant ratio r = h2/h1 = h3/h2 is p = ln((f3 - f2)/(f2 - f1)) / ln r
-  (Roache 1998, eq. 5.10.6.1; the general form is Celik et al. 2008, eqs. 3-4).
+  (Roache 1998, chapter 5; the varying-ratio form as in Celik et al. 2008).
   Then C = (f2 - f1) / (h2^p - h1^p) and f_inf = f1 - C h1^p.
 - More than three: least-squares fit of (f_inf, C, p) to all points, as the thesis
   fitted its four meshes (seed 002, section 6.1: "minimizing the difference between the
   left-hand side and the right-hand side in (6.3)"), started from the three finest.
-- Grid convergence index of the finest grid (Roache 1994, eq. 19; Roache 1998, ch. 5):
+- Grid convergence index of the finest grid (Roache 1994; Roache 1998, chapter 5):
 
       GCI = F_s |(f2 - f1) / f1| / (r^p - 1),   r = h2 / h1,   F_s = 1.25
 
@@ -28,6 +28,12 @@ convergence and C a constant (eq. 6.4: C = |f_inf - f(h)| / h^p).
 Richardson extrapolation assumes monotone convergence: successive differences
 f(h_k+1) - f(h_k) of one sign, shrinking as h decreases. Oscillating or diverging
 sequences raise :class:`ConvergenceError` instead of returning a meaningless fit.
+
+References: P. J. Roache, Perspective: a method for uniform reporting of grid refinement
+studies, J. Fluids Eng. 116 (1994) 405-413; P. J. Roache, Verification and Validation in
+Computational Science and Engineering, Hermosa, 1998; I. B. Celik et al., Procedure for
+estimation and reporting of uncertainty due to discretization in CFD applications,
+J. Fluids Eng. 130 (2008) 078001.
 """
 
 from __future__ import annotations

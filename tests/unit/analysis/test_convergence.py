@@ -1,7 +1,7 @@
 """Richardson extrapolation (peridyn.analysis.convergence) against data built from its own model.
 
 Source of the formulas: seed 002 eqs. 6.3-6.5 (f = f_inf + C h^p), Roache 1998 ch. 5 and
-Celik et al. 2008 (three grids, any refinement ratio), Roache 1994 eq. 19 (GCI).
+Celik et al. 2008 (three grids, any refinement ratio), Roache 1994 (GCI).
 """
 
 import numpy as np
@@ -48,7 +48,7 @@ def test_decreasing_sequence_and_high_order():
 
 
 def test_gci_of_constant_ratio_matches_roache_formula():
-    # Roache 1994 eq. 19: GCI = 1.25 |(f2 - f1)/f1| / (r^p - 1); for exact data the true
+    # Roache 1994: GCI = 1.25 |(f2 - f1)/f1| / (r^p - 1); for exact data the true
     # relative error of f1, |f1 - A|/f1 = |f2 - f1| / f1 / (r^p - 1), times 1.25.
     h = np.array([1e-3, 2e-3, 4e-3])
     f = _exact(h)
