@@ -27,6 +27,7 @@ COMMAND_MODULES = (
     "peridyn.cli.modal_cmd",
     "peridyn.cli.plot_cmd",
     "peridyn.cli.fatigue_cmd",
+    "peridyn.cli.study_cmd",
 )
 
 
