@@ -27,6 +27,7 @@ from peridyn.kernels.lps import (
     lps_pair_force_cf,
 )
 from peridyn.materials.base import Model
+from peridyn.materials.lps_correction import energy_factors
 from peridyn.materials.elastic import (
     bulk_modulus,
     check_elastic,
@@ -35,7 +36,7 @@ from peridyn.materials.elastic import (
 )
 
 #: ``shear-factor``: Peridigm's former "Apply Shear Correction Factor" (see ``LPSModel``).
-SURFACE_CORRECTIONS = ("none", "shear-factor")
+SURFACE_CORRECTIONS = ("none", "shear-factor", "energy")
 
 
 class LPSModel(Model):
@@ -82,12 +83,24 @@ class LPSModel(Model):
         if surface_correction == "shear-factor":
             self.shear_factor = self._shear_correction_factor(w)
             self.alpha = self.alpha * self.shear_factor
+        self.dev_factor = np.ones(b.n_bonds)
+        if surface_correction == "energy":
+            owners = b.owners()
+            n_vec = (body.points[b.neighbours] - body.points[owners]) / b.length[:, None]
+            self.dev_factor = energy_factors(owners, n_vec, b.length, np.where(b.intact, w, 0.0),
+                                             self.alpha, self.shear, dim, body.n_points)
+        # m~_i = sum_j g_ij w |xi|^2 (= m without correction), m^5
+        self.dev_weighted_volume = np.add.reduceat(
+            np.where(b.intact, self.dev_factor * w * b.length**2, 0.0), b.offsets[:-1])
+        # k_ij = w (alpha_i g_ij + alpha_j g_ji), the bond's deviatoric stiffness (both energies)
+        point_dev = self.alpha[b.owners()] * self.dev_factor
+        self.dev = (w * (point_dev + point_dev[b.reverse()])).astype(self.dtype)
         self.length = b.length.astype(self.dtype)
         self.w = w.astype(self.dtype)
-        self._alpha = self.alpha.astype(self.dtype)
         self._theta_coef = self.theta_coef.astype(self.dtype)
         # P_i = theta_i * p_coef_i, see peridyn.kernels.lps
-        self._p_coef = (dim * self.bulk / m - self.alpha / dim).astype(self.dtype)
+        self._p_coef = (dim * self.bulk / m - self.alpha * self.dev_weighted_volume / (dim * m)
+                        ).astype(self.dtype)
         self._theta = np.empty(body.n_points, dtype=self.dtype)
         self._p = np.empty(body.n_points, dtype=self.dtype)
 
@@ -144,10 +157,10 @@ class LPSModel(Model):
         u = self._as_state(u)
         p = np.multiply(self._dilatation(u), self._p_coef, out=self._p)
         if self.dtype == np.float32:
-            return lps_pair_force_cf(self.x, u, b.offsets, b.neighbours, self.w, b.intact, p,
-                                     self._alpha, out)
-        return lps_pair_force(self.x, u, b.offsets, b.neighbours, self.length, self.w, b.intact,
-                              p, self._alpha, out)
+            return lps_pair_force_cf(self.x, u, b.offsets, b.neighbours, self.w, self.dev,
+                                     b.intact, p, out)
+        return lps_pair_force(self.x, u, b.offsets, b.neighbours, self.length, self.w, self.dev,
+                              b.intact, p, out)
 
     def energy_density(self, u):
         b = self.bonds
@@ -156,8 +169,11 @@ class LPSModel(Model):
         w64 = self.w.astype(np.float64)
         theta = lps_dilatation(x64, u64, b.offsets, b.neighbours, b.length, w64, b.intact,
                                self.theta_coef, np.empty(self.body.n_points))
-        dev = lps_deviatoric_energy(x64, u64, b.offsets, b.neighbours, b.length, w64, b.intact,
-                                    theta, float(self.dim), np.empty(self.body.n_points))
+        # sum_j g w e^2 (the kernel with theta = 0), then the m~ theta^2 / d^2 of the energy
+        squares = lps_deviatoric_energy(x64, u64, b.offsets, b.neighbours, b.length,
+                                        w64 * self.dev_factor, b.intact, np.zeros_like(theta),
+                                        float(self.dim), np.empty(self.body.n_points))
+        dev = squares - self.dev_weighted_volume * theta**2 / self.dim**2
         return 0.5 * self.bulk * theta**2 + 0.5 * self.alpha * dev
 
     def stiffness_bound(self):
@@ -173,7 +189,7 @@ class LPSModel(Model):
         w = np.where(b.intact, b.influence * self.bond_volume, 0.0)
         nbr = b.neighbours
         s = self.theta_coef * np.add.reduceat(w * b.length, b.offsets[:-1])
-        pair = 2.0 * w * (self.alpha[b.owners()] + self.alpha[nbr])
+        pair = 2.0 * np.where(b.intact, self.dev.astype(np.float64), 0.0)
         dil = 2.0 * self.bulk * self.theta_coef[nbr] * w * b.length * s[nbr]
         return np.add.reduceat(pair + dil, b.offsets[:-1]) + 2.0 * self.bulk * s**2
 
