@@ -10,6 +10,17 @@ In d dimensions the energy density of point i is
 
 alpha = 15 mu / m (3D), 8 mu / m (2D), w = omega beta V_j, m_i = sum_j w_ij |xi|^2 over
 the intact bonds at set-up (each point's own family, so surfaces are seen).
+
+With ``surface_correction: energy`` each point weights its own bonds in the deviatoric
+part with factors g_ij (``peridyn.materials.lps_correction``):
+
+    W_i = kappa theta_i^2 / 2 + (alpha_i / 2) [ sum_j g_ij w_ij e_ij^2 - m~_i theta_i^2 / d^2 ],
+
+m~_i = sum_j g_ij w_ij |xi|^2 (set-up); g = 1 gives the form above. Its force is
+t_ij = w |xi| P_i + alpha_i g_ij w e_ij with P_i = theta_i p_coef_i,
+p_coef = d kappa / m - alpha m~ / (d m), so every consumer (force kernels, linear force,
+stiffness, tangent, Bloch cell) reads the per-bond deviatoric stiffness
+``dev`` = w (alpha_i g_ij + alpha_j g_ji) and ``_p_coef`` from the model.
 """
 
 from __future__ import annotations
@@ -27,13 +38,13 @@ from peridyn.kernels.lps import (
     lps_pair_force_cf,
 )
 from peridyn.materials.base import Model
-from peridyn.materials.lps_correction import energy_factors
 from peridyn.materials.elastic import (
     bulk_modulus,
     check_elastic,
     plane_bulk_modulus,
     shear_modulus,
 )
+from peridyn.materials.lps_correction import energy_factors
 
 #: ``shear-factor``: Peridigm's former "Apply Shear Correction Factor" (see ``LPSModel``).
 SURFACE_CORRECTIONS = ("none", "shear-factor", "energy")
@@ -48,10 +59,19 @@ class LPSModel(Model):
     E : float, Pa
     nu : float
     density : float, kg/m^3
-    surface_correction : {"none", "shear-factor"}
+    surface_correction : {"none", "shear-factor", "energy"}
         ``shear-factor`` scales each point's deviatoric coefficient alpha by
-        Peridigm's shear correction factor (see ``_shear_correction_factor``).
+        Peridigm's shear correction factor (see ``_shear_correction_factor``);
+        ``energy`` sets per-bond deviatoric factors (module docstring).
     dtype : float64 or float32
+
+    Attributes (beyond ``Model``'s)
+    -------------------------------
+    alpha : (n,) Pa/m^5, theta_coef : (n,) 1/m^5, weighted_volume m : (n,) m^5
+    dev_factor : (n_bonds,) g_ij of the owner's deviatoric part (1 unless ``energy``)
+    dev_weighted_volume : (n,) m~, m^5
+    dev : (n_bonds,) kernel dtype, w (alpha_i g_ij + alpha_j g_ji), the bond's deviatoric
+        stiffness read by every force and stiffness routine
     """
 
     name = "lps"
