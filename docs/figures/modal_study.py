@@ -47,7 +47,10 @@ def run(spacing: float, horizon: float, correction: str) -> dict:
     model = LPSModel(body, bonds, E=5.35e9, nu=0.33, density=1200.0,
                      surface_correction=correction)
     _, _, rows = modal_table(model, N_MODES)
-    by_type = {(r["type"], r["order"]): r["frequency_hz"] for r in rows if r["type"] != "rigid"}
+    by_type = {}  # the lowest mode of each type and order
+    for r in rows:
+        if r["type"] != "rigid":
+            by_type.setdefault((r["type"], r["order"]), r["frequency_hz"])
     record = {"points": body.n_points, "spacing": spacing, "horizon": horizon,
               "correction": correction, "frequencies": [by_type.get(t) for t in TYPES],
               "max_residual": max(r["residual"] for r in rows),
