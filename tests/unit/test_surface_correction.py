@@ -2,11 +2,17 @@
 deviatoric factors give surface points the continuum shear energy, leave bulk points and
 isotropic expansion alone, and stay an energy (symmetric K, K u = -V f(u), f = -dE/du)."""
 
+import warnings
+
 import numpy as np
 import pytest
 from conftest import small_model
 
+from peridyn import geometry
+from peridyn.analysis.bloch import Discretisation, bloch_cell
+from peridyn.bonds import find_bonds
 from peridyn.errors import InputError
+from peridyn.materials import make_model
 from peridyn.materials.lps_correction import deviatoric_tests
 from peridyn.stiffness import assemble_stiffness, linear_force, stiffness_operator
 from peridyn.tangent import tangent_stiffness
@@ -173,8 +179,6 @@ def test_bloch_cell_long_waves_become_classical_on_anisotropic_lattices(horizon_
     interior point to the continuum deviatoric energies (the dilatation of a full cubic
     family is already exact), so cL and cS equal the closed forms sqrt((K + 4 mu / 3) / rho)
     and sqrt(mu / rho) in every direction (measured to 1e-6)."""
-    from peridyn.analysis.bloch import Discretisation, bloch_cell
-
     bulk, shear, rho = 132.77e9, 81.92e9, 8000.0  # maraging steel, VALIDATION.md V3
     young = 9 * bulk * shear / (3 * bulk + shear)
     nu = (3 * bulk - 2 * shear) / (2 * (3 * bulk + shear))
@@ -185,3 +189,18 @@ def test_bloch_cell_long_waves_become_classical_on_anisotropic_lattices(horizon_
     for direction in ((1, 0, 0), (1, 1, 0), (1, 1, 1)):
         speeds = cell.long_wave_speeds(direction)
         np.testing.assert_allclose(speeds, [c_s, c_s, c_l], rtol=1e-5)
+
+
+def test_negative_bond_weights_are_reported():
+    """A plate two points thick with horizon 3 h: the fit needs negative weights on some
+    bonds (measured min g = -0.16), which a user must hear about; with sqrt(2) h it does not
+    (min g = 0.475)."""
+    body = geometry.box((10e-3, 6e-3, 2e-3), 1e-3)
+    with pytest.warns(UserWarning, match=r"\d+ bonds need a negative deviatoric weight"):
+        make_model("lps", body, find_bonds(body, 3.015e-3, partial_volumes=False), E=200e9,
+                   density=7850.0, nu=0.25, surface_correction="energy")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        model = make_model("lps", body, find_bonds(body, 1.4143e-3, partial_volumes=False),
+                           E=200e9, density=7850.0, nu=0.25, surface_correction="energy")
+    assert model.dev_factor.min() > 0.4

@@ -25,6 +25,8 @@ stiffness, tangent, Bloch cell) reads the per-bond deviatoric stiffness
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
 from peridyn.body import Body
@@ -109,6 +111,14 @@ class LPSModel(Model):
             n_vec = (body.points[b.neighbours] - body.points[owners]) / b.length[:, None]
             self.dev_factor = energy_factors(owners, n_vec, b.length, np.where(b.intact, w, 0.0),
                                              self.alpha, self.shear, dim, body.n_points)
+            negative = int(np.count_nonzero(self.dev_factor[b.intact] <= 0.0))
+            if negative:
+                warnings.warn(
+                    f"LPS energy surface correction: {negative} bonds need a negative deviatoric "
+                    "weight (the horizon reaches across most of the body); the energy may lose "
+                    "positivity: use a smaller horizon or another surface_correction",
+                    stacklevel=2,
+                )
         # m~_i = sum_j g_ij w |xi|^2 (= m without correction), m^5
         self.dev_weighted_volume = np.add.reduceat(
             np.where(b.intact, self.dev_factor * w * b.length**2, 0.0), b.offsets[:-1])
