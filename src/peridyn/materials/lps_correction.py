@@ -27,8 +27,10 @@ W_k = (alpha_i / 2) sum_j g_ij w |xi|^2 r_jk with r_jk = (n.eps_k.n)^2 - theta_i
     A_kl = (alpha_i / 2) sum_j w |xi|^2 r_jk r_jl,
 
 solved with a pseudo-inverse (tests that a cut family cannot tell apart share the
-correction). Points whose family already gives the continuum energies (bulk points of a
-cubic grid with horizon sqrt(2) h or 2 h) get g = 1 to round-off.
+correction). Interior points of a cubic grid with horizon sqrt(2) h (18 neighbours,
+already exact) get g = 1 to round-off; on other lattices (2 h, 3 h) the interior factors
+also remove the lattice's anisotropy (the same factors at every interior point; Bloch
+long waves then classical to 1e-6).
 """
 
 from __future__ import annotations
