@@ -6,8 +6,9 @@ bodies keep their z dofs (they carry no stiffness: constrain or drop them with
 small ``u`` (N), and the lumped mass is ``M = rho V`` (kg).
 
 PMB: each directed bond i->j adds the energy (V_i k_ij / |xi|) (n . eta)^2 / 2.
-LPS: the energy of point p is V_p [c_p theta_p^2 + (alpha_p / 2) sum_j w e^2] with
-c_p = kappa / 2 - alpha_p m_p / (2 d^2) (since sum w (e^d)^2 = sum w e^2 - m theta^2 / d^2);
+LPS: the energy of point p is V_p [c_p theta_p^2 + (alpha_p / 2) sum_j g_pj w e^2] with
+c_p = kappa / 2 - alpha_p m~_p / (2 d^2) (``peridyn.materials.lps``; without surface
+correction g = 1, m~ = m and sum w (e^d)^2 = sum w e^2 - m theta^2 / d^2);
 theta_p = g_p . u couples p with its whole family, so each point adds a dense
 block 2 c_p V_p g_p g_p^T over its family: the matrix reaches two horizons
 (about (n_family + 1)^2 blocks per point). ``stiffness_parts`` keeps it factored
@@ -44,8 +45,8 @@ def linear_force(model: Model, u: np.ndarray) -> np.ndarray:
                                 model.bond_stiffness.astype(np.float64), b.intact)
     if isinstance(model, LPSModel):
         return lps_linear_force(x, u, b.offsets, b.neighbours, b.length,
-                                model.w.astype(np.float64), b.intact, model.theta_coef,
-                                model._p_coef.astype(np.float64), model.alpha)
+                                model.w.astype(np.float64), model.dev.astype(np.float64), b.intact,
+                                model.theta_coef, model._p_coef.astype(np.float64))
     raise TypeError(f"no linearisation for {type(model).__name__}")
 
 
@@ -128,10 +129,11 @@ def stiffness_parts(model: Model, energy_of: np.ndarray | None = None) -> Stiffn
                                            pair[counted], n))
     if isinstance(model, LPSModel):
         w = np.where(counted, model.w.astype(np.float64), 0.0)
-        pair = 2.0 * vol[owners] * model.alpha[owners] * w  # (V alpha w / 2) e^2 per bond
+        # (V alpha g w / 2) e^2 per bond
+        pair = 2.0 * vol[owners] * model.alpha[owners] * model.dev_factor * w
         k_pair = _pair_matrix(owners[counted], b.neighbours[counted], n_vec[counted], pair[counted], n)
         d = model.dim
-        c = 0.5 * model.bulk - model.alpha * model.weighted_volume / (2 * d * d)
+        c = 0.5 * model.bulk - model.alpha * model.dev_weighted_volume / (2 * d * d)
         a = model.theta_coef[owners] * w * b.length  # d theta_p / d e_pj
         return StiffnessParts(k_pair, _dilatation_gradients(owners, b.neighbours, n_vec, a, n),
                               2.0 * c * vol)

@@ -18,7 +18,8 @@ The first bracket is the bond block B: a stretch term along n and a geometric
 (rotation) term across it, T / r, which vanishes in the reference state.
 
 - PMB: T = k (r / L - 1) (stretch times bond stiffness), dT/dr = k / L.
-- LPS: T = w [L (P_i + P_j) + (alpha_i + alpha_j) e], e = r - L, dT/dr = w (alpha_i + alpha_j);
+- LPS: T = w L (P_i + P_j) + k e, e = r - L, dT/dr = k (k = w (alpha_i g_ij + alpha_j g_ji) the
+  bond's deviatoric stiffness, ``LPSModel.dev``);
   P_k = p_coef_k theta_k also varies with u: dP_k = p_coef_k (d / m_k) sum_m w_km L_km n_km . dY_km,
   which adds d f_i = sum_j w_ij L_ij n_ij (dP_i + dP_j), a product H G of two sparse
   matrices (H: (3 n, n) bond directions weighted w L; G: (n, 3 n) the gradient of P).
@@ -55,9 +56,9 @@ def tangent_stiffness(model: Model, u: np.ndarray) -> sp.csr_matrix:
         theta = model.theta_coef * np.bincount(owners, weights=w * length * e, minlength=len(x))
         p_coef = model._p_coef.astype(np.float64)
         p = theta * p_coef
-        a_sum = model.alpha[owners] + model.alpha[nbr]
-        force = w * (length * (p[owners] + p[nbr]) + a_sum * e)
-        jacobian = _bond_blocks(b.offsets, nbr, n_vec, w * a_sum, force / r)
+        k = np.where(b.intact, model.dev.astype(np.float64), 0.0)
+        force = w * length * (p[owners] + p[nbr]) + k * e
+        jacobian = _bond_blocks(b.offsets, nbr, n_vec, k, force / r)
         jacobian = jacobian + _dilatation_jacobian(model, owners, nbr, n_vec, w, p_coef)
     else:
         raise TypeError(f"no tangent for {type(model).__name__}")

@@ -108,7 +108,7 @@ def test_kernel_matches_numpy_reference(case, rng):
                                   model.bond_stiffness, b.intact)
     else:
         ref = reference.lps_force(model.x, u, b.offsets, b.neighbours, model.length, model.w,
-                                  b.intact, model.theta_coef, model._p_coef, model.alpha)
+                                  model.dev, b.intact, model.theta_coef, model._p_coef)
     got = model.force(u)
     np.testing.assert_allclose(got, ref, rtol=1e-10, atol=1e-12 * np.abs(ref).max())
 

@@ -4,7 +4,8 @@ With n = xi/|xi| and eta = u_j - u_i, the linearised extension is e = n . eta.
 
 - PMB: f_i = sum_j (k_ij / |xi|) (n . eta) n;
 - LPS: theta_i = (d / m_i) sum_j w |xi| (n . eta),
-  f_i = sum_j w [ |xi| (P_i + P_j) + (alpha_i + alpha_j) (n . eta) ] n, P_i = theta_i p_coef_i.
+  f_i = sum_j [ w |xi| (P_i + P_j) + k_ij (n . eta) ] n, P_i = theta_i p_coef_i, k_ij the
+  bond's deviatoric stiffness (see ``peridyn.kernels.lps``).
 
 ``K u = -V f_lin(u)`` holds to round-off for the matrices of ``peridyn.stiffness``.
 """
@@ -48,12 +49,11 @@ def pmb_linear_force(x, u, offsets, nbr, length, k, intact):
     return scatter_along_bonds(x, offsets, nbr, length, k / length * e, np.empty_like(x))
 
 
-def lps_linear_force(x, u, offsets, nbr, length, w, intact, theta_coef, p_coef, alpha):
+def lps_linear_force(x, u, offsets, nbr, length, w, dev, intact, theta_coef, p_coef):
     """Linearised LPS force density (n_points, 3), N/m^3."""
     e = bond_extension(x, u, offsets, nbr, length, intact, np.empty(len(nbr)))
     owners = np.repeat(np.arange(len(x)), np.diff(offsets))
     theta = theta_coef * np.bincount(owners, w * length * e, minlength=len(x))
     p = theta * p_coef
-    t = np.where(intact, w * (length * (p[owners] + p[nbr]) + (alpha[owners] + alpha[nbr]) * e),
-                 0.0)
+    t = np.where(intact, w * length * (p[owners] + p[nbr]) + dev * e, 0.0)
     return scatter_along_bonds(x, offsets, nbr, length, t, np.empty_like(x))

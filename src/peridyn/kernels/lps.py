@@ -2,12 +2,14 @@
 
 Per point: weighted volume m_i = sum_j w_ij |xi|^2 with w_ij = omega beta V_j,
 dilatation theta_i = (d / m_i) sum_j w_ij |xi| e_ij, extension e = |Y| - |xi|.
-Scalar force state t_ij = (d kappa theta_i / m_i) omega |xi| + alpha_i omega e^d_ij,
-e^d = e - theta_i |xi| / d, alpha = 15 mu / m (3D) or 8 mu / m (2D). The pair
-force on i is (t_ij + t_ji) Y/|Y| beta V_j, which the kernel writes as
+Scalar force state t_ij = |xi| omega P_i + alpha_i g_ij omega e_ij, with the per-point
+P_i = theta_i p_coef_i (``peridyn.materials.lps``: p_coef = d kappa / m - alpha / d without
+surface correction) and g_ij the point's deviatoric factor (1 without correction).
+The pair force on i is (t_ij + t_ji) Y/|Y| beta V_j, which the kernel writes as
 
-    sum_j w_ij [ |xi| (P_i + P_j) + (alpha_i + alpha_j) e_ij ] Y / |Y|,
-    P_i = theta_i (d kappa_i / m_i - alpha_i / d).
+    sum_j [ w_ij |xi| (P_i + P_j) + k_ij e_ij ] Y / |Y|,   k_ij = w_ij (alpha_i g_ij + alpha_j g_ji),
+
+with the per-bond deviatoric stiffness ``dev`` = k_ij.
 
 The force takes two passes over the bonds (the pair force needs the neighbours'
 dilatations). ``lps_dilatation`` / ``lps_pair_force`` (float64) and the ``*_cf``
@@ -54,8 +56,8 @@ def lps_dilatation(x, u, offsets, nbr, length, w, intact, theta_coef, theta):
 
 
 @numba.njit(parallel=True, fastmath=FASTMATH, cache=True)
-def lps_pair_force(x, u, offsets, nbr, length, w, intact, p, alpha, f):
-    """Force density ``f`` (OUT) from the per-point ``p`` = P_i and ``alpha`` (see module).
+def lps_pair_force(x, u, offsets, nbr, length, w, dev, intact, p, f):
+    """Force density ``f`` (OUT) from the per-point ``p`` = P_i and per-bond ``dev`` (see module).
 
     Length form (float64).
     """
@@ -71,9 +73,9 @@ def lps_pair_force(x, u, offsets, nbr, length, w, intact, p, alpha, f):
         fam = nbr[lo:hi]
         lb = length[lo:hi]
         wb = w[lo:hi]
+        kb = dev[lo:hi]
         ok = intact[lo:hi]
         pi = p[i]
-        ai = alpha[i]
         f0 = zero
         f1 = zero
         f2 = zero
@@ -85,7 +87,7 @@ def lps_pair_force(x, u, offsets, nbr, length, w, intact, p, alpha, f):
             _, _, y2 = bond_differences(xf[j + 2], xi2, uf[j + 2], ui2)
             r = np.sqrt(y0 * y0 + y1 * y1 + y2 * y2)
             L = lb[q]
-            t = wb[q] * (L * (pi + p[jp]) + (ai + alpha[jp]) * (r - L)) / r
+            t = (wb[q] * L * (pi + p[jp]) + kb[q] * (r - L)) / r
             t = t if ok[q] else zero
             f0 += t * y0
             f1 += t * y1
@@ -131,10 +133,10 @@ def lps_dilatation_cf(x, u, offsets, nbr, w, intact, theta_coef, theta):
 
 
 @numba.njit(parallel=True, fastmath=FASTMATH, cache=True)
-def lps_pair_force_cf(x, u, offsets, nbr, w, intact, p, alpha, f):
+def lps_pair_force_cf(x, u, offsets, nbr, w, dev, intact, p, f):
     """:func:`lps_pair_force` in the cancellation-free form (float32), one division per bond:
 
-    t = w [ |xi| (|Y| + |xi|) (P_i + P_j) + (alpha_i + alpha_j) du . (Y + xi) ] / (|Y| (|Y| + |xi|)).
+    t = [ w |xi| (|Y| + |xi|) (P_i + P_j) + dev du . (Y + xi) ] / (|Y| (|Y| + |xi|)).
     """
     n = x.shape[0]
     zero = f.dtype.type(0.0)
@@ -147,9 +149,9 @@ def lps_pair_force_cf(x, u, offsets, nbr, w, intact, p, alpha, f):
         hi = offsets[i + 1]
         fam = nbr[lo:hi]
         wb = w[lo:hi]
+        kb = dev[lo:hi]
         ok = intact[lo:hi]
         pi = p[i]
-        ai = alpha[i]
         f0 = zero
         f1 = zero
         f2 = zero
@@ -163,7 +165,7 @@ def lps_pair_force_cf(x, u, offsets, nbr, w, intact, p, alpha, f):
             L = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
             ext2 = e0 * (y0 + d0) + e1 * (y1 + d1) + e2 * (y2 + d2)
             rl = r + L
-            t = wb[q] * (L * rl * (pi + p[jp]) + (ai + alpha[jp]) * ext2) / (r * rl)
+            t = (wb[q] * L * rl * (pi + p[jp]) + kb[q] * ext2) / (r * rl)
             t = t if ok[q] else zero
             f0 += t * y0
             f1 += t * y1

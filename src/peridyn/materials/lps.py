@@ -10,9 +10,22 @@ In d dimensions the energy density of point i is
 
 alpha = 15 mu / m (3D), 8 mu / m (2D), w = omega beta V_j, m_i = sum_j w_ij |xi|^2 over
 the intact bonds at set-up (each point's own family, so surfaces are seen).
+
+With ``surface_correction: energy`` each point weights its own bonds in the deviatoric
+part with factors g_ij (``peridyn.materials.lps_correction``):
+
+    W_i = kappa theta_i^2 / 2 + (alpha_i / 2) [ sum_j g_ij w_ij e_ij^2 - m~_i theta_i^2 / d^2 ],
+
+m~_i = sum_j g_ij w_ij |xi|^2 (set-up); g = 1 gives the form above. Its force is
+t_ij = w |xi| P_i + alpha_i g_ij w e_ij with P_i = theta_i p_coef_i,
+p_coef = d kappa / m - alpha m~ / (d m), so every consumer (force kernels, linear force,
+stiffness, tangent, Bloch cell) reads the per-bond deviatoric stiffness
+``dev`` = w (alpha_i g_ij + alpha_j g_ji) and ``_p_coef`` from the model.
 """
 
 from __future__ import annotations
+
+import warnings
 
 import numpy as np
 
@@ -33,9 +46,10 @@ from peridyn.materials.elastic import (
     plane_bulk_modulus,
     shear_modulus,
 )
+from peridyn.materials.lps_correction import energy_factors
 
 #: ``shear-factor``: Peridigm's former "Apply Shear Correction Factor" (see ``LPSModel``).
-SURFACE_CORRECTIONS = ("none", "shear-factor")
+SURFACE_CORRECTIONS = ("none", "shear-factor", "energy")
 
 
 class LPSModel(Model):
@@ -47,10 +61,19 @@ class LPSModel(Model):
     E : float, Pa
     nu : float
     density : float, kg/m^3
-    surface_correction : {"none", "shear-factor"}
+    surface_correction : {"none", "shear-factor", "energy"}
         ``shear-factor`` scales each point's deviatoric coefficient alpha by
-        Peridigm's shear correction factor (see ``_shear_correction_factor``).
+        Peridigm's shear correction factor (see ``_shear_correction_factor``);
+        ``energy`` sets per-bond deviatoric factors (module docstring).
     dtype : float64 or float32
+
+    Attributes (beyond ``Model``'s)
+    -------------------------------
+    alpha : (n,) Pa/m^5, theta_coef : (n,) 1/m^5, weighted_volume m : (n,) m^5
+    dev_factor : (n_bonds,) g_ij of the owner's deviatoric part (1 unless ``energy``)
+    dev_weighted_volume : (n,) m~, m^5
+    dev : (n_bonds,) kernel dtype, w (alpha_i g_ij + alpha_j g_ji), the bond's deviatoric
+        stiffness read by every force and stiffness routine
     """
 
     name = "lps"
@@ -82,12 +105,32 @@ class LPSModel(Model):
         if surface_correction == "shear-factor":
             self.shear_factor = self._shear_correction_factor(w)
             self.alpha = self.alpha * self.shear_factor
+        self.dev_factor = np.ones(b.n_bonds)
+        if surface_correction == "energy":
+            owners = b.owners()
+            n_vec = (body.points[b.neighbours] - body.points[owners]) / b.length[:, None]
+            self.dev_factor = energy_factors(owners, n_vec, b.length, np.where(b.intact, w, 0.0),
+                                             self.alpha, self.shear, dim, body.n_points)
+            negative = int(np.count_nonzero(self.dev_factor[b.intact] <= 0.0))
+            if negative:
+                warnings.warn(
+                    f"LPS energy surface correction: {negative} bonds need a negative deviatoric "
+                    "weight (the horizon reaches across most of the body); the energy may lose "
+                    "positivity: use a smaller horizon or another surface_correction",
+                    stacklevel=2,
+                )
+        # m~_i = sum_j g_ij w |xi|^2 (= m without correction), m^5
+        self.dev_weighted_volume = np.add.reduceat(
+            np.where(b.intact, self.dev_factor * w * b.length**2, 0.0), b.offsets[:-1])
+        # k_ij = w (alpha_i g_ij + alpha_j g_ji), the bond's deviatoric stiffness (both energies)
+        point_dev = self.alpha[b.owners()] * self.dev_factor
+        self.dev = (w * (point_dev + point_dev[b.reverse()])).astype(self.dtype)
         self.length = b.length.astype(self.dtype)
         self.w = w.astype(self.dtype)
-        self._alpha = self.alpha.astype(self.dtype)
         self._theta_coef = self.theta_coef.astype(self.dtype)
         # P_i = theta_i * p_coef_i, see peridyn.kernels.lps
-        self._p_coef = (dim * self.bulk / m - self.alpha / dim).astype(self.dtype)
+        self._p_coef = (dim * self.bulk / m - self.alpha * self.dev_weighted_volume / (dim * m)
+                        ).astype(self.dtype)
         self._theta = np.empty(body.n_points, dtype=self.dtype)
         self._p = np.empty(body.n_points, dtype=self.dtype)
 
@@ -144,10 +187,10 @@ class LPSModel(Model):
         u = self._as_state(u)
         p = np.multiply(self._dilatation(u), self._p_coef, out=self._p)
         if self.dtype == np.float32:
-            return lps_pair_force_cf(self.x, u, b.offsets, b.neighbours, self.w, b.intact, p,
-                                     self._alpha, out)
-        return lps_pair_force(self.x, u, b.offsets, b.neighbours, self.length, self.w, b.intact,
-                              p, self._alpha, out)
+            return lps_pair_force_cf(self.x, u, b.offsets, b.neighbours, self.w, self.dev,
+                                     b.intact, p, out)
+        return lps_pair_force(self.x, u, b.offsets, b.neighbours, self.length, self.w, self.dev,
+                              b.intact, p, out)
 
     def energy_density(self, u):
         b = self.bonds
@@ -156,8 +199,11 @@ class LPSModel(Model):
         w64 = self.w.astype(np.float64)
         theta = lps_dilatation(x64, u64, b.offsets, b.neighbours, b.length, w64, b.intact,
                                self.theta_coef, np.empty(self.body.n_points))
-        dev = lps_deviatoric_energy(x64, u64, b.offsets, b.neighbours, b.length, w64, b.intact,
-                                    theta, float(self.dim), np.empty(self.body.n_points))
+        # sum_j g w e^2 (the kernel with theta = 0), then the m~ theta^2 / d^2 of the energy
+        squares = lps_deviatoric_energy(x64, u64, b.offsets, b.neighbours, b.length,
+                                        w64 * self.dev_factor, b.intact, np.zeros_like(theta),
+                                        float(self.dim), np.empty(self.body.n_points))
+        dev = squares - self.dev_weighted_volume * theta**2 / self.dim**2
         return 0.5 * self.bulk * theta**2 + 0.5 * self.alpha * dev
 
     def stiffness_bound(self):
@@ -173,7 +219,7 @@ class LPSModel(Model):
         w = np.where(b.intact, b.influence * self.bond_volume, 0.0)
         nbr = b.neighbours
         s = self.theta_coef * np.add.reduceat(w * b.length, b.offsets[:-1])
-        pair = 2.0 * w * (self.alpha[b.owners()] + self.alpha[nbr])
+        pair = 2.0 * np.where(b.intact, self.dev.astype(np.float64), 0.0)
         dil = 2.0 * self.bulk * self.theta_coef[nbr] * w * b.length * s[nbr]
         return np.add.reduceat(pair + dil, b.offsets[:-1]) + 2.0 * self.bulk * s**2
 
