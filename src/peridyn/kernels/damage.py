@@ -1,44 +1,150 @@
-"""Bond-breaking kernel."""
+"""Bond-breaking kernels: the stretch test and its skin, and the damage index."""
 
 import numba
 import numpy as np
 
 from peridyn.kernels import FASTMATH, bond_differences
 
+#: A bond's margin is taken as ``limit * MARGIN_SCALE - |Y|``: the 1e-9 relative slack covers
+#: the roundings of |Y|, of the squared-length test and of the displacement norms (a few
+#: 1e-16 relative), so that a margin never promises more room than the exact test allows.
+MARGIN_SCALE = 1.0 - 1e-9
+
+
+@numba.njit(cache=True)
+def squared_length(y0, y1, y2):
+    """``y0^2 + y1^2 + y2^2`` in this order, compiled without fast-math.
+
+    Inlined into the fast-math kernels with its roundings kept as written (no fused
+    multiply-add), so a bond's squared length is the same number in every kernel and in
+    every call, and its two directed copies (``Y_ji = -Y_ij`` exactly, see
+    :func:`~peridyn.kernels.bond_differences`) always get the same verdict.
+    """
+    return y0 * y0 + y1 * y1 + y2 * y2
+
 
 @numba.njit(parallel=True, fastmath=FASTMATH, cache=True)
-def break_stretched_bonds(x, u, offsets, nbr, length, critical_stretch, breakable, intact):
-    """Break (IN/OUT ``intact``) every breakable bond whose stretch exceeds its critical value.
+def break_stretched_families(x, u, offsets, nbr, limit, intact, points, margin):
+    """Stretch test of the families of ``points``: break, and measure the room left.
 
-    Both directed copies of a bond see the same stretch, so they break in the
-    same call. Returns the number of directed bonds broken. Laid out like the force
-    kernels (flat arrays, per-family slices, squared lengths) so that the stretch test
-    vectorises; the rare write is the only branch.
+    For each point i of ``points`` (int64 indices), every intact bond of i's family whose
+    deformed length |Y| = |xi + u_j - u_i| exceeds ``limit`` (m, per bond; ``inf`` for a bond
+    that may not break) is broken (``intact`` IN/OUT), and ``margin[i]`` (OUT, m) is set to
+    the smallest ``limit * MARGIN_SCALE - |Y|`` over the bonds of the family left intact
+    (``inf`` if none). Only the directed copies owned by ``points`` are touched.
+
+    The test ``|Y|^2 > limit^2`` and the margins vectorise over the family; the bonds
+    are broken in a second, scalar pass over the few families where some intact bond
+    failed. Returns the number of directed bonds broken.
     """
     n = x.shape[0]
     xf = x.reshape(3 * n)
     uf = u.reshape(3 * n)
-    count = np.zeros(n, dtype=np.int64)
-    for i in numba.prange(n):
+    count = np.zeros(points.shape[0], dtype=np.int64)
+    for p in numba.prange(points.shape[0]):
+        i = points[p]
         xi0, xi1, xi2 = xf[3 * i], xf[3 * i + 1], xf[3 * i + 2]
         ui0, ui1, ui2 = uf[3 * i], uf[3 * i + 1], uf[3 * i + 2]
         lo = offsets[i]
         hi = offsets[i + 1]
         fam = nbr[lo:hi]
-        ln = length[lo:hi]
-        sc = critical_stretch[lo:hi]
+        lim = limit[lo:hi]
+        alive = intact[lo:hi]
+        failed = 0
         broken = 0
+        room = np.inf
         for q in range(hi - lo):
             j = 3 * np.uint64(np.uint32(fam[q]))
             _, _, y0 = bond_differences(xf[j], xi0, uf[j], ui0)
             _, _, y1 = bond_differences(xf[j + 1], xi1, uf[j + 1], ui1)
             _, _, y2 = bond_differences(xf[j + 2], xi2, uf[j + 2], ui2)
-            limit = ln[q] * (1.0 + sc[q])
-            if y0 * y0 + y1 * y1 + y2 * y2 > limit * limit and intact[lo + q] and breakable[lo + q]:
-                intact[lo + q] = False
-                broken += 1
-        count[i] = broken
+            r2 = squared_length(y0, y1, y2)
+            failed += (r2 > lim[q] * lim[q]) & alive[q]
+            left = lim[q] * MARGIN_SCALE - np.sqrt(r2) if alive[q] else np.inf
+            room = left if left < room else room
+        if failed:
+            room = np.inf
+            for q in range(hi - lo):
+                if not alive[q]:
+                    continue
+                j = 3 * np.uint64(np.uint32(fam[q]))
+                _, _, y0 = bond_differences(xf[j], xi0, uf[j], ui0)
+                _, _, y1 = bond_differences(xf[j + 1], xi1, uf[j + 1], ui1)
+                _, _, y2 = bond_differences(xf[j + 2], xi2, uf[j + 2], ui2)
+                r2 = squared_length(y0, y1, y2)
+                if r2 > lim[q] * lim[q]:
+                    alive[q] = False
+                    broken += 1
+                else:
+                    room = min(room, lim[q] * MARGIN_SCALE - np.sqrt(r2))
+        margin[i] = room
+        count[p] = broken
     return count.sum()
+
+
+@numba.njit(parallel=True, fastmath=FASTMATH, cache=True)
+def retest_families(x, u, offsets, nbr, limit, intact, points, tested, moved, margin):
+    """Stretch test of the families of ``points`` only, both copies of each bond broken.
+
+    For each point i of ``points`` (int64; ``tested`` (n_points,) bool marks them), every
+    intact bond (i, j) longer than ``limit`` is broken, and so is its reverse copy (j, i)
+    when j is not tested itself (a tested j breaks it in its own family: every directed
+    bond is written by one thread only). ``margin[i]`` (OUT, m) is set to the smallest
+    ``limit * MARGIN_SCALE - |Y| - moved[j]`` over the bonds left intact, minus
+    ``moved[i]`` (``moved``: (n_points,) distance each point has moved since the
+    reference displacement, m): the room left, taken back to the reference.
+    Returns the number of directed bonds broken.
+    """
+    count = np.zeros(points.shape[0], dtype=np.int64)
+    for p in numba.prange(points.shape[0]):
+        count[p] = _retest_family(points[p], x, u, offsets, nbr, limit, intact, tested, moved, margin)
+    return count.sum()
+
+
+@numba.njit(fastmath=FASTMATH, cache=True)
+def _retest_family(i, x, u, offsets, nbr, limit, intact, tested, moved, margin):
+    """:func:`retest_families` for point ``i``; returns the number of directed bonds broken."""
+    broken = 0
+    room = np.inf
+    for b in range(offsets[i], offsets[i + 1]):
+        if not intact[b]:
+            continue
+        j = nbr[b]
+        _, _, y0 = bond_differences(x[j, 0], x[i, 0], u[j, 0], u[i, 0])
+        _, _, y1 = bond_differences(x[j, 1], x[i, 1], u[j, 1], u[i, 1])
+        _, _, y2 = bond_differences(x[j, 2], x[i, 2], u[j, 2], u[i, 2])
+        r2 = squared_length(y0, y1, y2)
+        if r2 > limit[b] * limit[b]:
+            intact[b] = False
+            broken += 1
+            if not tested[j]:
+                broken += _break_reverse(i, j, offsets, nbr, intact)
+        else:
+            room = min(room, limit[b] * MARGIN_SCALE - np.sqrt(r2) - moved[j])
+    margin[i] = room - moved[i]
+    return broken
+
+
+@numba.njit(cache=True)
+def _break_reverse(i, j, offsets, nbr, intact):
+    """Break the bond (j, i) of j's family if intact; returns 1 if it did, else 0."""
+    for r in range(offsets[j], offsets[j + 1]):
+        if nbr[r] == i and intact[r]:
+            intact[r] = False
+            return 1
+    return 0
+
+
+@numba.njit(parallel=True, fastmath=FASTMATH, cache=True)
+def moved_distance(u, u_ref, out):
+    """``out`` (OUT, (n_points,), m): ``out[k] = |u_k - u_ref_k|``; returns ``out``."""
+    n = u.shape[0]
+    for k in numba.prange(n):
+        d0 = u[k, 0] - u_ref[k, 0]
+        d1 = u[k, 1] - u_ref[k, 1]
+        d2 = u[k, 2] - u_ref[k, 2]
+        out[k] = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+    return out
 
 
 @numba.njit(parallel=True, cache=True)
