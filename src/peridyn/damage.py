@@ -37,7 +37,7 @@ from __future__ import annotations
 import numpy as np
 
 from peridyn.errors import InputError
-from peridyn.kernels.damage import break_stretched_families, damage_index, moved_distance, retest_families
+from peridyn.kernels.damage import MAX_QUANTA, damage_index, moved_distance, stretch_test_families
 from peridyn.materials.base import Model
 
 
@@ -109,6 +109,10 @@ class BondDamage:
         self._margin = np.empty(n)  # (n,) room left per point, taken at u_ref, m
         self._fresh = np.empty(n)  # (n,) margins measured by the last test, m
         self._moved = np.empty(n)  # (n,) |u - u_ref|, m
+        self._quantum = bonds.horizon / MAX_QUANTA  # margins are whole multiples of it, m
+        self._everyone = np.arange(n)
+        self._all_tested = np.ones(n, dtype=bool)
+        self._none_moved = np.zeros(n)
 
     def __repr__(self) -> str:
         return f"BondDamage(critical_stretch={self.value:.4g})"
@@ -133,8 +137,8 @@ class BondDamage:
         self.partial_tests += 1
         if flagged.size == 0:
             return 0
-        broken = retest_families(m.body.points, u, b.offsets, b.neighbours, self._limit, b.intact,
-                                 flagged, tested, moved, self._fresh)
+        broken = stretch_test_families(m.body.points, u, b.offsets, b.neighbours, self._limit,
+                                       b.intact, flagged, tested, moved, self._quantum, self._fresh)
         self._margin[flagged] = np.maximum(self._margin[flagged], self._fresh[flagged])
         return int(broken)
 
@@ -153,8 +157,9 @@ class BondDamage:
             self._limit = np.where(self.breakable, b.length * (1.0 + self.critical_stretch), np.inf)
             self.critical_stretch.flags.writeable = False
             self.breakable.flags.writeable = False
-        broken = break_stretched_families(m.body.points, u, b.offsets, b.neighbours, self._limit,
-                                          b.intact, np.arange(m.body.n_points), self._margin)
+        broken = stretch_test_families(m.body.points, u, b.offsets, b.neighbours, self._limit,
+                                       b.intact, self._everyone, self._all_tested, self._none_moved,
+                                       self._quantum, self._margin)
         self._u_ref = u.copy()
         self.full_tests += 1
         return int(broken)

@@ -23,105 +23,87 @@ def squared_length(y0, y1, y2):
     return y0 * y0 + y1 * y1 + y2 * y2
 
 
+#: Margins are counted in whole quanta (``quantum``, m) up to this many (< 2^31): an int32
+#: minimum vectorises where a floating-point one does not. Larger margins are capped.
+MAX_QUANTA = 2_000_000_000
+
+
 @numba.njit(parallel=True, fastmath=FASTMATH, cache=True)
-def break_stretched_families(x, u, offsets, nbr, limit, intact, points, margin):
+def stretch_test_families(x, u, offsets, nbr, limit, intact, points, tested, moved, quantum, margin):
     """Stretch test of the families of ``points``: break, and measure the room left.
 
-    For each point i of ``points`` (int64 indices), every intact bond of i's family whose
-    deformed length |Y| = |xi + u_j - u_i| exceeds ``limit`` (m, per bond; ``inf`` for a bond
-    that may not break) is broken (``intact`` IN/OUT), and ``margin[i]`` (OUT, m) is set to
-    the smallest ``limit * MARGIN_SCALE - |Y|`` over the bonds of the family left intact
-    (``inf`` if none). Only the directed copies owned by ``points`` are touched.
-
-    The test ``|Y|^2 > limit^2`` and the margins vectorise over the family; the bonds
-    are broken in a second, scalar pass over the few families where some intact bond
-    failed. Returns the number of directed bonds broken.
-    """
-    n = x.shape[0]
-    xf = x.reshape(3 * n)
-    uf = u.reshape(3 * n)
-    count = np.zeros(points.shape[0], dtype=np.int64)
-    for p in numba.prange(points.shape[0]):
-        i = points[p]
-        xi0, xi1, xi2 = xf[3 * i], xf[3 * i + 1], xf[3 * i + 2]
-        ui0, ui1, ui2 = uf[3 * i], uf[3 * i + 1], uf[3 * i + 2]
-        lo = offsets[i]
-        hi = offsets[i + 1]
-        fam = nbr[lo:hi]
-        lim = limit[lo:hi]
-        alive = intact[lo:hi]
-        failed = 0
-        broken = 0
-        room = np.inf
-        for q in range(hi - lo):
-            j = 3 * np.uint64(np.uint32(fam[q]))
-            _, _, y0 = bond_differences(xf[j], xi0, uf[j], ui0)
-            _, _, y1 = bond_differences(xf[j + 1], xi1, uf[j + 1], ui1)
-            _, _, y2 = bond_differences(xf[j + 2], xi2, uf[j + 2], ui2)
-            r2 = squared_length(y0, y1, y2)
-            failed += (r2 > lim[q] * lim[q]) & alive[q]
-            left = lim[q] * MARGIN_SCALE - np.sqrt(r2) if alive[q] else np.inf
-            room = left if left < room else room
-        if failed:
-            room = np.inf
-            for q in range(hi - lo):
-                if not alive[q]:
-                    continue
-                j = 3 * np.uint64(np.uint32(fam[q]))
-                _, _, y0 = bond_differences(xf[j], xi0, uf[j], ui0)
-                _, _, y1 = bond_differences(xf[j + 1], xi1, uf[j + 1], ui1)
-                _, _, y2 = bond_differences(xf[j + 2], xi2, uf[j + 2], ui2)
-                r2 = squared_length(y0, y1, y2)
-                if r2 > lim[q] * lim[q]:
-                    alive[q] = False
-                    broken += 1
-                else:
-                    room = min(room, lim[q] * MARGIN_SCALE - np.sqrt(r2))
-        margin[i] = room
-        count[p] = broken
-    return count.sum()
-
-
-@numba.njit(parallel=True, fastmath=FASTMATH, cache=True)
-def retest_families(x, u, offsets, nbr, limit, intact, points, tested, moved, margin):
-    """Stretch test of the families of ``points`` only, both copies of each bond broken.
-
     For each point i of ``points`` (int64; ``tested`` (n_points,) bool marks them), every
-    intact bond (i, j) longer than ``limit`` is broken, and so is its reverse copy (j, i)
-    when j is not tested itself (a tested j breaks it in its own family: every directed
-    bond is written by one thread only). ``margin[i]`` (OUT, m) is set to the smallest
-    ``limit * MARGIN_SCALE - |Y| - moved[j]`` over the bonds left intact, minus
-    ``moved[i]`` (``moved``: (n_points,) distance each point has moved since the
-    reference displacement, m): the room left, taken back to the reference.
-    Returns the number of directed bonds broken.
+    intact bond (i, j) whose deformed length |Y| = |xi + u_j - u_i| exceeds ``limit`` (m,
+    per bond; ``inf`` for a bond that may not break) is broken (``intact`` IN/OUT), and so
+    is its reverse copy (j, i) when j is not tested itself (a tested j breaks it in its
+    own family, so every directed bond is written by one thread only).
+
+    ``margin[i]`` (OUT, m) gets the room left to i's family, taken back to the reference
+    displacement that ``moved`` (n_points,), the distance each point moved since it, m,
+    is measured from: the smallest ``limit * MARGIN_SCALE - |Y| - moved[j]`` over the
+    bonds left intact, rounded down to whole ``quantum`` (at most ``MAX_QUANTA``, at
+    least 0), minus ``moved[i]``. Returns the number of directed bonds broken.
     """
     count = np.zeros(points.shape[0], dtype=np.int64)
     for p in numba.prange(points.shape[0]):
-        count[p] = _retest_family(points[p], x, u, offsets, nbr, limit, intact, tested, moved, margin)
+        count[p] = _test_family(points[p], x, u, offsets, nbr, limit, intact, tested, moved,
+                                quantum, margin)
     return count.sum()
 
 
 @numba.njit(fastmath=FASTMATH, cache=True)
-def _retest_family(i, x, u, offsets, nbr, limit, intact, tested, moved, margin):
-    """:func:`retest_families` for point ``i``; returns the number of directed bonds broken."""
-    broken = 0
-    room = np.inf
-    for b in range(offsets[i], offsets[i + 1]):
-        if not intact[b]:
-            continue
-        j = nbr[b]
-        _, _, y0 = bond_differences(x[j, 0], x[i, 0], u[j, 0], u[i, 0])
-        _, _, y1 = bond_differences(x[j, 1], x[i, 1], u[j, 1], u[i, 1])
-        _, _, y2 = bond_differences(x[j, 2], x[i, 2], u[j, 2], u[i, 2])
+def _test_family(i, x, u, offsets, nbr, limit, intact, tested, moved, quantum, margin):
+    """:func:`stretch_test_families` for point ``i``; returns the number of bonds broken.
+
+    A first loop, written to vectorise (see ``peridyn.kernels``), counts the failing intact
+    bonds and the margin; the few families with a failure get a second, scalar loop.
+    """
+    n = x.shape[0]
+    xf = x.reshape(3 * n)
+    uf = u.reshape(3 * n)
+    xi0, xi1, xi2 = xf[3 * i], xf[3 * i + 1], xf[3 * i + 2]
+    ui0, ui1, ui2 = uf[3 * i], uf[3 * i + 1], uf[3 * i + 2]
+    lo = offsets[i]
+    hi = offsets[i + 1]
+    fam = nbr[lo:hi]
+    lim = limit[lo:hi]
+    alive = intact[lo:hi]
+    per_quantum = 1.0 / quantum
+    none = np.int32(MAX_QUANTA)
+    failed = np.int32(0)
+    room = none
+    for q in range(hi - lo):
+        jj = np.uint64(np.uint32(fam[q]))
+        j = 3 * jj
+        _, _, y0 = bond_differences(xf[j], xi0, uf[j], ui0)
+        _, _, y1 = bond_differences(xf[j + 1], xi1, uf[j + 1], ui1)
+        _, _, y2 = bond_differences(xf[j + 2], xi2, uf[j + 2], ui2)
         r2 = squared_length(y0, y1, y2)
-        if r2 > limit[b] * limit[b]:
-            intact[b] = False
-            broken += 1
-            if not tested[j]:
-                broken += _break_reverse(i, j, offsets, nbr, intact)
-        else:
-            room = min(room, limit[b] * MARGIN_SCALE - np.sqrt(r2) - moved[j])
-    margin[i] = room - moved[i]
+        hit = np.int32(1) if r2 > lim[q] * lim[q] else np.int32(0)
+        failed += hit if alive[q] else np.int32(0)
+        left = (lim[q] * MARGIN_SCALE - np.sqrt(r2) - moved[jj]) * per_quantum
+        quanta = np.int32(min(max(left, 0.0), float(MAX_QUANTA)))
+        room = min(room, quanta if alive[q] else none)
+    broken = 0
+    if failed:
+        room = none
+        for q in range(hi - lo):
+            if not alive[q]:
+                continue
+            j = fam[q]
+            _, _, y0 = bond_differences(xf[3 * j], xi0, uf[3 * j], ui0)
+            _, _, y1 = bond_differences(xf[3 * j + 1], xi1, uf[3 * j + 1], ui1)
+            _, _, y2 = bond_differences(xf[3 * j + 2], xi2, uf[3 * j + 2], ui2)
+            r2 = squared_length(y0, y1, y2)
+            if r2 > lim[q] * lim[q]:
+                alive[q] = False
+                broken += 1
+                if not tested[j]:
+                    broken += _break_reverse(i, j, offsets, nbr, intact)
+            else:
+                left = (lim[q] * MARGIN_SCALE - np.sqrt(r2) - moved[j]) * per_quantum
+                room = min(room, np.int32(min(max(left, 0.0), float(MAX_QUANTA))))
+    margin[i] = room * quantum - moved[i]
     return broken
 
 
