@@ -37,7 +37,7 @@ from __future__ import annotations
 import numpy as np
 
 from peridyn.errors import InputError
-from peridyn.kernels.damage import MAX_QUANTA, damage_index, moved_distance, stretch_test_families
+from peridyn.kernels.damage import MAX_QUANTA, damage_index, flag_moved_points, stretch_test_families
 from peridyn.materials.base import Model
 
 
@@ -109,6 +109,7 @@ class BondDamage:
         self._margin = np.empty(n)  # (n,) room left per point, taken at u_ref, m
         self._fresh = np.empty(n)  # (n,) margins measured by the last test, m
         self._moved = np.empty(n)  # (n,) |u - u_ref|, m
+        self._tested = np.empty(n, dtype=bool)  # (n,) families the last partial test covered
         self._quantum = bonds.horizon / MAX_QUANTA  # margins are whole multiples of it, m
         self._everyone = np.arange(n)
         self._all_tested = np.ones(n, dtype=bool)
@@ -127,18 +128,15 @@ class BondDamage:
         u = np.ascontiguousarray(u, dtype=np.float64)
         if self._u_ref is None:
             return self._full_test(u)
-        moved = moved_distance(u, self._u_ref, self._moved)
-        if not np.isfinite(moved.max()):
-            return self._full_test(u)
-        tested = self._margin <= 2.0 * moved
-        flagged = np.flatnonzero(tested)
-        if flagged.size >= self.FULL_TEST_SHARE * self._margin.size:
+        n_tested = flag_moved_points(u, self._u_ref, self._margin, self._moved, self._tested)
+        if n_tested < 0 or n_tested >= self.FULL_TEST_SHARE * self._margin.size:
             return self._full_test(u)
         self.partial_tests += 1
-        if flagged.size == 0:
+        if n_tested == 0:
             return 0
-        broken = stretch_test_families(m.body.points, u, b.offsets, b.neighbours, self._limit,
-                                       b.intact, flagged, tested, moved, self._quantum, self._fresh)
+        flagged = np.flatnonzero(self._tested)
+        broken = stretch_test_families(m.body.points, u, b.offsets, b.neighbours, self._limit, b.intact,
+                                       flagged, self._tested, self._moved, self._quantum, self._fresh)
         self._margin[flagged] = np.maximum(self._margin[flagged], self._fresh[flagged])
         return int(broken)
 

@@ -118,15 +118,27 @@ def _break_reverse(i, j, offsets, nbr, intact):
 
 
 @numba.njit(parallel=True, fastmath=FASTMATH, cache=True)
-def moved_distance(u, u_ref, out):
-    """``out`` (OUT, (n_points,), m): ``out[k] = |u_k - u_ref_k|``; returns ``out``."""
+def flag_moved_points(u, u_ref, margin, moved, tested):
+    """Which families the skin must test at ``u`` (see ``peridyn.damage``).
+
+    ``moved`` (OUT, (n_points,), m): ``|u_k - u_ref_k|``; ``tested`` (OUT, (n_points,) bool):
+    ``margin[k] <= 2 moved[k]``. Returns the number of points tested, or -1 if some
+    ``moved`` is not finite.
+    """
     n = u.shape[0]
+    count = 0
+    bad = 0
     for k in numba.prange(n):
         d0 = u[k, 0] - u_ref[k, 0]
         d1 = u[k, 1] - u_ref[k, 1]
         d2 = u[k, 2] - u_ref[k, 2]
-        out[k] = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
-    return out
+        d = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+        moved[k] = d
+        flag = margin[k] <= 2.0 * d
+        tested[k] = flag
+        count += 1 if flag else 0
+        bad += 0 if np.isfinite(d) else 1
+    return -1 if bad else count
 
 
 @numba.njit(parallel=True, cache=True)
