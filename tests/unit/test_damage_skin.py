@@ -184,3 +184,20 @@ def test_criteria_are_frozen_after_the_first_update_until_reset():
     model.bonds.intact[:] = True  # mended
     assert damage.update(u) == 0
     assert damage.full_tests == 2
+
+
+def test_a_non_finite_displacement_falls_back_to_a_full_test():
+    """An infinite displacement has no finite move to bound: ``update`` tests every bond, and
+    the infinitely stretched bonds of that point (both copies) break, as a full test breaks them."""
+    model = line_model()
+    b = model.bonds
+    damage = BondDamage(model, critical_stretch=1e-3)
+    u = np.zeros_like(model.body.points)
+    assert damage.update(u) == 0
+    k = 7
+    u[k, 0] = np.inf
+    family = b.offsets[k + 1] - b.offsets[k]
+    assert damage.update(u) == 2 * family
+    assert damage.full_tests == 2 and damage.partial_tests == 0
+    assert not b.intact[b.offsets[k]:b.offsets[k + 1]].any()
+    np.testing.assert_array_equal(b.intact, b.intact[b.reverse()])
