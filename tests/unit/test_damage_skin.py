@@ -76,7 +76,7 @@ def test_skin_breaks_the_bonds_of_a_full_test_in_a_growing_crack():
     assert sum(broken1) >= 2000  # the crack grew by many bonds (2780 here)
     assert np.ptp(np.flatnonzero(broken1)) > 100  # over many steps, not in one burst
     assert full.full_tests == 400 and full.partial_tests == 0
-    assert skin.partial_tests >= 200  # at most half the calls were full tests
+    assert skin.partial_tests >= 200  # at most half the calls were full tests (116 here)
 
 
 def test_skin_breaks_the_bonds_of_a_full_test_when_bonds_break_everywhere():
@@ -89,14 +89,14 @@ def test_skin_breaks_the_bonds_of_a_full_test_when_bonds_break_everywhere():
     np.testing.assert_array_equal(m1.bonds.intact, m2.bonds.intact)
     np.testing.assert_array_equal(s1.u, s2.u)
     assert sum(broken1) > 0.001 * m1.bonds.n_bonds  # 356 of 155 512 here
-    assert np.count_nonzero(broken1) > 30  # in most steps
+    assert np.count_nonzero(broken1) > 30  # in most steps (52 of 60 here)
     assert skin.partial_tests >= 20  # 31 here
     b = m1.bonds
     np.testing.assert_array_equal(b.intact, b.intact[b.reverse()])  # both copies together
 
 
 def line_model():
-    """Points 0.5 mm apart along x in a 2D plate strip: bond (0, 1) is 0.5 mm long."""
+    """A 10 x 1.5 mm plate strip (2D, spacing 0.5 mm)."""
     body = geometry.rectangle(0.010, 0.0015, spacing=H, thickness=1e-3, plane="stress")
     bonds = find_bonds(body, 3.015 * H, partial_volumes=False)
     return make_model("pmb", body, bonds, E=70e9, density=2700)
