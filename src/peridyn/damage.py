@@ -16,6 +16,20 @@ bond (then every bond along the load carries stretch s = eps and sigma = E eps).
 The criterion sigma_b > sigma_u is therefore the critical stretch
 s_c = sigma_u / E (seed 004: sigma_u = 40 MPa, E = 70 GPa -> s_c = 5.71e-4), the same
 for PMB and LPS, 2D and 3D. See docs/theory.md, "Critical bond stress".
+
+The stretch-test skin. A bond (i, j) breaks when its deformed length |Y| passes its
+critical length L_c = |xi| (1 + s_c). Between two displacements |Y| changes by at most
+|du_i| + |du_j| (triangle inequality), so a bond with margin L_c - |Y| cannot break before
+its end points have moved that much. ``BondDamage.update`` therefore tests every bond only
+now and then (a "full test" at a reference displacement u_ref), keeping per point the
+smallest margin m_i of its intact breakable bonds. At the next calls, with
+d_k = |u_k - u_ref_k|, a bond can only break if m < d_i + d_j <= 2 max(d_i, d_j): only the
+points with m_i <= 2 d_i have their families tested, and a bond broken there is broken in
+both copies (the other end may not be tested). Their margins are refreshed, taken back to
+u_ref (minus d_j per bond and d_i). When ``FULL_TEST_SHARE`` of the points or more would
+be tested, a full test is done and u_ref reset. The bonds broken are exactly those that
+testing every bond at every call breaks (same test, same roundings; the margins carry a
+1e-9 relative slack for roundings).
 """
 
 from __future__ import annotations
@@ -23,7 +37,7 @@ from __future__ import annotations
 import numpy as np
 
 from peridyn.errors import InputError
-from peridyn.kernels.damage import break_stretched_bonds, damage_index
+from peridyn.kernels.damage import MAX_QUANTA, damage_index, flag_moved_points, stretch_test_families
 from peridyn.materials.base import Model
 
 
@@ -53,7 +67,16 @@ class BondDamage:
         Node sets whose bonds never break.
     critical_bond_stress : float or None, Pa
         Bonds break when E s exceeds it (module docstring); needs ``model.E``.
+
+    ``critical_stretch`` (n_bonds,) and ``breakable`` (n_bonds,) bool may be edited until
+    the first ``update``, which reads them into the critical lengths and makes them
+    read-only. Code that changes them later, or that mends bonds (sets ``intact`` back to
+    True), must call ``reset`` first. Breaking bonds elsewhere needs nothing.
     """
+
+    #: Share of the points from which on ``update`` tests every bond rather than the flagged
+    #: families (and resets the skin's reference displacement).
+    FULL_TEST_SHARE = 0.25
 
     def __init__(self, model: Model, critical_stretch: float | None = None,
                  fracture_energy: float | None = None, no_damage_sets=(),
@@ -78,17 +101,66 @@ class BondDamage:
         for name in no_damage_sets:
             protected[model.body.node_set(name)] = True
         self.breakable = ~(protected[bonds.owners()] | protected[bonds.neighbours])
+        n = model.body.n_points
+        self.full_tests = 0  # calls of ``update`` that tested every bond
+        self.partial_tests = 0  # calls that tested only the flagged families
+        self._limit = None  # (n_bonds,) critical length L_c, m (inf: may not break)
+        self._u_ref = None  # (n, 3) displacement of the last full test, m
+        self._margin = np.empty(n)  # (n,) room left per point, taken at u_ref, m
+        self._fresh = np.empty(n)  # (n,) margins measured by the last test, m
+        self._moved = np.empty(n)  # (n,) |u - u_ref|, m
+        self._tested = np.empty(n, dtype=bool)  # (n,) families the last partial test covered
+        self._quantum = bonds.horizon / MAX_QUANTA  # margins are whole multiples of it, m
+        self._everyone = np.arange(n)
+        self._all_tested = np.ones(n, dtype=bool)
+        self._none_moved = np.zeros(n)
 
     def __repr__(self) -> str:
         return f"BondDamage(critical_stretch={self.value:.4g})"
 
     def update(self, u: np.ndarray) -> int:
-        """Break every over-stretched breakable bond at displacement ``u``; returns the count."""
+        """Break every over-stretched breakable bond at displacement ``u`` (n_points, 3), m.
+
+        Returns the number of directed bonds broken.
+        """
         m = self.model
         b = m.bonds
-        return int(break_stretched_bonds(m.body.points, np.ascontiguousarray(u, dtype=np.float64),
-                                         b.offsets, b.neighbours, b.length, self.critical_stretch,
-                                         self.breakable, b.intact))
+        u = np.ascontiguousarray(u, dtype=np.float64)
+        if self._u_ref is None:
+            return self._full_test(u)
+        n_tested = flag_moved_points(u, self._u_ref, self._margin, self._moved, self._tested)
+        if n_tested < 0 or n_tested >= self.FULL_TEST_SHARE * self._margin.size:
+            return self._full_test(u)
+        self.partial_tests += 1
+        if n_tested == 0:
+            return 0
+        flagged = np.flatnonzero(self._tested)
+        broken = stretch_test_families(m.body.points, u, b.offsets, b.neighbours, self._limit, b.intact,
+                                       flagged, self._tested, self._moved, self._quantum, self._fresh)
+        self._margin[flagged] = np.maximum(self._margin[flagged], self._fresh[flagged])
+        return int(broken)
+
+    def reset(self) -> None:
+        """Forget the skin and the critical lengths (after mending bonds, or to edit
+        ``critical_stretch`` or ``breakable``): the next ``update`` tests every bond."""
+        self._limit = self._u_ref = None
+        self.critical_stretch.flags.writeable = True
+        self.breakable.flags.writeable = True
+
+    def _full_test(self, u: np.ndarray) -> int:
+        """Test every bond at ``u``; margins and u_ref taken there."""
+        m = self.model
+        b = m.bonds
+        if self._limit is None:
+            self._limit = np.where(self.breakable, b.length * (1.0 + self.critical_stretch), np.inf)
+            self.critical_stretch.flags.writeable = False
+            self.breakable.flags.writeable = False
+        broken = stretch_test_families(m.body.points, u, b.offsets, b.neighbours, self._limit,
+                                       b.intact, self._everyone, self._all_tested, self._none_moved,
+                                       self._quantum, self._margin)
+        self._u_ref = u.copy()
+        self.full_tests += 1
+        return int(broken)
 
 
 def damage_field(model: Model) -> np.ndarray:
