@@ -19,7 +19,8 @@ from peridyn.plotting.fields import _save  # noqa: E402
 def plot_damage_map(points: np.ndarray, u: np.ndarray, phi: np.ndarray, paths: list[CrackPath],
                     path: Path, scale: float | None = None, title: str = "damage") -> Path:
     """Damage index on the deformed configuration x + scale * u with the crack polylines
-    (each vertex moved by the scaled mean displacement of its 8 nearest points) over it.
+    (each vertex moved by the scaled mean displacement of its 8 nearest points, of their whole
+    columns through the thickness in 3D) over it.
 
     Parameters
     ----------
@@ -39,9 +40,12 @@ def plot_damage_map(points: np.ndarray, u: np.ndarray, phi: np.ndarray, paths: l
     sc = ax.scatter(xy[order, 0], xy[order, 1], c=phi[order], s=4, cmap="inferno_r",
                     vmin=0.0, vmax=1.0, linewidths=0)
     nearest = cKDTree(xy0)
+    # 8 nearest (x, y) positions, with every point of their columns through the thickness
+    per_column = len(xy0) // max(len(np.unique(xy0, axis=0)), 1)
+    count = min(8 * per_column, len(xy0))
     for k, p in enumerate(paths):
         # mean displacement of the nearest points: both faces of the crack, so its mid-line
-        near = nearest.query(p.points, k=min(8, len(xy0)))[1].reshape(len(p.points), -1)
+        near = nearest.query(p.points, k=count)[1].reshape(len(p.points), -1)
         line = (p.points + scale * uv[near].mean(axis=1)) * 1e3
         ax.plot(line[:, 0], line[:, 1], "-", color="tab:cyan", lw=1.5,
                 label="crack paths" if k == 0 else None)
