@@ -336,15 +336,23 @@ def crossing_segment(x_from: np.ndarray, x_to: np.ndarray, start, end) -> np.nda
     return (s1 * s2 < 0) & (s3 * s4 < 0)
 
 
+CUT_CHUNK = 1_000_000  # bonds tested at a time: bounds the (chunk, 3) temporaries of ``crossing``
+
+
 def cut_bonds(body: Body, bonds: Bonds, crossing) -> int:
     """Break (in place) every bond for which ``crossing(x_i, x_j)`` is True; returns the count cut.
 
-    ``crossing`` is e.g. ``lambda a, b: crossing_rectangle(a, b, o, u, v)``.
+    ``crossing`` is e.g. ``lambda a, b: crossing_rectangle(a, b, o, u, v)``; it is called on
+    CUT_CHUNK bonds at a time.
     """
     owners = bonds.owners()
-    mask = crossing(body.points[owners], body.points[bonds.neighbours])
-    bonds.intact[mask] = False
-    return int(mask.sum())
+    cut = 0
+    for start in range(0, bonds.n_bonds, CUT_CHUNK):
+        chunk = slice(start, start + CUT_CHUNK)
+        mask = crossing(body.points[owners[chunk]], body.points[bonds.neighbours[chunk]])
+        bonds.intact[chunk][mask] = False
+        cut += int(mask.sum())
+    return cut
 
 
 def family_sums(offsets: np.ndarray, values: np.ndarray) -> np.ndarray:

@@ -240,13 +240,14 @@ def run_case(case: Case, output_dir=None, case_path=None, checkpoint_every: int 
         summary = _run_explicit(case, setup, out, case_path, checkpoint_every, restart, progress)
     analysis, figures = analyse(case, setup.body, out, plots=case.output.plots)
     summary.update(analysis)
-    paths = final_crack_paths(case, setup) if setup.damage is not None else None
+    paths = (final_crack_paths(case, setup.body, damage_field(setup.model))
+             if setup.damage is not None else None)
     if paths is not None:
         summary["crack_paths"] = [p.summary() for p in paths]
     if case.output.plots and case.solver.type != "modal":  # a modal run draws its own
         summary["plots"] = [str(p) for p in [*draw_run_figures(case, setup.body, out), *figures]]
         if paths is not None:
-            summary["plots"] += [str(p) for p in draw_crack_figures(setup, out, paths, summary)]
+            summary["plots"] += [str(p) for p in draw_crack_figures(setup.body, out, paths, summary)]
     summary["seconds"] = time.perf_counter() - start
     store_summary(out / "results.h5", setup.body, summary)
     return summary
@@ -371,32 +372,46 @@ def _crack_observer(case, setup, n_steps):
     return CrackLengthObserver(setup.model, every)
 
 
-def final_crack_paths(case: Case, setup: Setup):
-    """Crack paths of the final damage field (pre-cracks as reference lines; 2D bodies or
-    the x-y projection of 3D ones)."""
+def final_crack_paths(case: Case, body: Body, phi: np.ndarray):
+    """Crack paths of the final damage field ``phi`` ((n_points,)) of ``body`` (pre-cracks as
+    reference lines; 2D bodies or the x-y projection of 3D ones)."""
     from peridyn.analysis.crack import crack_paths
 
     lines = [(c.start, c.end) for c in case.precracks if c.type == "segment"]
     lines += [(c.origin, np.add(c.origin, c.edge_u)) for c in case.precracks
               if c.type == "rectangle"]
-    return crack_paths(setup.body.points, damage_field(setup.model), setup.body.spacing,
-                       reference_lines=lines)
+    return crack_paths(body.points, phi, body.spacing, reference_lines=lines)
 
 
-def draw_crack_figures(setup: Setup, out: Path, paths, summary: dict) -> list[Path]:
+def draw_crack_figures(body: Body, out: Path, paths, summary: dict) -> list[Path]:
     """Damage map on the deformed configuration (x50, as seed 004, or less) with the crack
-    ``paths``, and the crack length against time when it was sampled."""
+    ``paths``, and the crack length against time when it was sampled; displacements and
+    damage are the final ones of ``out``/results.h5."""
     from peridyn.io.hdf5 import read_array
     from peridyn.plotting.crack import plot_crack_length, plot_damage_map
 
-    u = read_array(out / "results.h5", "final/u")
-    figures = [plot_damage_map(setup.body.points, u, damage_field(setup.model), paths,
-                               out / "crack_paths.png")]
+    results = out / "results.h5"
+    u, phi = read_array(results, "final/u"), read_array(results, "final/damage")
+    figures = [plot_damage_map(body.points, u, phi, paths, out / "crack_paths.png")]
     history = summary.get("crack_length_history")
     if history and len(history["time_s"]) > 1:
         figures.append(plot_crack_length(history["time_s"], history["length_m"],
                                          out / "crack_length.png"))
     return figures
+
+
+def redraw_crack_figures(case: Case, body: Body, out: Path):
+    """Crack paths and figures (``draw_crack_figures``) of a finished run with damage, from
+    its results.h5: the final damage and the crack length history of the stored summary.
+    Returns (paths, figure paths); (None, []) for a case without damage."""
+    from peridyn.io.hdf5 import read_array
+
+    if case.material.damage is None:
+        return None, []
+    results = out / "results.h5"
+    summary = json.loads(read_array(results, "summary/json"))
+    paths = final_crack_paths(case, body, read_array(results, "final/damage"))
+    return paths, draw_crack_figures(body, out, paths, summary)
 
 
 def _run_static(case, setup, out, case_path) -> dict:

@@ -44,3 +44,25 @@ def test_run_summary_holds_the_pre_crack_as_its_crack_path(tmp_path):
     assert history["time_s"] == sorted(history["time_s"]) and len(history["time_s"]) == 4
     assert history["length_m"][-1] == pytest.approx(path["length_m"])
     assert (tmp_path / "crack_paths.png").is_file() and (tmp_path / "crack_length.png").is_file()
+
+
+def test_plot_command_redraws_the_crack_figures_from_the_results(tmp_path, capsys):
+    """`peridyn plot DIR` on a fracture run redraws the damage map with crack paths and the
+    crack length against time from results.h5 alone, and finds the same crack: the
+    pre-crack's line, 20 mm long and horizontal (as in the run above)."""
+    import json
+
+    from peridyn.cli import main
+
+    split_plate(tmp_path)
+    for png in ("crack_paths.png", "crack_length.png"):
+        (tmp_path / png).unlink()
+    assert main(["plot", str(tmp_path), "--json"]) == 0
+    redrawn = json.loads(capsys.readouterr().out)
+    names = {p.split("/")[-1] for p in redrawn["plots"]}
+    assert {"crack_paths.png", "crack_length.png"} <= names
+    assert (tmp_path / "crack_paths.png").stat().st_size > 0
+    assert (tmp_path / "crack_length.png").stat().st_size > 0
+    (path,) = redrawn["crack_paths"]
+    assert path["length_m"] == pytest.approx(0.020, abs=2 * H)
+    assert path["angle_deg"] == pytest.approx(0.0, abs=2.0)

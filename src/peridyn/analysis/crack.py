@@ -103,6 +103,31 @@ def crack_paths(points: np.ndarray, phi: np.ndarray, spacing: float,
     return sorted(paths, key=lambda p: -p.length_m)
 
 
+def path_from(paths, tip, reach: float) -> CrackPath | None:
+    """The longest of ``paths`` with an end within ``reach`` (m) of ``tip`` (m, x and y), or
+    None when no path ends there."""
+    tip = np.asarray(tip, dtype=float)[:2]
+    ending = [p for p in paths if np.linalg.norm(p.points[[0, -1]] - tip, axis=1).min() <= reach]
+    return max(ending, key=lambda p: p.length_m, default=None)
+
+
+def departure_angle(path: CrackPath, tip, run: float) -> float:
+    """Angle (deg from +x, in (-180, 180]) at which ``path`` leaves ``tip`` (m, x and y): the
+    direction of the least-squares line through its vertices within ``run`` (m) of the tip,
+    pointing away from the tip."""
+    tip = np.asarray(tip, dtype=float)[:2]
+    pts = path.points
+    if np.linalg.norm(pts[-1] - tip) < np.linalg.norm(pts[0] - tip):
+        pts = pts[::-1]
+    near = pts[np.linalg.norm(pts - tip, axis=1) <= run]
+    if len(near) < 2:
+        raise InputError(f"fewer than two crack-path vertices within {run!r} m of the tip {tip}")
+    direction = np.linalg.svd(near - near.mean(axis=0))[2][0]
+    if direction @ (near[-1] - near[0]) < 0:
+        direction = -direction
+    return float(np.degrees(np.arctan2(direction[1], direction[0])))
+
+
 def total_crack_length(points, phi, spacing, threshold=DEFAULT_THRESHOLD) -> float:
     """Sum of the lengths of every crack path, m."""
     return float(sum(p.length_m for p in crack_paths(points, phi, spacing, threshold)))

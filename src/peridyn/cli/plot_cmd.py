@@ -1,4 +1,6 @@
-"""``peridyn plot RUN_DIR``: redraw the figures (and analyses) of a finished run from its HDF5."""
+"""``peridyn plot RUN_DIR``: redraw the figures (and analyses) of a finished run from its HDF5,
+with the crack figures (damage map and crack paths, crack length against time) of a run with
+damage."""
 
 from __future__ import annotations
 
@@ -19,11 +21,12 @@ def register(sub) -> None:
 
 
 def run(args) -> dict:
-    """Rebuild the run's case from its provenance and draw its figures again."""
+    """Rebuild the run's case from its provenance and draw its figures again (with the crack
+    paths of the final damage for a run with damage)."""
     from peridyn.io.case import validate_case
     from peridyn.io.hdf5 import read_provenance
     from peridyn.postprocess import analyse
-    from peridyn.simulation import add_actuators, build_body, draw_run_figures
+    from peridyn.simulation import add_actuators, build_body, draw_run_figures, redraw_crack_figures
 
     out = Path(args.run_dir)
     results = out / "results.h5"
@@ -39,8 +42,12 @@ def run(args) -> dict:
     base = Path(info.get("case_file", ".")).parent
     body, _ = add_actuators(case, build_body(case, base))
     analysis, figures = analyse(case, body, out, plots=True)
-    paths = [str(p) for p in [*draw_run_figures(case, body, out), *figures]]
+    cracks, crack_figures = redraw_crack_figures(case, body, out)
+    paths = [str(p) for p in [*draw_run_figures(case, body, out), *figures, *crack_figures]]
     if not args.json:
         for path in paths:
             print(f"plot: {path}")
-    return {"output_dir": str(out), "plots": paths, **analysis}
+    result = {"output_dir": str(out), "plots": paths, **analysis}
+    if cracks is not None:
+        result["crack_paths"] = [c.summary() for c in cracks]
+    return result

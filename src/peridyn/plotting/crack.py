@@ -19,7 +19,7 @@ from peridyn.plotting.fields import _save  # noqa: E402
 def plot_damage_map(points: np.ndarray, u: np.ndarray, phi: np.ndarray, paths: list[CrackPath],
                     path: Path, scale: float | None = None, title: str = "damage") -> Path:
     """Damage index on the deformed configuration x + scale * u with the crack polylines
-    (each vertex moved by the scaled mean displacement of its 8 nearest points) over it.
+    (``displaced_polylines``) over it.
 
     Parameters
     ----------
@@ -38,12 +38,8 @@ def plot_damage_map(points: np.ndarray, u: np.ndarray, phi: np.ndarray, paths: l
     order = np.argsort(phi)  # damaged points on top
     sc = ax.scatter(xy[order, 0], xy[order, 1], c=phi[order], s=4, cmap="inferno_r",
                     vmin=0.0, vmax=1.0, linewidths=0)
-    nearest = cKDTree(xy0)
-    for k, p in enumerate(paths):
-        # mean displacement of the nearest points: both faces of the crack, so its mid-line
-        near = nearest.query(p.points, k=min(8, len(xy0)))[1].reshape(len(p.points), -1)
-        line = (p.points + scale * uv[near].mean(axis=1)) * 1e3
-        ax.plot(line[:, 0], line[:, 1], "-", color="tab:cyan", lw=1.5,
+    for k, line in enumerate(displaced_polylines(xy0, uv, paths, scale)):
+        ax.plot(line[:, 0] * 1e3, line[:, 1] * 1e3, "-", color="tab:cyan", lw=1.5,
                 label="crack paths" if k == 0 else None)
     if paths:
         ax.legend(loc="upper right", fontsize=8)
@@ -53,6 +49,27 @@ def plot_damage_map(points: np.ndarray, u: np.ndarray, phi: np.ndarray, paths: l
     ax.set_title(f"{title}, displacements x{scale:.3g}")
     fig.colorbar(sc, ax=ax, label="damage index")
     return _save(fig, path)
+
+
+def displaced_polylines(xy: np.ndarray, uv: np.ndarray, paths: list[CrackPath],
+                        scale: float) -> list[np.ndarray]:
+    """Each path's polyline ((m, 2), m) moved by ``scale`` times the mean in-plane
+    displacement of the points of its vertex's 8 nearest (x, y) positions: both faces of the
+    crack, so it stays on the opened crack's mid-line. In 3D every point of those positions'
+    columns through the thickness counts (the 8 nearest points alone would be one column and
+    one face).
+
+    xy, uv : (n, 2) float64, m
+        Reference positions and displacements.
+    """
+    nearest = cKDTree(xy)
+    per_column = len(xy) // max(len(np.unique(xy, axis=0)), 1)
+    count = min(8 * per_column, len(xy))
+    lines = []
+    for p in paths:
+        near = nearest.query(p.points, k=count)[1].reshape(len(p.points), -1)
+        lines.append(p.points + scale * uv[near].mean(axis=1))
+    return lines
 
 
 def default_scale(xy: np.ndarray, uv: np.ndarray, largest: float = 50.0) -> float:
