@@ -36,8 +36,7 @@ from scipy.special import hankel1
 
 from peridyn.analysis.bloch import Discretisation, bloch_cell, plate_basis, zone_edge
 from peridyn.analysis.bloch_study import predict
-from peridyn.analysis.fk import (fk_transform, line_mode_wavenumbers, phase_wavenumber,
-                                 pick_wavenumbers)
+from peridyn.analysis.fk import fk_transform, line_mode_wavenumbers, phase_wavenumber, pick_wavenumbers
 from peridyn.analysis.lamb import lamb_modes
 from peridyn.io.case import load_case
 from peridyn.io.hdf5 import read_array, read_series
