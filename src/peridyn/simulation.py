@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from peridyn import geometry
+from peridyn.absorbing import layer_damping
 from peridyn.body import Body, in_box, in_cylinder, in_sphere
 from peridyn.bonds import Bonds, crossing_rectangle, crossing_segment, cut_bonds, find_bonds
 from peridyn.checkpoint import Checkpointer, load_checkpoint
@@ -317,7 +318,8 @@ def _run_explicit(case, setup, out, case_path, checkpoint_every, restart, progre
     s = case.solver
     if solver is None:
         solver = ExplicitSolver(setup.model, setup.loading, dt=s.dt, safety=s.safety,
-                                damping=s.damping, damage=setup.damage, contact=setup.contact)
+                                damping=explicit_damping(case, setup.body), damage=setup.damage,
+                                contact=setup.contact)
     n_steps = s.steps if s.steps is not None else int(np.ceil(s.time / solver.dt - 1e-9))
     ckpt_path = out / "checkpoint.h5"
     if restart:
@@ -359,6 +361,18 @@ def _run_explicit(case, setup, out, case_path, checkpoint_every, restart, progre
         summary["crack_length_history"] = cracks.history()
     recorder.finish(state)
     return summary
+
+
+def explicit_damping(case: Case, body: Body):
+    """``solver.damping`` (1/s), plus the absorbing layers' per-point damping when the case
+    has them: a number or an (n_points,) array for ``ExplicitSolver``."""
+    if case.absorbing is None:
+        return case.solver.damping
+    a = case.absorbing
+    try:
+        return case.solver.damping + layer_damping(body.points, a.width, a.damping, a.faces)
+    except InputError as exc:
+        raise CaseFileError(case.name, "absorbing", a.model_dump(), str(exc)) from None
 
 
 def _crack_observer(case, setup, n_steps):

@@ -349,6 +349,14 @@ class Case(Strict):
     analysis: Analysis | None = None
     contact: ContactSpec | None = None
     fatigue: Fatigue | None = None
+    absorbing: AbsorbingSpec | None = None
+
+    @model_validator(mode="after")
+    def _absorbing_solver(self):
+        if self.absorbing is not None and self.solver.type != "explicit":
+            raise ValueError(f"absorbing: layers damp the explicit solver only, not the "
+                             f"{self.solver.type} solver (use solver.type explicit)")
+        return self
 
     @model_validator(mode="after")
     def _sets_exist(self):
@@ -567,6 +575,17 @@ class Fatigue(Strict):
         if self.tip.axis == self.tip.depth_axis:
             raise ValueError("tip.axis and tip.depth_axis must differ")
         return self
+
+
+class AbsorbingSpec(Strict):
+    """Absorbing boundary layers (``peridyn.absorbing``): mass-proportional damping growing as
+    the cube of the depth into a layer ``width`` m wide along each of ``faces``, from 0 at its
+    inner edge to ``damping`` (1/s) on the face; added to ``solver.damping``."""
+
+    width: Positive
+    damping: Positive
+    faces: Annotated[list[Literal["x-", "x+", "y-", "y+", "z-", "z+"]], Field(min_length=1)] = [
+        "x-", "x+", "y-", "y+"]
 
 
 Case.model_rebuild()

@@ -37,8 +37,9 @@ class ExplicitSolver:
         Time step; ``None`` takes ``safety`` times the stable step.
     safety : float
         Fraction of the stable step used when ``dt`` is None (0 < safety <= 1).
-    damping : float, 1/s
-        Mass-proportional damping coefficient c (0: undamped).
+    damping : float or (n_points,) float, 1/s
+        Mass-proportional damping coefficient c, one for all points or one per point (e.g.
+        absorbing layers, ``peridyn.absorbing``); 0: undamped. It lowers the stable step.
     damage : BondDamage or None
     check_every : int
         Steps between checks for non-finite values.
@@ -51,12 +52,11 @@ class ExplicitSolver:
                  check_every: int = 50, contact: Contact | None = None):
         if not 0 < safety <= 1:
             raise InputError(f"time-step safety factor must lie in (0, 1], got {safety!r}")
-        if damping < 0:
-            raise InputError(f"damping must be non-negative, got {damping!r}")
+        damping = _damping_coefficients(damping, model.body.n_points)
         self.model = model
         self.loading = loading if loading is not None else Loading(model.body)
         self.contact = contact
-        self.stable_dt = stable_time_step(model, contact)
+        self.stable_dt = damped_stable_step(stable_time_step(model, contact), np.max(damping))
         if dt is None:
             dt = safety * self.stable_dt
         elif not dt > 0:
@@ -67,7 +67,8 @@ class ExplicitSolver:
                 f"model (Gershgorin bound): use dt <= {self.stable_dt:.4g} s or leave dt unset"
             )
         self.dt = float(dt)
-        self.damping = float(damping)
+        self.damping = float(damping[0]) if damping.size == 1 else damping
+        self._damping = (damping if damping.size == 1 else damping[:, None]) if damping.any() else None
         self.damage = damage
         self.check_every = int(check_every)
         n = model.body.n_points
@@ -76,7 +77,8 @@ class ExplicitSolver:
         self._inv_rho = (1.0 / model.density)[:, None]
 
     def __repr__(self) -> str:
-        return f"ExplicitSolver(model={self.model!r}, dt={self.dt:.4g} s, damping={self.damping})"
+        damping = self.damping if np.isscalar(self.damping) else f"up to {np.max(self.damping):g}"
+        return f"ExplicitSolver(model={self.model!r}, dt={self.dt:.4g} s, damping={damping})"
 
     def initial_state(self) -> State:
         """The state at t = 0: initial conditions applied and accelerations computed."""
@@ -93,8 +95,8 @@ class ExplicitSolver:
         a = state.a
         np.add(f, b, out=a)
         a *= self._inv_rho
-        if self.damping:
-            a -= self.damping * state.v
+        if self._damping is not None:
+            a -= self._damping * state.v
         a[self.loading.constrained] = 0.0
 
     def step(self, state: State) -> int:
@@ -141,6 +143,32 @@ class ExplicitSolver:
 def stable_time_step(model: Model, contact: Contact | None = None) -> float:
     """Largest stable velocity-Verlet step, s, of a model with optional contact."""
     return model.critical_time_step(None if contact is None else contact.stiffness_bound())
+
+
+def damped_stable_step(undamped_dt: float, damping: float) -> float:
+    """Largest stable step, s, with mass-proportional damping ``damping`` (1/s).
+
+    In this scheme the damping force uses the half-step velocity; for one mode of angular
+    frequency w the step is stable while (w dt)^2 + 2 c dt < 4 (spectral radius of the
+    amplification matrix; ``tests/unit/test_absorbing.py``). With the largest w = 2 /
+    ``undamped_dt`` and the largest c this gives dt = 4 / (c + sqrt(c^2 + 4 w^2)).
+    """
+    if damping == 0:
+        return float(undamped_dt)
+    omega = 2.0 / undamped_dt
+    return float(4.0 / (damping + np.sqrt(damping**2 + 4.0 * omega**2)))
+
+
+def _damping_coefficients(damping, n_points: int) -> np.ndarray:
+    """``damping`` as a (1,) or (n_points,) float64 array, checked."""
+    c = np.atleast_1d(np.asarray(damping, dtype=float))
+    if c.ndim != 1 or c.size not in (1, n_points):
+        raise InputError(f"damping must be a number or one value per point ({n_points}), got "
+                         f"shape {np.shape(damping)}")
+    if not np.all(np.isfinite(c) & (c >= 0)):
+        raise InputError("damping must be non-negative and finite (1/s)"
+                         + (f", got {damping!r}" if c.size == 1 else ""))
+    return c
 
 
 def check_finite(state: State) -> None:
