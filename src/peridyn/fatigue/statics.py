@@ -31,10 +31,9 @@ import time as clock
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.sparse as sp
-from scipy.sparse.linalg import LinearOperator, cg
 
 from peridyn.errors import InputError
+from peridyn.fatigue.pcg import PCGResult, RecycledDirections, deflated_pcg
 from peridyn.loads import Loading
 from peridyn.materials.base import Model
 from peridyn.solvers.modal import free_dofs, shifted_inverse
@@ -44,6 +43,8 @@ from peridyn.stiffness import stiffness_operator, stiffness_parts
 SHIFT = 1e-9
 #: CG iterations with an old factorisation after which K is factorised again.
 REFACTOR_ITERATIONS = 40
+#: Search directions of earlier solves kept to deflate the next ones (``fatigue.pcg``).
+RECYCLE = 80
 
 
 @dataclass
@@ -65,6 +66,7 @@ class LinearStatics:
     method : "auto" (= "direct"), "direct" (factorisation as CG preconditioner) or "cg" (Jacobi)
     rtol : relative equilibrium residual the solves reach
     refactor_iterations : CG iterations with an old factorisation before it is renewed
+    recycle : search directions of earlier solves kept to deflate later ones (0: none)
 
     Attributes
     ----------
@@ -72,13 +74,16 @@ class LinearStatics:
     """
 
     def __init__(self, model: Model, loading: Loading, time: float = 1.0, method: str = "auto",
-                 rtol: float = 1e-8, refactor_iterations: int = REFACTOR_ITERATIONS):
+                 rtol: float = 1e-8, refactor_iterations: int = REFACTOR_ITERATIONS,
+                 recycle: int = RECYCLE):
         if method not in ("auto", "direct", "cg"):
             raise InputError(f"linear solver must be auto, direct or cg, got {method!r}")
         if not 0.0 < rtol < 1.0:
             raise InputError(f"linear solver tolerance rtol must be in (0, 1), got {rtol!r}")
         if refactor_iterations < 1:
             raise InputError(f"refactor_iterations must be at least 1, got {refactor_iterations!r}")
+        if recycle < 0:
+            raise InputError(f"recycle (directions kept between solves) must be >= 0, got {recycle!r}")
         self.model, self.loading, self.time, self.rtol = model, loading, float(time), rtol
         self.refactor_iterations = int(refactor_iterations)
         self.method = "direct" if method == "auto" else method
@@ -96,6 +101,7 @@ class LinearStatics:
         self.shift = SHIFT * float(diagonal.mean()) if len(self.free) else 0.0
         self.records: list[SolveRecord] = []
         self._preconditioner = None
+        self.recycled = RecycledDirections(recycle if self.method == "direct" else 0)
         self._last = None
 
     def solve(self) -> np.ndarray:
@@ -104,47 +110,48 @@ class LinearStatics:
         u = self.u_prescribed.ravel().copy()
         if len(self.free) == 0:
             return u.reshape(-1, 3)
-        rhs = (self.force - self.stiffness @ u)[self.free]
-        system = self._free_system()
-        x = self._last
-        iterations = 0
+        rhs = (self.force - self._product(u))[self.free]
         factorised = False
         if self.method == "cg":
-            x, iterations, converged = self._cg(system, rhs, x, sp.diags(1.0 / self._diagonal()),
-                                                20 * len(rhs))
+            diagonal = self._diagonal()
+            result = deflated_pcg(self._free_product, lambda r: r / diagonal, rhs, self._last,
+                                  self.rtol, 20 * len(rhs))
         else:
             if self._preconditioner is None:
                 self._factorise()
                 factorised = True
-            x, iterations, converged = self._cg(system, rhs, x, self._preconditioner,
-                                                self.refactor_iterations)
-            if not converged and not factorised:  # the old factorisation is too far off now
+            result = self._factor_pcg(rhs, self._last)
+            if not result.converged and not factorised:  # the old factorisation is too far off now
                 self._factorise()
                 factorised = True
-                x, more, converged = self._cg(system, rhs, x, self._preconditioner,
-                                              self.refactor_iterations)
-                iterations += more
-        if not converged:
-            raise InputError(f"fatigue static solve: CG did not converge in {iterations} iterations "
-                             f"to the relative residual {self.rtol:g}")
-        self._last = x
-        u[self.free] = x
-        residual = float(np.linalg.norm(rhs - system @ x) / max(np.linalg.norm(rhs), 1e-300))
-        self.records.append(SolveRecord(iterations, factorised, residual, clock.perf_counter() - start))
+                more = self._factor_pcg(rhs, result.x)
+                result = PCGResult(more.x, result.iterations + more.iterations, more.converged,
+                                   more.directions)
+            self.recycled.add(result.directions)
+        if not result.converged:
+            raise InputError(f"fatigue static solve: CG did not converge in {result.iterations} "
+                             f"iterations to the relative residual {self.rtol:g}")
+        self._last = result.x
+        u[self.free] = result.x
+        residual = np.linalg.norm(rhs - self._free_product(result.x)) / max(np.linalg.norm(rhs), 1e-300)
+        self.records.append(SolveRecord(result.iterations, factorised, float(residual),
+                                        clock.perf_counter() - start))
         return u.reshape(-1, 3)
 
-    def _free_system(self) -> LinearOperator:
-        """K + shift I on the free dofs, with the bonds intact now (matrix-free)."""
-        n_all = 3 * self.model.body.n_points
-        free, shift, stiffness = self.free, self.shift, self.stiffness
-        full = np.zeros(n_all)
+    def _product(self, u: np.ndarray) -> np.ndarray:
+        """K u (3 n,), N, on all dofs, with the bonds intact now (matrix-free)."""
+        return self.stiffness @ u
 
-        def matvec(v):
-            full[free] = np.ravel(v)
-            return (stiffness @ full)[free] + shift * np.ravel(v)
+    def _free_product(self, v: np.ndarray) -> np.ndarray:
+        """(K + shift I) v on the free dofs (free,), with the bonds intact now."""
+        full = np.zeros(3 * self.model.body.n_points)
+        full[self.free] = v
+        return self._product(full)[self.free] + self.shift * v
 
-        return LinearOperator((len(free), len(free)), matvec=matvec, rmatvec=matvec,
-                              dtype=np.float64)
+    def _factor_pcg(self, rhs: np.ndarray, x0: np.ndarray | None) -> PCGResult:
+        """CG preconditioned by the factorisation, deflated by the recycled directions."""
+        return deflated_pcg(self._free_product, self._preconditioner.matvec, rhs, x0, self.rtol,
+                            self.refactor_iterations, self.recycled.basis(self._free_product))
 
     def _diagonal(self) -> np.ndarray:
         """Diagonal of the free system with the bonds intact now (free,)."""
@@ -153,18 +160,8 @@ class LinearStatics:
     def _factorise(self) -> None:
         """Factorise K + shift I on the free dofs with the bonds intact now."""
         self._preconditioner = None  # release the old factor before building the new one
+        self.recycled.clear()
         body = self.model.body
         self._preconditioner = shifted_inverse(stiffness_parts(self.model), self.free,
                                                np.full(len(self.free), self.shift), body.points,
                                                self.model.bonds.horizon)
-
-    def _cg(self, system, rhs, x0, preconditioner, maxiter):
-        """Preconditioned CG from ``x0``: (x, iterations, converged)."""
-        count = [0]
-
-        def tally(_):
-            count[0] += 1
-
-        x, info = cg(system, rhs, x0=x0, rtol=self.rtol, atol=0.0, M=preconditioner,
-                     maxiter=maxiter, callback=tally)
-        return x, count[0], info == 0
