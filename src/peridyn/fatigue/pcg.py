@@ -97,7 +97,7 @@ def deflated_pcg(matvec: Callable, precondition: Callable, b: np.ndarray, x0: np
         ap = matvec(p)
         alpha = rz / (p @ ap)
         x += alpha * p
-        r -= alpha * ap
+        r = r - alpha * ap  # not in place: the preconditioner may return r itself
         directions.append(p)
         if np.linalg.norm(r) <= target:
             return PCGResult(x, it, True, directions)
