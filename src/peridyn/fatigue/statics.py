@@ -9,9 +9,11 @@ free dofs is solved by preconditioned conjugate gradients, warm started from the
   earlier step (``solvers.modal.shifted_inverse``: the augmented LPS system in nested-dissection
   order, as sparse as the bonds). Fresh, it solves the system in one iteration; after bonds
   break, K differs from the factorised one by a low-rank change (each broken bond removes a
-  rank-one pair term and changes two dilatation rows), so CG needs a few iterations more. When a
-  solve has not converged after ``refactor_iterations``, K is factorised again and the solve goes
-  on from where it was.
+  rank-one pair term and changes two dilatation rows), so CG needs a few iterations more; the
+  search directions of the earlier solves (up to ``recycle``) deflate the later ones
+  (``fatigue.pcg``), so the iterations grow little as the change accumulates. When a solve has
+  not converged after ``refactor_iterations``, K is factorised again and the solve goes on from
+  where it was.
 - ``cg``: Jacobi preconditioner (no factorisation; least memory, many more iterations).
 
 Tolerance: the relative equilibrium residual ||F - K u|| / ||F|| on the free dofs is brought below
