@@ -43,13 +43,9 @@ FIRST_PASS = 15
 TOLERANCE_ROUNDS = 4
 
 
-def rigid_body_modes(points: np.ndarray, dofs: np.ndarray) -> np.ndarray:
-    """Rigid motions the constraints allow, on the ``dofs``: (len(dofs), r) orthonormal columns.
-
-    Translations and rotations of the points (six fields); only their combinations that
-    vanish on every dof outside ``dofs`` (fixed dofs, the z dofs of a 2D body) are kept:
-    six for a free 3D body, three for a free 2D one, none once enough dofs are fixed.
-    """
+def rigid_fields(points: np.ndarray) -> np.ndarray:
+    """The six rigid motions of the points (3 n, 6): translations x, y, z, then rotations about
+    the x, y, z axes through the centroid (scaled to unit largest entry)."""
     n = len(points)
     r = points - points.mean(axis=0)
     fields = np.zeros((n, 3, 6))
@@ -58,15 +54,29 @@ def rigid_body_modes(points: np.ndarray, dofs: np.ndarray) -> np.ndarray:
         axis = np.zeros(3)
         axis[a] = 1.0
         fields[:, :, 3 + a] = np.cross(axis, r) / max(np.abs(r).max(), 1e-300)
-    fields = fields.reshape(3 * n, 6)
-    held = np.ones(3 * n, dtype=bool)
+    return fields.reshape(3 * n, 6)
+
+
+def rigid_body_modes(points: np.ndarray, dofs: np.ndarray) -> np.ndarray:
+    """Rigid motions the constraints allow, on the ``dofs``: (len(dofs), r) orthonormal columns.
+
+    Only the combinations of ``rigid_fields`` that vanish on every dof outside ``dofs``
+    (fixed dofs, the z dofs of a 2D body) are kept: six for a free 3D body, three for a
+    free 2D one, none once enough dofs are fixed.
+    """
+    fields = rigid_fields(points)
+    held = np.ones(len(fields), dtype=bool)
     held[dofs] = False
     allowed = null_space(fields[held], rcond=1e-10) if held.any() else np.eye(6)
-    basis = fields[dofs] @ allowed
+    return _orthonormal(fields[dofs] @ allowed)
+
+
+def _orthonormal(basis: np.ndarray) -> np.ndarray:
+    """Orthonormal basis of the range of ``basis`` (columns), rank-revealing."""
     if basis.shape[1] == 0:
         return basis
-    q, _ = np.linalg.qr(basis)
-    return q
+    u, s, _ = np.linalg.svd(basis, full_matrices=False)
+    return u[:, s > 1e-10 * max(s.max(), 1e-300)]
 
 
 def proxy_stiffness(model: Model, dofs: np.ndarray) -> sp.csr_matrix:
@@ -133,7 +143,9 @@ def lobpcg_modes(model: Model, n_modes: int, dofs: np.ndarray, max_iterations: i
         return lam_rigid, rigid[:, :n_rigid], n_rigid, K
     proxy = proxy_stiffness(model, dofs)
     shift = 1e-6 * float(np.median(proxy.diagonal() / m))
-    precond = amg_preconditioner(proxy, m, rigid_body_modes(model.body.points, dofs), shift)
+    # near-null space: the local rigid motions, whatever the constraints (Vanek et al. 1996)
+    near_null = _orthonormal(rigid_fields(model.body.points)[dofs])
+    precond = amg_preconditioner(proxy, m, near_null, shift)
     block = min(n_elastic + GUARD_VECTORS, len(dofs) // 5)
     if block < n_elastic:
         raise InputError(f"lobpcg: {n_elastic} elastic modes need at least {5 * n_elastic} free "
