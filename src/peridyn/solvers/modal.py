@@ -15,6 +15,10 @@ at a fraction of the memory and time of K itself (D < 0, as for a 2D plane-stres
 with nu < 1/3, only needs more pivoting). Rigid-body modes
 (six for a free 3D body, three in 2D) come out with |f| near zero and are
 counted and reported separately.
+
+Where the factor would be too large (wide horizons, large bodies; the choice is
+``modal_run.choose_eigensolver``), ``method="lobpcg"`` finds the same modes without
+factorising anything (``solvers.eigen_iterative``).
 """
 
 from __future__ import annotations
