@@ -25,12 +25,16 @@ from peridyn.solvers.ordering import estimated_factor_entries
 
 #: Share of the machine's memory the factorisation may take.
 MEMORY_SHARE = 0.7
+#: ``auto`` factorises (shift-invert) only below this estimated factor size, bytes; above
+#: it LOBPCG is faster as well as smaller (benchmarks/RESULTS.md, modal section).
+FACTOR_BUDGET = 2**30
 
 
 def run_modal(case, setup, out: Path, case_path=None) -> dict:
     """Modal analysis of a built case; returns the summary (VALIDATION.md JSON keys)."""
     fixed = setup.loading.constrained if setup.loading.has_loads else None
-    result, types, modes = modal_table(setup.model, case.solver.modes, fixed=fixed)
+    result, types, modes = modal_table(setup.model, case.solver.modes, fixed=fixed,
+                                       eigensolver=case.solver.eigensolver)
     _write_tables(out, modes)
     body = setup.body
     with HDF5Writer(out / "results.h5", body.points[:, : body.dim], body.volumes,
@@ -52,11 +56,12 @@ def run_modal(case, setup, out: Path, case_path=None) -> dict:
     return summary
 
 
-def modal_table(model, n_modes: int, fixed=None):
-    """Modes of ``model`` (memory checked first), classified: (ModalResult, types, rows), the
-    rows being the JSON/CSV dicts index, frequency_hz, type, order, residual."""
-    check_assembly_fits(model)
-    result = modal_analysis(model, n_modes, fixed=fixed)
+def modal_table(model, n_modes: int, fixed=None, eigensolver: str = "auto"):
+    """Modes of ``model`` (eigensolver chosen by ``choose_eigensolver``), classified:
+    (ModalResult, types, rows), the rows being the JSON/CSV dicts index, frequency_hz, type,
+    order, residual."""
+    method = choose_eigensolver(model, eigensolver)
+    result = modal_analysis(model, n_modes, fixed=fixed, method=method)
     masses = model.density * model.body.volumes
     types = classify_modes(model.body.points, result.shapes, masses, result.rigid)
     rows = [{"index": i, "frequency_hz": float(f), "type": t.type, "order": t.order,
@@ -135,6 +140,46 @@ def mode_label(row: dict) -> str:
     return str(ModeType(row["type"], row["order"]))
 
 
+def choose_eigensolver(model, requested: str = "auto") -> str:
+    """``shift-invert`` or ``lobpcg`` for ``model``.
+
+    ``auto``: shift-invert when the estimated factor (``factor_bytes``) is at most
+    ``FACTOR_BUDGET`` and fits in the machine's memory (or when pyamg, which LOBPCG's
+    preconditioner needs, is not installed), LOBPCG otherwise. An explicit
+    ``shift-invert`` is refused when it cannot fit (``check_assembly_fits``).
+    """
+    if requested == "auto":
+        fits = factor_bytes(model) <= min(FACTOR_BUDGET, MEMORY_SHARE * _machine_memory())
+        return "shift-invert" if fits or not _has_pyamg() else "lobpcg"
+    if requested == "shift-invert":
+        check_assembly_fits(model)
+    elif requested != "lobpcg":
+        raise InputError(f"eigensolver must be auto, shift-invert or lobpcg, got {requested!r}")
+    return requested
+
+
+def factor_bytes(model) -> float:
+    """Estimated memory of the shift-invert factor, bytes (8-byte values, 4-byte indices)."""
+    unknowns = 4 if isinstance(model, LPSModel) else 3  # LPS: three dofs and a dilatation
+    return 12.0 * estimated_factor_entries(model.body.points, model.bonds.horizon, unknowns)
+
+
+def _has_pyamg() -> bool:
+    from importlib.util import find_spec
+
+    return find_spec("pyamg") is not None
+
+
+def _machine_memory() -> float:
+    """Physical memory, bytes (infinite where the system does not say)."""
+    import os
+
+    try:
+        return float(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
+    except (ValueError, OSError, AttributeError):
+        return float("inf")
+
+
 def check_assembly_fits(model) -> None:
     """Refuse, with the numbers, a shift-invert factorisation too large for this machine.
 
@@ -142,20 +187,14 @@ def check_assembly_fits(model) -> None:
     points (``solvers.ordering.estimated_factor_entries``): it grows with the
     horizon (wider separators) much faster than the number of bonds does.
     """
-    unknowns = 4 if isinstance(model, LPSModel) else 3  # LPS: three dofs and a dilatation
-    entries = estimated_factor_entries(model.body.points, model.bonds.horizon, unknowns)
-    needed = 12.0 * entries  # 8-byte values and 4-byte indices
-    try:
-        import os
-
-        available = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
-    except (ValueError, OSError, AttributeError):
-        return
+    needed = factor_bytes(model)
+    entries = needed / 12.0
+    available = _machine_memory()
     if needed > MEMORY_SHARE * available:
         raise InputError(
             f"the sparse factorisation of this model would hold about {entries / 1e9:.2f} billion "
             f"entries (~{needed / 2**30:.0f} GiB; this machine has {available / 2**30:.0f} GiB): "
-            "use a smaller horizon (1.4143 spacing: 18 neighbours) or a coarser spacing"
+            "use solver.eigensolver lobpcg (or auto), a smaller horizon or a coarser spacing"
         )
 
 

@@ -269,6 +269,9 @@ class Solver(Strict):
     breaking_rounds: Annotated[int, Field(ge=1)] = 100
     displacement_tolerance: Positive = 1e-10
     linear_solver: Literal["lu", "cg"] = "lu"
+    #: modal: ``shift-invert`` (factorised), ``lobpcg`` (matrix-free) or ``auto`` (by the
+    #: estimated factor size, ``modal_run.choose_eigensolver``).
+    eigensolver: Literal["auto", "shift-invert", "lobpcg"] = "auto"
 
     @model_validator(mode="after")
     def _newmark(self):

@@ -15,6 +15,10 @@ at a fraction of the memory and time of K itself (D < 0, as for a 2D plane-stres
 with nu < 1/3, only needs more pivoting). Rigid-body modes
 (six for a free 3D body, three in 2D) come out with |f| near zero and are
 counted and reported separately.
+
+Where the factor would be too large (wide horizons, large bodies; the choice is
+``modal_run.choose_eigensolver``), ``method="lobpcg"`` finds the same modes without
+factorising anything (``solvers.eigen_iterative``).
 """
 
 from __future__ import annotations
@@ -78,8 +82,13 @@ def free_dofs(model: Model, fixed: np.ndarray | None = None) -> np.ndarray:
     return np.flatnonzero(free.ravel())
 
 
+#: Eigensolvers of ``modal_analysis``.
+EIGENSOLVERS = ("shift-invert", "lobpcg")
+
+
 def modal_analysis(model: Model, n_modes: int = 12, fixed: np.ndarray | None = None,
-                   shift: float | None = None, tol: float = 1e-10) -> ModalResult:
+                   shift: float | None = None, tol: float = 1e-10,
+                   method: str = "shift-invert") -> ModalResult:
     """The ``n_modes`` lowest modes of ``model`` (free-free unless ``fixed`` dofs are given).
 
     Parameters
@@ -89,36 +98,56 @@ def modal_analysis(model: Model, n_modes: int = 12, fixed: np.ndarray | None = N
     fixed : (n_points, 3) bool or None
         Dofs held at zero.
     shift : float or None, 1/s^2
-        Magnitude s of the negative shift; default: 1e-3 of the largest K_ii / M_ii
-        estimate scaled to the low end of the spectrum (see code).
+        Shift-invert only: magnitude s of the negative shift; default: 1e-3 of the largest
+        K_ii / M_ii estimate scaled to the low end of the spectrum (see code).
+    method : {"shift-invert", "lobpcg"}
+        ``shift-invert``: Lanczos on the factorised K + s M (this module);
+        ``lobpcg``: matrix-free and preconditioned, no factor (``solvers.eigen_iterative``),
+        the rigid modes are the exact rigid motions.
     """
     if n_modes < 1:
         raise InputError(f"number of modes must be positive, got {n_modes}")
+    if method not in EIGENSOLVERS:
+        raise InputError(f"eigensolver must be one of {EIGENSOLVERS}, got {method!r}")
     dofs = free_dofs(model, fixed)
     if n_modes >= len(dofs):
         raise InputError(f"asked for {n_modes} modes of a model with {len(dofs)} free dofs")
+    m = mass_matrix(model).diagonal()[dofs]
+    if method == "lobpcg":
+        from peridyn.solvers.eigen_iterative import lobpcg_modes
+
+        lam, vecs, n_rigid, K = lobpcg_modes(model, n_modes, dofs)
+        # Gershgorin: the row sums bound every diagonal entry of K
+        k_max = float(np.max(model.stiffness_bound() * model.body.volumes))
+        known_rigid = np.arange(n_modes) < n_rigid
+        return _result(lam, vecs, K, m, dofs, model.body.n_points, k_max, known_rigid)
     parts = stiffness_parts(model)
     K = parts.restricted(dofs)
-    m = mass_matrix(model).diagonal()[dofs]
     M = sp.diags(m).tocsc()
     if shift is None:
         # a fraction of the lowest diagonal frequency estimate keeps K + s M well conditioned
         shift = 1e-6 * float(np.median(parts.diagonal()[dofs] / m))
     op = shifted_inverse(parts, dofs, shift * m, model.body.points, model.bonds.horizon)
     lam, vecs = eigsh(K, k=n_modes, M=M, sigma=-shift, which="LM", OPinv=op, tol=tol)
+    k_max = float(np.abs(parts.diagonal()[dofs]).max())
+    return _result(lam, vecs, K, m, dofs, model.body.n_points, k_max, np.zeros(n_modes, bool))
+
+
+def _result(lam, vecs, K, m, dofs, n_points, k_max, known_rigid) -> ModalResult:
+    """ModalResult from eigenpairs on the ``dofs`` (any order): frequencies, residuals and the
+    rigid modes (``known_rigid``, and those below RIGID_FRACTION of the highest frequency)."""
     order = np.argsort(lam)
-    lam, vecs = lam[order], vecs[:, order]
+    lam, vecs, known_rigid = lam[order], vecs[:, order], known_rigid[order]
     kx = K @ vecs
-    mx = M @ vecs
+    mx = m[:, None] * vecs
     freqs = np.sign(lam) * np.sqrt(np.abs(lam)) / (2 * np.pi)
-    rigid = np.abs(freqs) < RIGID_FRACTION * np.abs(freqs).max()
+    rigid = known_rigid | (np.abs(freqs) < RIGID_FRACTION * np.abs(freqs).max())
     resid = np.linalg.norm(kx - mx * lam, axis=0)
     # elastic modes: relative to ||K x||; rigid ones (K x ~ 0): relative to max K_ii ||x||
-    k_scale = np.abs(parts.diagonal()[dofs]).max() * np.linalg.norm(vecs, axis=0)
-    scale = np.where(rigid, k_scale, np.linalg.norm(kx, axis=0))
-    shapes = np.zeros((n_modes, model.body.n_points * 3))
+    scale = np.where(rigid, k_max * np.linalg.norm(vecs, axis=0), np.linalg.norm(kx, axis=0))
+    shapes = np.zeros((len(lam), n_points * 3))
     shapes[:, dofs] = vecs.T
-    return ModalResult(freqs, shapes.reshape(n_modes, -1, 3), resid / np.maximum(scale, 1e-300),
+    return ModalResult(freqs, shapes.reshape(len(lam), -1, 3), resid / np.maximum(scale, 1e-300),
                        rigid)
 
 

@@ -1,0 +1,138 @@
+"""The stiffness applied to a block of vectors at once, matrix-free (for iterative eigensolvers).
+
+``kernels.linear`` applies K to one displacement field; an eigensolver such as LOBPCG
+applies it to a dozen at every iteration. Here each bond is visited once per block: its
+unit vector and coefficients are read once and used for all ``k`` vectors, which sit
+contiguously in memory (``u`` of shape (n_points, 3, k)). Same formulas as
+``kernels.linear`` (``K u = -V f_lin(u)``), nothing is assembled: the memory is the
+bonds' plus a few (n_bonds, k) arrays, whatever the horizon.
+"""
+
+from __future__ import annotations
+
+import numba
+import numpy as np
+from scipy.sparse.linalg import LinearOperator
+
+from peridyn.materials import LPSModel, Model, PMBModel
+
+
+@numba.njit(parallel=True, cache=True)
+def block_extension(x, u, offsets, nbr, length, intact, out):
+    """``out`` (OUT, (n_bonds, k)): extension n . (u_j - u_i) of each intact bond, per vector.
+
+    ``u`` (n_points, 3, k).
+    """
+    n, k = x.shape[0], u.shape[2]
+    for i in numba.prange(n):
+        for b in range(offsets[i], offsets[i + 1]):
+            j = nbr[b]
+            for c in range(k):
+                out[b, c] = 0.0
+            if not intact[b]:
+                continue
+            for a in range(3):
+                na = (x[j, a] - x[i, a]) / length[b]
+                for c in range(k):
+                    out[b, c] += na * (u[j, a, c] - u[i, a, c])
+    return out
+
+
+@numba.njit(parallel=True, cache=True)
+def block_family_sum(offsets, weight, e, out):
+    """``out`` (OUT, (n_points, k)): sum over each point's bonds of weight_b e_b."""
+    n, k = out.shape
+    for i in numba.prange(n):
+        for c in range(k):
+            out[i, c] = 0.0
+        for b in range(offsets[i], offsets[i + 1]):
+            for c in range(k):
+                out[i, c] += weight[b] * e[b, c]
+    return out
+
+
+@numba.njit(parallel=True, cache=True)
+def block_lps_force(x, e, offsets, nbr, length, w, intact, p, alpha, f):
+    """``f`` (OUT, (n_points, 3, k)): linearised LPS force density, N/m^3.
+
+    Bond force t = w [|xi| (P_i + P_j) + (alpha_i + alpha_j) e] along n, as in
+    ``kernels.linear.lps_linear_force``; ``p`` (n_points, k) is P = theta p_coef.
+    """
+    n, k = x.shape[0], e.shape[1]
+    for i in numba.prange(n):
+        for a in range(3):
+            for c in range(k):
+                f[i, a, c] = 0.0
+        for b in range(offsets[i], offsets[i + 1]):
+            if not intact[b]:
+                continue
+            j = nbr[b]
+            n0 = (x[j, 0] - x[i, 0]) / length[b]
+            n1 = (x[j, 1] - x[i, 1]) / length[b]
+            n2 = (x[j, 2] - x[i, 2]) / length[b]
+            pair = alpha[i] + alpha[j]
+            for c in range(k):
+                t = w[b] * (length[b] * (p[i, c] + p[j, c]) + pair * e[b, c])
+                f[i, 0, c] += t * n0
+                f[i, 1, c] += t * n1
+                f[i, 2, c] += t * n2
+    return f
+
+
+@numba.njit(parallel=True, cache=True)
+def block_pmb_force(x, e, offsets, nbr, length, k_bond, intact, f):
+    """``f`` (OUT, (n_points, 3, k)): linearised PMB force density, t = k e / |xi| along n."""
+    n, k = x.shape[0], e.shape[1]
+    for i in numba.prange(n):
+        for a in range(3):
+            for c in range(k):
+                f[i, a, c] = 0.0
+        for b in range(offsets[i], offsets[i + 1]):
+            if not intact[b]:
+                continue
+            j = nbr[b]
+            s = k_bond[b] / length[b]
+            for a in range(3):
+                na = s * (x[j, a] - x[i, a]) / length[b]
+                for c in range(k):
+                    f[i, a, c] += e[b, c] * na
+    return f
+
+
+def block_linear_force(model: Model, u: np.ndarray) -> np.ndarray:
+    """Linearised force density (n_points, 3, k), N/m^3, of the k fields ``u`` (n_points, 3, k)."""
+    b = model.bonds
+    x = model.body.points
+    u = np.ascontiguousarray(u, dtype=np.float64)
+    e = block_extension(x, u, b.offsets, b.neighbours, b.length, b.intact,
+                        np.empty((b.n_bonds, u.shape[2])))
+    f = np.empty_like(u)
+    if isinstance(model, PMBModel):
+        return block_pmb_force(x, e, b.offsets, b.neighbours, b.length,
+                               model.bond_stiffness.astype(np.float64), b.intact, f)
+    if isinstance(model, LPSModel):
+        w = model.w.astype(np.float64)
+        theta = block_family_sum(b.offsets, w * b.length, e, np.empty((len(x), u.shape[2])))
+        p = theta * (model.theta_coef * model._p_coef.astype(np.float64))[:, None]
+        return block_lps_force(x, e, b.offsets, b.neighbours, b.length, w, b.intact, p,
+                               model.alpha.astype(np.float64), f)
+    raise TypeError(f"no linearisation for {type(model).__name__}")
+
+
+def block_stiffness_operator(model: Model, dofs: np.ndarray) -> LinearOperator:
+    """K[dofs][:, dofs] (N/m) as an operator whose ``matmat`` visits the bonds once per block."""
+    n = model.body.n_points
+    vol = model.body.volumes
+    size = len(dofs)
+
+    def matmat(v):
+        v = np.asarray(v, dtype=np.float64)
+        block = v.reshape(size, -1)
+        full = np.zeros((3 * n, block.shape[1]))
+        full[dofs] = block
+        f = block_linear_force(model, full.reshape(n, 3, -1))
+        out = (-vol[:, None, None] * f).reshape(3 * n, -1)[dofs]
+        return out.reshape(v.shape)
+
+    return LinearOperator((size, size), matvec=matmat, matmat=matmat, rmatvec=matmat,
+                          dtype=np.float64)
