@@ -144,13 +144,12 @@ def choose_eigensolver(model, requested: str = "auto") -> str:
     """``shift-invert`` or ``lobpcg`` for ``model``.
 
     ``auto``: shift-invert when the estimated factor (``factor_bytes``) is at most
-    ``FACTOR_BUDGET`` and fits in the machine's memory (or when pyamg, which LOBPCG's
-    preconditioner needs, is not installed), LOBPCG otherwise. An explicit
+    ``FACTOR_BUDGET`` and fits in the machine's memory, LOBPCG otherwise. An explicit
     ``shift-invert`` is refused when it cannot fit (``check_assembly_fits``).
     """
     if requested == "auto":
         fits = factor_bytes(model) <= min(FACTOR_BUDGET, MEMORY_SHARE * _machine_memory())
-        return "shift-invert" if fits or not _has_pyamg() else "lobpcg"
+        return "shift-invert" if fits else "lobpcg"
     if requested == "shift-invert":
         check_assembly_fits(model)
     elif requested != "lobpcg":
@@ -162,12 +161,6 @@ def factor_bytes(model) -> float:
     """Estimated memory of the shift-invert factor, bytes (8-byte values, 4-byte indices)."""
     unknowns = 4 if isinstance(model, LPSModel) else 3  # LPS: three dofs and a dilatation
     return 12.0 * estimated_factor_entries(model.body.points, model.bonds.horizon, unknowns)
-
-
-def _has_pyamg() -> bool:
-    from importlib.util import find_spec
-
-    return find_spec("pyamg") is not None
 
 
 def _machine_memory() -> float:

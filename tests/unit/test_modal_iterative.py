@@ -14,8 +14,6 @@ from peridyn.errors import InputError
 from peridyn.materials import make_model
 from peridyn.solvers.modal import free_dofs, modal_analysis
 
-pytest.importorskip("pyamg")
-
 #: PMMA plate of VALIDATION.md V4 (m, Pa, -, kg/m^3); 4 mm spacing keeps it small (600 points).
 SIZE, E, NU, RHO = (0.10, 0.05, 0.008), 5.35e9, 0.33, 1200.0
 
@@ -74,16 +72,17 @@ def test_lobpcg_on_a_clamped_plate_has_no_rigid_mode():
 
 def test_block_operator_equals_the_linearised_force_kernel():
     """K applied to a block (solvers.block_operator) equals, column by column, the one-vector
-    operator K u = -V f_lin(u) of peridyn.stiffness, for LPS with cut bonds and for PMB."""
+    operator K u = -V f_lin(u) of peridyn.stiffness, for LPS (plain and with the energy surface
+    correction's per-bond deviatoric stiffness) with cut bonds and for PMB."""
     from peridyn.solvers.block_operator import block_stiffness_operator
     from peridyn.stiffness import stiffness_operator
 
     rng = np.random.default_rng(1)
-    for name in ("lps", "pmb"):
+    for name, correction in (("lps", "none"), ("lps", "energy"), ("pmb", "none")):
         body = geometry.box((0.012, 0.008, 0.006), 2e-3)
         bonds = find_bonds(body, 3.001 * 2e-3, partial_volumes=False)
         bonds.intact[rng.random(bonds.n_bonds) < 0.1] = False  # any cut: both sides use bonds.intact
-        model = make_model(name, body, bonds, E=E, nu=0.25, density=RHO)
+        model = make_model(name, body, bonds, E=E, nu=0.25, density=RHO, surface_correction=correction)
         dofs = free_dofs(model)
         block = block_stiffness_operator(model, dofs)
         single = stiffness_operator(model)

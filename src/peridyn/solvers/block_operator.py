@@ -52,11 +52,12 @@ def block_family_sum(offsets, weight, e, out):
 
 
 @numba.njit(parallel=True, cache=True)
-def block_lps_force(x, e, offsets, nbr, length, w, intact, p, alpha, f):
+def block_lps_force(x, e, offsets, nbr, length, w, dev, intact, p, f):
     """``f`` (OUT, (n_points, 3, k)): linearised LPS force density, N/m^3.
 
-    Bond force t = w [|xi| (P_i + P_j) + (alpha_i + alpha_j) e] along n, as in
-    ``kernels.linear.lps_linear_force``; ``p`` (n_points, k) is P = theta p_coef.
+    Bond force t = w |xi| (P_i + P_j) + dev e along n, as in
+    ``kernels.linear.lps_linear_force``; ``p`` (n_points, k) is P = theta p_coef and ``dev``
+    (n_bonds,) the model's deviatoric bond stiffness (``LPSModel.dev``).
     """
     n, k = x.shape[0], e.shape[1]
     for i in numba.prange(n):
@@ -70,9 +71,8 @@ def block_lps_force(x, e, offsets, nbr, length, w, intact, p, alpha, f):
             n0 = (x[j, 0] - x[i, 0]) / length[b]
             n1 = (x[j, 1] - x[i, 1]) / length[b]
             n2 = (x[j, 2] - x[i, 2]) / length[b]
-            pair = alpha[i] + alpha[j]
             for c in range(k):
-                t = w[b] * (length[b] * (p[i, c] + p[j, c]) + pair * e[b, c])
+                t = w[b] * length[b] * (p[i, c] + p[j, c]) + dev[b] * e[b, c]
                 f[i, 0, c] += t * n0
                 f[i, 1, c] += t * n1
                 f[i, 2, c] += t * n2
@@ -114,8 +114,8 @@ def block_linear_force(model: Model, u: np.ndarray) -> np.ndarray:
         w = model.w.astype(np.float64)
         theta = block_family_sum(b.offsets, w * b.length, e, np.empty((len(x), u.shape[2])))
         p = theta * (model.theta_coef * model._p_coef.astype(np.float64))[:, None]
-        return block_lps_force(x, e, b.offsets, b.neighbours, b.length, w, b.intact, p,
-                               model.alpha.astype(np.float64), f)
+        return block_lps_force(x, e, b.offsets, b.neighbours, b.length, w,
+                               model.dev.astype(np.float64), b.intact, p, f)
     raise TypeError(f"no linearisation for {type(model).__name__}")
 
 
