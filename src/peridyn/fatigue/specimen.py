@@ -14,6 +14,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from peridyn.bonds import crossing_rectangle, crossing_segment
 from peridyn.errors import InputError
 from peridyn.fatigue.statics import LinearStatics
 from peridyn.loads import Loading
@@ -61,3 +62,31 @@ def compliance_stress_intensity(crack_lengths, energy, thickness: float, modulus
     if np.any(g < 0):
         raise InputError("compliance K: the energy fell with crack length (loads not fixed?)")
     return np.sqrt(modulus * g)
+
+
+def straight_crack_cut(points: np.ndarray, spacing: float, bonds, precrack,
+                       axis: int) -> Callable[[float], np.ndarray]:
+    """The pre-crack ``precrack`` (a case's rectangle or segment) lengthened along ``axis`` (0, 1, 2):
+    a -> (n_bonds,) bool, the bonds crossing it when it runs to length a (m) from the body's low
+    edge (its outermost points minus half a spacing, as ``crack_tip`` measures).
+    """
+    owners, neighbours = bonds.owners(), bonds.neighbours
+    x_from, x_to = points[owners], points[neighbours]
+    low = points[:, axis].min() - 1.0  # 1 m beyond the edge: the crack starts outside the body
+    unit = np.eye(3)[axis]
+    edge = points[:, axis].min() - 0.5 * spacing
+    if precrack.type == "rectangle":
+        origin = np.array(precrack.origin, dtype=float)
+        origin[axis] = low
+        other = np.array(precrack.edge_v, dtype=float)
+
+        def cut(a):
+            return crossing_rectangle(x_from, x_to, origin, unit * (edge + a - low), other)
+    else:
+        start = np.array(precrack.start, dtype=float)
+        start[axis] = low
+
+        def cut(a):
+            return crossing_segment(x_from, x_to, start, start + unit * (edge + a - low))
+
+    return cut
