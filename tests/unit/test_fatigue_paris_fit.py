@@ -33,7 +33,7 @@ def _staircase(spacing=1e-3, a_end=20e-3, steps_between=3):
     columns = np.arange(A0, a_end + 0.5 * spacing, spacing)
     n_jump = _cycles_to(columns)
     cycles, lengths = [0.0], [0.0]  # the pre-crack is not cracked through at the start
-    for i, (n, a) in enumerate(zip(n_jump, columns)):
+    for i, (n, a) in enumerate(zip(n_jump, columns, strict=True)):
         if i > 0:
             quiet = np.linspace(n_jump[i - 1], n, steps_between + 2)[1:-1]
             cycles += quiet.tolist()
