@@ -81,3 +81,19 @@ def test_compliance_k_needs_increasing_crack_lengths():
     s = _specimen(0.010, 0.020, 1e-3)
     with pytest.raises(InputError, match="at least 3 increasing crack lengths"):
         compliance_energy(s.model, s.loading, [2e-3, 1e-3, 3e-3], lambda a: np.zeros(1, bool))
+
+
+def test_straight_crack_cut_lengthens_a_2d_segment_precrack():
+    """The pre-crack of a 2D case (a segment given by two coordinates) lengthened to a cuts the
+    bonds crossing y = H/2 at x < a (crack length from the low edge), and no others."""
+    from peridyn.fatigue.specimen import straight_crack_cut
+    from peridyn.io.case import Precrack
+
+    s = _specimen(0.010, 0.020, 1e-3)
+    x, own, nb = s.body.points, s.bonds.owners(), s.bonds.neighbours
+    crack = Precrack(type="segment", start=[-0.001, 0.010], end=[0.002, 0.010])
+    cut = straight_crack_cut(x, 1e-3, s.bonds, crack, 0)(4.2e-3)  # no bond crosses at x = 4.2 mm
+    y0, y1 = x[own, 1], x[nb, 1]
+    across = (y0 - 0.010) * (y1 - 0.010) < 0
+    x_cross = x[own, 0] + (0.010 - y0) / (y1 - y0 + ~across) * (x[nb, 0] - x[own, 0])
+    assert cut.sum() > 0 and np.array_equal(cut, across & (x_cross < 4.2e-3))

@@ -83,7 +83,8 @@ def straight_crack_cut(points: np.ndarray, spacing: float, bonds, precrack,
         def cut(a):
             return crossing_rectangle(x_from, x_to, origin, unit * (edge + a - low), other)
     else:
-        start = np.array(precrack.start, dtype=float)
+        start = np.zeros(3)
+        start[: len(precrack.start)] = precrack.start
         start[axis] = low
 
         def cut(a):
