@@ -87,3 +87,10 @@ def test_eq_7_12_on_a_specimen_with_another_k_bends_the_slope(sen_case):
     k_growth = np.polyfit(np.log(a), np.log(stress_intensity(50e6, a, 0.05)), 1)[0]
     assert slope == pytest.approx(M * GROWTH / k_growth, rel=0.05)
     assert slope > 1.5 * M
+
+
+def test_fit_range_must_be_increasing():
+    from peridyn.errors import CaseFileError
+
+    with pytest.raises(CaseFileError, match=r"paris.fit_range must be \[shortest, longest\]"):
+        load_case("cases/sen_fatigue.yaml", ["fatigue.paris.fit_range=[0.02, 0.01]"])

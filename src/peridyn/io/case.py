@@ -545,6 +545,13 @@ class ParisSpecimen(Strict):
     #: ``compliance`` of the modelled specimen (straight extensions of the first pre-crack)
     k: Literal["eq_7_12", "compliance"] = "eq_7_12"
 
+    @model_validator(mode="after")
+    def _range(self):
+        if self.fit_range is not None and self.fit_range[0] >= self.fit_range[1]:
+            raise ValueError(f"paris.fit_range must be [shortest, longest] crack length (m), got "
+                             f"{list(self.fit_range)}")
+        return self
+
 
 class Fatigue(Strict):
     """Remaining-life fatigue (thesis seed 002 ch. 7): phase I (A_I, m_I, eps_inf), phase II
