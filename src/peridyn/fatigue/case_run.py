@@ -21,6 +21,8 @@ from peridyn.fatigue.calibration import growth_rates, paris_fit, stress_intensit
 from peridyn.fatigue.mapping import CycleMapping
 from peridyn.fatigue.model import FatigueParameters, scale_A_II
 from peridyn.fatigue.run import FatigueResult, run_fatigue
+from peridyn.fatigue.specimen import compliance_energy, compliance_stress_intensity, straight_crack_cut
+from peridyn.fatigue.tip import AXES
 from peridyn.io.case import Case
 from peridyn.io.vtk import write_vtu
 from peridyn.modal_run import match_modes, modal_table
@@ -49,16 +51,60 @@ def fatigue_parameters(case: Case, horizon: float) -> FatigueParameters:
                              phi_c=f.phi_c)
 
 
-def paris_slope(case: Case, result: FatigueResult) -> float | None:
-    """Slope of log(da/dN) against log(dK) of the run (eqs. 7.12-7.14), or None without ``paris``."""
+def specimen_k(case: Case, setup) -> tuple[np.ndarray, np.ndarray] | None:
+    """K_I (Pa m^0.5) of the modelled specimen at the maximum load on a grid of crack lengths (m),
+    by compliance (``fatigue.specimen``), when ``paris.k`` is ``compliance``; else None."""
     p = case.fatigue.paris
-    if p is None:
+    if p is None or p.k != "compliance":
         return None
+    if not case.precracks:
+        raise CaseFileError(case.name, "fatigue.paris.k", p.k, "a pre-crack to lengthen (compliance K)")
+    body, axis = setup.body, AXES[case.fatigue.tip.axis]
+    h = body.spacing
+    span = np.ptp(body.points[:, axis]) + h
+    crack = case.precracks[0]
+    tips = [np.add(crack.origin, crack.edge_u), crack.origin] if crack.type == "rectangle" else [
+        crack.start, crack.end]
+    start = max(np.asarray(t, float)[axis] for t in tips) - (body.points[:, axis].min() - 0.5 * h)
+    end = min(span - 2.0 * h, p.stop_length or span, p.fit_range[1] if p.fit_range else span)
+    lengths = np.arange(start, end + 1.5 * h, h)
+    cut = straight_crack_cut(body.points, h, setup.bonds, crack, axis)
+    energy = compliance_energy(setup.model, setup.loading, lengths, cut, case.fatigue.max_load_time)
+    depth = case.geometry.thickness if body.dim == 2 else np.ptp(
+        body.points[:, AXES[case.fatigue.tip.depth_axis]]) + h
+    return lengths, compliance_stress_intensity(lengths, energy, depth, case.material.E)
+
+
+def paris_rates(case: Case, result: FatigueResult, k_curve=None) -> tuple[np.ndarray, np.ndarray]:
+    """(dK, da/dN) of the run's crack-length jumps (eq. 7.14), Pa m^0.5 and m/cycle, restricted to
+    ``paris.fit_range`` (phase II) when it is set. K from eq. 7.12, or from ``k_curve``
+    (lengths, K) of ``specimen_k`` interpolated in log-log."""
+    p = case.fatigue.paris
     a_mid, rate = growth_rates(result.cycles, result.crack_length)
+    if p.fit_range is not None:
+        keep = (a_mid >= p.fit_range[0]) & (a_mid <= p.fit_range[1])
+        a_mid, rate = a_mid[keep], rate[keep]
+    if k_curve is None:
+        k = stress_intensity(p.stress, a_mid, p.width)
+    else:
+        k = np.exp(np.interp(np.log(a_mid), np.log(k_curve[0]), np.log(k_curve[1])))
+    return (1.0 - case.fatigue.load_ratio) * k, rate
+
+
+def paris_slope(case: Case, result: FatigueResult, k_curve=None) -> float | None:
+    """Slope of log(da/dN) against log(dK) of the run (eqs. 7.10-7.14), or None without ``paris``
+    or with fewer than two rates in the fit range."""
+    if case.fatigue.paris is None:
+        return None
+    dk, rate = paris_rates(case, result, k_curve)
     if rate.size < 2:
         return None
-    dk = (1.0 - case.fatigue.load_ratio) * stress_intensity(p.stress, a_mid, p.width)
     return paris_fit(dk, rate)[0]
+
+
+def _stop_length(f) -> float:
+    """Crack length (m) that ends the run: ``paris.stop_length``, else none (inf)."""
+    return f.paris.stop_length if f.paris is not None and f.paris.stop_length is not None else np.inf
 
 
 def run_fatigue_case(case: Case, output_dir=None, base_dir=".", modal: bool | None = None,
@@ -75,16 +121,20 @@ def run_fatigue_case(case: Case, output_dir=None, base_dir=".", modal: bool | No
     before = setup_rows = None
     if do_modal:
         before, _, setup_rows = modal_table(setup.model, n_modes)
+    k_curve = specimen_k(case, setup)
     mapping = CycleMapping(tuple((b.steps, b.tau) for b in f.mapping), f.adaptive)
     if progress is not None:
         progress = progress(mapping.n_steps)
     result = run_fatigue(setup.model, setup.loading, fatigue_parameters(case, setup.bonds.horizon),
                          mapping, f.load_ratio, f.max_load_time, f.no_damage_sets, f.tip.axis,
-                         f.tip.depth_axis, f.tip.damage, f.solver, progress)
+                         f.tip.depth_axis, f.tip.damage, f.solver, progress,
+                         _stop_length(f))
     if progress is not None:
         progress.close()
     summary = {"cycles": float(result.cycles[-1]), "crack_length_m": float(result.crack_length[-1]),
-               "paris_slope": paris_slope(case, result), "bonds_broken": int(result.broken[-1]),
+               "paris_slope": paris_slope(case, result, k_curve),
+               "paris_rates": int(paris_rates(case, result)[1].size) if f.paris is not None else 0,
+               "bonds_broken": int(result.broken[-1]),
                "points": setup.body.n_points, "bonds": setup.bonds.n_bonds // 2,
                "output_dir": str(out)}
     if do_modal:

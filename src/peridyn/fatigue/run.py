@@ -57,7 +57,7 @@ def breakable_bonds(model: Model, no_damage_sets=()) -> np.ndarray:
 def run_fatigue(model: Model, loading: Loading, params: FatigueParameters, mapping: CycleMapping,
                 load_ratio: float = 0.0, max_load_time: float = 1.0, no_damage_sets=(),
                 tip_axis: str = "x", depth_axis: str = "z", tip_damage: float = TIP_DAMAGE,
-                solver: str = "auto", progress=None) -> FatigueResult:
+                solver: str = "auto", progress=None, stop_length: float = np.inf) -> FatigueResult:
     """Run the fatigue loop on ``model`` (its ``bonds.intact`` is updated in place).
 
     Parameters
@@ -65,6 +65,7 @@ def run_fatigue(model: Model, loading: Loading, params: FatigueParameters, mappi
     loading : the case's loads; their value at ``max_load_time`` (s) is the maximum load
     load_ratio : R = min load / max load, in [-1, 1)
     progress : object with update(n) (e.g. a tqdm bar) or None
+    stop_length : m, the run ends after the step at which the crack length reaches it
     """
     if not -1.0 <= load_ratio < 1.0:
         raise InputError(f"load ratio R must be in [-1, 1), got {load_ratio!r}")
@@ -101,6 +102,8 @@ def run_fatigue(model: Model, loading: Loading, params: FatigueParameters, mappi
         broken.append(int((~model.bonds.intact).sum()) // 2 - n_broken0)
         if progress is not None:
             progress.update(1)
+        if lengths[-1] >= stop_length:
+            break
     return FatigueResult(np.array(cycles), np.array(lengths), np.array(broken, dtype=np.int64),
                          (statics.solve() if changed else u) if u is not None else np.zeros_like(points),
                          damage_field(model), first_break)

@@ -543,10 +543,25 @@ class FatigueModal(Strict):
 
 class ParisSpecimen(Strict):
     """Single-edge-notch geometry for K_I = sigma sqrt(pi a) F(a/b) (thesis eqs. 7.12-7.13):
-    ``stress`` (Pa, maximum remote stress) and ``width`` b (m)."""
+    ``stress`` (Pa, maximum remote stress) and ``width`` b (m); see the fields for the fit."""
 
     stress: Positive
     width: Positive
+    #: crack lengths (m) whose growth rates enter the Paris fit: phase II only (not the growth out
+    #: of the pre-crack, not where eq. 7.12 stops holding); None: every rate
+    fit_range: tuple[Positive, Positive] | None = None
+    #: stop the run once the crack is this long (m); None: run every step
+    stop_length: Positive | None = None
+    #: dK from ``eq_7_12`` (the SEN formula, for strips loaded far from the crack) or from the
+    #: ``compliance`` of the modelled specimen (straight extensions of the first pre-crack)
+    k: Literal["eq_7_12", "compliance"] = "eq_7_12"
+
+    @model_validator(mode="after")
+    def _range(self):
+        if self.fit_range is not None and self.fit_range[0] >= self.fit_range[1]:
+            raise ValueError(f"paris.fit_range must be [shortest, longest] crack length (m), got "
+                             f"{list(self.fit_range)}")
+        return self
 
 
 class Fatigue(Strict):
