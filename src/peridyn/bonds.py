@@ -346,13 +346,23 @@ def cut_bonds(body: Body, bonds: Bonds, crossing) -> int:
     CUT_CHUNK bonds at a time.
     """
     owners = bonds.owners()
-    cut = 0
+    mask = np.zeros(bonds.n_bonds, dtype=bool)
     for start in range(0, bonds.n_bonds, CUT_CHUNK):
         chunk = slice(start, start + CUT_CHUNK)
-        mask = crossing(body.points[owners[chunk]], body.points[bonds.neighbours[chunk]])
-        bonds.intact[chunk][mask] = False
-        cut += int(mask.sum())
-    return cut
+        mask[chunk] = crossing(body.points[owners[chunk]], body.points[bonds.neighbours[chunk]])
+    mask = both_copies(mask, bonds.reverse())
+    bonds.intact[mask] = False
+    return int(mask.sum())
+
+
+def both_copies(mask: np.ndarray, reverse: np.ndarray) -> np.ndarray:
+    """(n_bonds,) bool: ``mask`` set on both directed copies of a bond where either has it.
+
+    A crossing test of i->j and of j->i can disagree when the bond ends exactly on a crack's
+    edge (round-off); a bond cut in one direction only would make the force and the stiffness
+    of LPS differ. ``reverse`` is ``Bonds.reverse()``.
+    """
+    return mask | mask[reverse]
 
 
 def family_sums(offsets: np.ndarray, values: np.ndarray) -> np.ndarray:

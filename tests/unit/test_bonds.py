@@ -144,3 +144,17 @@ def test_family_sums_gives_zero_for_an_empty_family():
     offsets = np.array([0, 2, 2, 5])
     sums = family_sums(offsets, np.array([1.0, 2.0, 3.0, 4.0, 5.0]))
     np.testing.assert_array_equal(sums, [3.0, 0.0, 12.0])
+
+
+def test_cut_bonds_cuts_both_copies_of_a_bond_ending_on_the_crack_edge():
+    """A segment ending exactly where a diagonal bond crosses it (x = 12 mm between point
+    columns 11.5 and 12.5 mm) may be seen as crossed from one end only (round-off); a bond
+    broken in one direction makes the LPS force and stiffness disagree, so cut_bonds breaks
+    both directed copies (peridynamic bonds are pairs)."""
+    from peridyn.bonds import crossing_segment, cut_bonds
+
+    body = geometry.rectangle(0.050, 0.008, 1e-3, 3e-3)
+    bonds = find_bonds(body, 3.0005e-3, partial_volumes=False)
+    cut = cut_bonds(body, bonds, lambda a, b: crossing_segment(a, b, [-1.0, 0.004], [0.012, 0.004]))
+    assert cut > 0
+    np.testing.assert_array_equal(bonds.intact, bonds.intact[bonds.reverse()])

@@ -14,7 +14,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from peridyn.bonds import crossing_rectangle, crossing_segment
+from peridyn.bonds import both_copies, crossing_rectangle, crossing_segment
 from peridyn.errors import InputError
 from peridyn.fatigue.statics import LinearStatics
 from peridyn.loads import Loading
@@ -37,11 +37,12 @@ def compliance_energy(model: Model, loading: Loading, crack_lengths, cut: Callab
         raise InputError("compliance K needs at least 3 increasing crack lengths")
     intact = model.bonds.intact
     start = intact.copy()
+    reverse = model.bonds.reverse()
     statics = LinearStatics(model, loading, time, "direct")
     energy = np.empty(a.size)
     try:
         for i, length in enumerate(a):
-            intact[:] = start & ~cut(length)
+            intact[:] = start & ~both_copies(cut(length), reverse)
             energy[i] = 0.5 * statics.force @ statics.solve().ravel()
     finally:
         intact[:] = start
