@@ -18,6 +18,7 @@ import time
 from peridyn import geometry
 from peridyn.bonds import find_bonds
 from peridyn.materials import make_model
+from peridyn.materials.lps import SURFACE_CORRECTIONS
 from peridyn.modal_run import choose_eigensolver
 from peridyn.solvers.modal import modal_analysis
 
@@ -31,7 +32,7 @@ def main(argv=None) -> dict:
     parser.add_argument("--horizon", type=float, default=3.001, help="horizon / h")
     parser.add_argument("--modes", type=int, default=12)
     parser.add_argument("--eigensolver", default="auto", choices=["auto", "shift-invert", "lobpcg"])
-    parser.add_argument("--correction", default="none", choices=["none", "shear-factor"])
+    parser.add_argument("--correction", default="none", choices=SURFACE_CORRECTIONS)
     args = parser.parse_args(argv)
     start = time.perf_counter()
     body = geometry.box(SIZE, args.spacing)
