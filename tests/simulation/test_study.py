@@ -36,7 +36,8 @@ def study(tmp_path_factory):
     out = tmp_path_factory.mktemp("study")
     buffer = io.StringIO()
     with contextlib.redirect_stdout(buffer):
-        status = main(["study", CASE, "--set", SIZE, "--set", PLAIN, "--spacing", ",".join(map(repr, SPACINGS)),
+        status = main(["study", CASE, "--set", SIZE, "--set", PLAIN,
+                       "--spacing", ",".join(map(repr, SPACINGS)),
                        "--horizon", "1.4143", "--out", str(out), "--json"])
     assert status == 0
     return out, json.loads(buffer.getvalue())
