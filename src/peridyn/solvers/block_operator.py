@@ -52,12 +52,13 @@ def block_family_sum(offsets, weight, e, out):
 
 
 @numba.njit(parallel=True, cache=True)
-def block_lps_force(x, e, offsets, nbr, length, w, dev, intact, p, f):
-    """``f`` (OUT, (n_points, 3, k)): linearised LPS force density, N/m^3.
+def block_bond_force(x, e, offsets, nbr, length, axial, extension_coef, intact, p, f):
+    """``f`` (OUT, (n_points, 3, k)): linearised force density, N/m^3, of bond forces along n
 
-    Bond force t = w |xi| (P_i + P_j) + dev e along n, as in
-    ``kernels.linear.lps_linear_force``; ``p`` (n_points, k) is P = theta p_coef and ``dev``
-    (n_bonds,) the model's deviatoric bond stiffness (``LPSModel.dev``).
+        t = axial (P_i + P_j) + extension_coef e,
+
+    as in ``kernels.linear``: LPS has axial = w |xi|, extension_coef = ``LPSModel.dev`` and
+    ``p`` (n_points, k) = theta p_coef; PMB has axial = 0, extension_coef = k / |xi|.
     """
     n, k = x.shape[0], e.shape[1]
     for i in numba.prange(n):
@@ -72,30 +73,10 @@ def block_lps_force(x, e, offsets, nbr, length, w, dev, intact, p, f):
             n1 = (x[j, 1] - x[i, 1]) / length[b]
             n2 = (x[j, 2] - x[i, 2]) / length[b]
             for c in range(k):
-                t = w[b] * length[b] * (p[i, c] + p[j, c]) + dev[b] * e[b, c]
+                t = axial[b] * (p[i, c] + p[j, c]) + extension_coef[b] * e[b, c]
                 f[i, 0, c] += t * n0
                 f[i, 1, c] += t * n1
                 f[i, 2, c] += t * n2
-    return f
-
-
-@numba.njit(parallel=True, cache=True)
-def block_pmb_force(x, e, offsets, nbr, length, k_bond, intact, f):
-    """``f`` (OUT, (n_points, 3, k)): linearised PMB force density, t = k e / |xi| along n."""
-    n, k = x.shape[0], e.shape[1]
-    for i in numba.prange(n):
-        for a in range(3):
-            for c in range(k):
-                f[i, a, c] = 0.0
-        for b in range(offsets[i], offsets[i + 1]):
-            if not intact[b]:
-                continue
-            j = nbr[b]
-            s = k_bond[b] / length[b]
-            for a in range(3):
-                na = s * (x[j, a] - x[i, a]) / length[b]
-                for c in range(k):
-                    f[i, a, c] += e[b, c] * na
     return f
 
 
@@ -108,14 +89,16 @@ def block_linear_force(model: Model, u: np.ndarray) -> np.ndarray:
                         np.empty((b.n_bonds, u.shape[2])))
     f = np.empty_like(u)
     if isinstance(model, PMBModel):
-        return block_pmb_force(x, e, b.offsets, b.neighbours, b.length,
-                               model.bond_stiffness.astype(np.float64), b.intact, f)
+        no_dilatation = np.zeros((len(x), u.shape[2]))
+        return block_bond_force(x, e, b.offsets, b.neighbours, b.length, np.zeros(b.n_bonds),
+                                model.bond_stiffness.astype(np.float64) / b.length, b.intact,
+                                no_dilatation, f)
     if isinstance(model, LPSModel):
-        w = model.w.astype(np.float64)
-        theta = block_family_sum(b.offsets, w * b.length, e, np.empty((len(x), u.shape[2])))
+        axial = model.w.astype(np.float64) * b.length
+        theta = block_family_sum(b.offsets, axial, e, np.empty((len(x), u.shape[2])))
         p = theta * (model.theta_coef * model._p_coef.astype(np.float64))[:, None]
-        return block_lps_force(x, e, b.offsets, b.neighbours, b.length, w,
-                               model.dev.astype(np.float64), b.intact, p, f)
+        return block_bond_force(x, e, b.offsets, b.neighbours, b.length, axial,
+                                model.dev.astype(np.float64), b.intact, p, f)
     raise TypeError(f"no linearisation for {type(model).__name__}")
 
 
