@@ -23,7 +23,7 @@ from peridyn.damage import BondDamage
 from peridyn.errors import InputError, InstabilityError
 from peridyn.loads import Loading
 from peridyn.materials.base import Model
-from peridyn.solvers.state import State
+from peridyn.solvers.state import State, advance
 
 
 class ExplicitSolver:
@@ -125,12 +125,7 @@ class ExplicitSolver:
         progress : object with ``update(n)`` or None
             E.g. a tqdm bar.
         """
-        for _ in range(int(n_steps)):
-            self.step(state)
-            for obs in observers:
-                obs.observe(state, self)
-            if progress is not None:
-                progress.update(1)
+        advance(self, state, n_steps, observers, progress)
         check_finite(state)
         return state
 

@@ -31,7 +31,7 @@ from peridyn.materials.base import Model
 from peridyn.solvers.explicit import check_finite
 from peridyn.solvers.modal import free_dofs
 from peridyn.solvers.newton import check_linear_solver, solve_held
-from peridyn.solvers.state import State
+from peridyn.solvers.state import State, advance
 from peridyn.stiffness import mass_matrix
 from peridyn.tangent import tangent_stiffness
 
@@ -153,13 +153,7 @@ class NewmarkSolver:
 
     def run(self, state: State, n_steps: int, observers: Sequence = (), progress=None) -> State:
         """Advance ``state`` by ``n_steps`` steps, calling ``observe(state, self)`` after each."""
-        for _ in range(int(n_steps)):
-            self.step(state)
-            for obs in observers:
-                obs.observe(state, self)
-            if progress is not None:
-                progress.update(1)
-        return state
+        return advance(self, state, n_steps, observers, progress)
 
     def kinetic_energy(self, state: State) -> float:
         """Total kinetic energy, J."""
