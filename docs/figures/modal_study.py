@@ -35,9 +35,12 @@ TYPES = [("bending", 1), ("torsional", 1), ("torsional", 2), ("bending", 2),
          ("transverse bending", 1), ("in-plane bending", 1)]
 LABELS = ["1B", "1T", "2T", "2B", "TB", "IPB"]
 FE = [1706.1, 1982.9, 4268.0, 4542.4, 6607.0, 6868.0]
-THESIS_40K = {1.4143: [1656.45, 1961.24, 4213.43, 4421.60, 6463.92, 6855.45],
-              2.001: [1666.51, 1882.92, 4071.67, 4436.87, 6457.59, 6847.60],
-              3.001: [1603.36, 1854.61, 4005.40, 4287.40, 6236.04, 6774.63]}
+#: the thesis's Table 5.1 (seed 002) by (points, horizon / h); it has no 135k row at 3h
+THESIS = {(40000, 1.4143): [1656.45, 1961.24, 4213.43, 4421.60, 6463.92, 6855.45],
+          (40000, 2.001): [1666.51, 1882.92, 4071.67, 4436.87, 6457.59, 6847.60],
+          (40000, 3.001): [1603.36, 1854.61, 4005.40, 4287.40, 6236.04, 6774.63],
+          (40000, 4.001): [1563.82, 1838.27, 3969.13, 4194.43, 6121.37, 6705.49],
+          (135000, 1.4143): [1683.39, 1969.31, 4236.11, 4486.55, 6545.51, 6860.09]}
 
 
 def run(spacing: float, horizon: float, correction: str) -> dict:
@@ -84,7 +87,7 @@ def plot() -> None:
                                                                             strict=True)]
                 ax.bar(x + k * width, dev, width, color=colours[r["correction"]],
                        label=r["correction"])
-            thesis = THESIS_40K.get(horizon) if points == 40000 else None
+            thesis = THESIS.get((points, horizon))
             if thesis:
                 ax.bar(x + len(rows) * width, [100 * (f / fe - 1) for f, fe in zip(thesis, FE,
                                                                                     strict=True)],

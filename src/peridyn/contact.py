@@ -27,7 +27,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from peridyn.errors import InputError
-from peridyn.kernels.contact import add_contact_force, pair_bond_index
+from peridyn.kernels.contact import add_contact_force, largest_squared_move, pair_bond_index
 from peridyn.materials.base import Model
 from peridyn.materials.pmb import pmb_micromodulus
 
@@ -94,8 +94,7 @@ class Contact:
         """True if no list exists or some point moved more than skin / 2 since the last build."""
         if self._u_built is None:
             return True
-        moved = u - self._u_built
-        return bool(np.max(np.einsum("ij,ij->i", moved, moved)) > (0.5 * self.skin) ** 2)
+        return bool(largest_squared_move(u, self._u_built) > (0.5 * self.skin) ** 2)
 
     def rebuild(self, u: np.ndarray) -> None:
         """Rebuild the Verlet list at displacement ``u`` (n_points, 3), m."""

@@ -146,3 +146,21 @@ def test_shear_factor_in_the_bulk_and_at_surfaces(dim, factor, partial, bulk_is_
     if bulk_is_one:
         assert bulk[0] == pytest.approx(1.0, rel=1e-6)
     assert np.max(np.abs(model.shear_factor[depth < model.body.spacing] / bulk[0] - 1.0)) > 0.05
+
+
+def test_lps_refuses_a_point_whose_bonds_are_all_broken():
+    """A point with no intact bond has weighted volume m = 0 and an undefined dilatation
+    theta = (d / m) sum w |xi| e (Silling et al. 2007): the LPS model must refuse it by name."""
+    from conftest import small_body
+
+    from peridyn.bonds import find_bonds
+    from peridyn.errors import InputError
+    from peridyn.materials import LPSModel
+
+    body = small_body(3, "stress", 6)
+    bonds = find_bonds(body, 1.5 * body.spacing, partial_volumes=False)
+    lonely = 7
+    family = slice(bonds.offsets[lonely], bonds.offsets[lonely + 1])
+    bonds.intact[family] = False
+    with pytest.raises(InputError, match=f"point {lonely} has no intact bond"):
+        LPSModel(body, bonds, E=200e9, nu=0.25, density=7850.0)

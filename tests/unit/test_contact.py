@@ -119,6 +119,22 @@ def test_verlet_list_matches_brute_force_at_every_step_of_random_motion():
     assert 2 <= contact.rebuilds < steps / 3
 
 
+def test_list_is_rebuilt_exactly_when_a_point_moved_half_the_skin():
+    """Verlet-list rule (Allen and Tildesley, Computer Simulation of Liquids, sec. 5.3): two
+    points approach each other by at most twice the largest move, so the list built with a
+    skin s stays complete while every point moved less than s / 2, and must be rebuilt after."""
+    model = cut_square(n=6)
+    skin = 0.4 * H
+    contact = Contact(model, radius=H, skin=skin)
+    u = np.zeros((model.body.n_points, 3))
+    contact.rebuild(u)
+    u[17] = [0.6, 0.8, 0.0]  # a unit direction
+    u[17] *= 0.499 * skin
+    assert not contact.needs_rebuild(u)
+    u[17] *= 0.501 / 0.499
+    assert contact.needs_rebuild(u)
+
+
 def test_collision_conserves_momentum_and_bounces():
     """Two halves of a cut square thrown at each other: momentum conserved, they separate."""
     model = cut_square(n=10)

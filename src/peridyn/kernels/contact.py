@@ -83,3 +83,16 @@ def add_contact_force(y, first, second, bond, intact, volumes, stiffness, radius
         f[j, 2] += tj * d2
         touching += 1
     return touching
+
+
+@numba.njit(parallel=True, cache=True)
+def largest_squared_move(u, u_ref):
+    """max_k |u_k - u_ref_k|^2 over the points of (n_points, 3) ``u`` and ``u_ref`` (m^2),
+    without temporaries."""
+    largest = 0.0
+    for k in numba.prange(u.shape[0]):
+        d0 = u[k, 0] - u_ref[k, 0]
+        d1 = u[k, 1] - u_ref[k, 1]
+        d2 = u[k, 2] - u_ref[k, 2]
+        largest = max(largest, d0 * d0 + d1 * d1 + d2 * d2)
+    return largest

@@ -30,7 +30,7 @@ import warnings
 import numpy as np
 
 from peridyn.body import Body
-from peridyn.bonds import Bonds
+from peridyn.bonds import Bonds, family_sums
 from peridyn.errors import InputError
 from peridyn.kernels.lps import (
     lps_deviatoric_energy,
@@ -93,8 +93,7 @@ class LPSModel(Model):
         self.bulk = bulk_modulus(E, nu) if dim == 3 else plane_bulk_modulus(E, nu, body.plane)
         b = bonds
         w = b.influence * self.bond_volume
-        self.weighted_volume = np.add.reduceat(np.where(b.intact, w * b.length**2, 0.0),
-                                               b.offsets[:-1])
+        self.weighted_volume = family_sums(b.offsets, np.where(b.intact, w * b.length**2, 0.0))
         m = self.weighted_volume
         if np.any(m <= 0):
             lonely = int(np.flatnonzero(m <= 0)[0])
@@ -120,8 +119,8 @@ class LPSModel(Model):
                     stacklevel=2,
                 )
         # m~_i = sum_j g_ij w |xi|^2 (= m without correction), m^5
-        self.dev_weighted_volume = np.add.reduceat(
-            np.where(b.intact, self.dev_factor * w * b.length**2, 0.0), b.offsets[:-1])
+        self.dev_weighted_volume = family_sums(
+            b.offsets, np.where(b.intact, self.dev_factor * w * b.length**2, 0.0))
         # k_ij = w (alpha_i g_ij + alpha_j g_ji), the bond's deviatoric stiffness (both energies)
         point_dev = self.alpha[b.owners()] * self.dev_factor
         self.dev = (w * (point_dev + point_dev[b.reverse()])).astype(self.dtype)
@@ -218,10 +217,10 @@ class LPSModel(Model):
         b = self.bonds
         w = np.where(b.intact, b.influence * self.bond_volume, 0.0)
         nbr = b.neighbours
-        s = self.theta_coef * np.add.reduceat(w * b.length, b.offsets[:-1])
+        s = self.theta_coef * family_sums(b.offsets, w * b.length)
         pair = 2.0 * np.where(b.intact, self.dev.astype(np.float64), 0.0)
         dil = 2.0 * self.bulk * self.theta_coef[nbr] * w * b.length * s[nbr]
-        return np.add.reduceat(pair + dil, b.offsets[:-1]) + 2.0 * self.bulk * s**2
+        return family_sums(b.offsets, pair + dil) + 2.0 * self.bulk * s**2
 
     def critical_stretch(self, fracture_energy):
         """s_c from G_c for LPS with a constant influence function (Madenci and Oterkus 2014).
