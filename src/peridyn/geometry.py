@@ -6,6 +6,8 @@ axis fastest, which keeps neighbours close in memory for the kernels.
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
 from peridyn.body import Body
@@ -19,12 +21,24 @@ def _positive_triplet(name: str, value, count: int = 3) -> np.ndarray:
     return arr
 
 
+#: Relative change of a side, from rounding it to whole cells, above which a warning says so.
+ROUNDING_WARNING = 1e-4
+
+
 def _cell_counts(lengths: np.ndarray, spacing: np.ndarray) -> np.ndarray:
+    """Whole cells along each side (the nearest count); warns when a side changes length."""
     counts = np.rint(lengths / spacing).astype(np.int64)
     if np.any(counts < 1):
         raise InputError(
             f"spacing {spacing.tolist()} m is larger than the body {lengths.tolist()} m"
         )
+    built = counts * spacing
+    changed = np.abs(built - lengths) > ROUNDING_WARNING * lengths
+    if np.any(changed):
+        sides = ", ".join(f"{lengths[a]:g} m -> {built[a]:g} m ({counts[a]} cells)"
+                          for a in np.flatnonzero(changed))
+        warnings.warn(f"the spacing does not divide the body: sides rounded to whole cells: "
+                      f"{sides}", stacklevel=3)
     return counts
 
 

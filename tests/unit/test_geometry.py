@@ -80,3 +80,22 @@ def test_unknown_node_set_suggests_a_name():
     body = geometry.box((0.004, 0.004, 0.004), 1e-3).with_node_set("left", lambda x: x[:, 0] < 1e-3)
     with pytest.raises(InputError, match="did you mean 'left'"):
         body.node_set("lfet")
+
+
+def test_a_side_the_spacing_does_not_divide_is_rounded_with_a_warning():
+    """A grid of whole cells cannot hold 50 mm at 1.5 mm spacing (33.3 cells): the body gets
+    33 cells (49.5 mm) and the user is told which side changed and by how much."""
+    with pytest.warns(UserWarning, match=r"0.05 m -> 0.0495 m \(33 cells\)"):
+        body = geometry.box((0.06, 0.05, 0.006), 0.0015)
+    assert body.points[:, 1].max() + 0.00075 == pytest.approx(0.0495)
+    with pytest.warns(UserWarning, match="sides rounded"):
+        geometry.rectangle(0.1, 0.0101, 1e-3, 1e-3)
+
+
+def test_a_side_the_spacing_divides_gives_no_warning():
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        geometry.box((0.1, 0.05, 0.008), 0.001)
+        geometry.box((0.1, 0.05, 0.008), 0.00066667)  # 150 x 75 x 12 cells, 5e-6 relative
