@@ -97,7 +97,7 @@ def test_old_factorisation_preconditions_the_damaged_body_to_the_direct_solution
     u1 = statics.solve()
     _check_equal_to_direct(model, loading, statics, u1)
     second = statics.records[1]
-    assert not second.factorised and 2 <= second.iterations < 40 and second.residual < 1e-8
+    assert not second.factorised and 2 <= second.iterations < 30 and second.residual < 1e-8
     # the crack softens the bar: the crack mouth opens (the right end moves more under the force)
     assert np.abs(u1 - u0).max() > 1e-3 * np.abs(u0).max()
 
@@ -154,7 +154,7 @@ def test_amg_preconditioner_of_the_intact_bar_solves_the_damaged_one(load):
     _check_equal_to_direct(model, loading, statics, statics.solve())
     first, second = statics.records
     assert first.factorised and not second.factorised
-    assert second.iterations < 40 and second.residual < 1e-8
+    assert second.iterations < 30 and second.residual < 1e-8
 
 
 def test_auto_factorises_small_systems_and_uses_amg_above_the_threshold(monkeypatch):

@@ -51,8 +51,10 @@ from peridyn.stiffness import stiffness_operator, stiffness_parts
 
 #: Diagonal shift relative to the mean diagonal stiffness.
 SHIFT = 1e-9
-#: CG iterations with a preconditioner of earlier bonds after which it is built again.
-REFACTOR_ITERATIONS = 40
+#: CG iterations with a preconditioner of earlier bonds after which it is built again (a fresh
+#: AMG V-cycle needs about 20 on the dog-bone at 14 000-48 000 points, a stale one up to 36 after
+#: 900 broken bonds; rebuilding costs about as much as 30 iterations; a stale factor needs < 20).
+REFACTOR_ITERATIONS = 30
 #: CG iterations at most with a preconditioner built from the bonds intact now.
 FRESH_ITERATIONS = 1000
 #: ``auto`` factorises up to this many free dofs and uses AMG above (at the 0.5 mm dog-bone,
