@@ -145,10 +145,11 @@ def test_jacobi_cg_reaches_the_same_equilibrium():
 @pytest.mark.parametrize("load", ["displacement", "force"])
 def test_amg_preconditioner_of_the_intact_bar_solves_the_damaged_one(load):
     """AMG route: one V-cycle on the intact bar's pair proxy preconditions every solve; after an
-    edge crack of 3 spacings it is kept (no rebuild) and the displacement still satisfies the
-    damaged body's equilibrium to rtol, bond strains as the direct solve's to 1e-6."""
+    edge crack of 3 spacings (half the section at once) it is kept (rebuild threshold raised)
+    and the displacement still satisfies the damaged body's equilibrium to rtol, bond strains as
+    the direct solve's to 1e-6. Measured: 12 then 26 iterations (displacement), 16 then 33 (force)."""
     model, loading = _notched_bar(load)
-    statics = LinearStatics(model, loading, method="amg")
+    statics = LinearStatics(model, loading, method="amg", refactor_iterations=100)
     _check_equal_to_direct(model, loading, statics, statics.solve())
     _cut(model, 3)
     _check_equal_to_direct(model, loading, statics, statics.solve())
