@@ -17,8 +17,8 @@ built again from the bonds intact now and the solve goes on from where it was.
   system in nested-dissection order). Fresh, it solves the system in one iteration; after bonds
   break, a few more, fewer still because the search directions of the earlier solves (up to
   ``recycle``) deflate the later ones (``fatigue.pcg``). Each iteration is a triangular solve
-  with the whole factor, whose size grows faster than the points (3 GB and ~1 s per solve at
-  50 000 points of the dog-bone, against 0.15 s for a V-cycle).
+  with the whole factor, whose size grows faster than the points (3 GB and 1.5 s per solve at
+  48 000 points of the dog-bone under load, against 0.12-0.2 s for a V-cycle).
 - ``auto`` (default): ``direct`` up to ``DIRECT_DOFS`` free dofs, ``amg`` above.
 - ``cg``: Jacobi preconditioner (no set-up; many more iterations).
 
