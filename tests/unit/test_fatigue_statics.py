@@ -97,7 +97,7 @@ def test_old_factorisation_preconditions_the_damaged_body_to_the_direct_solution
     u1 = statics.solve()
     _check_equal_to_direct(model, loading, statics, u1)
     second = statics.records[1]
-    assert not second.factorised and 2 <= second.iterations < 40 and second.residual < 1e-8
+    assert not second.factorised and 2 <= second.iterations < 30 and second.residual < 1e-8
     # the crack softens the bar: the crack mouth opens (the right end moves more under the force)
     assert np.abs(u1 - u0).max() > 1e-3 * np.abs(u0).max()
 
@@ -142,6 +142,47 @@ def test_jacobi_cg_reaches_the_same_equilibrium():
     _check_equal_to_direct(model, loading, statics, u)
 
 
+@pytest.mark.parametrize("load", ["displacement", "force"])
+def test_amg_preconditioner_of_the_intact_bar_solves_the_damaged_one(load):
+    """AMG route: one V-cycle on the intact bar's pair proxy preconditions every solve; after an
+    edge crack of 3 spacings (half the section at once) it is kept (rebuild threshold raised)
+    and the displacement still satisfies the damaged body's equilibrium to rtol, bond strains as
+    the direct solve's to 1e-6. Measured: 12 then 26 iterations (displacement), 16 then 33 (force)."""
+    model, loading = _notched_bar(load)
+    statics = LinearStatics(model, loading, method="amg", refactor_iterations=100)
+    _check_equal_to_direct(model, loading, statics, statics.solve())
+    _cut(model, 3)
+    _check_equal_to_direct(model, loading, statics, statics.solve())
+    first, second = statics.records
+    assert first.factorised and not second.factorised
+    assert second.iterations < 40 and second.residual < 1e-8
+
+
+def test_stale_amg_preconditioner_is_rebuilt_and_the_solve_still_reaches_equilibrium():
+    """Default threshold (30): the force-loaded bar cut through half its section needs more with
+    the intact bar's proxy (33 measured), so the V-cycle is rebuilt on the cut bonds mid-solve and
+    the solve still equals the direct one."""
+    model, loading = _notched_bar("force")
+    statics = LinearStatics(model, loading, method="amg")
+    statics.solve()
+    _cut(model, 3)
+    u = statics.solve()
+    assert statics.records[1].factorised
+    _check_equal_to_direct(model, loading, statics, u)
+
+
+def test_auto_factorises_small_systems_and_uses_amg_above_the_threshold(monkeypatch):
+    """``auto``: direct up to DIRECT_DOFS free dofs (the bar: 16 x 6 x 3 points, both end columns
+    held, 252 x 3 = 756 free dofs), AMG above (threshold lowered below the bar's dofs)."""
+    from peridyn.fatigue import statics as module
+
+    model, loading = _notched_bar("displacement")
+    statics = LinearStatics(model, loading)
+    assert len(statics.free) == 756 and statics.method == "direct"
+    monkeypatch.setattr(module, "DIRECT_DOFS", 100)
+    assert LinearStatics(model, loading).method == "amg"
+
+
 def test_shift_is_a_tiny_fraction_of_the_stiffness():
     """The regularising shift is SHIFT (1e-9) of the mean diagonal stiffness of the intact body."""
     model, loading = _notched_bar("force")
@@ -151,7 +192,7 @@ def test_shift_is_a_tiny_fraction_of_the_stiffness():
 
 
 @pytest.mark.parametrize("kwargs, message", [
-    ({"method": "lu"}, "linear solver must be auto, direct or cg, got 'lu'"),
+    ({"method": "lu"}, "linear solver must be auto, amg, direct or cg, got 'lu'"),
     ({"rtol": 0.0}, "rtol must be in (0, 1), got 0.0"),
     ({"refactor_iterations": 0}, "refactor_iterations must be at least 1, got 0"),
     ({"recycle": -1}, "recycle (directions kept between solves) must be >= 0, got -1"),

@@ -8,8 +8,9 @@ direction A-orthogonal to W, so CG only works on the rest of the spectrum.
 The fatigue loop solves a sequence of systems whose matrices differ by the bonds broken so far,
 all preconditioned by one old factorisation; the search directions of the earlier solves span
 where that factorisation is off, so they make a good W for the next solve
-(``RecycledDirections``). Products with A are cheap here next to the preconditioner (a sparse
-triangular solve of the factor), so re-multiplying W by the new A at each solve costs little.
+(``RecycledDirections``). W is multiplied by the new A at each solve as one block (one pass over
+the bonds for all directions, ``solvers.block_operator``), which costs about as much as a few
+single products.
 """
 
 from __future__ import annotations
@@ -43,13 +44,13 @@ class RecycledDirections:
         """Forget every direction (e.g. after a new factorisation)."""
         self.vectors = []
 
-    def basis(self, matvec: Callable) -> tuple[np.ndarray, np.ndarray] | None:
-        """A-orthonormal basis of the kept directions for the A of ``matvec``: (W, A W), each
-        (n, k), with W^T A W = I; None when none are kept."""
+    def basis(self, matmat: Callable) -> tuple[np.ndarray, np.ndarray] | None:
+        """A-orthonormal basis of the kept directions for the A of ``matmat`` ((n, k) -> A of each
+        column, (n, k)): (W, A W), each (n, k), with W^T A W = I; None when none are kept."""
         if not self.vectors:
             return None
         W = np.column_stack(self.vectors)
-        AW = np.column_stack([matvec(w) for w in self.vectors])
+        AW = matmat(W)
         lam, Q = np.linalg.eigh(0.5 * (W.T @ AW + AW.T @ W))
         keep = lam > DEPENDENT * lam.max()
         scale = Q[:, keep] / np.sqrt(lam[keep])

@@ -584,7 +584,7 @@ class Fatigue(Strict):
     adaptive: bool = False
     no_damage_sets: list[str] = []
     tip: FatigueTip = FatigueTip()
-    solver: Literal["auto", "direct", "cg"] = "auto"
+    solver: Literal["auto", "amg", "direct", "cg"] = "auto"
     modal_after: FatigueModal | None = None
     paris: ParisSpecimen | None = None
 
