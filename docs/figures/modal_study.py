@@ -3,11 +3,16 @@
     PYTHONPATH=src python docs/figures/modal_study.py run SPACING HORIZON CORRECTION
     PYTHONPATH=src python docs/figures/modal_study.py plot
     PYTHONPATH=src python docs/figures/modal_study.py table
+    PYTHONPATH=src python docs/figures/modal_study.py runs
+    PYTHONPATH=src python docs/figures/modal_study.py lattice
 
 ``run`` solves the free PMMA plate of VALIDATION.md V4 (LPS, no partial volumes) and
 appends its six elastic frequencies, by type, to docs/figures/modal_study.json; ``plot``
 draws docs/figures/modal_study_*.png from that file and ``table`` prints its Markdown table
-(frequency in Hz and its deviation from FE in %, by type).
+(frequency in Hz and its deviation from FE in %, by type; then the deviations from the
+thesis's Table 5.1 row of the same points and horizon, where it has one); ``runs`` prints each
+run's time, peak memory and largest eigen-residual; ``lattice`` the long-wave stiffness of an
+interior point (Bloch cell) against the continuum for each horizon.
 """
 
 from __future__ import annotations
@@ -105,8 +110,9 @@ def plot() -> None:
 
 
 def table() -> str:
-    lines = ["| points | horizon | correction | " + " | ".join(LABELS) + " | max abs dev |",
-             "|---|---|---|" + "---|" * (len(LABELS) + 1)]
+    lines = ["| points | horizon | correction | " + " | ".join(LABELS)
+             + " | max abs dev | vs Table 5.1 |",
+             "|---|---|---|" + "---|" * (len(LABELS) + 2)]
     records = sorted(json.loads(RESULTS.read_text()),
                      key=lambda r: (r["points"], r["horizon"], r["correction"]))
     for r in records:
@@ -115,8 +121,47 @@ def table() -> str:
         cells = [f"{f:.1f} ({d:+.2f})" if f else "-" for f, d in zip(r["frequencies"], devs,
                                                                     strict=True)]
         worst = max(abs(d) for d in devs if d is not None)
+        thesis = THESIS.get((r["points"], r["horizon"]))
+        vs_thesis = "-" if thesis is None else ", ".join(
+            f"{100 * (f / t - 1):+.1f}" for f, t in zip(r["frequencies"], thesis, strict=True))
         lines.append(f"| {r['points']} | {r['horizon']:g} h | {r['correction']} | "
-                     + " | ".join(cells) + f" | {worst:.2f} % |")
+                     + " | ".join(cells) + f" | {worst:.2f} % | {vs_thesis} |")
+    return "\n".join(lines)
+
+
+def runs() -> str:
+    """Markdown table of each run's time, peak memory and largest eigen-residual."""
+    lines = ["| points | horizon | correction | time (s) | peak memory (GB) | max eigen-residual |",
+             "|---|---|---|---|---|---|"]
+    for r in sorted(json.loads(RESULTS.read_text()),
+                    key=lambda r: (r["points"], r["horizon"], r["correction"])):
+        lines.append(f"| {r['points']} | {r['horizon']:g} h | {r['correction']} | "
+                     f"{r['seconds']:.0f} | {r['peak_memory_gb']:.2f} | {r['max_residual']:.1e} |")
+    return "\n".join(lines)
+
+
+def lattice() -> str:
+    """Long-wave stiffness of an interior point against the continuum, in %, from the Bloch
+    cell of this plate's material at each horizon: shear modulus from cS^2 and P-wave modulus
+    M = K + 4 mu / 3 from cL^2, along [100] and [111]."""
+    from peridyn.analysis.bloch import Discretisation, bloch_cell
+
+    young, nu, rho = 5.35e9, 0.33, 1200.0
+    mu = young / (2 * (1 + nu))
+    p_modulus = young * (1 - nu) / ((1 + nu) * (1 - 2 * nu))
+    lines = ["| horizon | correction | mu [100] | mu [111] | M [100] | M [111] |",
+             "|---|---|---|---|---|---|"]
+    for horizon in (1.4143, 2.001, 3.001, 4.001):
+        for correction in ("none", "shear-factor"):
+            cell = bloch_cell(Discretisation(spacing=1e-3, horizon=horizon * 1e-3, model="lps",
+                                             E=young, nu=nu, density=rho, partial_volumes=False,
+                                             surface_correction=correction))
+            cells = []
+            for direction in ((1, 0, 0), (1, 1, 1)):
+                c_s, _, c_l = cell.long_wave_speeds(direction)
+                cells.append((100 * (rho * c_s**2 / mu - 1), 100 * (rho * c_l**2 / p_modulus - 1)))
+            lines.append(f"| {horizon:g} h | {correction} | {cells[0][0]:+.1f} % | {cells[1][0]:+.1f} % | "
+                         f"{cells[0][1]:+.1f} % | {cells[1][1]:+.1f} % |")
     return "\n".join(lines)
 
 
@@ -125,5 +170,9 @@ if __name__ == "__main__":
         print(json.dumps(run(float(sys.argv[2]), float(sys.argv[3]), sys.argv[4])))
     elif sys.argv[1] == "table":
         print(table())
+    elif sys.argv[1] == "runs":
+        print(runs())
+    elif sys.argv[1] == "lattice":
+        print(lattice())
     else:
         plot()
