@@ -134,7 +134,7 @@ class BlockVCycle:
 
         self.A, self.diag_inv, self.P, self.R = [], [], [], []
         blocks = [sp.bsr_matrix(level.A).blocksize[0] for level in hierarchy.levels]
-        for level, fine, coarse in zip(hierarchy.levels[:-1], blocks[:-1], blocks[1:]):
+        for level, fine, coarse in zip(hierarchy.levels[:-1], blocks[:-1], blocks[1:], strict=True):
             a = sp.bsr_matrix(level.A)
             self.A.append(_BSR(a))
             self.diag_inv.append(np.ascontiguousarray(

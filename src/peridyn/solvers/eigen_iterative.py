@@ -110,9 +110,10 @@ def proxy_aggregates(model: Model, dofs: np.ndarray) -> sp.csr_matrix:
     """First-level aggregates of the preconditioner: (len(dofs), n_aggregates) 0/1 matrix.
 
     Points are aggregated (pyamg's standard aggregation) on the graph joining points up to
-    two short bonds apart, so an aggregate is a point with its neighbours' neighbours (about
-    60 points inside a grid) and all dofs of a point share its aggregate: the coarse level
-    has a tenth of the unknowns of a one-bond aggregation and is sparser than the fine one.
+    two short bonds apart, so an aggregate is a point with its neighbours' neighbours (93
+    points on average for the 40 000-point plate) and all dofs of a point share its
+    aggregate: the coarse level has a ninth of the unknowns of pyamg's aggregation of the
+    dofs and is sparser than the fine one (operator complexity 1.04 instead of 6.2 there).
     Cut bonds are not in the graph: an aggregate does not reach across a crack.
     """
     from pyamg.aggregation import standard_aggregation
