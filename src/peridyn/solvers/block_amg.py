@@ -143,6 +143,7 @@ class BlockVCycle:
             self.R.append(_BSR(level.R, (coarse, fine)))
         self.coarse = _CoarseSolver(hierarchy.levels[-1].A.toarray())
         self.shape = hierarchy.levels[0].A.shape
+        self.rows = blocks[0]
         self.groups = numba.get_num_threads()
 
     def __call__(self, v: np.ndarray) -> np.ndarray:
@@ -153,26 +154,21 @@ class BlockVCycle:
         kg = -(-k // groups)
         padded = np.zeros((len(v), groups * kg))
         padded[:, :k] = block
-        rows = self.A[0].blocksize[0]
-        b = np.ascontiguousarray(padded.reshape(-1, rows, groups, kg).transpose(2, 0, 1, 3))
+        b = np.ascontiguousarray(padded.reshape(-1, self.rows, groups, kg).transpose(2, 0, 1, 3))
         x = self._cycle(0, b)
         out = x.transpose(1, 2, 0, 3).reshape(len(v), groups * kg)[:, :k]
         return np.ascontiguousarray(out).reshape(v.shape)
 
     def _cycle(self, level, b):
         """V-cycle from zero on ``level`` for the right-hand sides ``b`` (groups, n_blocks, R, kg)."""
+        if level == len(self.A):
+            groups, kg = b.shape[0], b.shape[3]
+            x = self.coarse(b.transpose(1, 2, 0, 3).reshape(-1, groups * kg))
+            return np.ascontiguousarray(x.reshape(-1, b.shape[2], groups, kg).transpose(2, 0, 1, 3))
         A = self.A[level]
         x = np.zeros_like(b)
         symmetric_block_gauss_seidel(A.indptr, A.indices, A.data, self.diag_inv[level], x, b)
         residual = b - A @ x
-        coarse_b = self.R[level] @ residual
-        if level == len(self.A) - 1:
-            groups, kg = coarse_b.shape[0], coarse_b.shape[3]
-            flat = coarse_b.transpose(1, 2, 0, 3).reshape(-1, groups * kg)
-            coarse_x = self.coarse(flat).reshape(-1, coarse_b.shape[2], groups, kg)
-            coarse_x = np.ascontiguousarray(coarse_x.transpose(2, 0, 1, 3))
-        else:
-            coarse_x = self._cycle(level + 1, coarse_b)
-        x += self.P[level] @ coarse_x
+        x += self.P[level] @ self._cycle(level + 1, self.R[level] @ residual)
         symmetric_block_gauss_seidel(A.indptr, A.indices, A.data, self.diag_inv[level], x, b)
         return x
