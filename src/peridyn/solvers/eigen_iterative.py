@@ -9,7 +9,9 @@ is factorised:
   that the fixed dofs allow) and are kept out of the search space by M-orthogonality
   (``Y`` of ``scipy.sparse.linalg.lobpcg``, Knyazev 2001);
 - the preconditioner is one V-cycle of smoothed-aggregation AMG (pyamg; Vanek, Mandel
-  and Brezina 1996) with the rigid modes as near-null space, built on a sparse proxy:
+  and Brezina 1996), applied to the whole block at once (``solvers.block_amg``), with the
+  rigid modes as near-null space and points aggregated with their neighbours up to two
+  short bonds away (``proxy_aggregates``), built on a sparse proxy:
   the pair stiffness of the body's bonds no longer than ``PROXY_REACH`` spacings. This
   proxy is spectrally equivalent to K (both are elasticity operators on the same points
   and bonds, and the LPS dilatation energy is bounded by its bond energy by
