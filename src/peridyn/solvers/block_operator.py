@@ -80,13 +80,17 @@ def block_bond_force(x, e, offsets, nbr, length, axial, extension_coef, intact, 
     return f
 
 
-def block_linear_force(model: Model, u: np.ndarray) -> np.ndarray:
-    """Linearised force density (n_points, 3, k), N/m^3, of the k fields ``u`` (n_points, 3, k)."""
+def block_linear_force(model: Model, u: np.ndarray, extension: np.ndarray | None = None) -> np.ndarray:
+    """Linearised force density (n_points, 3, k), N/m^3, of the k fields ``u`` (n_points, 3, k).
+
+    ``extension``: optional (n_bonds, k) float64 work array, reused between calls (a fresh
+    one of a few hundred MB per call costs its page faults every time)."""
     b = model.bonds
     x = model.body.points
     u = np.ascontiguousarray(u, dtype=np.float64)
-    e = block_extension(x, u, b.offsets, b.neighbours, b.length, b.intact,
-                        np.empty((b.n_bonds, u.shape[2])))
+    if extension is None or extension.shape != (b.n_bonds, u.shape[2]):
+        extension = np.empty((b.n_bonds, u.shape[2]))
+    e = block_extension(x, u, b.offsets, b.neighbours, b.length, b.intact, extension)
     f = np.empty_like(u)
     if isinstance(model, PMBModel):
         no_dilatation = np.zeros((len(x), u.shape[2]))
@@ -107,13 +111,18 @@ def block_stiffness_operator(model: Model, dofs: np.ndarray) -> LinearOperator:
     n = model.body.n_points
     vol = model.body.volumes
     size = len(dofs)
+    work = [np.empty(0)]  # flat extension buffer, kept between calls, grown to the widest block
 
     def matmat(v):
         v = np.asarray(v, dtype=np.float64)
         block = v.reshape(size, -1)
         full = np.zeros((3 * n, block.shape[1]))
         full[dofs] = block
-        f = block_linear_force(model, full.reshape(n, 3, -1))
+        wanted = model.bonds.n_bonds * block.shape[1]
+        if len(work[0]) < wanted:
+            work[0] = np.empty(wanted)
+        extension = work[0][:wanted].reshape(model.bonds.n_bonds, -1)
+        f = block_linear_force(model, full.reshape(n, 3, -1), extension)
         out = (-vol[:, None, None] * f).reshape(3 * n, -1)[dofs]
         return out.reshape(v.shape)
 
