@@ -10,7 +10,8 @@ without sharing a cache line.
 The cycle is pyamg's V-cycle (``pyamg.MultilevelSolver``) for the hierarchy that
 ``smoothed_aggregation_hierarchy`` builds: one symmetric block Gauss-Seidel sweep before
 and after the coarse correction on every level (block = the BSR block of that level),
-restriction R = P^T, pseudo-inverse on the coarsest level. Pre- and post-smoother are
+restriction R = P^T, and pyamg's pseudo-inverse on the coarsest level, here a Cholesky solve
+on its non-zero rows (``_CoarseSolver``). Pre- and post-smoother are
 each other's adjoints and R = P^T, so the cycle is a symmetric positive definite
 operator when the matrix is (Vassilevski 2008, Multilevel Block Factorization
 Preconditioners, ch. 5).
