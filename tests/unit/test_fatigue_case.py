@@ -21,6 +21,7 @@ CASE = Path(__file__).resolve().parents[2] / "cases" / "dogbone_fatigue.yaml"
     ("fatigue.mapping=[]", "fatigue.mapping"),
     ("fatigue.mapping.0.tau=-1e-5", "fatigue.mapping[0].tau"),
     ("fatigue.tip.depth_axis=y", "tip.axis and tip.depth_axis must differ"),
+    ("fatigue.tip.sense=down", "fatigue.tip.sense"),
 ])
 def test_bad_fatigue_values_name_their_key(override, message):
     with pytest.raises(CaseFileError, match=message.replace("[", r"\[").replace("]", r"\]")):
@@ -45,3 +46,11 @@ def test_unknown_no_damage_set_is_refused():
     case = load_case(CASE, ["fatigue.no_damage_sets=[left_edn]"])
     with pytest.raises(CaseFileError, match="fatigue.no_damage_sets.*did you mean"):
         check_fatigue_case(case)
+
+
+def test_paris_fit_refuses_a_crack_measured_from_inside_the_body():
+    """The Paris fit's K (eqs. 7.12-7.13, or the specimen's compliance) takes the crack length
+    from the specimen's edge: a tip rule measuring from an interior start is refused by name."""
+    sen = CASE.parent / "sen_fatigue_2d.yaml"
+    with pytest.raises(CaseFileError, match="leave tip.start and tip.sense at their defaults"):
+        load_case(sen, ["fatigue.tip.start=0.01"])

@@ -90,6 +90,21 @@ def test_crack_tip_needs_damage_through_the_whole_depth():
     assert crack_tip(body.points, phi, SPACING) == pytest.approx(0.0035, abs=1e-12)
 
 
+def test_crack_tip_from_a_notch_root_inside_the_body_growing_towards_minus_x():
+    """A crack that starts at a notch root inside the body (x = 8 mm) and grows towards -x has
+    the length from the root to its farthest column cracked through the depth; columns on the
+    other side of the root (the notch's own damaged rim) do not count; without a start the
+    length runs from the edge the crack grows from (the high edge, 10 mm)."""
+    body = geometry.box((0.010, 0.004, 0.003), SPACING)
+    x, y, z = body.points.T
+    phi = np.where((x > 0.005) & (y < 0.001), 0.5, 0.0)  # columns at x = 5.5 ... 9.5 mm
+    assert crack_tip(body.points, phi, SPACING, start=0.008, sense="-") == pytest.approx(0.0025, abs=1e-12)
+    assert crack_tip(body.points, phi, SPACING, sense="-") == pytest.approx(0.0045, abs=1e-12)
+    assert crack_tip(body.points, np.where(x > 0.008, 0.5, 0.0), SPACING, start=0.008, sense="-") == 0.0
+    with pytest.raises(InputError, match="sense must be"):
+        crack_tip(body.points, phi, SPACING, sense="down")
+
+
 @pytest.mark.parametrize("kwargs, message", [
     ({"A_I": -1.0}, "A_I must be positive"),
     ({"m_II": 0.0}, "m_II must be positive"),

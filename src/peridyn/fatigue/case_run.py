@@ -128,7 +128,7 @@ def run_fatigue_case(case: Case, output_dir=None, base_dir=".", modal: bool | No
     result = run_fatigue(setup.model, setup.loading, fatigue_parameters(case, setup.bonds.horizon),
                          mapping, f.load_ratio, f.max_load_time, f.no_damage_sets, f.tip.axis,
                          f.tip.depth_axis, f.tip.damage, f.solver, progress,
-                         _stop_length(f))
+                         _stop_length(f), f.tip.start, f.tip.sense)
     if progress is not None:
         progress.close()
     summary = {"cycles": float(result.cycles[-1]), "crack_length_m": float(result.crack_length[-1]),

@@ -57,7 +57,8 @@ def breakable_bonds(model: Model, no_damage_sets=()) -> np.ndarray:
 def run_fatigue(model: Model, loading: Loading, params: FatigueParameters, mapping: CycleMapping,
                 load_ratio: float = 0.0, max_load_time: float = 1.0, no_damage_sets=(),
                 tip_axis: str = "x", depth_axis: str = "z", tip_damage: float = TIP_DAMAGE,
-                solver: str = "auto", progress=None, stop_length: float = np.inf) -> FatigueResult:
+                solver: str = "auto", progress=None, stop_length: float = np.inf,
+                tip_start: float | None = None, tip_sense: str = "+") -> FatigueResult:
     """Run the fatigue loop on ``model`` (its ``bonds.intact`` is updated in place).
 
     Parameters
@@ -66,6 +67,8 @@ def run_fatigue(model: Model, loading: Loading, params: FatigueParameters, mappi
     load_ratio : R = min load / max load, in [-1, 1)
     progress : object with update(n) (e.g. a tqdm bar) or None
     stop_length : m, the run ends after the step at which the crack length reaches it
+    tip_axis, depth_axis, tip_damage, tip_start, tip_sense : the crack-tip rule
+        (``fatigue.tip.crack_tip``: growth axis, depth axis, damage threshold, start, sense)
     """
     if not -1.0 <= load_ratio < 1.0:
         raise InputError(f"load ratio R must be in [-1, 1), got {load_ratio!r}")
@@ -77,7 +80,10 @@ def run_fatigue(model: Model, loading: Loading, params: FatigueParameters, mappi
     first_break = np.full(model.body.n_points, np.inf)
     life.update_phase(damage_field(model))  # pre-cracks may start families in phase II
     cycles, lengths, broken = [0.0], [], [0]
-    lengths.append(crack_tip(points, damage_field(model), spacing, tip_axis, depth_axis, tip_damage))
+    def crack_length(phi):
+        return crack_tip(points, phi, spacing, tip_axis, depth_axis, tip_damage, tip_start, tip_sense)
+
+    lengths.append(crack_length(damage_field(model)))
     n_cycles = 0.0
     u = None
     changed = True
@@ -98,7 +104,7 @@ def run_fatigue(model: Model, loading: Loading, params: FatigueParameters, mappi
         phi = damage_field(model)
         life.update_phase(phi)
         cycles.append(n_cycles)
-        lengths.append(crack_tip(points, phi, spacing, tip_axis, depth_axis, tip_damage))
+        lengths.append(crack_length(phi))
         broken.append(int((~model.bonds.intact).sum()) // 2 - n_broken0)
         if progress is not None:
             progress.update(1)

@@ -527,12 +527,16 @@ class FatigueBlock(Strict):
 
 
 class FatigueTip(Strict):
-    """Crack tip: largest coordinate along ``axis`` whose points through ``depth_axis`` all have
-    damage >= ``damage`` (thesis: 0.385); crack length measured from the low edge of ``axis``."""
+    """Crack tip: farthest coordinate along ``axis``, in the ``sense`` the crack grows ("+" or
+    "-"), whose points through ``depth_axis`` all have damage >= ``damage`` (thesis: 0.385);
+    crack length measured from ``start`` (m, e.g. a notch root), by default from the body's edge
+    the crack grows from (``fatigue.tip.crack_tip``)."""
 
     axis: Literal["x", "y", "z"] = "x"
     depth_axis: Literal["x", "y", "z"] = "z"
     damage: Annotated[float, Field(gt=0, le=1)] = 0.385
+    start: float | None = None
+    sense: Literal["+", "-"] = "+"
 
 
 class FatigueModal(Strict):
@@ -592,6 +596,9 @@ class Fatigue(Strict):
     def _axes(self):
         if self.tip.axis == self.tip.depth_axis:
             raise ValueError("tip.axis and tip.depth_axis must differ")
+        if self.paris is not None and (self.tip.start is not None or self.tip.sense != "+"):
+            raise ValueError("fatigue.paris measures the crack from the low edge of tip.axis (a "
+                             "single edge notch): leave tip.start and tip.sense at their defaults")
         return self
 
 
