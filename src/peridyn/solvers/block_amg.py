@@ -45,23 +45,28 @@ def smoothed_aggregation_hierarchy(a: sp.bsr_matrix, near_null: np.ndarray, firs
                                              max_coarse=max_coarse)
 
 
+@numba.njit(cache=True)
+def _add_row_product(indptr, indices, data, x, i, scale, acc):
+    """``acc`` (R, kg) += scale * (A x)_i for block row ``i`` of A (BSR arrays, ``data``
+    (nnz_blocks, R, C)) and one group's ``x`` (n_block_cols, C, kg)."""
+    rows, cols, kg = data.shape[1], data.shape[2], x.shape[2]
+    for p in range(indptr[i], indptr[i + 1]):
+        j = indices[p]
+        for a in range(rows):
+            for c in range(cols):
+                v = scale * data[p, a, c]
+                for q in range(kg):
+                    acc[a, q] += v * x[j, c, q]
+
+
 @numba.njit(parallel=True, cache=True)
 def bsr_matmat(indptr, indices, data, x, out):
     """``out`` (OUT, (groups, n_block_rows, R, kg)) = A x for each group; ``x`` (groups,
     n_block_cols, C, kg); A in BSR form: ``data`` (nnz_blocks, R, C)."""
-    groups, n_rows, rows, cols, kg = x.shape[0], out.shape[1], data.shape[1], data.shape[2], x.shape[3]
-    for g in numba.prange(groups):
-        for i in range(n_rows):
-            for a in range(rows):
-                for q in range(kg):
-                    out[g, i, a, q] = 0.0
-            for p in range(indptr[i], indptr[i + 1]):
-                j = indices[p]
-                for a in range(rows):
-                    for c in range(cols):
-                        v = data[p, a, c]
-                        for q in range(kg):
-                            out[g, i, a, q] += v * x[g, j, c, q]
+    for g in numba.prange(x.shape[0]):
+        for i in range(out.shape[1]):
+            out[g, i] = 0.0
+            _add_row_product(indptr, indices, data, x[g], i, 1.0, out[g, i])
     return out
 
 
@@ -74,16 +79,8 @@ def symmetric_block_gauss_seidel(indptr, indices, data, diag_inv, x, b):
         r = np.empty((rows, kg), dtype=x.dtype)
         for t in range(2 * n):
             i = t if t < n else 2 * n - 1 - t
-            for a in range(rows):
-                for q in range(kg):
-                    r[a, q] = b[g, i, a, q]
-            for p in range(indptr[i], indptr[i + 1]):
-                j = indices[p]
-                for a in range(rows):
-                    for c in range(rows):
-                        v = data[p, a, c]
-                        for q in range(kg):
-                            r[a, q] -= v * x[g, j, c, q]
+            r[:, :] = b[g, i]
+            _add_row_product(indptr, indices, data, x[g], i, -1.0, r)
             for a in range(rows):
                 for c in range(rows):
                     v = diag_inv[i, a, c]
