@@ -1,6 +1,6 @@
 """Explicit-step throughput with bond breaking and contact against the undamaged step.
 
-Same grid as ``peridyn bench`` (``peridyn.benchmark``: cube of 46^3 points, 1 mm, horizon
+Same grid as ``peridyn bench`` (``peridyn.jobs.bench``: cube of 46^3 points, 1 mm, horizon
 3.015 h, no partial volumes), PMB float64. All rows start from the same random
 velocity field (``--velocity``, default 1 m/s rms: strains just below the critical
 stretch, few or no bonds break; 2 m/s: bonds break here and there all through the cube).
@@ -25,13 +25,13 @@ from dataclasses import replace
 
 import numpy as np
 
-from peridyn import geometry
-from peridyn.benchmark import DEFAULT_POINTS_PER_SIDE, DENSITY, HORIZON_FACTOR, SPACING, E
-from peridyn.bonds import find_bonds
-from peridyn.contact import Contact
-from peridyn.damage import BondDamage
-from peridyn.loads import Loading
-from peridyn.materials import make_model
+from peridyn.discretization import geometry
+from peridyn.jobs.bench import DEFAULT_POINTS_PER_SIDE, DENSITY, HORIZON_FACTOR, SPACING, E
+from peridyn.discretization.bonds import find_bonds
+from peridyn.physics.contact import Contact
+from peridyn.physics.damage import BondDamage
+from peridyn.physics.loads import Loading
+from peridyn.physics.materials import make_model
 from peridyn.solvers import ExplicitSolver
 
 

@@ -1,6 +1,6 @@
 """Force-kernel throughput benchmark; writes ``bench_kernels.json`` next to this script.
 
-Same measurement as ``peridyn bench`` (``peridyn.benchmark``), plus the machine, the
+Same measurement as ``peridyn bench`` (``peridyn.jobs.bench``), plus the machine, the
 command line and the UTC date in the JSON, for ``RESULTS.md``::
 
     python benchmarks/bench_kernels.py                      # 46^3 grid, no partial volumes
@@ -20,7 +20,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-from peridyn.benchmark import DEFAULT_POINTS, format_table, run_benchmark
+from peridyn.jobs.bench import DEFAULT_POINTS, format_table, run_benchmark
 
 HERE = Path(__file__).resolve().parent
 

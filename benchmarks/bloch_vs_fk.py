@@ -40,8 +40,8 @@ from peridyn.analysis.fk import fk_transform, line_mode_wavenumbers, phase_waven
 from peridyn.analysis.lamb import lamb_modes
 from peridyn.io.case import load_case
 from peridyn.io.hdf5 import read_array, read_series
-from peridyn.postprocess import centre_frequency
-from peridyn.timefunctions import from_spec
+from peridyn.jobs.lamb_analysis import centre_frequency
+from peridyn.physics.timefunctions import from_spec
 
 #: Per mode: Bloch family, Hankel order of the f-k pick's record (u_x, u_z) and of the phase
 #: fit's record (divergence, u_z).

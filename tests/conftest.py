@@ -3,9 +3,9 @@
 import numpy as np
 import pytest
 
-from peridyn import geometry
-from peridyn.bonds import find_bonds
-from peridyn.materials import make_model
+from peridyn.discretization import geometry
+from peridyn.discretization.bonds import find_bonds
+from peridyn.physics.materials import make_model
 
 #: Maraging steel of seed 001 / VALIDATION V3: rho = 8000, mu = 81.92 GPa, K = 132.77 GPa.
 STEEL_K, STEEL_MU, STEEL_RHO = 132.77e9, 81.92e9, 8000.0

@@ -25,10 +25,10 @@ from pathlib import Path
 
 import numpy as np
 
-from peridyn import geometry
-from peridyn.bonds import find_bonds
-from peridyn.materials import LPSModel
-from peridyn.modal_run import modal_table
+from peridyn.discretization import geometry
+from peridyn.discretization.bonds import find_bonds
+from peridyn.physics.materials import LPSModel
+from peridyn.jobs.modal import modal_table
 
 #: 6 rigid + 8 elastic: the 1st in-plane bending can come 7th on coarse grids
 N_MODES = 14

@@ -153,9 +153,9 @@ def test_lps_refuses_a_point_whose_bonds_are_all_broken():
     theta = (d / m) sum w |xi| e (Silling et al. 2007): the LPS model must refuse it by name."""
     from conftest import small_body
 
-    from peridyn.bonds import find_bonds
+    from peridyn.discretization.bonds import find_bonds
     from peridyn.errors import InputError
-    from peridyn.materials import LPSModel
+    from peridyn.physics.materials import LPSModel
 
     body = small_body(3, "stress", 6)
     bonds = find_bonds(body, 1.5 * body.spacing, partial_volumes=False)

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from conftest import MODEL_CASES, small_model
 
-from peridyn.stiffness import assemble_stiffness, linear_force, mass_matrix, stiffness_operator
+from peridyn.linalg.stiffness import assemble_stiffness, linear_force, mass_matrix, stiffness_operator
 
 
 def _setup(case, rng, amplitude=1e-9):
@@ -79,7 +79,7 @@ def test_split_stiffness_and_augmented_solve_equal_the_assembled_matrix(case, rn
     """K = P + G^T D G exactly, and the augmented factorisation solves (K + s M) x = b
     (block elimination of y = D G x; see solvers.modal) to round-off."""
     from peridyn.solvers.modal import free_dofs, shifted_inverse
-    from peridyn.stiffness import stiffness_parts
+    from peridyn.linalg.stiffness import stiffness_parts
 
     model, _ = _setup(case, rng)
     parts = stiffness_parts(model)

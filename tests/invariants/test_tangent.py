@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 from conftest import MODEL_CASES, small_model
 
-from peridyn.stiffness import assemble_stiffness
-from peridyn.tangent import tangent_stiffness
+from peridyn.linalg.stiffness import assemble_stiffness
+from peridyn.linalg.tangent import tangent_stiffness
 
 
 def _deformed(model, rng):

@@ -15,13 +15,13 @@ criterion (60 here; measured ratio 0.948).
 import numpy as np
 import pytest
 
-from peridyn import geometry
-from peridyn.bonds import crossing_segment, cut_bonds, find_bonds
-from peridyn.contact import Contact
-from peridyn.loads import BoundaryCondition, Loading
-from peridyn.materials import make_model
+from peridyn.discretization import geometry
+from peridyn.discretization.bonds import crossing_segment, cut_bonds, find_bonds
+from peridyn.physics.contact import Contact
+from peridyn.physics.loads import BoundaryCondition, Loading
+from peridyn.physics.materials import make_model
 from peridyn.solvers import relax
-from peridyn.timefunctions import Constant
+from peridyn.physics.timefunctions import Constant
 
 H = 1e-3
 LENGTH = 60 * H

@@ -5,10 +5,10 @@ import pytest
 from conftest import STEEL_E, STEEL_NU, STEEL_RHO
 from scipy.sparse.linalg import LinearOperator, eigsh
 
-from peridyn import geometry
-from peridyn.bonds import find_bonds
-from peridyn.loads import InitialCondition, Loading
-from peridyn.materials import make_model
+from peridyn.discretization import geometry
+from peridyn.discretization.bonds import find_bonds
+from peridyn.physics.loads import InitialCondition, Loading
+from peridyn.physics.materials import make_model
 from peridyn.solvers import ExplicitSolver
 
 

@@ -4,7 +4,7 @@ output") and the fracture plots."""
 import pytest
 
 from peridyn.io.case import validate_case
-from peridyn.simulation import run_case
+from peridyn.jobs.run import run_case
 
 H = 0.5e-3
 

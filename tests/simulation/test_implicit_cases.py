@@ -8,7 +8,7 @@ import pytest
 from peridyn.errors import CaseFileError
 from peridyn.io.case import validate_case
 from peridyn.io.hdf5 import read_array, read_series
-from peridyn.simulation import run_case
+from peridyn.jobs.run import run_case
 
 BAR = {
     "name": "bar",

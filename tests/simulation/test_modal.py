@@ -3,10 +3,10 @@
 import numpy as np
 import pytest
 
-from peridyn import geometry
+from peridyn.discretization import geometry
 from peridyn.analysis.modes import classify_modes, mac_matrix
-from peridyn.bonds import find_bonds
-from peridyn.materials import make_model
+from peridyn.discretization.bonds import find_bonds
+from peridyn.physics.materials import make_model
 from peridyn.solvers.modal import modal_analysis
 
 #: PMMA plate of VALIDATION.md V4.
@@ -79,7 +79,7 @@ def test_edge_crack_lowers_most_the_mode_whose_bending_stress_it_cuts(coarse):
     in-plane bending mode falls most (here 26 %, the others 1-7 %) and drops below the 1st
     transverse bending mode: the classifier must follow the swap, which the MAC with the
     healthy modes confirms."""
-    from peridyn.bonds import crossing_rectangle, cut_bonds
+    from peridyn.discretization.bonds import crossing_rectangle, cut_bonds
 
     healthy_model, healthy = coarse
     model = _plate_model(2e-3)
@@ -108,7 +108,7 @@ def test_too_large_factorisation_is_refused_with_its_size(monkeypatch):
     import os
 
     from peridyn.errors import InputError
-    from peridyn.modal_run import check_assembly_fits
+    from peridyn.jobs.modal import check_assembly_fits
 
     model = _plate_model(2e-3)
     pages = {"SC_PAGE_SIZE": 4096, "SC_PHYS_PAGES": 64 * 2**20 // 4096}
@@ -121,8 +121,8 @@ def test_factor_size_estimate_matches_the_sparse_lu():
     """The nested-dissection estimate (solvers.ordering) against SuperLU's L + U entries for
     the LPS plate at 2 mm: within a factor 1.5 either way (its stated accuracy: 1.4)."""
     from peridyn.solvers.modal import factorise_shifted, free_dofs
-    from peridyn.solvers.ordering import estimated_factor_entries
-    from peridyn.stiffness import stiffness_parts
+    from peridyn.linalg.ordering import estimated_factor_entries
+    from peridyn.linalg.stiffness import stiffness_parts
 
     model = _plate_model(2e-3)
     dofs = free_dofs(model)

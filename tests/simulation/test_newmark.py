@@ -3,16 +3,16 @@
 import numpy as np
 import pytest
 
-from peridyn import geometry
-from peridyn.bonds import find_bonds
-from peridyn.damage import BondDamage
+from peridyn.discretization import geometry
+from peridyn.discretization.bonds import find_bonds
+from peridyn.physics.damage import BondDamage
 from peridyn.errors import InputError
-from peridyn.loads import BoundaryCondition, InitialCondition, Loading
-from peridyn.materials import make_model
+from peridyn.physics.loads import BoundaryCondition, InitialCondition, Loading
+from peridyn.physics.materials import make_model
 from peridyn.solvers import ExplicitSolver
 from peridyn.solvers.newmark import NewmarkSolver
-from peridyn.tangent import tangent_stiffness
-from peridyn.timefunctions import Ramp, ToneBurst
+from peridyn.linalg.tangent import tangent_stiffness
+from peridyn.physics.timefunctions import Ramp, ToneBurst
 
 
 def _strip():

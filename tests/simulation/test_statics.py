@@ -4,13 +4,13 @@ import numpy as np
 import pytest
 from conftest import STEEL_K, STEEL_MU
 
-from peridyn import geometry
-from peridyn.bonds import find_bonds
-from peridyn.loads import BoundaryCondition, Loading
-from peridyn.materials import make_model
-from peridyn.materials.elastic import bulk_modulus, shear_modulus
+from peridyn.discretization import geometry
+from peridyn.discretization.bonds import find_bonds
+from peridyn.physics.loads import BoundaryCondition, Loading
+from peridyn.physics.materials import make_model
+from peridyn.physics.materials.elastic import bulk_modulus, shear_modulus
 from peridyn.solvers import relax
-from peridyn.timefunctions import Constant
+from peridyn.physics.timefunctions import Constant
 
 E_AL, RHO_AL = 70e9, 2700.0
 

@@ -115,9 +115,9 @@ def test_torsional_modes_turn_and_get_no_fit(study):
 
 
 def test_runs_that_would_not_fit_in_memory_are_skipped_and_reported(tmp_path, monkeypatch, capsys):
-    import peridyn.modal_run
+    import peridyn.jobs.modal
 
-    monkeypatch.setattr(peridyn.modal_run, "MEMORY_SHARE", 1e-12)  # nothing fits
+    monkeypatch.setattr(peridyn.jobs.modal, "MEMORY_SHARE", 1e-12)  # nothing fits
     status = main(["study", CASE, "--spacing", "4e-3", "--horizon", "1.4143,2.001", "--out",
                    str(tmp_path)])
     captured = capsys.readouterr()
@@ -156,7 +156,7 @@ def test_delta_m_limits_of_two_horizons_agree_for_first_bending():
     # grids, 1st bending extrapolates to 1940.2 Hz at 1.4143 h and 1933.1 Hz at 3.001 h
     # (0.4 %), against 9 % apart at 1.6 mm (1903.4 and 1744.0 Hz). Only the longest-wavelength
     # mode agrees this well on grids this coarse (2nd bending 1.7 %, transverse 5.5 %).
-    from peridyn.study_run import fit_series, run_grid
+    from peridyn.jobs.study import fit_series, run_grid
 
     runs = run_grid(CASE, SPACINGS, (1.4143, 3.001), overrides=[SIZE])
     fits = {f["group"]: f for f in fit_series(runs, finest=3) if f["mode"] == "1st bending"}

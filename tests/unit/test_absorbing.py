@@ -1,7 +1,7 @@
-"""Absorbing boundary layers (peridyn.absorbing) and the damped explicit step.
+"""Absorbing boundary layers (peridyn.physics.absorbing) and the damped explicit step.
 
 Sources: the cubic damping profile and its round-trip amplitude factor
-exp(-c_max w / (4 c_g)) (module docstring of ``peridyn.absorbing``; graded absorbing layers
+exp(-c_max w / (4 c_g)) (module docstring of ``peridyn.physics.absorbing``; graded absorbing layers
 after Rajagopal et al., NDT&E Int. 2012); the stability limit (w dt)^2 + 2 c dt < 4 of
 velocity Verlet with the damping force taken at the half-step velocity (spectral radius of
 its amplification matrix, ``solvers.explicit.damped_stable_step``).
@@ -11,14 +11,14 @@ import numpy as np
 import pytest
 from conftest import STEEL_E, STEEL_NU, STEEL_RHO
 
-from peridyn import geometry
-from peridyn.absorbing import layer_damping
-from peridyn.bonds import find_bonds
+from peridyn.discretization import geometry
+from peridyn.physics.absorbing import layer_damping
+from peridyn.discretization.bonds import find_bonds
 from peridyn.errors import InputError, InstabilityError
 from peridyn.io.case import load_case
-from peridyn.loads import InitialCondition, Loading
-from peridyn.materials import make_model
-from peridyn.simulation import build, explicit_damping
+from peridyn.physics.loads import InitialCondition, Loading
+from peridyn.physics.materials import make_model
+from peridyn.jobs.run import build, explicit_damping
 from peridyn.solvers import ExplicitSolver
 from peridyn.solvers.explicit import damped_stable_step
 

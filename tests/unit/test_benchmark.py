@@ -1,11 +1,11 @@
-"""The benchmark machinery (``peridyn.benchmark``, ``peridyn bench``) on a tiny grid: structure only."""
+"""The benchmark machinery (``peridyn.jobs.bench``, ``peridyn bench``) on a tiny grid: structure only."""
 
 import functools
 import json
 
 import pytest
 
-from peridyn import benchmark
+from peridyn.jobs import bench as benchmark
 from peridyn.cli import bench_cmd, main
 from peridyn.errors import InputError
 

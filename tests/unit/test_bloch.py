@@ -17,7 +17,7 @@ import scipy.sparse as sp
 from peridyn.analysis.bloch import Discretisation, bloch_cell, plate_basis, tiled_model
 from peridyn.analysis.bloch_study import format_study, predict, study
 from peridyn.cli import main
-from peridyn.stiffness import assemble_stiffness
+from peridyn.linalg.stiffness import assemble_stiffness
 
 # maraging steel of V3
 K_STEEL, MU_STEEL, RHO_STEEL = 132.77e9, 81.92e9, 8000.0

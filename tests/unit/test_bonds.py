@@ -5,8 +5,8 @@ import itertools
 import numpy as np
 import pytest
 
-from peridyn import geometry
-from peridyn.bonds import (
+from peridyn.discretization import geometry
+from peridyn.discretization.bonds import (
     cell_fraction_in_ball,
     crossing_rectangle,
     crossing_segment,
@@ -139,7 +139,7 @@ def test_segment_precrack_2d():
 
 def test_family_sums_gives_zero_for_an_empty_family():
     """An empty CSR family sums to 0 (np.add.reduceat would return the next family's first value)."""
-    from peridyn.bonds import family_sums
+    from peridyn.discretization.bonds import family_sums
 
     offsets = np.array([0, 2, 2, 5])
     sums = family_sums(offsets, np.array([1.0, 2.0, 3.0, 4.0, 5.0]))
@@ -151,7 +151,7 @@ def test_cut_bonds_cuts_both_copies_of_a_bond_ending_on_the_crack_edge():
     columns 11.5 and 12.5 mm) may be seen as crossed from one end only (round-off); a bond
     broken in one direction makes the LPS force and stiffness disagree, so cut_bonds breaks
     both directed copies (peridynamic bonds are pairs)."""
-    from peridyn.bonds import crossing_segment, cut_bonds
+    from peridyn.discretization.bonds import crossing_segment, cut_bonds
 
     body = geometry.rectangle(0.050, 0.008, 1e-3, 3e-3)
     bonds = find_bonds(body, 3.0005e-3, partial_volumes=False)

@@ -1,4 +1,4 @@
-"""Short-range contact forces (peridyn.contact): range, repulsion, Newton's third law,
+"""Short-range contact forces (peridyn.physics.contact): range, repulsion, Newton's third law,
 Verlet-list correctness and input checks. Model: Silling's short-range force as in Peridigm
 (Parks et al.), f_i = -c_sr (d_c - |Y|) / delta V_j Y / |Y| for |Y| < d_c."""
 
@@ -7,15 +7,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from peridyn import geometry
-from peridyn.bonds import crossing_segment, cut_bonds, find_bonds
-from peridyn.contact import Contact
+from peridyn.discretization import geometry
+from peridyn.discretization.bonds import crossing_segment, cut_bonds, find_bonds
+from peridyn.physics.contact import Contact
 from peridyn.errors import CaseFileError, InputError
 from peridyn.io.case import load_case
-from peridyn.loads import InitialCondition, Loading
-from peridyn.materials import make_model
-from peridyn.materials.pmb import pmb_micromodulus
-from peridyn.simulation import build
+from peridyn.physics.loads import InitialCondition, Loading
+from peridyn.physics.materials import make_model
+from peridyn.physics.materials.pmb import pmb_micromodulus
+from peridyn.jobs.run import build
 from peridyn.solvers import ExplicitSolver
 
 H = 1e-3

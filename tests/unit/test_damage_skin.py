@@ -1,4 +1,4 @@
-"""The stretch-test skin of ``BondDamage.update`` (peridyn.damage, module docstring).
+"""The stretch-test skin of ``BondDamage.update`` (peridyn.physics.damage, module docstring).
 
 Its contract is exactness: the bonds broken, and so every later displacement, are bit for
 bit those of testing every bond at every call (``FULL_TEST_SHARE = 0`` forces that). The
@@ -9,13 +9,13 @@ skin itself rests on one inequality: between two displacements a bond's deformed
 import numpy as np
 import pytest
 
-from peridyn import geometry
-from peridyn.bonds import crossing_rectangle, crossing_segment, cut_bonds, find_bonds
-from peridyn.damage import BondDamage
-from peridyn.loads import BoundaryCondition, Loading
-from peridyn.materials import make_model
+from peridyn.discretization import geometry
+from peridyn.discretization.bonds import crossing_rectangle, crossing_segment, cut_bonds, find_bonds
+from peridyn.physics.damage import BondDamage
+from peridyn.physics.loads import BoundaryCondition, Loading
+from peridyn.physics.materials import make_model
 from peridyn.solvers import ExplicitSolver
-from peridyn.timefunctions import Constant
+from peridyn.physics.timefunctions import Constant
 
 H = 0.5e-3
 

@@ -1,14 +1,14 @@
-"""Critical bond stress criterion (peridyn.damage): sigma_b = E s, so s_c = sigma_u / E."""
+"""Critical bond stress criterion (peridyn.physics.damage): sigma_b = E s, so s_c = sigma_u / E."""
 
 import numpy as np
 import pytest
 
-from peridyn import geometry
-from peridyn.bonds import find_bonds
-from peridyn.damage import BondDamage, stretch_from_bond_stress
+from peridyn.discretization import geometry
+from peridyn.discretization.bonds import find_bonds
+from peridyn.physics.damage import BondDamage, stretch_from_bond_stress
 from peridyn.errors import CaseFileError, InputError
 from peridyn.io.case import validate_case
-from peridyn.materials.pmb import PMBModel
+from peridyn.physics.materials.pmb import PMBModel
 
 
 def small_model():

@@ -3,13 +3,13 @@
 import numpy as np
 import pytest
 
-from peridyn import geometry
-from peridyn.bonds import find_bonds
+from peridyn.discretization import geometry
+from peridyn.discretization.bonds import find_bonds
 from peridyn.errors import InputError
 from peridyn.fatigue import CycleMapping, FatigueParameters, crack_tip, run_fatigue, scale_A_II
-from peridyn.loads import BoundaryCondition, Loading
-from peridyn.materials import make_model
-from peridyn.timefunctions import Constant
+from peridyn.physics.loads import BoundaryCondition, Loading
+from peridyn.physics.materials import make_model
+from peridyn.physics.timefunctions import Constant
 
 #: V5 steel parameters (VALIDATION.md V5, thesis table 7.1).
 V5 = FatigueParameters(A_I=426.0, m_I=2.77, eps_inf=0.00186, A_II=25237.48, m_II=4.0, phi_c=0.385)

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from peridyn.fatigue.calibration import stress_intensity
-from peridyn.fatigue.case_run import paris_rates, paris_slope
+from peridyn.jobs.fatigue import paris_rates, paris_slope
 from peridyn.fatigue.run import FatigueResult
 from peridyn.io.case import load_case
 

@@ -8,12 +8,12 @@ compare it with eq. 7.12.
 import numpy as np
 import pytest
 
-from peridyn.bonds import crossing_segment
+from peridyn.discretization.bonds import crossing_segment
 from peridyn.errors import InputError
 from peridyn.fatigue.calibration import stress_intensity
 from peridyn.fatigue.specimen import compliance_energy, compliance_stress_intensity
 from peridyn.io.case import parse_yaml, validate_case
-from peridyn.simulation import build
+from peridyn.jobs.run import build
 
 E, STRESS, T = 189.9e9, 50e6, 3e-3
 

@@ -12,15 +12,15 @@ import pytest
 import scipy.sparse as sp
 from scipy.sparse.linalg import spsolve
 
-from peridyn import geometry
-from peridyn.bonds import find_bonds
+from peridyn.discretization import geometry
+from peridyn.discretization.bonds import find_bonds
 from peridyn.errors import InputError
 from peridyn.fatigue.model import bond_strain
 from peridyn.fatigue.statics import SHIFT, LinearStatics
-from peridyn.loads import BoundaryCondition, Loading
-from peridyn.materials import make_model
-from peridyn.stiffness import assemble_stiffness
-from peridyn.timefunctions import Constant
+from peridyn.physics.loads import BoundaryCondition, Loading
+from peridyn.physics.materials import make_model
+from peridyn.linalg.stiffness import assemble_stiffness
+from peridyn.physics.timefunctions import Constant
 
 SPACING = 1e-3
 LENGTH, WIDTH, DEPTH = 0.016, 0.006, 0.003  # m: a small steel bar, 16 x 6 x 3 points

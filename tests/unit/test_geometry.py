@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from peridyn import geometry
-from peridyn.body import Body, in_cylinder
+from peridyn.discretization import geometry
+from peridyn.discretization.body import Body, in_cylinder
 from peridyn.errors import InputError
 
 

@@ -8,10 +8,10 @@ to 1e-6 relative, with every residual ||K x - lambda M x|| / ||K x|| below 1e-6.
 import numpy as np
 import pytest
 
-from peridyn import geometry
-from peridyn.bonds import find_bonds
+from peridyn.discretization import geometry
+from peridyn.discretization.bonds import find_bonds
 from peridyn.errors import InputError
-from peridyn.materials import make_model
+from peridyn.physics.materials import make_model
 from peridyn.solvers.modal import free_dofs, modal_analysis
 
 #: PMMA plate of VALIDATION.md V4 (m, Pa, -, kg/m^3); 4 mm spacing keeps it small (600 points).
@@ -72,10 +72,10 @@ def test_lobpcg_on_a_clamped_plate_has_no_rigid_mode():
 
 def test_block_operator_equals_the_linearised_force_kernel():
     """K applied to a block (solvers.block_operator) equals, column by column, the one-vector
-    operator K u = -V f_lin(u) of peridyn.stiffness, for LPS (plain and with the energy surface
+    operator K u = -V f_lin(u) of peridyn.linalg.stiffness, for LPS (plain and with the energy surface
     correction's per-bond deviatoric stiffness) with cut bonds and for PMB."""
-    from peridyn.solvers.block_operator import block_stiffness_operator
-    from peridyn.stiffness import stiffness_operator
+    from peridyn.linalg.block_operator import block_stiffness_operator
+    from peridyn.linalg.stiffness import stiffness_operator
 
     rng = np.random.default_rng(1)
     for name, correction in (("lps", "none"), ("lps", "energy"), ("pmb", "none")):
@@ -126,7 +126,7 @@ def test_auto_picks_lobpcg_when_the_factor_would_not_fit(monkeypatch):
     machine's memory share, LOBPCG beyond; a forced shift-invert that cannot fit is refused."""
     import os
 
-    from peridyn import modal_run
+    from peridyn.jobs import modal as modal_run
 
     model = _plate(spacing=2e-3, horizon=1.4143)
     assert modal_run.factor_bytes(model) < modal_run.FACTOR_BUDGET
@@ -146,7 +146,7 @@ def test_unknown_eigensolver_is_refused():
     model = _plate(spacing=8e-3, horizon=1.4143)
     with pytest.raises(InputError, match=r"eigensolver must be one of .* got 'arpack'"):
         modal_analysis(model, 3, method="arpack")
-    from peridyn.modal_run import choose_eigensolver
+    from peridyn.jobs.modal import choose_eigensolver
 
     with pytest.raises(InputError, match="got 'arpack'"):
         choose_eigensolver(model, "arpack")

@@ -11,10 +11,10 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from peridyn import geometry
-from peridyn.bonds import find_bonds
-from peridyn.materials import make_model
-from peridyn.solvers.block_amg import BlockVCycle, smoothed_aggregation_hierarchy
+from peridyn.discretization import geometry
+from peridyn.discretization.bonds import find_bonds
+from peridyn.physics.materials import make_model
+from peridyn.linalg.block_amg import BlockVCycle, smoothed_aggregation_hierarchy
 from peridyn.solvers.eigen_iterative import _orthonormal, proxy_aggregates, proxy_stiffness, rigid_fields
 from peridyn.solvers.modal import free_dofs
 

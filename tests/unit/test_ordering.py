@@ -3,7 +3,7 @@
 import numpy as np
 from scipy.spatial import cKDTree
 
-from peridyn.solvers.ordering import nested_dissection, order_unknowns
+from peridyn.linalg.ordering import nested_dissection, order_unknowns
 
 
 def test_order_is_a_permutation_and_the_halves_before_the_last_separator_are_uncoupled():

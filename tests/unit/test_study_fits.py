@@ -1,4 +1,4 @@
-"""Series grouping and fits of ``peridyn.study_run`` on runs built from f = a + b h^p.
+"""Series grouping and fits of ``peridyn.jobs.study`` on runs built from f = a + b h^p.
 
 Synthetic runs (no solve): the model of seed 002 eq. 6.5 truncated to one term, with the
 thesis's order range (table 6.1: 1 < p < 2); expected limits are the a of the formula.
@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from peridyn.errors import InputError
-from peridyn.study_run import StudyRun, fit_series, write_study
+from peridyn.jobs.study import StudyRun, fit_series, write_study
 
 #: Continuum values (Hz) and orders of two mode types; FE values of issue 9.
 LIMITS = {"1st bending": (1706.1, 1.6), "1st torsional": (1982.9, 1.9)}

@@ -1,4 +1,4 @@
-"""LPS ``surface_correction: energy`` (peridyn.materials.lps_correction): the per-bond
+"""LPS ``surface_correction: energy`` (peridyn.physics.materials.lps_correction): the per-bond
 deviatoric factors give surface points the continuum shear energy, leave bulk points and
 isotropic expansion alone, and stay an energy (symmetric K, K u = -V f(u), f = -dE/du)."""
 
@@ -8,14 +8,14 @@ import numpy as np
 import pytest
 from conftest import small_model
 
-from peridyn import geometry
+from peridyn.discretization import geometry
 from peridyn.analysis.bloch import Discretisation, bloch_cell
-from peridyn.bonds import find_bonds
+from peridyn.discretization.bonds import find_bonds
 from peridyn.errors import InputError
-from peridyn.materials import make_model
-from peridyn.materials.lps_correction import deviatoric_tests
-from peridyn.stiffness import assemble_stiffness, linear_force, stiffness_operator
-from peridyn.tangent import tangent_stiffness
+from peridyn.physics.materials import make_model
+from peridyn.physics.materials.lps_correction import deviatoric_tests
+from peridyn.linalg.stiffness import assemble_stiffness, linear_force, stiffness_operator
+from peridyn.linalg.tangent import tangent_stiffness
 
 GAMMA = 1e-6  # strain amplitude: geometric nonlinearity O(gamma) = 1e-6 relative
 

@@ -7,11 +7,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from peridyn import geometry
+from peridyn.discretization import geometry
 from peridyn.analysis.modes import classify_modes
-from peridyn.bonds import find_bonds
+from peridyn.discretization.bonds import find_bonds
 from peridyn.io.case import load_case
-from peridyn.materials import make_model
+from peridyn.physics.materials import make_model
 from peridyn.solvers.modal import modal_analysis
 
 FE = [1706.1, 1982.9, 4268.0, 4542.4, 6607.0, 6868.0]

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from peridyn.errors import InputError
-from peridyn.timefunctions import (
+from peridyn.physics.timefunctions import (
     Constant,
     GaussianBurst,
     Ramp,

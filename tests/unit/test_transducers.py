@@ -1,15 +1,15 @@
-"""PZT actuators (radial displacement, pin force) and the PZT sensor signal (peridyn.transducers)."""
+"""PZT actuators (radial displacement, pin force) and the PZT sensor signal (peridyn.physics.transducers)."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from peridyn import geometry
+from peridyn.discretization import geometry
 from peridyn.errors import InputError
-from peridyn.loads import Loading
-from peridyn.timefunctions import ToneBurst
-from peridyn.transducers import (
+from peridyn.physics.loads import Loading
+from peridyn.physics.timefunctions import ToneBurst
+from peridyn.physics.transducers import (
     pin_force_actuator,
     pzt_radial_actuator,
     pzt_sensor_signal,

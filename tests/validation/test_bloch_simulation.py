@@ -23,7 +23,7 @@ from peridyn.analysis.bloch import Discretisation
 from peridyn.analysis.bloch_study import predict
 from peridyn.analysis.fk import line_mode_wavenumbers
 from peridyn.io.case import load_case
-from peridyn.simulation import run_case
+from peridyn.jobs.run import run_case
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 #: VALIDATION.md V1: A0 group velocity of the 2 mm aluminium plate at 150 kHz, m/s.

@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 from peridyn.analysis.harmonics import second_harmonic_ratio
-from peridyn.breathing import compare, drive_frequency
+from peridyn.jobs.breathing import compare, drive_frequency
 from peridyn.io.case import load_case
 
 CASE = Path(__file__).resolve().parents[2] / "cases" / "lamb_breathing_crack.yaml"

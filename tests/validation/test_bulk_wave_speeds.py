@@ -13,12 +13,12 @@ import numpy as np
 import pytest
 from conftest import STEEL_E, STEEL_K, STEEL_MU, STEEL_NU, STEEL_RHO
 
-from peridyn import geometry
-from peridyn.bonds import find_bonds
-from peridyn.loads import BoundaryCondition, Loading
-from peridyn.materials import make_model
+from peridyn.discretization import geometry
+from peridyn.discretization.bonds import find_bonds
+from peridyn.physics.loads import BoundaryCondition, Loading
+from peridyn.physics.materials import make_model
 from peridyn.solvers import ExplicitSolver
-from peridyn.timefunctions import ToneBurst
+from peridyn.physics.timefunctions import ToneBurst
 
 H = 1e-3
 WAVELENGTH = 20 * H

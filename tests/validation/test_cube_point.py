@@ -79,7 +79,7 @@ def test_fronts_from_dilatation_and_rotation_of_a_synthetic_field(tmp_path):
 
 @pytest.mark.slow
 def test_cube_fronts_travel_at_the_group_velocity_of_the_relation(tmp_path):
-    from peridyn.simulation import run_case
+    from peridyn.jobs.run import run_case
 
     case = load_case(CASE, ["output.plots=false"])
     start = time.perf_counter()

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 
-from peridyn.fatigue.case_run import run_fatigue_case
+from peridyn.jobs.fatigue import run_fatigue_case
 from peridyn.io.case import load_case
 
 CASES = Path(__file__).parents[2] / "cases"

@@ -14,7 +14,7 @@ from scipy.signal import hilbert
 
 from peridyn.io.case import load_case
 from peridyn.io.hdf5 import read_series
-from peridyn.simulation import run_case
+from peridyn.jobs.run import run_case
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 #: V1, 150 kHz: S0 and A0 wavenumbers (rad/m) and group velocities (m/s).

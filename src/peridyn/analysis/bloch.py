@@ -28,11 +28,11 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import brentq
 
-from peridyn import geometry
-from peridyn.bonds import find_bonds
+from peridyn.discretization import geometry
+from peridyn.discretization.bonds import find_bonds
 from peridyn.errors import InputError
-from peridyn.materials import make_model
-from peridyn.stiffness import assemble_stiffness
+from peridyn.physics.materials import make_model
+from peridyn.linalg.stiffness import assemble_stiffness
 
 #: Plate subspaces: (name, parity of u_x, u_y, u_z under the mid-plane mirror; None: absent).
 PLATE_FAMILIES = {"S": (1, None, -1), "A": (-1, None, 1), "SH": (None, 1, None)}

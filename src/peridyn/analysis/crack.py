@@ -34,7 +34,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components, shortest_path
 from scipy.spatial import cKDTree
 
-from peridyn.damage import damage_field
+from peridyn.physics.damage import damage_field
 from peridyn.errors import InputError
 
 DEFAULT_THRESHOLD = 0.35

@@ -24,7 +24,7 @@ acoustic tensor of an isotropic solid whenever the family is isotropic to
 fourth order, i.e. exactly for the continuous relations and for every
 influence function: 3D LPS ``rho cL^2 = K + 4 mu / 3``, ``rho cS^2 = mu``.
 
-Constants are those of the running code (``peridyn.materials``): PMB
+Constants are those of the running code (``peridyn.physics.materials``): PMB
 ``c0 = pmb_micromodulus(E, ...)`` (3D and 2D; it implies nu = 1/4, or 1/3 in
 plane stress, so a PMB's long-wave speeds are those of (E, that nu)); LPS
 ``kappa = K`` (3D) or the in-plane bulk modulus (2D, plane stress or strain).
@@ -41,12 +41,12 @@ Families:
   ``d`` so that the pure-mode symmetry is exact; enough nodes to resolve
   ``k_max delta``;
 - discrete: the family of the centre point of a block of a simple cubic
-  (square) lattice of spacing ``h``, found by :func:`peridyn.bonds.find_bonds`
+  (square) lattice of spacing ``h``, found by :func:`peridyn.discretization.bonds.find_bonds`
   exactly as in a run (same neighbours, influence values and partial-volume
   factors ``beta``, ``V = beta h^dim``); ``m`` is the discrete sum. 1D has no
   body in the engine: its lattice family is ``xi = j h``, with partial volumes
   the exact length fraction of each cell inside ``[-delta, delta]``
-  (:func:`peridyn.bonds.cell_fraction_in_ball`).
+  (:func:`peridyn.discretization.bonds.cell_fraction_in_ball`).
 
 Branches are labelled by polarisation: ``longitudinal`` along ``d``;
 ``shear_1`` along ``z x d`` (in-plane; ``x`` when ``d`` is ``z``), ``shear_2``
@@ -73,18 +73,18 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import brentq
 
-from peridyn import geometry
-from peridyn.body import in_sphere
-from peridyn.bonds import HORIZON_RTOL, cell_fraction_in_ball, find_bonds, influence_function
+from peridyn.discretization import geometry
+from peridyn.discretization.body import in_sphere
+from peridyn.discretization.bonds import HORIZON_RTOL, cell_fraction_in_ball, find_bonds, influence_function
 from peridyn.errors import InputError
-from peridyn.materials.elastic import (
+from peridyn.physics.materials.elastic import (
     bulk_modulus,
     check_elastic,
     plane_bulk_modulus,
     radial_moment,
     shear_modulus,
 )
-from peridyn.materials.pmb import pmb_micromodulus, pmb_poisson_ratio
+from peridyn.physics.materials.pmb import pmb_micromodulus, pmb_poisson_ratio
 
 __all__ = [
     "BRANCHES",
@@ -347,7 +347,7 @@ def lattice_family(spacing: float, horizon: float, influence: str = "constant", 
     """Family of a point of an infinite simple cubic (square, 1D: uniform) lattice.
 
     In 2D and 3D the family of the centre point of a ball-shaped block of
-    lattice points, found by :func:`peridyn.bonds.find_bonds` as in a run (2D:
+    lattice points, found by :func:`peridyn.discretization.bonds.find_bonds` as in a run (2D:
     thickness = spacing). The geometry (bonds and partial volumes) does not
     depend on the influence function and is cached, so studies over influence
     functions and models search each lattice once.

@@ -40,7 +40,7 @@ from scipy.special import hankel1
 
 from peridyn.errors import InputError
 from peridyn.io.hdf5 import iter_series_chunks, read_array, read_series
-from peridyn.loads import parse_components
+from peridyn.physics.loads import parse_components
 
 __all__ = [
     "PointGrid",

@@ -1,7 +1,7 @@
 """Dispersion measured on the running code: plane-wave Rayleigh quotients of ``Model.force``.
 
 A block of the simple cubic (square) lattice is built with the engine
-(``peridyn.geometry``, ``find_bonds``, ``make_model``). For the plane wave
+(``peridyn.discretization.geometry``, ``find_bonds``, ``make_model``). For the plane wave
 ``u = A e_b cos(k d.(x - c))`` (polarisation ``e_b``, ``c`` the block centre)
 the force of an infinite lattice is ``f = -D(k) u`` at every point, so at
 points whose own family and whose neighbours' families are complete (farther
@@ -28,7 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from peridyn import geometry
+from peridyn.discretization import geometry
 from peridyn.analysis.dispersion import (
     BRANCHES,
     Medium,
@@ -36,9 +36,9 @@ from peridyn.analysis.dispersion import (
     parse_direction,
     polarisations,
 )
-from peridyn.bonds import find_bonds
+from peridyn.discretization.bonds import find_bonds
 from peridyn.errors import InputError
-from peridyn.materials import Model, make_model
+from peridyn.physics.materials import Model, make_model
 
 __all__ = ["MeasuredDispersion", "lattice_block_model", "measure_dispersion"]
 

@@ -4,7 +4,7 @@ Times one explicit-step force evaluation of the baseline PMB loop and of the PMB
 LPS models (float64 and float32, through ``model.force``) on a cube of about 100k
 points (1 mm spacing, horizon 3.015 spacings, no partial volumes unless
 ``--partial-volumes``), next to the machine's triad memory bandwidth. Best of
-``--repeat`` interleaved rounds after a warm-up. See ``peridyn.benchmark`` for what
+``--repeat`` interleaved rounds after a warm-up. See ``peridyn.jobs.bench`` for what
 is counted.
 """
 
@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import sys
 
-from peridyn.benchmark import DEFAULT_POINTS, format_table, run_benchmark
+from peridyn.jobs.bench import DEFAULT_POINTS, format_table, run_benchmark
 from peridyn.cli import add_json_flag
 
 

@@ -9,7 +9,7 @@ import sys
 import numpy as np
 
 from peridyn.analysis.dispersion import MODELS, Medium, dispersion_relation, parse_direction
-from peridyn.bonds import INFLUENCE_FUNCTIONS
+from peridyn.discretization.bonds import INFLUENCE_FUNCTIONS
 from peridyn.cli import add_json_flag
 from peridyn.errors import InputError
 

@@ -53,7 +53,7 @@ def run(args) -> dict:
         return calibrate(args)
     from tqdm import tqdm
 
-    from peridyn.fatigue.case_run import run_fatigue_case
+    from peridyn.jobs.fatigue import run_fatigue_case
     from peridyn.io.case import load_case
 
     case = load_case(args.case, args.overrides)

@@ -24,8 +24,8 @@ def register(sub) -> None:
 
 def run(args) -> dict:
     """Solve and print the frequency table unless --json."""
-    from peridyn.modal_run import mode_label
-    from peridyn.simulation import run_case
+    from peridyn.jobs.modal import mode_label
+    from peridyn.jobs.run import run_case
 
     overrides = [*args.overrides, "solver.type=modal"]
     if args.modes is not None:
@@ -33,7 +33,7 @@ def run(args) -> dict:
     case = load_case(args.case, overrides)
     summary = run_case(case, args.output, case_path=args.case, base_dir=Path(args.case).parent)
     if args.compare:
-        from peridyn.modal_run import compare_with_run
+        from peridyn.jobs.modal import compare_with_run
 
         summary["comparison"] = compare_with_run(Path(summary["output_dir"]), Path(args.compare))
     if not args.json:

@@ -9,7 +9,7 @@ from tqdm import tqdm
 
 from peridyn.cli import add_json_flag
 from peridyn.io.case import load_case
-from peridyn.recorder import provenance
+from peridyn.io.recorder import provenance
 
 
 def add_case_arguments(parser) -> None:
@@ -37,7 +37,7 @@ def register(sub) -> None:
 
 def run(args) -> dict:
     """Run the case; print a readable summary unless --json."""
-    from peridyn.simulation import run_case
+    from peridyn.jobs.run import run_case
 
     case = load_case(args.case, args.overrides)
     info = provenance()

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from peridyn.errors import InputError
-from peridyn.materials.base import Model
+from peridyn.physics.materials.base import Model
 
 
 @dataclass(frozen=True)

@@ -14,11 +14,11 @@ from collections.abc import Callable
 
 import numpy as np
 
-from peridyn.bonds import both_copies, crossing_rectangle, crossing_segment
+from peridyn.discretization.bonds import both_copies, crossing_rectangle, crossing_segment
 from peridyn.errors import InputError
 from peridyn.fatigue.statics import LinearStatics
-from peridyn.loads import Loading
-from peridyn.materials.base import Model
+from peridyn.physics.loads import Loading
+from peridyn.physics.materials.base import Model
 
 
 def compliance_energy(model: Model, loading: Loading, crack_lengths, cut: Callable[[float], np.ndarray],

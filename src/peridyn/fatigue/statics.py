@@ -1,7 +1,7 @@
 """Linear static equilibrium K u = F of the current bonds, with prescribed displacements.
 
 The fatigue loop needs the displacement at the maximum load after every step that broke bonds;
-the linearised model (``peridyn.stiffness``) is adequate for fatigue strains. K is applied
+the linearised model (``peridyn.linalg.stiffness``) is adequate for fatigue strains. K is applied
 matrix-free (``stiffness_operator``, always with the bonds intact now) and the system on the
 free dofs is solved by preconditioned conjugate gradients, warm started from the previous step.
 The preconditioner is built once from the bonds of some step and kept while bonds break (K then
@@ -42,12 +42,12 @@ import numpy as np
 
 from peridyn.errors import InputError
 from peridyn.fatigue.pcg import PCGResult, RecycledDirections, deflated_pcg
-from peridyn.loads import Loading
-from peridyn.materials.base import Model
-from peridyn.solvers.block_operator import block_stiffness_operator
+from peridyn.physics.loads import Loading
+from peridyn.physics.materials.base import Model
+from peridyn.linalg.block_operator import block_stiffness_operator
 from peridyn.solvers.eigen_iterative import amg_preconditioner, proxy_stiffness, rigid_fields
 from peridyn.solvers.modal import free_dofs, shifted_inverse
-from peridyn.stiffness import stiffness_operator, stiffness_parts
+from peridyn.linalg.stiffness import stiffness_operator, stiffness_parts
 
 #: Diagonal shift relative to the mean diagonal stiffness.
 SHIFT = 1e-9

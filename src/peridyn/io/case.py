@@ -99,7 +99,7 @@ class Discretization(Strict):
 
 class Damage(Strict):
     """Bond failure: ``critical_stretch``, ``fracture_energy`` (J/m^2) or
-    ``critical_bond_stress`` (Pa; bond stress E s, see ``peridyn.damage``), and node sets
+    ``critical_bond_stress`` (Pa; bond stress E s, see ``peridyn.physics.damage``), and node sets
     where bonds never break."""
 
     critical_stretch: Positive | None = None
@@ -173,7 +173,7 @@ class Precrack(Strict):
 
 class BoundaryConditionSpec(Strict):
     """A condition on node set ``set``: kind, components ("x", "xy", ...) and a value
-    (a number or a time function mapping, see ``peridyn.timefunctions.from_spec``)."""
+    (a number or a time function mapping, see ``peridyn.physics.timefunctions.from_spec``)."""
 
     set: str
     kind: Literal["displacement", "velocity", "force", "body_force"]
@@ -317,7 +317,7 @@ class Output(Strict):
 
 
 class ContactSpec(Strict):
-    """Short-range contact forces between unbonded points (``peridyn.contact``): contact
+    """Short-range contact forces between unbonded points (``peridyn.physics.contact``): contact
     distance as a multiple of the spacing (``radius``) or in metres (``radius_m``), and the
     short-range constant as a multiple of the PMB micromodulus (``stiffness_factor``,
     Peridigm's 15 by default)."""
@@ -603,7 +603,7 @@ class Fatigue(Strict):
 
 
 class AbsorbingSpec(Strict):
-    """Absorbing boundary layers (``peridyn.absorbing``): mass-proportional damping growing as
+    """Absorbing boundary layers (``peridyn.physics.absorbing``): mass-proportional damping growing as
     the cube of the depth into a layer ``width`` m wide along each of ``faces``, from 0 at its
     inner edge to ``damping`` (1/s) on the face; added to ``solver.damping``."""
 

@@ -1,6 +1,6 @@
 """Numba CPU kernels: pure functions of arrays, no checks, no objects.
 
-Layout expected by every kernel (the drivers in ``peridyn.materials`` and
+Layout expected by every kernel (the drivers in ``peridyn.physics.materials`` and
 ``peridyn.solvers`` normalise inputs once):
 
 - ``x, u, f``: (n_points, 3) C-contiguous, float64 or float32 (all the same);

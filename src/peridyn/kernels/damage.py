@@ -119,7 +119,7 @@ def _break_reverse(i, j, offsets, nbr, intact):
 
 @numba.njit(parallel=True, fastmath=FASTMATH, cache=True)
 def flag_moved_points(u, u_ref, margin, moved, tested):
-    """Which families the skin must test at ``u`` (see ``peridyn.damage``).
+    """Which families the skin must test at ``u`` (see ``peridyn.physics.damage``).
 
     ``moved`` (OUT, (n_points,), m): ``|u_k - u_ref_k|``; ``tested`` (OUT, (n_points,) bool):
     ``margin[k] <= 2 moved[k]``. Returns the number of points tested, or -1 if some

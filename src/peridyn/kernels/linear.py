@@ -7,7 +7,7 @@ With n = xi/|xi| and eta = u_j - u_i, the linearised extension is e = n . eta.
   f_i = sum_j [ w |xi| (P_i + P_j) + k_ij (n . eta) ] n, P_i = theta_i p_coef_i, k_ij the
   bond's deviatoric stiffness (see ``peridyn.kernels.lps``).
 
-``K u = -V f_lin(u)`` holds to round-off for the matrices of ``peridyn.stiffness``.
+``K u = -V f_lin(u)`` holds to round-off for the matrices of ``peridyn.linalg.stiffness``.
 """
 
 import numba

@@ -3,7 +3,7 @@
 Per point: weighted volume m_i = sum_j w_ij |xi|^2 with w_ij = omega beta V_j,
 dilatation theta_i = (d / m_i) sum_j w_ij |xi| e_ij, extension e = |Y| - |xi|.
 Scalar force state t_ij = |xi| omega P_i + alpha_i g_ij omega e_ij, with the per-point
-P_i = theta_i p_coef_i (``peridyn.materials.lps``: p_coef = d kappa / m - alpha / d without
+P_i = theta_i p_coef_i (``peridyn.physics.materials.lps``: p_coef = d kappa / m - alpha / d without
 surface correction) and g_ij the point's deviatoric factor (1 without correction).
 The pair force on i is (t_ij + t_ji) Y/|Y| beta V_j, which the kernel writes as
 

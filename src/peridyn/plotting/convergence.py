@@ -21,9 +21,9 @@ def plot_convergence(runs, fits, path=None, title: str | None = None) -> Figure:
 
     Parameters
     ----------
-    runs : list of peridyn.study_run.StudyRun
+    runs : list of peridyn.jobs.study.StudyRun
     fits : list of dict
-        From :func:`peridyn.study_run.fit_series` (only ``delta-m`` rows are drawn).
+        From :func:`peridyn.jobs.study.fit_series` (only ``delta-m`` rows are drawn).
     path : str or os.PathLike, optional
         Where to save the figure as PNG.
     """

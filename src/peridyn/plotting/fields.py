@@ -13,7 +13,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.tri import Triangulation  # noqa: E402
 
-from peridyn.body import Body  # noqa: E402
+from peridyn.discretization.body import Body  # noqa: E402
 
 COMPONENT_NAMES = ("x", "y", "z")
 

@@ -2,7 +2,7 @@
 
 Every function draws on an Agg canvas (never a window), saves a PNG at ``path``
 and returns that path. Results-file figures read ``results.h5`` as written by
-:class:`peridyn.recorder.Recorder`: ``/geometry/points`` and the ``field_u``
+:class:`peridyn.io.recorder.Recorder`: ``/geometry/points`` and the ``field_u``
 snapshots. The layer of each point of a plate is recovered from its z
 coordinate (layers numbered from the bottom, as ``Body.layer_index``). B-scans
 of line probes are drawn by :func:`peridyn.plotting.fields.plot_bscan`.
@@ -22,7 +22,7 @@ from peridyn.analysis.fk import point_grid
 from peridyn.analysis.lamb import DispersionBranch, LambMode
 from peridyn.errors import InputError
 from peridyn.io.hdf5 import iter_series_chunks, read_array
-from peridyn.loads import parse_components
+from peridyn.physics.loads import parse_components
 
 __all__ = [
     "plot_fk_map",
@@ -246,7 +246,7 @@ def plot_sensor_signals(times, signals: dict, path: str | os.PathLike, excitatio
     ----------
     times : (n_t,) float, s
     signals : dict of str to (n_t,) float
-        Sensor name to signal, e.g. from :func:`peridyn.transducers.pzt_sensor_signal`.
+        Sensor name to signal, e.g. from :func:`peridyn.physics.transducers.pzt_sensor_signal`.
     path : str or path-like
         The PNG to write.
     excitation : (n_t,) float, optional

@@ -29,10 +29,10 @@ from scipy.linalg import null_space
 from scipy.sparse.linalg import LinearOperator, lobpcg
 
 from peridyn.errors import InputError
-from peridyn.materials.base import Model
-from peridyn.solvers.block_amg import BlockVCycle, smoothed_aggregation_hierarchy
-from peridyn.solvers.block_operator import block_stiffness_operator
-from peridyn.stiffness import _pair_matrix
+from peridyn.physics.materials.base import Model
+from peridyn.linalg.block_amg import BlockVCycle, smoothed_aggregation_hierarchy
+from peridyn.linalg.block_operator import block_stiffness_operator
+from peridyn.linalg.stiffness import _pair_matrix
 
 #: Bonds kept in the preconditioner's proxy: length <= this times the shortest bond
 #: (1.5: the 18 nearest neighbours of a cubic grid).

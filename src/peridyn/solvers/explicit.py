@@ -8,7 +8,7 @@ One step of size dt (rho a = f(u) + b - rho c v, c the mass-proportional damping
 
 The step defaults to ``safety`` times the model's stable step (``Model.critical_time_step``);
 a larger step given by the user is refused. With contact (``f_c``, the short-range
-forces of ``peridyn.contact``) the stable step comes from the sum of the model's and the
+forces of ``peridyn.physics.contact``) the stable step comes from the sum of the model's and the
 contact's stiffness bounds, 2 / sqrt(max((s_model + s_contact) / rho)) (Gershgorin).
 """
 
@@ -18,12 +18,12 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from peridyn.contact import Contact
-from peridyn.damage import BondDamage
+from peridyn.physics.contact import Contact
+from peridyn.physics.damage import BondDamage
 from peridyn.errors import InputError, InstabilityError
-from peridyn.loads import Loading
-from peridyn.materials.base import Model
-from peridyn.solvers.state import State, advance
+from peridyn.physics.loads import Loading
+from peridyn.physics.materials.base import Model
+from peridyn.discretization.state import State, advance
 
 
 class ExplicitSolver:
@@ -39,7 +39,7 @@ class ExplicitSolver:
         Fraction of the stable step used when ``dt`` is None (0 < safety <= 1).
     damping : float or (n_points,) float, 1/s
         Mass-proportional damping coefficient c, one for all points or one per point (e.g.
-        absorbing layers, ``peridyn.absorbing``); 0: undamped. It lowers the stable step.
+        absorbing layers, ``peridyn.physics.absorbing``); 0: undamped. It lowers the stable step.
     damage : BondDamage or None
     check_every : int
         Steps between checks for non-finite values.

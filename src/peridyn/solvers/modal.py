@@ -30,9 +30,9 @@ import scipy.sparse as sp
 from scipy.sparse.linalg import LinearOperator, eigsh, splu
 
 from peridyn.errors import InputError
-from peridyn.materials.base import Model
-from peridyn.solvers.ordering import order_unknowns
-from peridyn.stiffness import StiffnessParts, mass_matrix, stiffness_parts
+from peridyn.physics.materials.base import Model
+from peridyn.linalg.ordering import order_unknowns
+from peridyn.linalg.stiffness import StiffnessParts, mass_matrix, stiffness_parts
 
 #: Modes whose frequency is below this fraction of the highest computed one are rigid.
 RIGID_FRACTION = 1e-4

@@ -6,7 +6,7 @@ damping c:
     u* = u + dt v + dt^2 a / 4;  a' = 4 (u' - u*) / dt^2;  v' = v + dt (a + a') / 2;
     R(u') = V (f(u') + b(t + dt)) - M (a' + c v') = 0  at the free dofs,
 
-solved by Newton with the consistent tangent ``K`` (``peridyn.tangent``):
+solved by Newton with the consistent tangent ``K`` (``peridyn.linalg.tangent``):
 ``(K + (4 / dt^2 + 2 c / dt) M) du = R``, until the largest displacement increment
 |du| is below ``tolerance`` (m; seed 004: dt = 20 ns, 0.1 nm). Prescribed displacements
 are imposed at t + dt, prescribed velocities integrated by the trapezoidal rule, and
@@ -24,16 +24,16 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from peridyn.damage import BondDamage
+from peridyn.physics.damage import BondDamage
 from peridyn.errors import InputError
-from peridyn.loads import Loading
-from peridyn.materials.base import Model
+from peridyn.physics.loads import Loading
+from peridyn.physics.materials.base import Model
 from peridyn.solvers.explicit import check_finite
 from peridyn.solvers.modal import free_dofs
 from peridyn.solvers.newton import check_linear_solver, solve_held
-from peridyn.solvers.state import State, advance
-from peridyn.stiffness import mass_matrix
-from peridyn.tangent import tangent_stiffness
+from peridyn.discretization.state import State, advance
+from peridyn.linalg.stiffness import mass_matrix
+from peridyn.linalg.tangent import tangent_stiffness
 
 
 class NewmarkSolver:

@@ -6,7 +6,7 @@ out-of-balance force (N) is
     r(u) = V f(u) + V b,
 
 and each iteration solves ``K(u) du = r(u)`` with the consistent tangent
-``K = -d(V f)/du`` (``peridyn.tangent``) by a sparse LU factorisation (or
+``K = -d(V f)/du`` (``peridyn.linalg.tangent``) by a sparse LU factorisation (or
 Jacobi-preconditioned conjugate gradients to 1e-12 for large 3D systems), the
 prescribed dofs held at their values (elimination). Near the solution the
 residual falls quadratically, r_(k+1) ~ C r_k^2. Converged when
@@ -31,12 +31,12 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import splu
 
-from peridyn.damage import BondDamage
+from peridyn.physics.damage import BondDamage
 from peridyn.errors import InputError, did_you_mean
-from peridyn.loads import Loading
-from peridyn.materials.base import Model
+from peridyn.physics.loads import Loading
+from peridyn.physics.materials.base import Model
 from peridyn.solvers.modal import free_dofs
-from peridyn.tangent import tangent_stiffness
+from peridyn.linalg.tangent import tangent_stiffness
 
 
 @dataclass

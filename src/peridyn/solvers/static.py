@@ -21,11 +21,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from peridyn.contact import Contact
-from peridyn.damage import BondDamage
+from peridyn.physics.contact import Contact
+from peridyn.physics.damage import BondDamage
 from peridyn.errors import InputError
-from peridyn.loads import Loading
-from peridyn.materials.base import Model
+from peridyn.physics.loads import Loading
+from peridyn.physics.materials.base import Model
 
 
 @dataclass

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from peridyn import geometry
+from peridyn.discretization import geometry
 from peridyn.analysis.fk import (
     azimuthal_average,
     fk_transform,

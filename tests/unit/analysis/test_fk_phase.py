@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 from scipy.special import hankel1
 
-from peridyn import geometry
+from peridyn.discretization import geometry
 from peridyn.analysis.fk import LINE_SUFFIXES, line_mode_wavenumbers, mirror_parts, phase_wavenumber
 from peridyn.errors import InputError
 from peridyn.io.hdf5 import HDF5Writer, read_series

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from peridyn import geometry
+from peridyn.discretization import geometry
 from peridyn.analysis.fk import fk_transform, kxky_transform
 from peridyn.analysis.lamb import dispersion_curves, lamb_modes
 from peridyn.errors import InputError
@@ -17,7 +17,7 @@ from peridyn.plotting.lamb_wavefield import (
     plot_through_thickness,
     plot_wavefield_snapshots,
 )
-from peridyn.timefunctions import ToneBurst
+from peridyn.physics.timefunctions import ToneBurst
 
 # VALIDATION.md V1: 2 mm aluminium plate (E Pa, nu, rho kg/m^3, thickness m); V2: 3 layers
 # on the faces and mid-plane, snapshots at 20 and 40 us.

@@ -38,7 +38,7 @@ import numpy as np
 
 from peridyn.errors import InputError
 from peridyn.kernels.damage import MAX_QUANTA, damage_index, flag_moved_points, stretch_test_families
-from peridyn.materials.base import Model
+from peridyn.physics.materials.base import Model
 
 
 def stretch_from_bond_stress(critical_bond_stress: float, E: float) -> float:

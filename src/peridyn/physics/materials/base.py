@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from peridyn.body import Body
-from peridyn.bonds import Bonds
+from peridyn.discretization.body import Body
+from peridyn.discretization.bonds import Bonds
 
 
 class Model:

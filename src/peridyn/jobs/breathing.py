@@ -1,6 +1,6 @@
 """Breathing-crack comparison: one case run as given, without its cracks, and without contact.
 
-``python -m peridyn.breathing CASE.yaml OUT.png [SENSOR]`` runs the three variants of an
+``python -m peridyn.jobs.breathing CASE.yaml OUT.png [SENSOR]`` runs the three variants of an
 explicit case with pre-cracks and a ``contact`` block, prints each sensor's second-harmonic
 ratio A2/A1 and draws their spectra (``peridyn.plotting.spectra``). The drive frequency is
 the first boundary condition's tone-burst frequency.
@@ -14,7 +14,7 @@ import numpy as np
 
 from peridyn.errors import InputError
 from peridyn.io.case import Case, load_case
-from peridyn.simulation import build
+from peridyn.jobs.run import build
 from peridyn.solvers import ExplicitSolver
 
 VARIANTS = {"breathing crack": {}, "no crack": {"precracks": []}, "open crack": {"contact": None}}

@@ -3,7 +3,7 @@
 ``K(u) = -d(V f(u)) / du`` (3 n, 3 n), N/m, the exact Jacobian of the force kernels
 (``peridyn.kernels.pmb``, ``peridyn.kernels.lps``), so that Newton's method on
 ``V f(u) + V b = 0`` converges quadratically. At ``u = 0`` it equals the linear
-stiffness of ``peridyn.stiffness.assemble_stiffness``.
+stiffness of ``peridyn.linalg.stiffness.assemble_stiffness``.
 
 Both models write the force on point i as a sum over its intact bonds i->j of a
 scalar T_ij along the deformed bond direction n = Y / r, Y = xi + u_j - u_i, r = |Y|:
@@ -32,7 +32,7 @@ import numba
 import numpy as np
 import scipy.sparse as sp
 
-from peridyn.materials import LPSModel, Model, PMBModel
+from peridyn.physics.materials import LPSModel, Model, PMBModel
 
 
 def tangent_stiffness(model: Model, u: np.ndarray) -> sp.csr_matrix:

@@ -14,7 +14,7 @@ import numba
 import numpy as np
 from scipy.sparse.linalg import LinearOperator
 
-from peridyn.materials import LPSModel, Model, PMBModel
+from peridyn.physics.materials import LPSModel, Model, PMBModel
 
 
 @numba.njit(parallel=True, cache=True)

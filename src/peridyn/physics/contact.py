@@ -9,7 +9,7 @@ configuration, and not joined by an intact bond, repel each other with the force
 zero beyond d_c and never attractive. The short-range constant is ``c_sr = factor * c``
 with c the micromodulus of a PMB material of the same Young's modulus and a constant
 influence function (3D: c = 18 K / (pi delta^4), K = E / (3 (1 - 2/4)); 2D: see
-``peridyn.materials.pmb``). Peridigm's documentation and Silling's EMU use
+``peridyn.physics.materials.pmb``). Peridigm's documentation and Silling's EMU use
 ``factor = 15``, the default here: a contact pair at overlap d is then about as stiff as
 15 bonds of length delta stretched by d, so that closed crack faces carry compression
 nearly as the intact material did, while the stable time step shrinks by only ~20 %
@@ -28,8 +28,8 @@ from scipy.spatial import cKDTree
 
 from peridyn.errors import InputError
 from peridyn.kernels.contact import add_contact_force, largest_squared_move, pair_bond_index
-from peridyn.materials.base import Model
-from peridyn.materials.pmb import pmb_micromodulus
+from peridyn.physics.materials.base import Model
+from peridyn.physics.materials.pmb import pmb_micromodulus
 
 #: Peridigm's / EMU's short-range force constant as a multiple of the PMB micromodulus.
 DEFAULT_STIFFNESS_FACTOR = 15.0

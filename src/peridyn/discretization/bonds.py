@@ -13,7 +13,7 @@ import numba
 import numpy as np
 from scipy.spatial import cKDTree
 
-from peridyn.body import Body
+from peridyn.discretization.body import Body
 from peridyn.errors import InputError, did_you_mean
 
 #: Relative tolerance on the horizon: a neighbour at exactly ``delta`` is in.

@@ -13,7 +13,7 @@ import numpy as np
 
 from peridyn.analysis.fk import kxky_from_hdf5, line_fk, pick_wavenumbers, point_grid, ring_radius
 from peridyn.analysis.lamb import dispersion_curves, lamb_modes
-from peridyn.body import Body
+from peridyn.discretization.body import Body
 from peridyn.errors import CaseFileError, InputError
 from peridyn.io.case import Case
 

@@ -8,7 +8,7 @@ offset of a point from the patch centre, the *patch radius* of a point is
 ``rho <= a`` and its perimeter ``rho = a``.
 
 Actuators (each returns the body with a new node set and the boundary
-conditions to pass to :class:`~peridyn.loads.Loading`):
+conditions to pass to :class:`~peridyn.physics.loads.Loading`):
 
 - :func:`pzt_radial_actuator`, seed 000 (sec. 2.2, after its ref. 37): an
   in-plane *radial* displacement prescribed on the patch's points, zero at the
@@ -44,11 +44,11 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import Delaunay, cKDTree
 
-from peridyn import geometry
-from peridyn.body import Body
+from peridyn.discretization import geometry
+from peridyn.discretization.body import Body
 from peridyn.errors import InputError
-from peridyn.loads import BoundaryCondition
-from peridyn.timefunctions import TimeFunction
+from peridyn.physics.loads import BoundaryCondition
+from peridyn.physics.timefunctions import TimeFunction
 
 __all__ = [
     "SHAPES",

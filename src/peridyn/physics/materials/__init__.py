@@ -4,12 +4,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from peridyn.body import Body
-from peridyn.bonds import Bonds
+from peridyn.discretization.body import Body
+from peridyn.discretization.bonds import Bonds
 from peridyn.errors import InputError, did_you_mean
-from peridyn.materials.base import Model
-from peridyn.materials.lps import LPSModel
-from peridyn.materials.pmb import PMBModel
+from peridyn.physics.materials.base import Model
+from peridyn.physics.materials.lps import LPSModel
+from peridyn.physics.materials.pmb import PMBModel
 
 MODELS = {"pmb": PMBModel, "lps": LPSModel}
 

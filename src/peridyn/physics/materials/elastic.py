@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.integrate import quad
 
-from peridyn.bonds import influence_function
+from peridyn.discretization.bonds import influence_function
 from peridyn.errors import InputError
 
 

@@ -13,24 +13,24 @@ from pathlib import Path
 
 import numpy as np
 
-from peridyn import geometry
-from peridyn.absorbing import layer_damping
-from peridyn.body import Body, in_box, in_cylinder, in_sphere
-from peridyn.bonds import Bonds, crossing_rectangle, crossing_segment, cut_bonds, find_bonds
-from peridyn.checkpoint import Checkpointer, load_checkpoint
-from peridyn.contact import Contact
-from peridyn.damage import BondDamage, damage_field
+from peridyn.discretization import geometry
+from peridyn.physics.absorbing import layer_damping
+from peridyn.discretization.body import Body, in_box, in_cylinder, in_sphere
+from peridyn.discretization.bonds import Bonds, crossing_rectangle, crossing_segment, cut_bonds, find_bonds
+from peridyn.io.checkpoint import Checkpointer, load_checkpoint
+from peridyn.physics.contact import Contact
+from peridyn.physics.damage import BondDamage, damage_field
 from peridyn.errors import CaseFileError, InputError
 from peridyn.io.case import Case, Region
 from peridyn.io.hdf5 import HDF5Writer, read_series
-from peridyn.loads import BoundaryCondition, InitialCondition, Loading
-from peridyn.materials import Model, make_model
-from peridyn.postprocess import analyse
-from peridyn.recorder import LineProbe, Recorder, RecorderSpec, provenance
+from peridyn.physics.loads import BoundaryCondition, InitialCondition, Loading
+from peridyn.physics.materials import Model, make_model
+from peridyn.jobs.lamb_analysis import analyse
+from peridyn.io.recorder import LineProbe, Recorder, RecorderSpec, provenance
 from peridyn.solvers import ExplicitSolver, relax
-from peridyn.solvers.state import State
-from peridyn.timefunctions import from_spec
-from peridyn.transducers import pin_force_actuator, pzt_radial_actuator, pzt_sensor_weights
+from peridyn.discretization.state import State
+from peridyn.physics.timefunctions import from_spec
+from peridyn.physics.transducers import pin_force_actuator, pzt_radial_actuator, pzt_sensor_weights
 
 
 @dataclass
@@ -234,7 +234,7 @@ def run_case(case: Case, output_dir=None, case_path=None, checkpoint_every: int 
         summary = _run_explicit(case, setup, out, case_path, checkpoint_every, restart, progress,
                                 solver=_newmark_solver(case, setup))
     elif case.solver.type == "modal":
-        from peridyn.modal_run import run_modal
+        from peridyn.jobs.modal import run_modal
 
         summary = run_modal(case, setup, out, case_path)
     else:

@@ -12,7 +12,7 @@ alpha = 15 mu / m (3D), 8 mu / m (2D), w = omega beta V_j, m_i = sum_j w_ij |xi|
 the intact bonds at set-up (each point's own family, so surfaces are seen).
 
 With ``surface_correction: energy`` each point weights its own bonds in the deviatoric
-part with factors g_ij (``peridyn.materials.lps_correction``):
+part with factors g_ij (``peridyn.physics.materials.lps_correction``):
 
     W_i = kappa theta_i^2 / 2 + (alpha_i / 2) [ sum_j g_ij w_ij e_ij^2 - m~_i theta_i^2 / d^2 ],
 
@@ -29,8 +29,8 @@ import warnings
 
 import numpy as np
 
-from peridyn.body import Body
-from peridyn.bonds import Bonds, family_sums
+from peridyn.discretization.body import Body
+from peridyn.discretization.bonds import Bonds, family_sums
 from peridyn.errors import InputError
 from peridyn.kernels.lps import (
     lps_deviatoric_energy,
@@ -39,14 +39,14 @@ from peridyn.kernels.lps import (
     lps_pair_force,
     lps_pair_force_cf,
 )
-from peridyn.materials.base import Model
-from peridyn.materials.elastic import (
+from peridyn.physics.materials.base import Model
+from peridyn.physics.materials.elastic import (
     bulk_modulus,
     check_elastic,
     plane_bulk_modulus,
     shear_modulus,
 )
-from peridyn.materials.lps_correction import energy_factors
+from peridyn.physics.materials.lps_correction import energy_factors
 
 #: ``shear-factor``: Peridigm's former "Apply Shear Correction Factor" (see ``LPSModel``).
 SURFACE_CORRECTIONS = ("none", "shear-factor", "energy")

@@ -10,7 +10,7 @@ import warnings
 
 import numpy as np
 
-from peridyn.body import Body
+from peridyn.discretization.body import Body
 from peridyn.errors import InputError
 
 

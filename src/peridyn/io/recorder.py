@@ -25,12 +25,12 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from peridyn import __version__
-from peridyn.body import Body
-from peridyn.damage import damage_field
+from peridyn.discretization.body import Body
+from peridyn.physics.damage import damage_field
 from peridyn.errors import InputError
 from peridyn.io.hdf5 import HDF5Writer
 from peridyn.io.vtk import PVDCollection, write_vtu
-from peridyn.solvers.state import State
+from peridyn.discretization.state import State
 
 
 @dataclass
@@ -59,7 +59,7 @@ class RecorderSpec:
     planes : dict of name -> (n,) point indices
     pzt_sensors : dict of name -> ((n,) point indices, (n, 2) weights)
         The signal is sum(weights * u[indices, :2]): the mean in-plane strain under a patch
-        (see ``peridyn.transducers.pzt_sensor_weights``).
+        (see ``peridyn.physics.transducers.pzt_sensor_weights``).
     series_dtype : "float64" or "float32"
         Storage type of the line and plane series (float32 halves big records).
     vtu : bool

@@ -25,12 +25,12 @@ import warnings
 
 import numpy as np
 
-from peridyn.body import Body
-from peridyn.bonds import Bonds
+from peridyn.discretization.body import Body
+from peridyn.discretization.bonds import Bonds
 from peridyn.errors import InputError
 from peridyn.kernels.pmb import pmb_energy, pmb_force, pmb_force_cf
-from peridyn.materials.base import Model
-from peridyn.materials.elastic import (
+from peridyn.physics.materials.base import Model
+from peridyn.physics.materials.elastic import (
     bulk_modulus,
     check_elastic,
     mean_fourth_power,

@@ -14,7 +14,7 @@ import h5py
 import numpy as np
 
 from peridyn.errors import InputError
-from peridyn.solvers.state import State
+from peridyn.discretization.state import State
 
 
 def save_checkpoint(path, state: State, intact: np.ndarray) -> None:

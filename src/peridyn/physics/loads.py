@@ -18,9 +18,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from peridyn.body import Body
+from peridyn.discretization.body import Body
 from peridyn.errors import InputError, did_you_mean
-from peridyn.timefunctions import Constant, TimeFunction
+from peridyn.physics.timefunctions import Constant, TimeFunction
 
 BC_KINDS = ("displacement", "velocity", "force", "body_force")
 IC_KINDS = ("displacement", "velocity")

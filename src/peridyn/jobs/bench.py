@@ -49,11 +49,11 @@ from collections.abc import Callable
 import numba
 import numpy as np
 
-from peridyn import geometry
-from peridyn.bonds import find_bonds
+from peridyn.discretization import geometry
+from peridyn.discretization.bonds import find_bonds
 from peridyn.errors import InputError
 from peridyn.kernels.pmb import pmb_force_baseline
-from peridyn.materials import make_model
+from peridyn.physics.materials import make_model
 
 #: Default grid: 46^3 = 97,336 points.
 DEFAULT_POINTS_PER_SIDE = 46

@@ -18,10 +18,10 @@ from peridyn.analysis.modes import classify_modes, mac_matrix
 from peridyn.errors import InputError
 from peridyn.io.hdf5 import HDF5Writer
 from peridyn.io.vtk import write_vtu
-from peridyn.materials import LPSModel
-from peridyn.recorder import provenance
+from peridyn.physics.materials import LPSModel
+from peridyn.io.recorder import provenance
 from peridyn.solvers.modal import modal_analysis
-from peridyn.solvers.ordering import estimated_factor_entries
+from peridyn.linalg.ordering import estimated_factor_entries
 
 #: Share of the machine's memory the factorisation may take.
 MEMORY_SHARE = 0.7

@@ -7,7 +7,7 @@ small ``u`` (N), and the lumped mass is ``M = rho V`` (kg).
 
 PMB: each directed bond i->j adds the energy (V_i k_ij / |xi|) (n . eta)^2 / 2.
 LPS: the energy of point p is V_p [c_p theta_p^2 + (alpha_p / 2) sum_j g_pj w e^2] with
-c_p = kappa / 2 - alpha_p m~_p / (2 d^2) (``peridyn.materials.lps``; without surface
+c_p = kappa / 2 - alpha_p m~_p / (2 d^2) (``peridyn.physics.materials.lps``; without surface
 correction g = 1, m~ = m and sum w (e^d)^2 = sum w e^2 - m theta^2 / d^2);
 theta_p = g_p . u couples p with its whole family, so each point adds a dense
 block 2 c_p V_p g_p g_p^T over its family: the matrix reaches two horizons
@@ -26,7 +26,7 @@ import scipy.sparse as sp
 from scipy.sparse.linalg import LinearOperator
 
 from peridyn.kernels.linear import lps_linear_force, pmb_linear_force
-from peridyn.materials import LPSModel, Model, PMBModel
+from peridyn.physics.materials import LPSModel, Model, PMBModel
 
 
 def mass_matrix(model: Model) -> sp.dia_matrix:

@@ -1,7 +1,7 @@
 """A convergence study: modal runs of one case over a spacing x horizon grid, Richardson fits.
 
 Each run is the case with ``discretization.spacing`` and ``discretization.horizon`` (a
-multiple of the spacing) overridden, solved by :func:`peridyn.modal_run.modal_table`.
+multiple of the spacing) overridden, solved by :func:`peridyn.jobs.modal.modal_table`.
 Modes are matched across runs by type and order ("1st bending", ...; rigid and
 unclassified modes are left out) and each series of runs is extrapolated with
 :func:`peridyn.analysis.convergence.richardson`. The series (seed 002, section 6.1,
@@ -81,11 +81,11 @@ def run_grid(case_path, spacings, horizon_factors, n_modes: int | None = None, o
         Receives one line per run.
 
     Runs whose factorisation would not fit in memory
-    (:func:`peridyn.modal_run.check_assembly_fits`) are skipped with the reason.
+    (:func:`peridyn.jobs.modal.check_assembly_fits`) are skipped with the reason.
     """
     from peridyn.io.case import load_case
-    from peridyn.modal_run import check_assembly_fits, modal_table, mode_label
-    from peridyn.simulation import build
+    from peridyn.jobs.modal import check_assembly_fits, modal_table, mode_label
+    from peridyn.jobs.run import build
 
     combos = [(h, m) for m in horizon_factors for h in spacings]
     runs = []
