@@ -26,8 +26,8 @@ from dataclasses import replace
 import numpy as np
 
 from peridyn.discretization import geometry
-from peridyn.jobs.bench import DEFAULT_POINTS_PER_SIDE, DENSITY, HORIZON_FACTOR, SPACING, E
 from peridyn.discretization.bonds import find_bonds
+from peridyn.jobs.bench import DEFAULT_POINTS_PER_SIDE, DENSITY, HORIZON_FACTOR, SPACING, E
 from peridyn.physics.contact import Contact
 from peridyn.physics.damage import BondDamage
 from peridyn.physics.loads import Loading

@@ -11,12 +11,12 @@ __version__ = "0.1.0"
 from peridyn.discretization import geometry  # noqa: E402
 from peridyn.discretization.body import Body  # noqa: E402
 from peridyn.discretization.bonds import Bonds, find_bonds  # noqa: E402
-from peridyn.physics.damage import BondDamage, damage_field  # noqa: E402
 from peridyn.errors import CaseFileError, InputError, InstabilityError, PeridynError  # noqa: E402
 from peridyn.io.case import load_case  # noqa: E402
+from peridyn.jobs.run import run_case  # noqa: E402
+from peridyn.physics.damage import BondDamage, damage_field  # noqa: E402
 from peridyn.physics.loads import BoundaryCondition, InitialCondition, Loading  # noqa: E402
 from peridyn.physics.materials import LPSModel, PMBModel, make_model  # noqa: E402
-from peridyn.jobs.run import run_case  # noqa: E402
 from peridyn.solvers import ExplicitSolver, State, relax  # noqa: E402
 
 __all__ = [

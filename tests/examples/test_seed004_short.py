@@ -6,9 +6,9 @@ from pathlib import Path
 
 import numpy as np
 
-from peridyn.physics.damage import damage_field
 from peridyn.io.case import load_case
 from peridyn.jobs.run import build
+from peridyn.physics.damage import damage_field
 from peridyn.solvers import ExplicitSolver
 
 CASE = Path(__file__).parents[2] / "cases" / "plate2d_stretch.yaml"

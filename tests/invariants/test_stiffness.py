@@ -78,7 +78,8 @@ def test_operator_equals_matrix_and_mass_is_lumped(name, rng):
 def test_split_stiffness_and_augmented_solve_equal_the_assembled_matrix(case, rng):
     """K = P + G^T D G exactly, and the augmented factorisation solves (K + s M) x = b
     (block elimination of y = D G x; see solvers.modal) to round-off."""
-    from peridyn.solvers.modal import free_dofs, shifted_inverse
+    from peridyn.linalg.dofs import free_dofs
+    from peridyn.linalg.shift_invert import shifted_inverse
     from peridyn.linalg.stiffness import stiffness_parts
 
     model, _ = _setup(case, rng)

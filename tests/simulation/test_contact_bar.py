@@ -20,8 +20,8 @@ from peridyn.discretization.bonds import crossing_segment, cut_bonds, find_bonds
 from peridyn.physics.contact import Contact
 from peridyn.physics.loads import BoundaryCondition, Loading
 from peridyn.physics.materials import make_model
-from peridyn.solvers import relax
 from peridyn.physics.timefunctions import Constant
+from peridyn.solvers import relax
 
 H = 1e-3
 LENGTH = 60 * H

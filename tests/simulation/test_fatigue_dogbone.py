@@ -5,10 +5,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from peridyn.jobs.fatigue import fatigue_parameters, run_fatigue_case
 from peridyn.fatigue.mapping import CycleMapping
 from peridyn.fatigue.run import run_fatigue
 from peridyn.io.case import load_case
+from peridyn.jobs.fatigue import fatigue_parameters, run_fatigue_case
 from peridyn.jobs.run import build
 
 CASE = Path(__file__).resolve().parents[2] / "cases" / "dogbone_fatigue.yaml"

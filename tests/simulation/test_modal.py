@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from peridyn.discretization import geometry
 from peridyn.analysis.modes import classify_modes, mac_matrix
+from peridyn.discretization import geometry
 from peridyn.discretization.bonds import find_bonds
 from peridyn.physics.materials import make_model
 from peridyn.solvers.modal import modal_analysis
@@ -118,10 +118,11 @@ def test_too_large_factorisation_is_refused_with_its_size(monkeypatch):
 
 
 def test_factor_size_estimate_matches_the_sparse_lu():
-    """The nested-dissection estimate (solvers.ordering) against SuperLU's L + U entries for
+    """The nested-dissection estimate (linalg.ordering) against SuperLU's L + U entries for
     the LPS plate at 2 mm: within a factor 1.5 either way (its stated accuracy: 1.4)."""
-    from peridyn.solvers.modal import factorise_shifted, free_dofs
+    from peridyn.linalg.dofs import free_dofs
     from peridyn.linalg.ordering import estimated_factor_entries
+    from peridyn.linalg.shift_invert import factorise_shifted
     from peridyn.linalg.stiffness import stiffness_parts
 
     model = _plate_model(2e-3)

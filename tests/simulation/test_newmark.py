@@ -5,14 +5,14 @@ import pytest
 
 from peridyn.discretization import geometry
 from peridyn.discretization.bonds import find_bonds
-from peridyn.physics.damage import BondDamage
 from peridyn.errors import InputError
+from peridyn.linalg.tangent import tangent_stiffness
+from peridyn.physics.damage import BondDamage
 from peridyn.physics.loads import BoundaryCondition, InitialCondition, Loading
 from peridyn.physics.materials import make_model
+from peridyn.physics.timefunctions import Ramp, ToneBurst
 from peridyn.solvers import ExplicitSolver
 from peridyn.solvers.newmark import NewmarkSolver
-from peridyn.linalg.tangent import tangent_stiffness
-from peridyn.physics.timefunctions import Ramp, ToneBurst
 
 
 def _strip():

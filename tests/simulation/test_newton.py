@@ -5,13 +5,13 @@ import pytest
 
 from peridyn.discretization import geometry
 from peridyn.discretization.bonds import find_bonds
-from peridyn.physics.damage import BondDamage
 from peridyn.errors import InputError
+from peridyn.physics.damage import BondDamage
 from peridyn.physics.loads import BoundaryCondition, Loading
 from peridyn.physics.materials import make_model
+from peridyn.physics.timefunctions import Constant, Ramp
 from peridyn.solvers import relax
 from peridyn.solvers.newton import newton
-from peridyn.physics.timefunctions import Constant, Ramp
 
 E_AL, RHO_AL = 70e9, 2700.0
 

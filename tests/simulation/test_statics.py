@@ -9,8 +9,8 @@ from peridyn.discretization.bonds import find_bonds
 from peridyn.physics.loads import BoundaryCondition, Loading
 from peridyn.physics.materials import make_model
 from peridyn.physics.materials.elastic import bulk_modulus, shear_modulus
-from peridyn.solvers import relax
 from peridyn.physics.timefunctions import Constant
+from peridyn.solvers import relax
 
 E_AL, RHO_AL = 70e9, 2700.0
 

@@ -12,13 +12,13 @@ import pytest
 from conftest import STEEL_E, STEEL_NU, STEEL_RHO
 
 from peridyn.discretization import geometry
-from peridyn.physics.absorbing import layer_damping
 from peridyn.discretization.bonds import find_bonds
 from peridyn.errors import InputError, InstabilityError
 from peridyn.io.case import load_case
+from peridyn.jobs.run import build, explicit_damping
+from peridyn.physics.absorbing import layer_damping
 from peridyn.physics.loads import InitialCondition, Loading
 from peridyn.physics.materials import make_model
-from peridyn.jobs.run import build, explicit_damping
 from peridyn.solvers import ExplicitSolver
 from peridyn.solvers.explicit import damped_stable_step
 

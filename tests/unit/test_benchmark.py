@@ -5,9 +5,9 @@ import json
 
 import pytest
 
-from peridyn.jobs import bench as benchmark
 from peridyn.cli import bench_cmd, main
 from peridyn.errors import InputError
+from peridyn.jobs import bench as benchmark
 
 ROW_KEYS = {"model", "dtype", "points", "bonds", "bond_updates_per_s", "bytes_per_bond",
             "roofline_fraction", "speedup_vs_baseline"}

@@ -14,8 +14,8 @@ from peridyn.discretization.bonds import crossing_rectangle, crossing_segment, c
 from peridyn.physics.damage import BondDamage
 from peridyn.physics.loads import BoundaryCondition, Loading
 from peridyn.physics.materials import make_model
-from peridyn.solvers import ExplicitSolver
 from peridyn.physics.timefunctions import Constant
+from peridyn.solvers import ExplicitSolver
 
 H = 0.5e-3
 

@@ -5,9 +5,9 @@ import pytest
 
 from peridyn.discretization import geometry
 from peridyn.discretization.bonds import find_bonds
-from peridyn.physics.damage import BondDamage, stretch_from_bond_stress
 from peridyn.errors import CaseFileError, InputError
 from peridyn.io.case import validate_case
+from peridyn.physics.damage import BondDamage, stretch_from_bond_stress
 from peridyn.physics.materials.pmb import PMBModel
 
 

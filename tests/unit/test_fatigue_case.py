@@ -5,8 +5,8 @@ from pathlib import Path
 import pytest
 
 from peridyn.errors import CaseFileError
-from peridyn.jobs.fatigue import check_fatigue_case
 from peridyn.io.case import load_case
+from peridyn.jobs.fatigue import check_fatigue_case
 
 CASE = Path(__file__).resolve().parents[2] / "cases" / "dogbone_fatigue.yaml"
 

@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 
 from peridyn.fatigue.calibration import stress_intensity
-from peridyn.jobs.fatigue import paris_rates, paris_slope
 from peridyn.fatigue.run import FatigueResult
 from peridyn.io.case import load_case
+from peridyn.jobs.fatigue import paris_rates, paris_slope
 
 M, C, A0, K0, GROWTH = 4.0, 1e-38, 5e-3, 23e6, 1.57
 

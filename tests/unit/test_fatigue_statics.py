@@ -17,9 +17,9 @@ from peridyn.discretization.bonds import find_bonds
 from peridyn.errors import InputError
 from peridyn.fatigue.model import bond_strain
 from peridyn.fatigue.statics import SHIFT, LinearStatics
+from peridyn.linalg.stiffness import assemble_stiffness
 from peridyn.physics.loads import BoundaryCondition, Loading
 from peridyn.physics.materials import make_model
-from peridyn.linalg.stiffness import assemble_stiffness
 from peridyn.physics.timefunctions import Constant
 
 SPACING = 1e-3

@@ -14,9 +14,9 @@ import pytest
 
 from peridyn.discretization import geometry
 from peridyn.discretization.bonds import find_bonds
-from peridyn.physics.damage import damage_field
 from peridyn.fatigue.tip import TIP_DAMAGE, crack_tip
 from peridyn.io.case import load_case
+from peridyn.physics.damage import damage_field
 from peridyn.physics.materials import make_model
 
 CASE = Path(__file__).resolve().parents[2] / "cases" / "dogbone_fatigue.yaml"

@@ -6,6 +6,7 @@ import pytest
 from peridyn.discretization import geometry
 from peridyn.discretization.body import Body, in_cylinder
 from peridyn.errors import InputError
+from peridyn.io import mesh_text
 
 
 def test_box_cells_and_volume():
@@ -48,8 +49,8 @@ def test_hole_removal_reindexes_node_sets():
 
 def test_text_mesh_round_trip(tmp_path):
     body = geometry.box((0.003, 0.002, 0.002), 1e-3)
-    geometry.to_text_mesh(body, tmp_path / "m.txt")
-    back = geometry.from_text_mesh(tmp_path / "m.txt")
+    mesh_text.to_text_mesh(body, tmp_path / "m.txt")
+    back = mesh_text.from_text_mesh(tmp_path / "m.txt")
     np.testing.assert_array_equal(back.points, body.points)
     np.testing.assert_allclose(back.volumes, body.volumes, rtol=1e-15)
     assert list(back.node_sets) == ["block_1"]

@@ -11,8 +11,9 @@ import pytest
 from peridyn.discretization import geometry
 from peridyn.discretization.bonds import find_bonds
 from peridyn.errors import InputError
+from peridyn.linalg.dofs import free_dofs
 from peridyn.physics.materials import make_model
-from peridyn.solvers.modal import free_dofs, modal_analysis
+from peridyn.solvers.modal import modal_analysis
 
 #: PMMA plate of VALIDATION.md V4 (m, Pa, -, kg/m^3); 4 mm spacing keeps it small (600 points).
 SIZE, E, NU, RHO = (0.10, 0.05, 0.008), 5.35e9, 0.33, 1200.0
@@ -71,7 +72,7 @@ def test_lobpcg_on_a_clamped_plate_has_no_rigid_mode():
 
 
 def test_block_operator_equals_the_linearised_force_kernel():
-    """K applied to a block (solvers.block_operator) equals, column by column, the one-vector
+    """K applied to a block (linalg.block_operator) equals, column by column, the one-vector
     operator K u = -V f_lin(u) of peridyn.linalg.stiffness, for LPS (plain and with the energy surface
     correction's per-bond deviatoric stiffness) with cut bonds and for PMB."""
     from peridyn.linalg.block_operator import block_stiffness_operator
@@ -95,7 +96,7 @@ def test_rigid_body_modes_follow_the_constraints():
     """Six rigid motions for a free 3D body, three (x, y translations, z rotation) for a free
     2D one, one (the rotation about that line) when the points on a line are fixed, two when
     they may slide along it."""
-    from peridyn.solvers.eigen_iterative import rigid_body_modes
+    from peridyn.linalg.amg import rigid_body_modes
 
     body = geometry.box((0.01, 0.006, 0.004), 2e-3)
     n = body.n_points

@@ -1,4 +1,4 @@
-"""Block V-cycle of the LOBPCG preconditioner (solvers.block_amg) and its aggregates.
+"""Block V-cycle of the LOBPCG preconditioner (linalg.block_amg) and its aggregates.
 
 References: pyamg's own V-cycle (``MultilevelSolver.aspreconditioner``) on the same hierarchy,
 applied column by column, is the cycle the block version must reproduce; a V-cycle with
@@ -13,10 +13,10 @@ import scipy.sparse as sp
 
 from peridyn.discretization import geometry
 from peridyn.discretization.bonds import find_bonds
-from peridyn.physics.materials import make_model
+from peridyn.linalg.amg import orthonormal, proxy_aggregates, proxy_stiffness, rigid_fields
 from peridyn.linalg.block_amg import BlockVCycle, smoothed_aggregation_hierarchy
-from peridyn.solvers.eigen_iterative import _orthonormal, proxy_aggregates, proxy_stiffness, rigid_fields
-from peridyn.solvers.modal import free_dofs
+from peridyn.linalg.dofs import free_dofs
+from peridyn.physics.materials import make_model
 
 #: PMMA plate of VALIDATION.md V4 at 4 mm spacing (600 points), horizon 3.001 spacings.
 SIZE, E, NU, RHO = (0.10, 0.05, 0.008), 5.35e9, 0.33, 1200.0
@@ -34,7 +34,7 @@ def _system(fixed_face=None, size=SIZE):
     proxy = proxy_stiffness(model, dofs)
     m = np.repeat(RHO * body.volumes, 3)[dofs]
     a = (proxy + sp.diags(1e-6 * np.median(proxy.diagonal() / m) * m)).tocsr()
-    near_null = _orthonormal(rigid_fields(body.points)[dofs])
+    near_null = orthonormal(rigid_fields(body.points)[dofs])
     return model, dofs, a, near_null
 
 

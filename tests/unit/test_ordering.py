@@ -1,4 +1,4 @@
-"""Geometric nested dissection (solvers.ordering): a permutation whose separators split."""
+"""Geometric nested dissection (linalg.ordering): a permutation whose separators split."""
 
 import numpy as np
 from scipy.spatial import cKDTree

@@ -8,14 +8,14 @@ import numpy as np
 import pytest
 from conftest import small_model
 
-from peridyn.discretization import geometry
 from peridyn.analysis.bloch import Discretisation, bloch_cell
+from peridyn.discretization import geometry
 from peridyn.discretization.bonds import find_bonds
 from peridyn.errors import InputError
-from peridyn.physics.materials import make_model
-from peridyn.physics.materials.lps_correction import deviatoric_tests
 from peridyn.linalg.stiffness import assemble_stiffness, linear_force, stiffness_operator
 from peridyn.linalg.tangent import tangent_stiffness
+from peridyn.physics.materials import make_model
+from peridyn.physics.materials.lps_correction import deviatoric_tests
 
 GAMMA = 1e-6  # strain amplitude: geometric nonlinearity O(gamma) = 1e-6 relative
 

@@ -7,8 +7,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from peridyn.discretization import geometry
 from peridyn.analysis.modes import classify_modes
+from peridyn.discretization import geometry
 from peridyn.discretization.bonds import find_bonds
 from peridyn.io.case import load_case
 from peridyn.physics.materials import make_model

@@ -10,8 +10,8 @@ from pathlib import Path
 import pytest
 
 from peridyn.analysis.harmonics import second_harmonic_ratio
-from peridyn.jobs.breathing import compare, drive_frequency
 from peridyn.io.case import load_case
+from peridyn.jobs.breathing import compare, drive_frequency
 
 CASE = Path(__file__).resolve().parents[2] / "cases" / "lamb_breathing_crack.yaml"
 

@@ -17,8 +17,8 @@ from peridyn.discretization import geometry
 from peridyn.discretization.bonds import find_bonds
 from peridyn.physics.loads import BoundaryCondition, Loading
 from peridyn.physics.materials import make_model
-from peridyn.solvers import ExplicitSolver
 from peridyn.physics.timefunctions import ToneBurst
+from peridyn.solvers import ExplicitSolver
 
 H = 1e-3
 WAVELENGTH = 20 * H

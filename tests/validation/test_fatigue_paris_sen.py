@@ -12,8 +12,8 @@ from pathlib import Path
 
 import pytest
 
-from peridyn.jobs.fatigue import run_fatigue_case
 from peridyn.io.case import load_case
+from peridyn.jobs.fatigue import run_fatigue_case
 
 CASES = Path(__file__).parents[2] / "cases"
 

@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 
 from peridyn.analysis.crack import crack_paths, departure_angle, path_from
-from peridyn.physics.damage import damage_field
 from peridyn.io.case import load_case
 from peridyn.jobs.run import build
+from peridyn.physics.damage import damage_field
 from peridyn.solvers import ExplicitSolver
 
 CASE = Path(__file__).parents[2] / "cases" / "kalthoff_winkler.yaml"

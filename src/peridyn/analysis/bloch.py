@@ -31,8 +31,8 @@ from scipy.optimize import brentq
 from peridyn.discretization import geometry
 from peridyn.discretization.bonds import find_bonds
 from peridyn.errors import InputError
-from peridyn.physics.materials import make_model
 from peridyn.linalg.stiffness import assemble_stiffness
+from peridyn.physics.materials import make_model
 
 #: Plate subspaces: (name, parity of u_x, u_y, u_z under the mid-plane mirror; None: absent).
 PLATE_FAMILIES = {"S": (1, None, -1), "A": (-1, None, 1), "SH": (None, 1, None)}

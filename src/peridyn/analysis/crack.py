@@ -34,8 +34,8 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components, shortest_path
 from scipy.spatial import cKDTree
 
-from peridyn.physics.damage import damage_field
 from peridyn.errors import InputError
+from peridyn.physics.damage import damage_field
 
 DEFAULT_THRESHOLD = 0.35
 GEODESIC_LINK = 2.5  # spacings: links of the graph for path distances (near-Euclidean)

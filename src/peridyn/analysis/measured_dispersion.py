@@ -28,7 +28,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from peridyn.discretization import geometry
 from peridyn.analysis.dispersion import (
     BRANCHES,
     Medium,
@@ -36,6 +35,7 @@ from peridyn.analysis.dispersion import (
     parse_direction,
     polarisations,
 )
+from peridyn.discretization import geometry
 from peridyn.discretization.bonds import find_bonds
 from peridyn.errors import InputError
 from peridyn.physics.materials import Model, make_model

@@ -12,8 +12,8 @@ from __future__ import annotations
 
 import sys
 
-from peridyn.jobs.bench import DEFAULT_POINTS, format_table, run_benchmark
 from peridyn.cli import add_json_flag
+from peridyn.jobs.bench import DEFAULT_POINTS, format_table, run_benchmark
 
 
 def register(sub) -> None:

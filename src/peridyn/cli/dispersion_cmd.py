@@ -9,8 +9,8 @@ import sys
 import numpy as np
 
 from peridyn.analysis.dispersion import MODELS, Medium, dispersion_relation, parse_direction
-from peridyn.discretization.bonds import INFLUENCE_FUNCTIONS
 from peridyn.cli import add_json_flag
+from peridyn.discretization.bonds import INFLUENCE_FUNCTIONS
 from peridyn.errors import InputError
 
 #: Rows of the human-readable table per branch.

@@ -53,8 +53,8 @@ def run(args) -> dict:
         return calibrate(args)
     from tqdm import tqdm
 
-    from peridyn.jobs.fatigue import run_fatigue_case
     from peridyn.io.case import load_case
+    from peridyn.jobs.fatigue import run_fatigue_case
 
     case = load_case(args.case, args.overrides)
     progress = None if args.no_progress or args.json else (

@@ -45,8 +45,8 @@ def register(sub) -> None:
 def run(args) -> dict:
     """Run the grid, fit, write the tables and the figure; print the table unless --json."""
     from peridyn.io.case import load_case
-    from peridyn.plotting.convergence import plot_convergence
     from peridyn.jobs.study import SERIES, fit_series, run_grid, write_study
+    from peridyn.plotting.convergence import plot_convergence
 
     spacings = _positive_list("--spacing", args.spacing)
     factors = _positive_list("--horizon", args.horizon)

@@ -9,12 +9,12 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-import numba
 import numpy as np
 from scipy.spatial import cKDTree
 
 from peridyn.discretization.body import Body
 from peridyn.errors import InputError, did_you_mean
+from peridyn.kernels.bond_search import bond_families, bond_geometry, box_fraction_in_ball
 
 #: Relative tolerance on the horizon: a neighbour at exactly ``delta`` is in.
 HORIZON_RTOL = 1e-12
@@ -163,8 +163,8 @@ def find_bonds(body: Body, horizon: float, influence: str = "constant",
     if partial_volumes:
         reach += 0.5 * float(np.max(np.linalg.norm(cells, axis=1)))
     pairs = cKDTree(x).query_pairs(reach, output_type="ndarray")
-    offsets, j = _families(pairs, body.n_points)
-    length, factor = _bond_geometry(x, cells, offsets, j, horizon * (1 + HORIZON_RTOL),
+    offsets, j = bond_families(pairs, body.n_points)
+    length, factor = bond_geometry(x, cells, offsets, j, horizon * (1 + HORIZON_RTOL),
                                     partial_volumes, quadrature_points)
     if partial_volumes:  # drop neighbours whose cell lies wholly outside the sphere
         keep = factor > 0
@@ -190,74 +190,6 @@ def find_bonds(body: Body, horizon: float, influence: str = "constant",
     )
 
 
-@numba.njit(cache=True)
-def _families(pairs, n):
-    """CSR families (offsets (n+1,) int64, neighbours int32 sorted per family) from i<j pairs."""
-    counts = np.zeros(n + 1, dtype=np.int64)
-    for p in range(pairs.shape[0]):
-        counts[pairs[p, 0] + 1] += 1
-        counts[pairs[p, 1] + 1] += 1
-    offsets = np.cumsum(counts)
-    cursor = offsets[:-1].copy()
-    nbr = np.empty(offsets[-1], dtype=np.int32)
-    for p in range(pairs.shape[0]):
-        a, b = pairs[p, 0], pairs[p, 1]
-        nbr[cursor[a]] = b
-        cursor[a] += 1
-        nbr[cursor[b]] = a
-        cursor[b] += 1
-    for i in range(n):
-        nbr[offsets[i]:offsets[i + 1]].sort()
-    return offsets, nbr
-
-
-@numba.njit(parallel=True, cache=True)
-def _bond_geometry(x, cells, offsets, nbr, radius, partial, q):
-    """Bond lengths and volume factors (fraction of the neighbour's cell inside the ball)."""
-    n = x.shape[0]
-    length = np.empty(nbr.shape[0])
-    factor = np.empty(nbr.shape[0])
-    for i in numba.prange(n):
-        for b in range(offsets[i], offsets[i + 1]):
-            j = nbr[b]
-            d0 = x[j, 0] - x[i, 0]
-            d1 = x[j, 1] - x[i, 1]
-            d2 = x[j, 2] - x[i, 2]
-            length[b] = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
-            if partial:
-                factor[b] = _box_fraction_in_ball(d0, d1, d2, cells[j, 0], cells[j, 1],
-                                                  cells[j, 2], radius, q)
-            else:
-                factor[b] = 1.0 if length[b] <= radius else 0.0
-    return length, factor
-
-
-@numba.njit(cache=True)
-def _box_fraction_in_ball(c0, c1, c2, h0, h1, h2, radius, q):
-    """Fraction of the box centred at (c0, c1, c2) with sides (h0, h1, h2) inside the ball
-    of ``radius`` at the origin (h2 = 0: a rectangle in the plane z = c2).
-
-    Exact along x, midpoint rule with ``q`` samples along y and z (1 along z if h2 = 0).
-    """
-    half = 0.5 * np.sqrt(h0 * h0 + h1 * h1 + h2 * h2)
-    r = np.sqrt(c0 * c0 + c1 * c1 + c2 * c2)
-    if r + half <= radius:
-        return 1.0
-    if r - half >= radius:
-        return 0.0
-    qz = q if h2 > 0 else 1
-    lo, hi = c0 - 0.5 * h0, c0 + 0.5 * h0
-    total = 0.0
-    for a in range(q):
-        y = c1 + h1 * ((a + 0.5) / q - 0.5)
-        for e in range(qz):
-            z = c2 + h2 * ((e + 0.5) / qz - 0.5)
-            rest = radius * radius - y * y - z * z
-            if rest > 0:
-                s = np.sqrt(rest)
-                total += max(0.0, min(hi, s) - max(lo, -s))
-    return total / (h0 * q * qz)
-
 
 def cell_fraction_in_ball(xi: np.ndarray, cell: np.ndarray, radius: float,
                           quadrature_points: int = 8) -> np.ndarray:
@@ -278,7 +210,7 @@ def cell_fraction_in_ball(xi: np.ndarray, cell: np.ndarray, radius: float,
     (n,) float64 in [0, 1]
     """
     return np.array([
-        _box_fraction_in_ball(*xi[k], *cell[k], radius, quadrature_points) for k in range(len(xi))
+        box_fraction_in_ball(*xi[k], *cell[k], radius, quadrature_points) for k in range(len(xi))
     ])
 
 

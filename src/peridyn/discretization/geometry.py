@@ -141,36 +141,6 @@ def rectangle(length, width, spacing, thickness, plane: str = "stress",
                 dim=2, spacing=h, thickness=t, plane=plane)
 
 
-def from_text_mesh(path, dim: int = 3, thickness: float | None = None,
-                   plane: str | None = None) -> Body:
-    """A body from a Peridigm-style text mesh (``x y z block_id volume`` per line).
-
-    Cells are taken as cubes of the point's volume (squares times ``thickness``
-    in 2D); node sets ``block_<id>`` hold the points of each block.
-    """
-    from peridyn.io.mesh_text import read_text_mesh
-
-    points, blocks, volumes = read_text_mesh(path)
-    if dim == 2:
-        if thickness is None:
-            raise InputError("a 2D text mesh needs the thickness of the body")
-        side = np.sqrt(volumes / thickness)
-        cells = np.stack([side, side, np.full_like(side, thickness)], axis=1)
-    else:
-        side = np.cbrt(volumes)
-        cells = np.stack([side, side, side], axis=1)
-    sets = {f"block_{b}": np.flatnonzero(blocks == b) for b in np.unique(blocks)}
-    return Body(points=points, volumes=volumes, cells=cells, dim=dim,
-                spacing=float(np.median(side)), node_sets=sets, thickness=thickness, plane=plane)
-
-
-def to_text_mesh(body: Body, path, block_ids=None) -> None:
-    """Write ``body`` as a Peridigm-style text mesh (block 1 unless ``block_ids`` given)."""
-    from peridyn.io.mesh_text import write_text_mesh
-
-    blocks = np.ones(body.n_points, dtype=np.int64) if block_ids is None else block_ids
-    write_text_mesh(path, body.points, blocks, body.volumes)
-
 
 def face(body: Body, which: str, depth: float | None = None) -> np.ndarray:
     """Mask of the points within ``depth`` (default: half a cell) of a bounding-box face.

@@ -1,4 +1,4 @@
-"""The mutable state of a dynamic run."""
+"""The mutable state of the points in a dynamic run: displacement, velocity, acceleration."""
 
 from __future__ import annotations
 
@@ -28,15 +28,3 @@ class State:
     def zeros(cls, n_points: int) -> State:
         """A body at rest in its reference configuration."""
         return cls(np.zeros((n_points, 3)), np.zeros((n_points, 3)), np.zeros((n_points, 3)))
-
-
-def advance(solver, state: State, n_steps: int, observers=(), progress=None) -> State:
-    """Call ``solver.step(state)`` ``n_steps`` times, then ``observe(state, solver)`` of each
-    observer and ``progress.update(1)`` (e.g. a tqdm bar) after every step."""
-    for _ in range(int(n_steps)):
-        solver.step(state)
-        for obs in observers:
-            obs.observe(state, solver)
-        if progress is not None:
-            progress.update(1)
-    return state

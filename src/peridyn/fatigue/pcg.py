@@ -9,7 +9,7 @@ The fatigue loop solves a sequence of systems whose matrices differ by the bonds
 all preconditioned by one old factorisation; the search directions of the earlier solves span
 where that factorisation is off, so they make a good W for the next solve
 (``RecycledDirections``). W is multiplied by the new A at each solve as one block (one pass over
-the bonds for all directions, ``solvers.block_operator``), which costs about as much as a few
+the bonds for all directions, ``linalg.block_operator``), which costs about as much as a few
 single products.
 """
 

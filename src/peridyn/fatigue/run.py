@@ -13,12 +13,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from peridyn.physics.damage import damage_field
 from peridyn.errors import InputError
 from peridyn.fatigue.mapping import CycleMapping
 from peridyn.fatigue.model import FatigueParameters, RemainingLife, cyclic_bond_strain
 from peridyn.fatigue.statics import LinearStatics
 from peridyn.fatigue.tip import TIP_DAMAGE, crack_tip
+from peridyn.physics.damage import damage_field
 from peridyn.physics.loads import Loading
 from peridyn.physics.materials.base import Model
 

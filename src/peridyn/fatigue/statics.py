@@ -10,10 +10,10 @@ two dilatation rows); when a solve with it has not converged after ``refactor_it
 built again from the bonds intact now and the solve goes on from where it was.
 
 - ``amg``: one V-cycle of smoothed-aggregation AMG on the pair proxy of the bonds
-  (``solvers.eigen_iterative.proxy_stiffness`` and ``amg_preconditioner``, rigid motions as
+  (``linalg.amg.proxy_stiffness`` and ``amg_preconditioner``, rigid motions as
   near-null space). About 15-25 iterations per solve, each a V-cycle and a product, both linear
   in the number of points; little memory.
-- ``direct``: a sparse factorisation of K (``solvers.modal.shifted_inverse``: the augmented LPS
+- ``direct``: a sparse factorisation of K (``linalg.shift_invert.shifted_inverse``: the augmented LPS
   system in nested-dissection order). Fresh, it solves the system in one iteration; after bonds
   break, a few more, fewer still because the search directions of the earlier solves (up to
   ``recycle``) deflate the later ones (``fatigue.pcg``). Each iteration is a triangular solve
@@ -42,12 +42,13 @@ import numpy as np
 
 from peridyn.errors import InputError
 from peridyn.fatigue.pcg import PCGResult, RecycledDirections, deflated_pcg
+from peridyn.linalg.amg import amg_preconditioner, proxy_stiffness, rigid_fields
+from peridyn.linalg.block_operator import block_stiffness_operator
+from peridyn.linalg.dofs import free_dofs
+from peridyn.linalg.shift_invert import shifted_inverse
+from peridyn.linalg.stiffness import stiffness_operator, stiffness_parts
 from peridyn.physics.loads import Loading
 from peridyn.physics.materials.base import Model
-from peridyn.linalg.block_operator import block_stiffness_operator
-from peridyn.solvers.eigen_iterative import amg_preconditioner, proxy_stiffness, rigid_fields
-from peridyn.solvers.modal import free_dofs, shifted_inverse
-from peridyn.linalg.stiffness import stiffness_operator, stiffness_parts
 
 #: Diagonal shift relative to the mean diagonal stiffness.
 SHIFT = 1e-9
@@ -62,7 +63,7 @@ FRESH_ITERATIONS = 1000
 DIRECT_DOFS = 40_000
 #: Search directions of earlier solves kept to deflate the next ones (``fatigue.pcg``).
 RECYCLE = 80
-#: Vectors per block product (bounds the (n_bonds, BLOCK) work arrays of ``solvers.block_operator``).
+#: Vectors per block product (bounds the (n_bonds, BLOCK) work arrays of ``linalg.block_operator``).
 BLOCK = 20
 
 

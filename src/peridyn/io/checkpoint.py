@@ -13,8 +13,8 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-from peridyn.errors import InputError
 from peridyn.discretization.state import State
+from peridyn.errors import InputError
 
 
 def save_checkpoint(path, state: State, intact: np.ndarray) -> None:

@@ -12,6 +12,7 @@ import warnings
 
 import numpy as np
 
+from peridyn.discretization.body import Body
 from peridyn.errors import InputError
 
 N_COLUMNS = 5
@@ -190,3 +191,30 @@ def _check_volumes(path: str, volumes: np.ndarray) -> None:
         raise InputError(
             f"{path}, line {line}: volume must be positive and finite, got {float(value)!r}"
         )
+
+
+def from_text_mesh(path, dim: int = 3, thickness: float | None = None,
+                   plane: str | None = None) -> Body:
+    """A body from a Peridigm-style text mesh (``x y z block_id volume`` per line).
+
+    Cells are taken as cubes of the point's volume (squares times ``thickness``
+    in 2D); node sets ``block_<id>`` hold the points of each block.
+    """
+    points, blocks, volumes = read_text_mesh(path)
+    if dim == 2:
+        if thickness is None:
+            raise InputError("a 2D text mesh needs the thickness of the body")
+        side = np.sqrt(volumes / thickness)
+        cells = np.stack([side, side, np.full_like(side, thickness)], axis=1)
+    else:
+        side = np.cbrt(volumes)
+        cells = np.stack([side, side, side], axis=1)
+    sets = {f"block_{b}": np.flatnonzero(blocks == b) for b in np.unique(blocks)}
+    return Body(points=points, volumes=volumes, cells=cells, dim=dim,
+                spacing=float(np.median(side)), node_sets=sets, thickness=thickness, plane=plane)
+
+
+def to_text_mesh(body: Body, path, block_ids=None) -> None:
+    """Write ``body`` as a Peridigm-style text mesh (block 1 unless ``block_ids`` given)."""
+    blocks = np.ones(body.n_points, dtype=np.int64) if block_ids is None else block_ids
+    write_text_mesh(path, body.points, blocks, body.volumes)

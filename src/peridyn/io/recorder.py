@@ -26,11 +26,11 @@ from scipy.spatial import cKDTree
 
 from peridyn import __version__
 from peridyn.discretization.body import Body
-from peridyn.physics.damage import damage_field
+from peridyn.discretization.state import State
 from peridyn.errors import InputError
 from peridyn.io.hdf5 import HDF5Writer
 from peridyn.io.vtk import PVDCollection, write_vtu
-from peridyn.discretization.state import State
+from peridyn.physics.damage import damage_field
 
 
 @dataclass

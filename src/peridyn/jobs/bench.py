@@ -53,6 +53,7 @@ from peridyn.discretization import geometry
 from peridyn.discretization.bonds import find_bonds
 from peridyn.errors import InputError
 from peridyn.kernels.pmb import pmb_force_baseline
+from peridyn.kernels.triad import triad
 from peridyn.physics.materials import make_model
 
 #: Default grid: 46^3 = 97,336 points.
@@ -74,22 +75,17 @@ ROWS = (
 E, NU, DENSITY = 200e9, 0.25, 7850.0
 
 
-@numba.njit(parallel=True, cache=True)
-def _triad(a, b, c, s):
-    for i in numba.prange(a.shape[0]):
-        a[i] = b[i] + s * c[i]
-
 
 def triad_bandwidth(elements: int = DEFAULT_TRIAD_ELEMENTS, repeat: int = 10) -> float:
     """Memory bandwidth (bytes/s) of the triad ``a = b + s c``, STREAM's count (24 B per element)."""
     b = np.full(elements, 1.0)
     c = np.full(elements, 2.0)
     a = np.zeros(elements)
-    _triad(a, b, c, 3.0)  # compile (or load) and touch the pages
+    triad(a, b, c, 3.0)  # compile (or load) and touch the pages
     best = np.inf
     for _ in range(max(1, repeat)):
         t0 = time.perf_counter()
-        _triad(a, b, c, 3.0)
+        triad(a, b, c, 3.0)
         best = min(best, time.perf_counter() - t0)
     return 3 * a.itemsize * elements / best
 

@@ -17,11 +17,11 @@ import numpy as np
 from peridyn.analysis.modes import classify_modes, mac_matrix
 from peridyn.errors import InputError
 from peridyn.io.hdf5 import HDF5Writer
-from peridyn.io.vtk import write_vtu
-from peridyn.physics.materials import LPSModel
 from peridyn.io.recorder import provenance
-from peridyn.solvers.modal import modal_analysis
+from peridyn.io.vtk import write_vtu
 from peridyn.linalg.ordering import estimated_factor_entries
+from peridyn.physics.materials import LPSModel
+from peridyn.solvers.modal import modal_analysis
 
 #: Share of the machine's memory the factorisation may take.
 MEMORY_SHARE = 0.7
@@ -177,7 +177,7 @@ def check_assembly_fits(model) -> None:
     """Refuse, with the numbers, a shift-invert factorisation too large for this machine.
 
     The factor's size is estimated from the nested-dissection separators of the
-    points (``solvers.ordering.estimated_factor_entries``): it grows with the
+    points (``linalg.ordering.estimated_factor_entries``): it grows with the
     horizon (wider separators) much faster than the number of bonds does.
     """
     needed = factor_bytes(model)

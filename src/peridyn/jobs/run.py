@@ -14,23 +14,24 @@ from pathlib import Path
 import numpy as np
 
 from peridyn.discretization import geometry
-from peridyn.physics.absorbing import layer_damping
 from peridyn.discretization.body import Body, in_box, in_cylinder, in_sphere
 from peridyn.discretization.bonds import Bonds, crossing_rectangle, crossing_segment, cut_bonds, find_bonds
+from peridyn.discretization.state import State
+from peridyn.errors import CaseFileError, InputError
+from peridyn.io import mesh_text
+from peridyn.io.case import Case, Region
 from peridyn.io.checkpoint import Checkpointer, load_checkpoint
+from peridyn.io.hdf5 import HDF5Writer, read_series
+from peridyn.io.recorder import LineProbe, Recorder, RecorderSpec, provenance
+from peridyn.jobs.lamb_analysis import analyse
+from peridyn.physics.absorbing import layer_damping
 from peridyn.physics.contact import Contact
 from peridyn.physics.damage import BondDamage, damage_field
-from peridyn.errors import CaseFileError, InputError
-from peridyn.io.case import Case, Region
-from peridyn.io.hdf5 import HDF5Writer, read_series
 from peridyn.physics.loads import BoundaryCondition, InitialCondition, Loading
 from peridyn.physics.materials import Model, make_model
-from peridyn.jobs.lamb_analysis import analyse
-from peridyn.io.recorder import LineProbe, Recorder, RecorderSpec, provenance
-from peridyn.solvers import ExplicitSolver, relax
-from peridyn.discretization.state import State
 from peridyn.physics.timefunctions import from_spec
 from peridyn.physics.transducers import pin_force_actuator, pzt_radial_actuator, pzt_sensor_weights
+from peridyn.solvers import ExplicitSolver, relax
 
 
 @dataclass
@@ -61,7 +62,7 @@ def build_body(case: Case, base_dir=".") -> Body:
                                   plane=g.plane, origin=(g.origin or (0.0, 0.0))[:2])
     else:
         mesh = Path(g.file) if Path(g.file).is_absolute() else Path(base_dir) / g.file
-        body = geometry.from_text_mesh(mesh, dim=g.dimension, thickness=g.thickness,
+        body = mesh_text.from_text_mesh(mesh, dim=g.dimension, thickness=g.thickness,
                                        plane=g.plane if g.dimension == 2 else None)
     for k, region in enumerate(case.removals):
         body = body.remove(region_mask(body, region, f"removals[{k}]"))

@@ -125,13 +125,13 @@ def stiffness_parts(model: Model, energy_of: np.ndarray | None = None) -> Stiffn
     n = model.body.n_points
     if isinstance(model, PMBModel):
         pair = vol[owners] * model.bond_stiffness.astype(np.float64) / b.length  # W = k e^2 / 4L
-        return StiffnessParts(_pair_matrix(owners[counted], b.neighbours[counted], n_vec[counted],
+        return StiffnessParts(pair_matrix(owners[counted], b.neighbours[counted], n_vec[counted],
                                            pair[counted], n))
     if isinstance(model, LPSModel):
         w = np.where(counted, model.w.astype(np.float64), 0.0)
         # (V alpha g w / 2) e^2 per bond
         pair = 2.0 * vol[owners] * model.alpha[owners] * model.dev_factor * w
-        k_pair = _pair_matrix(owners[counted], b.neighbours[counted], n_vec[counted], pair[counted], n)
+        k_pair = pair_matrix(owners[counted], b.neighbours[counted], n_vec[counted], pair[counted], n)
         d = model.dim
         c = 0.5 * model.bulk - model.alpha * model.dev_weighted_volume / (2 * d * d)
         a = model.theta_coef[owners] * w * b.length  # d theta_p / d e_pj
@@ -148,7 +148,7 @@ def assemble_stiffness(model: Model, energy_of: np.ndarray | None = None) -> sp.
     return stiffness_parts(model, energy_of).assemble()
 
 
-def _pair_matrix(i, j, n_vec, coef, n_points) -> sp.csr_matrix:
+def pair_matrix(i, j, n_vec, coef, n_points) -> sp.csr_matrix:
     """Sum over bonds of coef (n n^T) on the blocks ii, jj and -coef (n n^T) on ij, ji."""
     outer = coef[:, None, None] * n_vec[:, :, None] * n_vec[:, None, :]  # (nb, 3, 3)
     a = np.arange(3)

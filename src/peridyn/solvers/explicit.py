@@ -18,12 +18,13 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from peridyn.discretization.state import State
+from peridyn.errors import InputError, InstabilityError
 from peridyn.physics.contact import Contact
 from peridyn.physics.damage import BondDamage
-from peridyn.errors import InputError, InstabilityError
 from peridyn.physics.loads import Loading
 from peridyn.physics.materials.base import Model
-from peridyn.discretization.state import State, advance
+from peridyn.solvers.stepping import advance
 
 
 class ExplicitSolver:

@@ -10,7 +10,7 @@ Shift-invert Lanczos (``scipy.sparse.linalg.eigsh``) with a negative shift
 
 is as sparse as the bonds and gives (K + s M) x = b; it is quasi-definite (D > 0 on
 usual materials), so a symmetric fill-reducing order (geometric nested dissection,
-``solvers.ordering``) with little pivoting factorises it
+``linalg.ordering``) with little pivoting factorises it
 at a fraction of the memory and time of K itself (D < 0, as for a 2D plane-stress LPS
 with nu < 1/3, only needs more pivoting). Rigid-body modes
 (six for a free 3D body, three in 2D) come out with |f| near zero and are
@@ -27,12 +27,13 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.sparse.linalg import LinearOperator, eigsh, splu
+from scipy.sparse.linalg import eigsh
 
 from peridyn.errors import InputError
+from peridyn.linalg.dofs import free_dofs
+from peridyn.linalg.shift_invert import shifted_inverse
+from peridyn.linalg.stiffness import mass_matrix, stiffness_parts
 from peridyn.physics.materials.base import Model
-from peridyn.linalg.ordering import order_unknowns
-from peridyn.linalg.stiffness import StiffnessParts, mass_matrix, stiffness_parts
 
 #: Modes whose frequency is below this fraction of the highest computed one are rigid.
 RIGID_FRACTION = 1e-4
@@ -70,16 +71,6 @@ class ModalResult:
         return ModalResult(self.frequencies[keep], self.shapes[keep], self.residuals[keep],
                            self.rigid[keep])
 
-
-def free_dofs(model: Model, fixed: np.ndarray | None = None) -> np.ndarray:
-    """Indices of the free dofs: all but the z dofs of a 2D body and the ``fixed`` ones."""
-    n = model.body.n_points
-    free = np.ones((n, 3), dtype=bool)
-    if model.body.dim == 2:
-        free[:, 2] = False
-    if fixed is not None:
-        free &= ~fixed
-    return np.flatnonzero(free.ravel())
 
 
 #: Eigensolvers of ``modal_analysis``.
@@ -151,48 +142,3 @@ def _result(lam, vecs, K, m, dofs, n_points, k_max, known_rigid) -> ModalResult:
                        rigid)
 
 
-def shifted_inverse(parts: StiffnessParts, dofs: np.ndarray, shift_mass: np.ndarray,
-                    points: np.ndarray, reach: float) -> LinearOperator:
-    """(K + s M)^-1 on the ``dofs`` as an operator, factorised once (``factorise_shifted``)."""
-    lu, perm = factorise_shifted(parts, dofs, shift_mass, points, reach)
-    n = len(dofs)
-    rhs = np.zeros(len(perm))
-    inverse = np.empty_like(perm)
-    inverse[perm] = np.arange(len(perm))
-
-    def solve(b):
-        rhs[:n] = b
-        return lu.solve(rhs[perm])[inverse[:n]]
-
-    return LinearOperator((n, n), matvec=solve, dtype=np.float64)
-
-
-def factorise_shifted(parts: StiffnessParts, dofs: np.ndarray, shift_mass: np.ndarray,
-                      points: np.ndarray, reach: float):
-    """Sparse LU of K + s M on the ``dofs`` (or of the augmented system), and its order.
-
-    ``shift_mass`` ((len(dofs),) N/m) is s M on those dofs; ``points`` (n, 3) m and
-    ``reach`` (m, the horizon) give the nested-dissection order of the unknowns
-    (``solvers.ordering``). With a dilatation part the augmented system of the module
-    docstring is factorised instead of K + s M; its first len(dofs) unknowns are the dofs.
-
-    Returns
-    -------
-    lu : scipy SuperLU of the permuted matrix A[perm][:, perm]
-    perm : (n_unknowns,) int64
-    """
-    P = parts.pair[dofs][:, dofs] + sp.diags(shift_mass)
-    unknown_points = dofs // 3
-    if parts.G is None:
-        A = P
-    else:
-        active = np.flatnonzero(parts.dilatation != 0.0)
-        # scale the multipliers so that both diagonal blocks have the size of P's diagonal
-        scale = np.sqrt(np.median(P.diagonal()) * np.abs(parts.dilatation[active]))
-        SG = sp.diags(scale) @ parts.G[active][:, dofs]  # unknowns y' = y / scale
-        A = sp.bmat([[P, SG.T], [SG, sp.diags(-(scale**2) / parts.dilatation[active])]])
-        unknown_points = np.concatenate([unknown_points, active])
-    perm = order_unknowns(unknown_points, points, reach)
-    lu = splu(A.tocsr()[perm][:, perm].tocsc(), permc_spec="NATURAL", diag_pivot_thresh=0.1,
-              options={"SymmetricMode": True})
-    return lu, perm

@@ -24,16 +24,17 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from peridyn.physics.damage import BondDamage
+from peridyn.discretization.state import State
 from peridyn.errors import InputError
+from peridyn.linalg.dofs import free_dofs
+from peridyn.linalg.stiffness import mass_matrix
+from peridyn.linalg.tangent import tangent_stiffness
+from peridyn.physics.damage import BondDamage
 from peridyn.physics.loads import Loading
 from peridyn.physics.materials.base import Model
 from peridyn.solvers.explicit import check_finite
-from peridyn.solvers.modal import free_dofs
 from peridyn.solvers.newton import check_linear_solver, solve_held
-from peridyn.discretization.state import State, advance
-from peridyn.linalg.stiffness import mass_matrix
-from peridyn.linalg.tangent import tangent_stiffness
+from peridyn.solvers.stepping import advance
 
 
 class NewmarkSolver:

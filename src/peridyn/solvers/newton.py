@@ -31,12 +31,12 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import splu
 
-from peridyn.physics.damage import BondDamage
 from peridyn.errors import InputError, did_you_mean
+from peridyn.linalg.dofs import free_dofs
+from peridyn.linalg.tangent import tangent_stiffness
+from peridyn.physics.damage import BondDamage
 from peridyn.physics.loads import Loading
 from peridyn.physics.materials.base import Model
-from peridyn.solvers.modal import free_dofs
-from peridyn.linalg.tangent import tangent_stiffness
 
 
 @dataclass

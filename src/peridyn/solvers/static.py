@@ -21,9 +21,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from peridyn.errors import InputError
 from peridyn.physics.contact import Contact
 from peridyn.physics.damage import BondDamage
-from peridyn.errors import InputError
 from peridyn.physics.loads import Loading
 from peridyn.physics.materials.base import Model
 

@@ -5,7 +5,6 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from peridyn.discretization import geometry
 from peridyn.analysis.fk import (
     azimuthal_average,
     fk_transform,
@@ -16,6 +15,7 @@ from peridyn.analysis.fk import (
     point_grid,
     ring_radius,
 )
+from peridyn.discretization import geometry
 from peridyn.errors import InputError
 from peridyn.io.hdf5 import HDF5Writer
 

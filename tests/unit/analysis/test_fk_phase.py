@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 from scipy.special import hankel1
 
-from peridyn.discretization import geometry
 from peridyn.analysis.fk import LINE_SUFFIXES, line_mode_wavenumbers, mirror_parts, phase_wavenumber
+from peridyn.discretization import geometry
 from peridyn.errors import InputError
 from peridyn.io.hdf5 import HDF5Writer, read_series
 

@@ -5,11 +5,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from peridyn.discretization import geometry
 from peridyn.analysis.fk import fk_transform, kxky_transform
 from peridyn.analysis.lamb import dispersion_curves, lamb_modes
+from peridyn.discretization import geometry
 from peridyn.errors import InputError
 from peridyn.io.hdf5 import HDF5Writer
+from peridyn.physics.timefunctions import ToneBurst
 from peridyn.plotting.lamb_wavefield import (
     plot_fk_map,
     plot_kxky_maps,
@@ -17,7 +18,6 @@ from peridyn.plotting.lamb_wavefield import (
     plot_through_thickness,
     plot_wavefield_snapshots,
 )
-from peridyn.physics.timefunctions import ToneBurst
 
 # VALIDATION.md V1: 2 mm aluminium plate (E Pa, nu, rho kg/m^3, thickness m); V2: 3 layers
 # on the faces and mid-plane, snapshots at 20 and 40 us.
