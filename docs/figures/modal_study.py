@@ -27,8 +27,8 @@ import numpy as np
 
 from peridyn.discretization import geometry
 from peridyn.discretization.bonds import find_bonds
-from peridyn.physics.materials import LPSModel
 from peridyn.jobs.modal import modal_table
+from peridyn.physics.materials import LPSModel
 
 #: 6 rigid + 8 elastic: the 1st in-plane bending can come 7th on coarse grids
 N_MODES = 14

@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from peridyn.io.case import load_case
-from peridyn.jobs.run import build
+from peridyn.jobs.build import build
 from peridyn.physics.damage import damage_field
 from peridyn.solvers import ExplicitSolver
 

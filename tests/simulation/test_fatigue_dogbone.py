@@ -8,8 +8,8 @@ import pytest
 from peridyn.fatigue.mapping import CycleMapping
 from peridyn.fatigue.run import run_fatigue
 from peridyn.io.case import load_case
+from peridyn.jobs.build import build
 from peridyn.jobs.fatigue import fatigue_parameters, run_fatigue_case
-from peridyn.jobs.run import build
 
 CASE = Path(__file__).resolve().parents[2] / "cases" / "dogbone_fatigue.yaml"
 NOTCH_ROOTS = ((0.030, 0.0040), (0.030, 0.0080))  # edge-notch roots (x, y) of the case, m

@@ -9,7 +9,8 @@ import pytest
 from peridyn.cli import main
 from peridyn.io.case import validate_case
 from peridyn.io.hdf5 import read_array, read_series
-from peridyn.jobs.run import build, run_case
+from peridyn.jobs.build import build
+from peridyn.jobs.run import run_case
 
 BAR = {
     "name": "bar",

@@ -15,7 +15,8 @@ from peridyn.discretization import geometry
 from peridyn.discretization.bonds import find_bonds
 from peridyn.errors import InputError, InstabilityError
 from peridyn.io.case import load_case
-from peridyn.jobs.run import build, explicit_damping
+from peridyn.jobs.build import build
+from peridyn.jobs.run import explicit_damping
 from peridyn.physics.absorbing import layer_damping
 from peridyn.physics.loads import InitialCondition, Loading
 from peridyn.physics.materials import make_model

@@ -11,7 +11,7 @@ from peridyn.discretization import geometry
 from peridyn.discretization.bonds import crossing_segment, cut_bonds, find_bonds
 from peridyn.errors import CaseFileError, InputError
 from peridyn.io.case import load_case
-from peridyn.jobs.run import build
+from peridyn.jobs.build import build
 from peridyn.physics.contact import Contact
 from peridyn.physics.loads import InitialCondition, Loading
 from peridyn.physics.materials import make_model

@@ -4,8 +4,9 @@ construction: a band of cracked points along a line of known length and angle.""
 import numpy as np
 import pytest
 
-from peridyn.analysis.crack import CrackLengthObserver, crack_paths, total_crack_length
+from peridyn.analysis.crack import crack_paths, total_crack_length
 from peridyn.errors import InputError
+from peridyn.jobs.observers import CrackLengthObserver
 
 H = 1e-3  # spacing (m)
 

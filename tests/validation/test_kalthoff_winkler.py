@@ -11,7 +11,7 @@ import pytest
 
 from peridyn.analysis.crack import crack_paths, departure_angle, path_from
 from peridyn.io.case import load_case
-from peridyn.jobs.run import build
+from peridyn.jobs.build import build
 from peridyn.physics.damage import damage_field
 from peridyn.solvers import ExplicitSolver
 

@@ -35,7 +35,6 @@ from scipy.sparse.csgraph import connected_components, shortest_path
 from scipy.spatial import cKDTree
 
 from peridyn.errors import InputError
-from peridyn.physics.damage import damage_field
 
 DEFAULT_THRESHOLD = 0.35
 GEODESIC_LINK = 2.5  # spacings: links of the graph for path distances (near-Euclidean)
@@ -259,35 +258,3 @@ def _distance_to_polyline(xy, polyline) -> np.ndarray:
                                                                  strict=True)], axis=0)
 
 
-class CrackLengthObserver:
-    """Total crack length against time, sampled every ``every`` steps of a run.
-
-    Parameters
-    ----------
-    model : Model
-        Its ``bonds.intact`` gives the damage field.
-    every : int
-    threshold : float
-    """
-
-    def __init__(self, model, every: int, threshold: float = DEFAULT_THRESHOLD):
-        if every < 1:
-            raise InputError(f"crack observer interval must be >= 1 step, got {every!r}")
-        self.model, self.every, self.threshold = model, int(every), threshold
-        self.times: list[float] = []
-        self.lengths: list[float] = []
-
-    def observe(self, state, solver=None) -> None:
-        if state.step % self.every == 0:
-            self.sample(state.time)
-
-    def sample(self, time: float) -> None:
-        """Record the crack length of the current damage at ``time`` (s)."""
-        body = self.model.body
-        self.times.append(float(time))
-        self.lengths.append(total_crack_length(body.points, damage_field(self.model),
-                                               body.spacing, self.threshold))
-
-    def history(self) -> dict:
-        """``{"time_s": [...], "length_m": [...]}``."""
-        return {"time_s": list(self.times), "length_m": list(self.lengths)}

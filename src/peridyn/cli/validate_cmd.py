@@ -24,7 +24,7 @@ def run(args) -> dict:
     case = load_case(args.case, args.overrides)
     summary = {"case": case.name, "valid": True}
     if args.build:
-        from peridyn.jobs.run import build
+        from peridyn.jobs.build import build
         from peridyn.solvers import ExplicitSolver
 
         setup = build(case, Path(args.case).parent)

@@ -270,7 +270,7 @@ class Solver(Strict):
     displacement_tolerance: Positive = 1e-10
     linear_solver: Literal["lu", "cg"] = "lu"
     #: modal: ``shift-invert`` (factorised), ``lobpcg`` (matrix-free) or ``auto`` (by the
-    #: estimated factor size, ``modal_run.choose_eigensolver``).
+    #: estimated factor size, ``jobs.modal.choose_eigensolver``).
     eigensolver: Literal["auto", "shift-invert", "lobpcg"] = "auto"
 
     @model_validator(mode="after")

@@ -25,8 +25,9 @@ from peridyn.fatigue.specimen import compliance_energy, compliance_stress_intens
 from peridyn.fatigue.tip import AXES
 from peridyn.io.case import Case
 from peridyn.io.vtk import write_vtu
+from peridyn.jobs.build import build
 from peridyn.jobs.modal import match_modes, modal_table
-from peridyn.jobs.run import build, output_directory
+from peridyn.jobs.run import output_directory
 
 
 def check_fatigue_case(case: Case) -> None:

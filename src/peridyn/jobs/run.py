@@ -1,182 +1,30 @@
-"""From a validated case to results: build the body, bonds, model and loads, then run.
-
-``run_case`` is what ``peridyn run`` calls; the ``build_*`` functions are the
-same steps for Python users who want to stop half-way (e.g. to inspect the bonds).
-"""
+"""Run a built case and write its results: explicit, static, Newton and Newmark runs (modal
+runs are ``jobs.modal``), recording, checkpoints, crack history and the stored summary.
+``run_case`` is what ``peridyn run`` calls."""
 
 from __future__ import annotations
 
 import json
 import time
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from peridyn.discretization import geometry
-from peridyn.discretization.body import Body, in_box, in_cylinder, in_sphere
-from peridyn.discretization.bonds import Bonds, crossing_rectangle, crossing_segment, cut_bonds, find_bonds
+from peridyn.discretization.body import Body
 from peridyn.discretization.state import State
 from peridyn.errors import CaseFileError, InputError
-from peridyn.io import mesh_text
-from peridyn.io.case import Case, Region
+from peridyn.io.case import Case
 from peridyn.io.checkpoint import Checkpointer, load_checkpoint
-from peridyn.io.hdf5 import HDF5Writer, read_series
+from peridyn.io.hdf5 import HDF5Writer
 from peridyn.io.recorder import LineProbe, Recorder, RecorderSpec, provenance
+from peridyn.jobs.build import Setup, build, pad3
+from peridyn.jobs.figures import draw_crack_figures, draw_run_figures, final_crack_paths
 from peridyn.jobs.lamb_analysis import analyse
 from peridyn.physics.absorbing import layer_damping
-from peridyn.physics.contact import Contact
-from peridyn.physics.damage import BondDamage, damage_field
-from peridyn.physics.loads import BoundaryCondition, InitialCondition, Loading
-from peridyn.physics.materials import Model, make_model
-from peridyn.physics.timefunctions import from_spec
-from peridyn.physics.transducers import pin_force_actuator, pzt_radial_actuator, pzt_sensor_weights
+from peridyn.physics.damage import damage_field
+from peridyn.physics.transducers import pzt_sensor_weights
 from peridyn.solvers import ExplicitSolver, relax
-
-
-@dataclass
-class Setup:
-    """Everything a case builds before running."""
-
-    body: Body
-    bonds: Bonds
-    model: Model
-    loading: Loading
-    damage: BondDamage | None
-    contact: Contact | None = None
-
-
-def build_body(case: Case, base_dir=".") -> Body:
-    """Points of the case geometry, minus removals, with the case's node sets (and ``all``)."""
-    g, d = case.geometry, case.discretization
-    if g.type != "mesh" and d.spacing is None:
-        raise CaseFileError(case.name, "discretization.spacing", None, "a positive spacing (m)")
-    if g.type == "box":
-        body = geometry.box(g.size, d.spacing, g.origin or (0.0, 0.0, 0.0))
-    elif g.type == "plate":
-        body = geometry.plate(*g.size, spacing=d.spacing, layers=g.layers,
-                              origin=g.origin or (0.0, 0.0, 0.0),
-                              layer_placement=g.layer_placement)
-    elif g.type == "rectangle":
-        body = geometry.rectangle(*g.size, spacing=d.spacing, thickness=g.thickness,
-                                  plane=g.plane, origin=(g.origin or (0.0, 0.0))[:2])
-    else:
-        mesh = Path(g.file) if Path(g.file).is_absolute() else Path(base_dir) / g.file
-        body = mesh_text.from_text_mesh(mesh, dim=g.dimension, thickness=g.thickness,
-                                       plane=g.plane if g.dimension == 2 else None)
-    for k, region in enumerate(case.removals):
-        body = body.remove(region_mask(body, region, f"removals[{k}]"))
-    body = body.with_node_set("all", np.ones(body.n_points, dtype=bool))
-    for name, region in case.node_sets.items():
-        mask = region_mask(body, region, f"node_sets.{name}")
-        if not mask.any():
-            raise CaseFileError(case.name, f"node_sets.{name}", region.model_dump(exclude_none=True),
-                                "a region that contains at least one point")
-        body = body.with_node_set(name, mask)
-    return body
-
-
-def region_mask(body: Body, region: Region, where: str) -> np.ndarray:
-    """(n_points,) bool mask of a case-file region."""
-    pad = _pad3
-    if region.type == "all":
-        return np.ones(body.n_points, dtype=bool)
-    if region.type == "box":
-        return in_box(pad(region.min), pad(region.max))(body.points)
-    if region.type == "sphere":
-        return in_sphere(pad(region.center), region.radius)(body.points)
-    if region.type == "cylinder":
-        return in_cylinder(pad(region.center), region.radius, region.axis)(body.points)
-    if region.type == "face":
-        return geometry.face(body, region.face, region.depth)
-    try:
-        return geometry.layer(body, region.index)
-    except InputError as exc:
-        raise InputError(f"{where}: {exc}") from None
-
-
-def _pad3(v) -> list:
-    """A 2- or 3-component coordinate as 3 components (z = 0 for 2D input)."""
-    return list(v) + [0.0] * (3 - len(v))
-
-
-def build_bonds(case: Case, body: Body) -> Bonds:
-    """Families of the case's discretisation, with its pre-cracks cut."""
-    d = case.discretization
-    horizon = d.horizon_m if d.horizon_m is not None else d.horizon * body.spacing
-    bonds = find_bonds(body, horizon, d.influence, d.partial_volumes)
-    for crack in case.precracks:
-        if crack.type == "rectangle":
-            def crossing(a, b, c=crack):
-                return crossing_rectangle(a, b, c.origin, c.edge_u, c.edge_v)
-        else:
-            def crossing(a, b, c=crack):
-                return crossing_segment(a, b, c.start, c.end)
-        cut_bonds(body, bonds, crossing)
-    return bonds
-
-
-def add_actuators(case: Case, body: Body) -> tuple[Body, list[BoundaryCondition]]:
-    """The body with a node set per actuator, and the actuators' boundary conditions."""
-    conditions = []
-    for name, a in case.actuators.items():
-        signal = from_spec(a.signal, f"actuators.{name}.signal")
-        if a.type == "pzt_radial":
-            body, bcs = pzt_radial_actuator(body, a.center, a.size, signal, shape=a.shape,
-                                            layer=a.layer, amplitude=a.amplitude, name=name)
-        else:
-            body, bcs = pin_force_actuator(body, a.center, a.size, signal, shape=a.shape,
-                                           layer=a.layer, line_force=a.line_force, name=name)
-        conditions += bcs
-    return body, conditions
-
-
-def build_loading(case: Case, body: Body, extra=()) -> Loading:
-    """Boundary and initial conditions of the case (plus ``extra`` ones), checked for conflicts."""
-    bcs = [BoundaryCondition(bc.set, bc.kind, bc.components,
-                             from_spec(bc.value, f"boundary_conditions[{k}].value"))
-           for k, bc in enumerate(case.boundary_conditions)]
-    ics = [InitialCondition(ic.set, ic.kind, ic.components, ic.value)
-           for ic in case.initial_conditions]
-    return Loading(body, [*extra, *bcs], ics)
-
-
-def build(case: Case, base_dir=".") -> Setup:
-    """Body, bonds, model, loading and damage of a case."""
-    body, actuation = add_actuators(case, build_body(case, base_dir))
-    bonds = build_bonds(case, body)
-    mat = case.material
-    model = make_model(mat.model, body, bonds, E=mat.E, density=mat.density, nu=mat.nu,
-                       surface_correction=mat.surface_correction, dtype=case.solver.dtype)
-    damage = None
-    if mat.damage is not None:
-        damage = BondDamage(model, mat.damage.critical_stretch, mat.damage.fracture_energy,
-                            mat.damage.no_damage_sets,
-                            critical_bond_stress=mat.damage.critical_bond_stress)
-    loading = build_loading(case, body, actuation)
-    if case.solver.type == "static" and not loading.has_loads:
-        raise CaseFileError(case.name, "boundary_conditions", [], "at least one load for a static run")
-    if case.solver.type == "newmark" and not (loading.has_loads or loading.initial):
-        raise CaseFileError(case.name, "boundary_conditions", [],
-                            "a load or an initial condition: nothing would move")
-    if case.solver.type == "newton" and not loading.has_loads:
-        raise CaseFileError(case.name, "boundary_conditions", [], "at least one load for a newton run")
-    if case.solver.type == "explicit" and not (loading.has_loads or loading.initial):
-        raise CaseFileError(case.name, "boundary_conditions", [],
-                            "a load or an initial condition: nothing would move")
-    return Setup(body, bonds, model, loading, damage, build_contact(case, model))
-
-
-def build_contact(case: Case, model: Model) -> Contact | None:
-    """The case's short-range contact forces, or None without a ``contact`` block."""
-    c = case.contact
-    if c is None:
-        return None
-    radius = c.radius_m if c.radius_m is not None else c.radius * model.body.spacing
-    try:
-        return Contact(model, radius, c.stiffness_factor)
-    except InputError as exc:
-        raise CaseFileError(case.name, "contact", c.model_dump(exclude_none=True), str(exc)) from None
 
 
 def recorder_spec(case: Case, body: Body, dt: float) -> RecorderSpec:
@@ -187,8 +35,8 @@ def recorder_spec(case: Case, body: Body, dt: float) -> RecorderSpec:
         every=out.every,
         snapshot_every=out.snapshot_every,
         snapshot_steps=[int(round(t / dt)) for t in out.snapshot_times],
-        sensors={k: _pad3(v) for k, v in out.sensors.items()},
-        lines={k: LineProbe(_pad3(v.start), _pad3(v.end), v.points) for k, v in out.lines.items()},
+        sensors={k: pad3(v) for k, v in out.sensors.items()},
+        lines={k: LineProbe(pad3(v.start), pad3(v.end), v.points) for k, v in out.lines.items()},
         planes=planes,
         pzt_sensors={k: _pzt_weights(body, v) for k, v in out.pzt_sensors.items()},
         series_dtype=out.series_dtype,
@@ -254,47 +102,6 @@ def run_case(case: Case, output_dir=None, case_path=None, checkpoint_every: int 
     store_summary(out / "results.h5", setup.body, summary)
     return summary
 
-
-def draw_run_figures(case: Case, body: Body, out: Path) -> list[Path]:
-    """The figures of a finished explicit or static run (not its analyses): sensor signals,
-    B-scans, final fields, damage and, for plates with snapshot times, the wavefield per layer."""
-    from peridyn.plotting.fields import plot_run
-
-    figures = plot_run(out, body)
-    if case.geometry.type == "plate" and case.output.snapshot_times:
-        from peridyn.plotting.lamb_wavefield import plot_wavefield_snapshots
-
-        _, times, _ = read_series(out / "results.h5", "field_u")
-        reached = [t for t in case.output.snapshot_times if t <= times[-1] * (1 + 1e-9)]
-        if reached:
-            figures.append(plot_wavefield_snapshots(out / "results.h5", out / "wavefield.png",
-                                                    reached))
-        figures += _actuator_figures(case, out, reached)
-    return figures
-
-
-def _actuator_figures(case: Case, out: Path, snapshot_times) -> list[Path]:
-    """Through-thickness field under each actuator's cut (+-50 mm along x, at the middle
-    snapshot) and the PZT sensor signals under the first actuator's excitation."""
-    from peridyn.plotting.lamb_wavefield import plot_sensor_signals, plot_through_thickness
-
-    figures = []
-    length = case.geometry.size[0]
-    for name, actuator in case.actuators.items():
-        if snapshot_times:
-            cx = actuator.center[0]
-            x_range = (max(0.0, cx - 0.050), min(length, cx + 0.050))
-            figures.append(plot_through_thickness(
-                out / "results.h5", out / f"cut_{name}.png",
-                snapshot_times[len(snapshot_times) // 2], actuator.center, x_range))
-    if case.output.pzt_sensors and case.actuators:
-        _, times, data = read_series(out / "results.h5", "pzt_signal")
-        first = next(iter(case.actuators.values()))
-        excitation = from_spec(first.signal, "actuators.signal")(times)
-        signals = {n: data[:, k] for k, n in enumerate(case.output.pzt_sensors)}
-        figures.append(plot_sensor_signals(times, signals, out / "pzt_sensors.png",
-                                           excitation=excitation))
-    return figures
 
 
 def store_summary(results, body: Body, summary: dict) -> None:
@@ -381,52 +188,11 @@ def _crack_observer(case, setup, n_steps):
     with damage; None without damage."""
     if setup.damage is None:
         return None
-    from peridyn.analysis.crack import CrackLengthObserver
+    from peridyn.jobs.observers import CrackLengthObserver
 
     every = case.output.snapshot_every or max(1, n_steps // 100)
     return CrackLengthObserver(setup.model, every)
 
-
-def final_crack_paths(case: Case, body: Body, phi: np.ndarray):
-    """Crack paths of the final damage field ``phi`` ((n_points,)) of ``body`` (pre-cracks as
-    reference lines; 2D bodies or the x-y projection of 3D ones)."""
-    from peridyn.analysis.crack import crack_paths
-
-    lines = [(c.start, c.end) for c in case.precracks if c.type == "segment"]
-    lines += [(c.origin, np.add(c.origin, c.edge_u)) for c in case.precracks
-              if c.type == "rectangle"]
-    return crack_paths(body.points, phi, body.spacing, reference_lines=lines)
-
-
-def draw_crack_figures(body: Body, out: Path, paths, summary: dict) -> list[Path]:
-    """Damage map on the deformed configuration (x50, as seed 004, or less) with the crack
-    ``paths``, and the crack length against time when it was sampled; displacements and
-    damage are the final ones of ``out``/results.h5."""
-    from peridyn.io.hdf5 import read_array
-    from peridyn.plotting.crack import plot_crack_length, plot_damage_map
-
-    results = out / "results.h5"
-    u, phi = read_array(results, "final/u"), read_array(results, "final/damage")
-    figures = [plot_damage_map(body.points, u, phi, paths, out / "crack_paths.png")]
-    history = summary.get("crack_length_history")
-    if history and len(history["time_s"]) > 1:
-        figures.append(plot_crack_length(history["time_s"], history["length_m"],
-                                         out / "crack_length.png"))
-    return figures
-
-
-def redraw_crack_figures(case: Case, body: Body, out: Path):
-    """Crack paths and figures (``draw_crack_figures``) of a finished run with damage, from
-    its results.h5: the final damage and the crack length history of the stored summary.
-    Returns (paths, figure paths); (None, []) for a case without damage."""
-    from peridyn.io.hdf5 import read_array
-
-    if case.material.damage is None:
-        return None, []
-    results = out / "results.h5"
-    summary = json.loads(read_array(results, "summary/json"))
-    paths = final_crack_paths(case, body, read_array(results, "final/damage"))
-    return paths, draw_crack_figures(body, out, paths, summary)
 
 
 def _run_static(case, setup, out, case_path) -> dict:

@@ -84,8 +84,8 @@ def run_grid(case_path, spacings, horizon_factors, n_modes: int | None = None, o
     (:func:`peridyn.jobs.modal.check_assembly_fits`) are skipped with the reason.
     """
     from peridyn.io.case import load_case
+    from peridyn.jobs.build import build
     from peridyn.jobs.modal import check_assembly_fits, modal_table, mode_label
-    from peridyn.jobs.run import build
 
     combos = [(h, m) for m in horizon_factors for h in spacings]
     runs = []

@@ -1,0 +1,98 @@
+"""The figures of a finished run (not its analyses): sensor signals, B-scans, final fields,
+wavefields of plates, crack paths and crack length."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+from peridyn.discretization.body import Body
+from peridyn.io.case import Case
+from peridyn.io.hdf5 import read_series
+from peridyn.physics.timefunctions import from_spec
+
+
+def draw_run_figures(case: Case, body: Body, out: Path) -> list[Path]:
+    """The figures of a finished explicit or static run (not its analyses): sensor signals,
+    B-scans, final fields, damage and, for plates with snapshot times, the wavefield per layer."""
+    from peridyn.plotting.fields import plot_run
+
+    figures = plot_run(out, body)
+    if case.geometry.type == "plate" and case.output.snapshot_times:
+        from peridyn.plotting.lamb_wavefield import plot_wavefield_snapshots
+
+        _, times, _ = read_series(out / "results.h5", "field_u")
+        reached = [t for t in case.output.snapshot_times if t <= times[-1] * (1 + 1e-9)]
+        if reached:
+            figures.append(plot_wavefield_snapshots(out / "results.h5", out / "wavefield.png",
+                                                    reached))
+        figures += _actuator_figures(case, out, reached)
+    return figures
+
+
+def _actuator_figures(case: Case, out: Path, snapshot_times) -> list[Path]:
+    """Through-thickness field under each actuator's cut (+-50 mm along x, at the middle
+    snapshot) and the PZT sensor signals under the first actuator's excitation."""
+    from peridyn.plotting.lamb_wavefield import plot_sensor_signals, plot_through_thickness
+
+    figures = []
+    length = case.geometry.size[0]
+    for name, actuator in case.actuators.items():
+        if snapshot_times:
+            cx = actuator.center[0]
+            x_range = (max(0.0, cx - 0.050), min(length, cx + 0.050))
+            figures.append(plot_through_thickness(
+                out / "results.h5", out / f"cut_{name}.png",
+                snapshot_times[len(snapshot_times) // 2], actuator.center, x_range))
+    if case.output.pzt_sensors and case.actuators:
+        _, times, data = read_series(out / "results.h5", "pzt_signal")
+        first = next(iter(case.actuators.values()))
+        excitation = from_spec(first.signal, "actuators.signal")(times)
+        signals = {n: data[:, k] for k, n in enumerate(case.output.pzt_sensors)}
+        figures.append(plot_sensor_signals(times, signals, out / "pzt_sensors.png",
+                                           excitation=excitation))
+    return figures
+
+
+def final_crack_paths(case: Case, body: Body, phi: np.ndarray):
+    """Crack paths of the final damage field ``phi`` ((n_points,)) of ``body`` (pre-cracks as
+    reference lines; 2D bodies or the x-y projection of 3D ones)."""
+    from peridyn.analysis.crack import crack_paths
+
+    lines = [(c.start, c.end) for c in case.precracks if c.type == "segment"]
+    lines += [(c.origin, np.add(c.origin, c.edge_u)) for c in case.precracks
+              if c.type == "rectangle"]
+    return crack_paths(body.points, phi, body.spacing, reference_lines=lines)
+
+
+def draw_crack_figures(body: Body, out: Path, paths, summary: dict) -> list[Path]:
+    """Damage map on the deformed configuration (x50, as seed 004, or less) with the crack
+    ``paths``, and the crack length against time when it was sampled; displacements and
+    damage are the final ones of ``out``/results.h5."""
+    from peridyn.io.hdf5 import read_array
+    from peridyn.plotting.crack import plot_crack_length, plot_damage_map
+
+    results = out / "results.h5"
+    u, phi = read_array(results, "final/u"), read_array(results, "final/damage")
+    figures = [plot_damage_map(body.points, u, phi, paths, out / "crack_paths.png")]
+    history = summary.get("crack_length_history")
+    if history and len(history["time_s"]) > 1:
+        figures.append(plot_crack_length(history["time_s"], history["length_m"],
+                                         out / "crack_length.png"))
+    return figures
+
+
+def redraw_crack_figures(case: Case, body: Body, out: Path):
+    """Crack paths and figures (``draw_crack_figures``) of a finished run with damage, from
+    its results.h5: the final damage and the crack length history of the stored summary.
+    Returns (paths, figure paths); (None, []) for a case without damage."""
+    from peridyn.io.hdf5 import read_array
+
+    if case.material.damage is None:
+        return None, []
+    results = out / "results.h5"
+    summary = json.loads(read_array(results, "summary/json"))
+    paths = final_crack_paths(case, body, read_array(results, "final/damage"))
+    return paths, draw_crack_figures(body, out, paths, summary)

@@ -1,0 +1,42 @@
+"""Observers of a running solver that a job attaches: each has ``observe(state, solver)``,
+called after every step."""
+
+from __future__ import annotations
+
+from peridyn.analysis.crack import DEFAULT_THRESHOLD, total_crack_length
+from peridyn.errors import InputError
+from peridyn.physics.damage import damage_field
+
+
+class CrackLengthObserver:
+    """Total crack length against time, sampled every ``every`` steps of a run.
+
+    Parameters
+    ----------
+    model : Model
+        Its ``bonds.intact`` gives the damage field.
+    every : int
+    threshold : float
+    """
+
+    def __init__(self, model, every: int, threshold: float = DEFAULT_THRESHOLD):
+        if every < 1:
+            raise InputError(f"crack observer interval must be >= 1 step, got {every!r}")
+        self.model, self.every, self.threshold = model, int(every), threshold
+        self.times: list[float] = []
+        self.lengths: list[float] = []
+
+    def observe(self, state, solver=None) -> None:
+        if state.step % self.every == 0:
+            self.sample(state.time)
+
+    def sample(self, time: float) -> None:
+        """Record the crack length of the current damage at ``time`` (s)."""
+        body = self.model.body
+        self.times.append(float(time))
+        self.lengths.append(total_crack_length(body.points, damage_field(self.model),
+                                               body.spacing, self.threshold))
+
+    def history(self) -> dict:
+        """``{"time_s": [...], "length_m": [...]}``."""
+        return {"time_s": list(self.times), "length_m": list(self.lengths)}
