@@ -6,18 +6,19 @@ material model (``make_model``), loads on node sets (``Loading`` with
 ``solver.run``. Case files do the same through ``load_case`` and ``run_case``.
 """
 
-__version__ = "0.1.0"
+from peridyn.discretization import geometry
+from peridyn.discretization.body import Body
+from peridyn.discretization.bonds import Bonds, find_bonds
+from peridyn.errors import CaseFileError, InputError, InstabilityError, PeridynError
+from peridyn.io.case import load_case
+from peridyn.io.provenance import package_version
+from peridyn.jobs.run import run_case
+from peridyn.physics.damage import BondDamage, damage_field
+from peridyn.physics.loads import BoundaryCondition, InitialCondition, Loading
+from peridyn.physics.materials import LPSModel, PMBModel, make_model
+from peridyn.solvers import ExplicitSolver, State, relax
 
-from peridyn.discretization import geometry  # noqa: E402
-from peridyn.discretization.body import Body  # noqa: E402
-from peridyn.discretization.bonds import Bonds, find_bonds  # noqa: E402
-from peridyn.errors import CaseFileError, InputError, InstabilityError, PeridynError  # noqa: E402
-from peridyn.io.case import load_case  # noqa: E402
-from peridyn.jobs.run import run_case  # noqa: E402
-from peridyn.physics.damage import BondDamage, damage_field  # noqa: E402
-from peridyn.physics.loads import BoundaryCondition, InitialCondition, Loading  # noqa: E402
-from peridyn.physics.materials import LPSModel, PMBModel, make_model  # noqa: E402
-from peridyn.solvers import ExplicitSolver, State, relax  # noqa: E402
+__version__ = package_version()
 
 __all__ = [
     "Body",

@@ -12,8 +12,9 @@ DEMO_CASE = "demo_plate_burst.yaml"
 def register(sub) -> None:
     """Add the ``demo`` subcommand."""
     p = sub.add_parser("demo", help="run the demo case and write its plots", description=__doc__)
-    p.add_argument("--output", "-o", default="peridyn-out/demo",
-                   help="output folder (default: peridyn-out/demo)")
+    p.add_argument(
+        "--output", "-o", default="peridyn-out/demo", help="output folder (default: peridyn-out/demo)"
+    )
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     add_json_flag(p)
     p.set_defaults(func=run)
@@ -26,6 +27,13 @@ def run(args) -> dict:
     from peridyn.cli import run_cmd
 
     with as_file(files("peridyn.data") / DEMO_CASE) as path:
-        ns = Namespace(case=str(path), overrides=[], output=args.output, checkpoint_every=None,
-                       restart=False, no_progress=args.no_progress, json=args.json)
+        ns = Namespace(
+            case=str(path),
+            overrides=[],
+            output=args.output,
+            checkpoint_every=None,
+            restart=False,
+            no_progress=args.no_progress,
+            json=args.json,
+        )
         return run_cmd.run(ns)

@@ -22,12 +22,19 @@ from peridyn.errors import InputError
 
 def register(sub) -> None:
     """Add the ``fatigue`` subcommand (``fatigue calibrate`` when the case is the word calibrate)."""
-    p = sub.add_parser("fatigue", help="fatigue run of a case, or 'fatigue calibrate'",
-                       description=__doc__, formatter_class=_raw())
+    p = sub.add_parser(
+        "fatigue",
+        help="fatigue run of a case, or 'fatigue calibrate'",
+        description=__doc__,
+        formatter_class=_raw(),
+    )
     add_case_arguments(p)
     p.add_argument("--output", "-o", help="output folder")
-    p.add_argument("--modal", action="store_true", help="modal analyses before and after "
-                   "(default: when the case has fatigue.modal_after)")
+    p.add_argument(
+        "--modal",
+        action="store_true",
+        help="modal analyses before and after (default: when the case has fatigue.modal_after)",
+    )
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     g = p.add_argument_group("calibrate")
     g.add_argument("--strain-life", help="CSV: cycles, strain")
@@ -57,14 +64,24 @@ def run(args) -> dict:
     from peridyn.jobs.fatigue import run_fatigue_case
 
     case = load_case(args.case, args.overrides)
-    progress = None if args.no_progress or args.json else (
-        lambda total: tqdm(total=total, desc="fatigue steps", file=sys.stderr))
-    summary = run_fatigue_case(case, args.output, base_dir=Path(args.case).parent,
-                               modal=True if args.modal else None, progress=progress)
+    progress = (
+        None
+        if args.no_progress or args.json
+        else (lambda total: tqdm(total=total, desc="fatigue steps", file=sys.stderr))
+    )
+    summary = run_fatigue_case(
+        case,
+        args.output,
+        base_dir=Path(args.case).parent,
+        modal=True if args.modal else None,
+        progress=progress,
+    )
     if not args.json:
-        print(f"{summary['points']} points, {summary['cycles']:.6g} cycles, crack length "
-              f"{1e3 * summary['crack_length_m']:.3f} mm, {summary['bonds_broken']} bonds broken, "
-              f"{summary['seconds']:.1f} s")
+        print(
+            f"{summary['points']} points, {summary['cycles']:.6g} cycles, crack length "
+            f"{1e3 * summary['crack_length_m']:.3f} mm, {summary['bonds_broken']} bonds broken, "
+            f"{summary['seconds']:.1f} s"
+        )
         if summary["paris_slope"] is not None:
             print(f"Paris slope {summary['paris_slope']:.3f}")
         if "modal" in summary:
@@ -79,9 +96,11 @@ def _print_modal(modal: dict) -> None:
     print("  mode  before (Hz)  type                      after (Hz)  type                   MAC   df")
     for pair in modal["matches"]:
         b, a = before[pair["before"]], after[pair["after"]]
-        print(f"  {pair['before'] + 1:4d}  {b['frequency_hz']:11.2f}  {_label(b):24s}  "
-              f"{a['frequency_hz']:11.2f}  {_label(a):20s}  {pair['mac']:.3f} "
-              f"{100 * pair['frequency_change']:+.2f}%")
+        print(
+            f"  {pair['before'] + 1:4d}  {b['frequency_hz']:11.2f}  {_label(b):24s}  "
+            f"{a['frequency_hz']:11.2f}  {_label(a):20s}  {pair['mac']:.3f} "
+            f"{100 * pair['frequency_change']:+.2f}%"
+        )
 
 
 def _label(mode: dict) -> str:
@@ -108,8 +127,12 @@ def calibrate(args) -> dict:
     if args.strain_life:
         d = _read_csv(args.strain_life, 2)
         fit = cal.fit_phase_one(d[:, 0], d[:, 1])
-        summary["phase_one"] = {"A_I": fit.A_I, "m_I": fit.m_I, "eps_inf": fit.eps_inf,
-                                "r_squared": fit.r_squared}
+        summary["phase_one"] = {
+            "A_I": fit.A_I,
+            "m_I": fit.m_I,
+            "eps_inf": fit.eps_inf,
+            "r_squared": fit.r_squared,
+        }
     if args.paris:
         p = _read_csv(args.paris, 2)
         dk_exp, rate_exp = p[:, 0] * 1e6, p[:, 1]
@@ -128,8 +151,18 @@ def calibrate(args) -> dict:
 
             out = Path(args.output or "peridyn-out/fatigue-calibration")
             out.mkdir(parents=True, exist_ok=True)
-            summary["plots"] = [str(plot_paris(dk_sim, rate, dk_exp, rate_exp, out / "paris.png",
-                                               f"simulated (A_II' = {args.trial_a_ii:g})"))]
+            summary["plots"] = [
+                str(
+                    plot_paris(
+                        dk_sim,
+                        rate,
+                        dk_exp,
+                        rate_exp,
+                        out / "paris.png",
+                        f"simulated (A_II' = {args.trial_a_ii:g})",
+                    )
+                )
+            ]
     if not args.json:
         for key, value in summary.items():
             print(f"{key}: {value}")

@@ -15,9 +15,12 @@ def register(sub) -> None:
     add_case_arguments(p)
     p.add_argument("--modes", type=int, default=None, help="number of modes (rigid included)")
     p.add_argument("--output", "-o", help="output folder")
-    p.add_argument("--compare", metavar="RUN_DIR",
-                   help="a modal run of the same grid (e.g. the healthy body): frequency-shift "
-                        "table of this run's modes against it, matched by MAC")
+    p.add_argument(
+        "--compare",
+        metavar="RUN_DIR",
+        help="a modal run of the same grid (e.g. the healthy body): frequency-shift "
+        "table of this run's modes against it, matched by MAC",
+    )
     add_json_flag(p)
     p.set_defaults(func=run)
 
@@ -37,13 +40,14 @@ def run(args) -> dict:
 
         summary["comparison"] = compare_with_run(Path(summary["output_dir"]), Path(args.compare))
     if not args.json:
-        print(f"{summary['points']} points, {summary['rigid_modes']} rigid modes, "
-              f"{summary['seconds']:.1f} s")
+        print(f"{summary['points']} points, {summary['rigid_modes']} rigid modes, {summary['seconds']:.1f} s")
         for m in summary["modes"]:
             print(f"  {m['index']:3d}  {m['frequency_hz']:12.2f} Hz  {mode_label(m)}")
         for row in summary.get("comparison", []):
-            print(f"  {row['reference_type']:>28s} {row['reference_frequency_hz']:10.2f} Hz -> "
-                  f"{row['frequency_hz']:10.2f} Hz ({100 * row['frequency_change']:+.2f} %, "
-                  f"MAC {row['mac']:.2f}, now {row['type']})")
+            print(
+                f"  {row['reference_type']:>28s} {row['reference_frequency_hz']:10.2f} Hz -> "
+                f"{row['frequency_hz']:10.2f} Hz ({100 * row['frequency_change']:+.2f} %, "
+                f"MAC {row['mac']:.2f}, now {row['type']})"
+            )
         print(f"results written to {summary['output_dir']}")
     return summary

@@ -13,8 +13,7 @@ from peridyn.errors import InputError
 
 def register(sub) -> None:
     """Add the ``plot`` subcommand."""
-    p = sub.add_parser("plot", help="redraw a run's figures from its results.h5",
-                       description=__doc__)
+    p = sub.add_parser("plot", help="redraw a run's figures from its results.h5", description=__doc__)
     p.add_argument("run_dir", help="output folder of a run (holds results.h5)")
     add_json_flag(p)
     p.set_defaults(func=run)
@@ -35,8 +34,9 @@ def run(args) -> dict:
         raise InputError(f"{str(out)!r} holds no results.h5: not the output folder of a run")
     info = read_provenance(results)
     if "case_json" not in info:
-        raise InputError(f"{str(results)!r} does not record its case (written by an older "
-                         "peridyn): run the case again")
+        raise InputError(
+            f"{str(results)!r} does not record its case (written by an older peridyn): run the case again"
+        )
     case = validate_case(json.loads(info["case_json"]), str(results))
     if case.solver.type == "modal":
         raise InputError("modal runs draw their figures with `peridyn modal`; nothing to redraw")

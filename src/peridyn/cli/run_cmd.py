@@ -9,27 +9,35 @@ from tqdm import tqdm
 
 from peridyn.cli import add_json_flag
 from peridyn.io.case import load_case
-from peridyn.io.recorder import provenance
+from peridyn.io.provenance import provenance
 
 
 def add_case_arguments(parser) -> None:
     """The case path and the repeatable ``--set key.path=value`` override."""
     parser.add_argument("case", help="YAML case file")
-    parser.add_argument("--set", dest="overrides", action="append", default=[],
-                        metavar="KEY=VALUE", help="override a case entry, e.g. "
-                        "discretization.spacing=0.001 (repeatable)")
+    parser.add_argument(
+        "--set",
+        dest="overrides",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="override a case entry, e.g. discretization.spacing=0.001 (repeatable)",
+    )
 
 
 def register(sub) -> None:
     """Add the ``run`` subcommand."""
     p = sub.add_parser("run", help="run a case file", description=__doc__)
     add_case_arguments(p)
-    p.add_argument("--output", "-o", help="output folder (default: the case's output.directory "
-                   "or peridyn-out/<case name>)")
-    p.add_argument("--checkpoint-every", type=int, default=None, metavar="N",
-                   help="write a checkpoint every N steps")
-    p.add_argument("--restart", action="store_true",
-                   help="continue from the output folder's checkpoint.h5")
+    p.add_argument(
+        "--output",
+        "-o",
+        help="output folder (default: the case's output.directory or peridyn-out/<case name>)",
+    )
+    p.add_argument(
+        "--checkpoint-every", type=int, default=None, metavar="N", help="write a checkpoint every N steps"
+    )
+    p.add_argument("--restart", action="store_true", help="continue from the output folder's checkpoint.h5")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     add_json_flag(p)
     p.set_defaults(func=run)
@@ -41,16 +49,26 @@ def run(args) -> dict:
 
     case = load_case(args.case, args.overrides)
     info = provenance()
-    print(f"peridyn {info['peridyn_version']} (commit {info['git_commit'][:12]}): case "
-          f"{case.name!r} from {args.case}", file=sys.stderr)
+    print(
+        f"peridyn {info['peridyn_version']} (commit {info['git_commit'][:12]}): case "
+        f"{case.name!r} from {args.case}",
+        file=sys.stderr,
+    )
     progress = None
     if not args.no_progress:
+
         def progress(total):
-            return tqdm(total=total, unit="step", file=sys.stderr, dynamic_ncols=True,
-                        desc=case.name)
-    summary = run_case(case, args.output, case_path=args.case,
-                       checkpoint_every=args.checkpoint_every, restart=args.restart,
-                       progress=progress, base_dir=Path(args.case).parent)
+            return tqdm(total=total, unit="step", file=sys.stderr, dynamic_ncols=True, desc=case.name)
+
+    summary = run_case(
+        case,
+        args.output,
+        case_path=args.case,
+        checkpoint_every=args.checkpoint_every,
+        restart=args.restart,
+        progress=progress,
+        base_dir=Path(args.case).parent,
+    )
     if not args.json:
         print_summary(summary)
     return summary
@@ -58,8 +76,10 @@ def run(args) -> dict:
 
 def print_summary(summary: dict) -> None:
     """Readable end-of-run report."""
-    print(f"points {summary['points']}, bonds {summary['bonds']}, steps {summary['steps']}, "
-          f"{summary['seconds']:.2f} s")
+    print(
+        f"points {summary['points']}, bonds {summary['bonds']}, steps {summary['steps']}, "
+        f"{summary['seconds']:.2f} s"
+    )
     for key in ("dt_s", "stable_dt_s", "broken_bonds", "max_damage", "strain_energy_j"):
         if key in summary:
             print(f"  {key}: {summary[key]:.6g}")

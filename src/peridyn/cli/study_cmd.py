@@ -18,26 +18,49 @@ from peridyn.errors import InputError
 
 def register(sub) -> None:
     """Add the ``study`` subcommand."""
-    p = sub.add_parser("study", help="spacing x horizon convergence study of a modal case",
-                       description=__doc__)
+    p = sub.add_parser(
+        "study", help="spacing x horizon convergence study of a modal case", description=__doc__
+    )
     add_case_arguments(p)
-    p.add_argument("--spacing", required=True, metavar="H1,H2,...",
-                   help="grid spacings in m, e.g. 2e-3,1.5e-3,1e-3")
-    p.add_argument("--horizon", required=True, metavar="M1,M2,...",
-                   help="horizons as multiples of the spacing, e.g. 1.4143,3.001")
+    p.add_argument(
+        "--spacing", required=True, metavar="H1,H2,...", help="grid spacings in m, e.g. 2e-3,1.5e-3,1e-3"
+    )
+    p.add_argument(
+        "--horizon",
+        required=True,
+        metavar="M1,M2,...",
+        help="horizons as multiples of the spacing, e.g. 1.4143,3.001",
+    )
     p.add_argument("--modes", type=int, default=None, help="modes per run (rigid included)")
-    p.add_argument("--series", default="delta-m", metavar="S1,S2",
-                   help="series to fit: delta-m (horizon factor fixed, spacing -> 0; default), "
-                        "delta (spacing fixed, horizon -> 0), m (horizon in m fixed, spacing -> 0)")
-    p.add_argument("--finest", type=int, default=None, metavar="K",
-                   help="fit only the K finest runs of each series (K >= 3; default all): "
-                        "leave coarse runs outside the asymptotic range out of the fit")
-    p.add_argument("--reference", action="append", default=[], metavar="MODE=HZ",
-                   help="a reference frequency, e.g. '1st bending=1706.1' (repeatable): "
-                        "errors of the finest run and of the extrapolation against it")
+    p.add_argument(
+        "--series",
+        default="delta-m",
+        metavar="S1,S2",
+        help="series to fit: delta-m (horizon factor fixed, spacing -> 0; default), "
+        "delta (spacing fixed, horizon -> 0), m (horizon in m fixed, spacing -> 0)",
+    )
+    p.add_argument(
+        "--finest",
+        type=int,
+        default=None,
+        metavar="K",
+        help="fit only the K finest runs of each series (K >= 3; default all): "
+        "leave coarse runs outside the asymptotic range out of the fit",
+    )
+    p.add_argument(
+        "--reference",
+        action="append",
+        default=[],
+        metavar="MODE=HZ",
+        help="a reference frequency, e.g. '1st bending=1706.1' (repeatable): "
+        "errors of the finest run and of the extrapolation against it",
+    )
     p.add_argument("--out", "-o", help="output folder (default: peridyn-out/<case name>-study)")
-    p.add_argument("--plot", metavar="FILE", help="also save the figure to FILE (PNG); "
-                   "study.png is always written in the output folder")
+    p.add_argument(
+        "--plot",
+        metavar="FILE",
+        help="also save the figure to FILE (PNG); study.png is always written in the output folder",
+    )
     add_json_flag(p)
     p.set_defaults(func=run)
 
@@ -61,11 +84,22 @@ def run(args) -> dict:
         raise InputError(f"--finest = {args.finest}: a Richardson fit needs at least three runs")
     case = load_case(args.case, args.overrides)  # fail early on a bad case or override
     out = Path(args.out or Path("peridyn-out") / f"{case.name}-study")
-    runs = run_grid(args.case, spacings, factors, args.modes, args.overrides,
-                    progress=lambda line: print(line, file=sys.stderr, flush=True))
+    runs = run_grid(
+        args.case,
+        spacings,
+        factors,
+        args.modes,
+        args.overrides,
+        progress=lambda line: print(line, file=sys.stderr, flush=True),
+    )
     fits = fit_series(runs, series, references, args.finest)
-    meta = {"case": case.name, "spacings_m": spacings, "horizon_factors": factors,
-            "series": series, "finest": args.finest}
+    meta = {
+        "case": case.name,
+        "spacings_m": spacings,
+        "horizon_factors": factors,
+        "series": series,
+        "finest": args.finest,
+    }
     summary = write_study(out, runs, fits, meta)
     plots = [out / "study.png", *([Path(args.plot)] if args.plot else [])]
     figure = plot_convergence(runs, fits, title=f"{case.name}: delta-m convergence")
@@ -82,20 +116,23 @@ def format_table(summary: dict) -> str:
     lines = []
     skipped = [r for r in summary["runs"] if r["skipped"]]
     for r in skipped:
-        lines.append(f"skipped spacing {r['spacing_m'] * 1e3:g} mm, horizon {r['horizon_factor']:g} h: "
-                     f"{r['skipped']}")
+        lines.append(
+            f"skipped spacing {r['spacing_m'] * 1e3:g} mm, horizon {r['horizon_factor']:g} h: {r['skipped']}"
+        )
     previous = None
     for fit in summary["fits"]:
         if (fit["series"], fit["group"]) != previous:
             previous = (fit["series"], fit["group"])
             unit = "h (mm)" if fit["variable"] == "spacing_m" else "delta (mm)"
-            xs = sorted({x for f in summary["fits"] if (f["series"], f["group"]) == previous
-                         for x in f["x"]})
-            lines.append(f"\n{fit['series']} convergence, {fit['group']}; {unit}: "
-                         + ", ".join(f"{x * 1e3:g}" for x in xs)
-                         + (f" (fits on the {summary['finest']} finest)" if summary["finest"] else ""))
-            lines.append(f"  {'mode':<26}{'frequencies (Hz), finest first':>34} {'f_inf (Hz)':>11} "
-                         f"{'p':>6} {'GCI':>7}")
+            xs = sorted({x for f in summary["fits"] if (f["series"], f["group"]) == previous for x in f["x"]})
+            lines.append(
+                f"\n{fit['series']} convergence, {fit['group']}; {unit}: "
+                + ", ".join(f"{x * 1e3:g}" for x in xs)
+                + (f" (fits on the {summary['finest']} finest)" if summary["finest"] else "")
+            )
+            lines.append(
+                f"  {'mode':<26}{'frequencies (Hz), finest first':>34} {'f_inf (Hz)':>11} {'p':>6} {'GCI':>7}"
+            )
         freqs = " ".join(f"{f:8.1f}" for f in fit["frequencies_hz"])
         if "value_hz" in fit:
             result = f"{fit['value_hz']:11.1f} {fit['order']:6.2f} {100 * fit['gci']:6.2f}%"
@@ -108,8 +145,7 @@ def format_table(summary: dict) -> str:
                 line += f", f_inf {100 * fit['value_error']:+.2f}%"
             line += ")"
         lines.append(line)
-    lines.append(f"\nresults written to {summary['output_dir']} (study.csv, runs.csv, study.json, "
-                 "study.png)")
+    lines.append(f"\nresults written to {summary['output_dir']} (study.csv, runs.csv, study.json, study.png)")
     return "\n".join(lines)
 
 

@@ -13,8 +13,11 @@ def register(sub) -> None:
     """Add the ``validate`` subcommand."""
     p = sub.add_parser("validate", help="check a case file", description=__doc__)
     add_case_arguments(p)
-    p.add_argument("--build", action="store_true",
-                   help="also build the body, bonds and model (finds isolated points, bad sets)")
+    p.add_argument(
+        "--build",
+        action="store_true",
+        help="also build the body, bonds and model (finds isolated points, bad sets)",
+    )
     add_json_flag(p)
     p.set_defaults(func=run)
 
@@ -30,10 +33,11 @@ def run(args) -> dict:
         setup = build(case, Path(args.case).parent)
         summary.update(points=setup.body.n_points, bonds=setup.bonds.n_bonds)
         if case.solver.type == "explicit":
-            solver = ExplicitSolver(setup.model, setup.loading, dt=case.solver.dt,
-                                    safety=case.solver.safety)
+            solver = ExplicitSolver(setup.model, setup.loading, dt=case.solver.dt, safety=case.solver.safety)
             summary.update(dt_s=solver.dt, stable_dt_s=solver.stable_dt)
     if not args.json:
-        print(f"{args.case}: valid" + "".join(f", {k} {v}" for k, v in summary.items()
-                                             if k not in ("case", "valid")))
+        print(
+            f"{args.case}: valid"
+            + "".join(f", {k} {v}" for k, v in summary.items() if k not in ("case", "valid"))
+        )
     return summary

@@ -25,11 +25,14 @@ class _Loader(yaml.SafeLoader):
 
 _Loader.add_implicit_resolver(
     "tag:yaml.org,2002:float",
-    re.compile(r"""^(?:[-+]?(?:[0-9][0-9_]*)(?:\.[0-9_]*)?(?:[eE][-+]?[0-9]+)
+    re.compile(
+        r"""^(?:[-+]?(?:[0-9][0-9_]*)(?:\.[0-9_]*)?(?:[eE][-+]?[0-9]+)
     |[-+]?(?:[0-9][0-9_]*)\.[0-9_]*
     |[-+]?\.[0-9_]+(?:[eE][-+]?[0-9]+)?
     |[-+]?\.(?:inf|Inf|INF)
-    |\.(?:nan|NaN|NAN))$""", re.X),
+    |\.(?:nan|NaN|NAN))$""",
+        re.X,
+    ),
     list("-+0123456789."),
 )
 
@@ -111,8 +114,7 @@ class Damage(Strict):
     def _one(self):
         given = [self.critical_stretch, self.fracture_energy, self.critical_bond_stress]
         if sum(v is not None for v in given) != 1:
-            raise ValueError("give exactly one of critical_stretch, fracture_energy or "
-                             "critical_bond_stress")
+            raise ValueError("give exactly one of critical_stretch, fracture_energy or critical_bond_stress")
         return self
 
 
@@ -143,8 +145,13 @@ class Region(Strict):
 
     @model_validator(mode="after")
     def _complete(self):
-        needs = {"box": ("min", "max"), "sphere": ("center", "radius"),
-                 "cylinder": ("center", "radius"), "face": ("face",), "layer": ("index",)}
+        needs = {
+            "box": ("min", "max"),
+            "sphere": ("center", "radius"),
+            "cylinder": ("center", "radius"),
+            "face": ("face",),
+            "layer": ("index",),
+        }
         missing = [k for k in needs.get(self.type, ()) if getattr(self, k) is None]
         if missing:
             raise ValueError(f"a {self.type} region needs {', '.join(missing)}")
@@ -279,8 +286,10 @@ class Solver(Strict):
             if (self.steps is None) == (self.time is None):
                 raise ValueError("a newmark run needs exactly one of steps or time (s)")
             if self.dt is None:
-                raise ValueError("a newmark run needs dt (s): the implicit step is not bounded "
-                                 "by the explicit stable step, so no default is taken")
+                raise ValueError(
+                    "a newmark run needs dt (s): the implicit step is not bounded "
+                    "by the explicit stable step, so no default is taken"
+                )
         return self
 
     @model_validator(mode="after")
@@ -357,8 +366,10 @@ class Case(Strict):
     @model_validator(mode="after")
     def _absorbing_solver(self):
         if self.absorbing is not None and self.solver.type != "explicit":
-            raise ValueError(f"absorbing: layers damp the explicit solver only, not the "
-                             f"{self.solver.type} solver (use solver.type explicit)")
+            raise ValueError(
+                f"absorbing: layers damp the explicit solver only, not the "
+                f"{self.solver.type} solver (use solver.type explicit)"
+            )
         return self
 
     @model_validator(mode="after")
@@ -367,30 +378,33 @@ class Case(Strict):
         if clash:
             raise ValueError(f"actuators: name {sorted(clash)[0]!r} is already a node set")
         known = set(self.node_sets) | {"all"} | set(self.actuators)
-        used = [(f"boundary_conditions[{i}].set", bc.set)
-                for i, bc in enumerate(self.boundary_conditions)]
-        used += [(f"initial_conditions[{i}].set", ic.set)
-                 for i, ic in enumerate(self.initial_conditions)]
+        used = [(f"boundary_conditions[{i}].set", bc.set) for i, bc in enumerate(self.boundary_conditions)]
+        used += [(f"initial_conditions[{i}].set", ic.set) for i, ic in enumerate(self.initial_conditions)]
         used += [(f"output.planes.{k}", v) for k, v in self.output.planes.items()]
         if self.material.damage:
-            used += [("material.damage.no_damage_sets", s)
-                     for s in self.material.damage.no_damage_sets]
+            used += [("material.damage.no_damage_sets", s) for s in self.material.damage.no_damage_sets]
         for where, name in used:
             if name not in known:
-                raise ValueError(f"{where}: unknown node set {name!r}{did_you_mean(name, known)};"
-                                 f" defined: {sorted(known)}")
+                raise ValueError(
+                    f"{where}: unknown node set {name!r}{did_you_mean(name, known)}; defined: {sorted(known)}"
+                )
         if self.contact is not None and self.solver.type not in ("explicit", "static"):
-            raise ValueError(f"contact: the {self.solver.type} solver has no contact forces; "
-                             "contact works with solver.type explicit or static")
+            raise ValueError(
+                f"contact: the {self.solver.type} solver has no contact forces; "
+                "contact works with solver.type explicit or static"
+            )
         a = self.analysis
         if a is not None and self.geometry.type != "plate":
             raise ValueError("analysis: Lamb-wave analyses need a plate geometry")
         if a is not None and a.fk is not None and a.fk.line not in self.output.lines:
-            raise ValueError(f"analysis.fk.line: {a.fk.line!r} is not one of output.lines "
-                             f"{sorted(self.output.lines)}")
+            raise ValueError(
+                f"analysis.fk.line: {a.fk.line!r} is not one of output.lines {sorted(self.output.lines)}"
+            )
         if a is not None and a.kxky is not None and a.kxky.plane not in self.output.planes:
-            raise ValueError(f"analysis.kxky.plane: {a.kxky.plane!r} is not one of output.planes "
-                             f"{sorted(self.output.planes)}")
+            raise ValueError(
+                f"analysis.kxky.plane: {a.kxky.plane!r} is not one of output.planes "
+                f"{sorted(self.output.planes)}"
+            )
         if a is not None and a.fk is not None and a.fk.frequency is None and not self.actuators:
             raise ValueError("analysis.fk.frequency: give it, or an actuator whose signal has one")
         return self
@@ -563,8 +577,9 @@ class ParisSpecimen(Strict):
     @model_validator(mode="after")
     def _range(self):
         if self.fit_range is not None and self.fit_range[0] >= self.fit_range[1]:
-            raise ValueError(f"paris.fit_range must be [shortest, longest] crack length (m), got "
-                             f"{list(self.fit_range)}")
+            raise ValueError(
+                f"paris.fit_range must be [shortest, longest] crack length (m), got {list(self.fit_range)}"
+            )
         return self
 
 
@@ -597,8 +612,10 @@ class Fatigue(Strict):
         if self.tip.axis == self.tip.depth_axis:
             raise ValueError("tip.axis and tip.depth_axis must differ")
         if self.paris is not None and (self.tip.start is not None or self.tip.sense != "+"):
-            raise ValueError("fatigue.paris measures the crack from the low edge of tip.axis (a "
-                             "single edge notch): leave tip.start and tip.sense at their defaults")
+            raise ValueError(
+                "fatigue.paris measures the crack from the low edge of tip.axis (a "
+                "single edge notch): leave tip.start and tip.sense at their defaults"
+            )
         return self
 
 
@@ -610,7 +627,11 @@ class AbsorbingSpec(Strict):
     width: Positive
     damping: Positive
     faces: Annotated[list[Literal["x-", "x+", "y-", "y+", "z-", "z+"]], Field(min_length=1)] = [
-        "x-", "x+", "y-", "y+"]
+        "x-",
+        "x+",
+        "y-",
+        "y+",
+    ]
 
 
 Case.model_rebuild()

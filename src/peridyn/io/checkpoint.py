@@ -36,8 +36,7 @@ def load_checkpoint(path, n_points: int, n_bonds: int) -> tuple[State, np.ndarra
     if not path.is_file():
         raise InputError(f"checkpoint file {str(path)!r} does not exist: nothing to restart from")
     with h5py.File(path, "r") as f:
-        state = State(f["u"][...], f["v"][...], f["a"][...], float(f.attrs["time"]),
-                      int(f.attrs["step"]))
+        state = State(f["u"][...], f["v"][...], f["a"][...], float(f.attrs["time"]), int(f.attrs["step"]))
         intact = f["intact"][...]
     if state.u.shape != (n_points, 3) or intact.shape != (n_bonds,):
         raise InputError(

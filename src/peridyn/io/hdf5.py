@@ -187,8 +187,7 @@ class HDF5Writer:
         values = np.asarray(values)
         if values.shape != series.data.shape[1:]:
             raise InputError(
-                f"series {name!r}: record has shape {values.shape}, "
-                f"expected {series.data.shape[1:]}"
+                f"series {name!r}: record has shape {values.shape}, expected {series.data.shape[1:]}"
             )
         series.append(step, time, values)
         self._pending += 1
@@ -263,8 +262,7 @@ class HDF5Writer:
     def _get_series(self, name: str) -> _Series:
         if name not in self._series:
             raise InputError(
-                f"series {name!r} does not exist; call create_series first"
-                + did_you_mean(name, self._series)
+                f"series {name!r} does not exist; call create_series first" + did_you_mean(name, self._series)
             )
         return self._series[name]
 
@@ -424,8 +422,7 @@ def _open_series(path: str | os.PathLike, name: str) -> Iterator[h5py.Group]:
         available = list(f.get("series", {}))
         if name not in available:
             raise InputError(
-                f"{os.fspath(path)}: no series {name!r}; it has {available}"
-                + did_you_mean(name, available)
+                f"{os.fspath(path)}: no series {name!r}; it has {available}" + did_you_mean(name, available)
             )
         yield f["series"][name]
 
@@ -440,9 +437,7 @@ def _check_geometry(points, volumes) -> tuple[np.ndarray, np.ndarray]:
     if points.ndim != 2 or points.shape[1] not in (2, 3):
         raise InputError(f"points must have shape (n_points, 2 or 3), got {points.shape}")
     if volumes.shape != points.shape[:1]:
-        raise InputError(
-            f"volumes must have shape ({points.shape[0]},) like points, got {volumes.shape}"
-        )
+        raise InputError(f"volumes must have shape ({points.shape[0]},) like points, got {volumes.shape}")
     return points, volumes
 
 

@@ -133,9 +133,7 @@ def _locate_parse_error(path: str, exc: ValueError) -> InputError:
 
 
 def _column_error(path: str, line_no: int, found: int) -> InputError:
-    return InputError(
-        f"{path}, line {line_no}: found {found} columns, expected {N_COLUMNS} ({COLUMNS})"
-    )
+    return InputError(f"{path}, line {line_no}: found {found} columns, expected {N_COLUMNS} ({COLUMNS})")
 
 
 def _is_number(token: str) -> bool:
@@ -188,13 +186,10 @@ def _check_volumes(path: str, volumes: np.ndarray) -> None:
     line = _first_bad_line(path, bad)
     if line is not None:
         value = volumes[np.flatnonzero(bad)[0]]
-        raise InputError(
-            f"{path}, line {line}: volume must be positive and finite, got {float(value)!r}"
-        )
+        raise InputError(f"{path}, line {line}: volume must be positive and finite, got {float(value)!r}")
 
 
-def from_text_mesh(path, dim: int = 3, thickness: float | None = None,
-                   plane: str | None = None) -> Body:
+def from_text_mesh(path, dim: int = 3, thickness: float | None = None, plane: str | None = None) -> Body:
     """A body from a Peridigm-style text mesh (``x y z block_id volume`` per line).
 
     Cells are taken as cubes of the point's volume (squares times ``thickness``
@@ -210,8 +205,16 @@ def from_text_mesh(path, dim: int = 3, thickness: float | None = None,
         side = np.cbrt(volumes)
         cells = np.stack([side, side, side], axis=1)
     sets = {f"block_{b}": np.flatnonzero(blocks == b) for b in np.unique(blocks)}
-    return Body(points=points, volumes=volumes, cells=cells, dim=dim,
-                spacing=float(np.median(side)), node_sets=sets, thickness=thickness, plane=plane)
+    return Body(
+        points=points,
+        volumes=volumes,
+        cells=cells,
+        dim=dim,
+        spacing=float(np.median(side)),
+        node_sets=sets,
+        thickness=thickness,
+        plane=plane,
+    )
 
 
 def to_text_mesh(body: Body, path, block_ids=None) -> None:

@@ -13,18 +13,12 @@ Series in ``results.h5`` (see ``peridyn.io.hdf5`` for the layout):
 
 from __future__ import annotations
 
-import hashlib
-import platform
-import subprocess
-import sys
 from dataclasses import dataclass, field
-from datetime import UTC, datetime
 from pathlib import Path
 
 import numpy as np
 from scipy.spatial import cKDTree
 
-from peridyn import __version__
 from peridyn.discretization.body import Body
 from peridyn.discretization.state import State
 from peridyn.errors import InputError
@@ -95,8 +89,15 @@ class Recorder:
         time (s), for a restart from a checkpoint.
     """
 
-    def __init__(self, body: Body, directory, spec: RecorderSpec, provenance: dict,
-                 model=None, resume: tuple[int, float] | None = None):
+    def __init__(
+        self,
+        body: Body,
+        directory,
+        spec: RecorderSpec,
+        provenance: dict,
+        model=None,
+        resume: tuple[int, float] | None = None,
+    ):
         self.body = body
         self.directory = Path(directory)
         self.directory.mkdir(parents=True, exist_ok=True)
@@ -106,14 +107,24 @@ class Recorder:
             raise InputError(f"output.every must be at least 1, got {spec.every}")
         tree = cKDTree(body.points)
         self.sensor_names = list(spec.sensors)
-        self.sensor_index = (tree.query(np.array([spec.sensors[k] for k in self.sensor_names]))[1]
-                             if spec.sensors else np.zeros(0, dtype=int))
-        self.line_index = {name: tree.query(np.linspace(p.start, p.end, p.points))[1]
-                           for name, p in spec.lines.items()}
+        self.sensor_index = (
+            tree.query(np.array([spec.sensors[k] for k in self.sensor_names]))[1]
+            if spec.sensors
+            else np.zeros(0, dtype=int)
+        )
+        self.line_index = {
+            name: tree.query(np.linspace(p.start, p.end, p.points))[1] for name, p in spec.lines.items()
+        }
         self.plane_index = {name: np.asarray(idx) for name, idx in spec.planes.items()}
         mode = "a" if resume is not None else "w"
-        self.h5 = HDF5Writer(self.directory / "results.h5", body.points[:, : body.dim],
-                             body.volumes, provenance, mode=mode, flush_every=1)
+        self.h5 = HDF5Writer(
+            self.directory / "results.h5",
+            body.points[:, : body.dim],
+            body.volumes,
+            provenance,
+            mode=mode,
+            flush_every=1,
+        )
         self._create_series()
         self.pvd = None
         if spec.vtu:
@@ -128,18 +139,18 @@ class Recorder:
         h5, spec = self.h5, self.spec
         if self.sensor_names:
             for q in ("u", "v"):
-                h5.create_series(f"sensor_{q}", (len(self.sensor_names), 3),
-                                 attrs={"names": self.sensor_names,
-                                        "points": self.sensor_index.tolist()})
+                h5.create_series(
+                    f"sensor_{q}",
+                    (len(self.sensor_names), 3),
+                    attrs={"names": self.sensor_names, "points": self.sensor_index.tolist()},
+                )
         for name, idx in self.line_index.items():
-            h5.create_series(f"line_{name}", (len(idx), 3), spec.series_dtype,
-                             attrs={"points": idx.tolist()})
+            h5.create_series(f"line_{name}", (len(idx), 3), spec.series_dtype, attrs={"points": idx.tolist()})
         for name, idx in self.plane_index.items():
             h5.create_series(f"plane_{name}", (len(idx), 3), spec.series_dtype)
             h5.write_array(f"probes/plane_{name}", idx)
         if spec.pzt_sensors:
-            h5.create_series("pzt_signal", (len(spec.pzt_sensors),),
-                             attrs={"names": list(spec.pzt_sensors)})
+            h5.create_series("pzt_signal", (len(spec.pzt_sensors),), attrs={"names": list(spec.pzt_sensors)})
         h5.create_series("field_u", (self.body.n_points, 3), spec.series_dtype)
 
     def observe(self, state: State, solver) -> None:
@@ -169,8 +180,7 @@ class Recorder:
         self.h5.append("field_u", state.step, state.time, state.u)
         if self.pvd is None:
             return
-        data = {"displacement": state.u[:, : self.body.dim],
-                "velocity": state.v[:, : self.body.dim]}
+        data = {"displacement": state.u[:, : self.body.dim], "velocity": state.v[:, : self.body.dim]}
         if self.model is not None:
             data["damage"] = damage_field(self.model)
         name = f"snapshots/step_{state.step:08d}.vtu"
@@ -184,34 +194,3 @@ class Recorder:
         if self.model is not None:
             self.h5.write_array("final/damage", damage_field(self.model))
         self.h5.close()
-
-
-def provenance(case_path=None, argv=None, case=None) -> dict:
-    """Package version, git commit, case file and its SHA-256, command line, host and date;
-    with ``case``, also the validated case (overrides applied) as JSON, which
-    ``peridyn plot`` uses to redraw a run."""
-    info = {
-        "peridyn_version": __version__,
-        "git_commit": _git_commit(),
-        "command_line": " ".join(sys.argv if argv is None else argv),
-        "python": platform.python_version(),
-        "machine": platform.platform(),
-        "created_utc": datetime.now(UTC).isoformat(timespec="seconds"),
-    }
-    if case_path is not None:
-        data = Path(case_path).read_bytes()
-        info["case_file"] = str(case_path)
-        info["case_sha256"] = hashlib.sha256(data).hexdigest()
-        info["case_text"] = data.decode("utf-8", errors="replace")
-    if case is not None:
-        info["case_json"] = case.model_dump_json()
-    return info
-
-
-def _git_commit() -> str:
-    try:
-        out = subprocess.run(["git", "rev-parse", "HEAD"], cwd=Path(__file__).parent,
-                             capture_output=True, text=True, timeout=5, check=False)
-    except (OSError, subprocess.SubprocessError):
-        return "unknown"
-    return out.stdout.strip() or "unknown"

@@ -35,9 +35,7 @@ def write_vtu(path: str | os.PathLike, points, point_data: dict) -> None:
     """
     points = _pad_columns(np.asarray(points, dtype=np.float64))
     if points.ndim != 2 or points.shape[1] != 3:
-        raise InputError(
-            f"write_vtu: points must have shape (n_points, 2 or 3), got {points.shape}"
-        )
+        raise InputError(f"write_vtu: points must have shape (n_points, 2 or 3), got {points.shape}")
     n = points.shape[0]
     fields = {name: _vtk_field(name, values, n) for name, values in point_data.items()}
     cells = [("vertex", np.arange(n, dtype=np.int64).reshape(-1, 1))]
@@ -119,9 +117,7 @@ def _read_pvd(path: Path) -> list[tuple[float, str]]:
     """``(time, file)`` entries of an existing .pvd file."""
     try:
         root = ET.parse(path).getroot()
-        return [
-            (float(item.attrib["timestep"]), item.attrib["file"]) for item in root.iter("DataSet")
-        ]
+        return [(float(item.attrib["timestep"]), item.attrib["file"]) for item in root.iter("DataSet")]
     except (ET.ParseError, KeyError, ValueError) as exc:
         raise InputError(
             f"{path}: not a valid .pvd collection (expected DataSet elements with "
@@ -140,8 +136,7 @@ def _vtk_field(name: str, values, n: int) -> np.ndarray:
     values = np.asarray(values)
     if values.ndim not in (1, 2) or values.shape[0] != n:
         raise InputError(
-            f"write_vtu: field {name!r} has shape {values.shape}, "
-            f"expected ({n},) or ({n}, k) for {n} points"
+            f"write_vtu: field {name!r} has shape {values.shape}, expected ({n},) or ({n}, k) for {n} points"
         )
     if values.dtype.kind == "b":
         values = values.astype(np.uint8)

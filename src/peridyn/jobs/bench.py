@@ -75,7 +75,6 @@ ROWS = (
 E, NU, DENSITY = 200e9, 0.25, 7850.0
 
 
-
 def triad_bandwidth(elements: int = DEFAULT_TRIAD_ELEMENTS, repeat: int = 10) -> float:
     """Memory bandwidth (bytes/s) of the triad ``a = b + s c``, STREAM's count (24 B per element)."""
     b = np.full(elements, 1.0)
@@ -126,15 +125,17 @@ def _row_callables(body, bonds, u64: np.ndarray) -> dict[tuple[str, str], Callab
     for name, dtype in ROWS:
         if name == "pmb-baseline":
             continue
-        models[name, dtype] = make_model(name, body, bonds, E=E, nu=NU, density=DENSITY,
-                                         dtype=np.dtype(dtype))
+        models[name, dtype] = make_model(
+            name, body, bonds, E=E, nu=NU, density=DENSITY, dtype=np.dtype(dtype)
+        )
     # the baseline computes the PMB force with c = the PMB bond stiffness (k (1/|xi| - 1/|Y|) Y)
     c = models["pmb", "float64"].bond_stiffness.astype(np.float64)
     out64 = np.empty_like(body.points)
 
     def baseline():
-        return pmb_force_baseline(body.points, u64, bonds.offsets, bonds.neighbours, bonds.length,
-                                  c, bonds.intact, out64)
+        return pmb_force_baseline(
+            body.points, u64, bonds.offsets, bonds.neighbours, bonds.length, c, bonds.intact, out64
+        )
 
     calls["pmb-baseline", "float64"] = baseline
     for key, model in models.items():
@@ -144,9 +145,14 @@ def _row_callables(body, bonds, u64: np.ndarray) -> dict[tuple[str, str], Callab
     return calls
 
 
-def run_benchmark(points: int = DEFAULT_POINTS, repeat: int = 10, partial_volumes: bool = False,
-                  triad_elements: int = DEFAULT_TRIAD_ELEMENTS, seed: int = 0,
-                  log: Callable[[str], None] | None = None) -> dict:
+def run_benchmark(
+    points: int = DEFAULT_POINTS,
+    repeat: int = 10,
+    partial_volumes: bool = False,
+    triad_elements: int = DEFAULT_TRIAD_ELEMENTS,
+    seed: int = 0,
+    log: Callable[[str], None] | None = None,
+) -> dict:
     """Measure every row and the triad bandwidth; returns the ``peridyn bench --json`` dict.
 
     Parameters
@@ -190,31 +196,42 @@ def run_benchmark(points: int = DEFAULT_POINTS, repeat: int = 10, partial_volume
     for name, dtype in ROWS:
         rate = bonds.n_bonds / best[name, dtype]
         nbytes = bytes_per_bond(name, dtype)
-        results.append({
-            "model": name,
-            "dtype": dtype,
-            "points": int(body.n_points),
-            "bonds": int(bonds.n_bonds),
-            "bond_updates_per_s": float(rate),
-            "bytes_per_bond": int(nbytes),
-            "roofline_fraction": float(rate * nbytes / bandwidth),
-            "speedup_vs_baseline": float(rate / base_rate),
-        })
-    return {"bandwidth_bytes_per_s": float(bandwidth), "threads": int(numba.get_num_threads()),
-            "results": results}
+        results.append(
+            {
+                "model": name,
+                "dtype": dtype,
+                "points": int(body.n_points),
+                "bonds": int(bonds.n_bonds),
+                "bond_updates_per_s": float(rate),
+                "bytes_per_bond": int(nbytes),
+                "roofline_fraction": float(rate * nbytes / bandwidth),
+                "speedup_vs_baseline": float(rate / base_rate),
+            }
+        )
+    return {
+        "bandwidth_bytes_per_s": float(bandwidth),
+        "threads": int(numba.get_num_threads()),
+        "results": results,
+    }
 
 
 def format_table(result: dict) -> str:
     """Readable table of a :func:`run_benchmark` result."""
     rows = result["results"]
-    head = (f"{rows[0]['points']} points, {rows[0]['bonds']} directed bonds, "
-            f"{result['threads']} numba threads, triad bandwidth "
-            f"{result['bandwidth_bytes_per_s'] / 1e9:.1f} GB/s")
-    lines = [head, "",
-             f"{'model':<13} {'dtype':<8} {'M bond/s':>9} {'x baseline':>10} {'B/bond':>7} "
-             f"{'roofline':>8}"]
+    head = (
+        f"{rows[0]['points']} points, {rows[0]['bonds']} directed bonds, "
+        f"{result['threads']} numba threads, triad bandwidth "
+        f"{result['bandwidth_bytes_per_s'] / 1e9:.1f} GB/s"
+    )
+    lines = [
+        head,
+        "",
+        f"{'model':<13} {'dtype':<8} {'M bond/s':>9} {'x baseline':>10} {'B/bond':>7} {'roofline':>8}",
+    ]
     for r in rows:
-        lines.append(f"{r['model']:<13} {r['dtype']:<8} {r['bond_updates_per_s'] / 1e6:>9.1f} "
-                     f"{r['speedup_vs_baseline']:>10.2f} {r['bytes_per_bond']:>7d} "
-                     f"{r['roofline_fraction']:>8.2f}")
+        lines.append(
+            f"{r['model']:<13} {r['dtype']:<8} {r['bond_updates_per_s'] / 1e6:>9.1f} "
+            f"{r['speedup_vs_baseline']:>10.2f} {r['bytes_per_bond']:>7d} "
+            f"{r['roofline_fraction']:>8.2f}"
+        )
     return "\n".join(lines)

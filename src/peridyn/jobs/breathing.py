@@ -25,8 +25,9 @@ def sensor_signal(case: Case, sensor: str) -> tuple[np.ndarray, float]:
     if sensor not in case.output.sensors:
         raise InputError(f"sensor {sensor!r} is not one of output.sensors {sorted(case.output.sensors)}")
     setup = build(case)
-    solver = ExplicitSolver(setup.model, setup.loading, dt=case.solver.dt, safety=case.solver.safety,
-                            contact=setup.contact)
+    solver = ExplicitSolver(
+        setup.model, setup.loading, dt=case.solver.dt, safety=case.solver.safety, contact=setup.contact
+    )
     state = solver.initial_state()
     where = np.array(case.output.sensors[sensor] + [0.0] * (3 - len(case.output.sensors[sensor])))
     point = int(np.argmin(np.linalg.norm(setup.body.points - where, axis=1)))

@@ -43,24 +43,38 @@ def build_body(case: Case, base_dir=".") -> Body:
     if g.type == "box":
         body = geometry.box(g.size, d.spacing, g.origin or (0.0, 0.0, 0.0))
     elif g.type == "plate":
-        body = geometry.plate(*g.size, spacing=d.spacing, layers=g.layers,
-                              origin=g.origin or (0.0, 0.0, 0.0),
-                              layer_placement=g.layer_placement)
+        body = geometry.plate(
+            *g.size,
+            spacing=d.spacing,
+            layers=g.layers,
+            origin=g.origin or (0.0, 0.0, 0.0),
+            layer_placement=g.layer_placement,
+        )
     elif g.type == "rectangle":
-        body = geometry.rectangle(*g.size, spacing=d.spacing, thickness=g.thickness,
-                                  plane=g.plane, origin=(g.origin or (0.0, 0.0))[:2])
+        body = geometry.rectangle(
+            *g.size,
+            spacing=d.spacing,
+            thickness=g.thickness,
+            plane=g.plane,
+            origin=(g.origin or (0.0, 0.0))[:2],
+        )
     else:
         mesh = Path(g.file) if Path(g.file).is_absolute() else Path(base_dir) / g.file
-        body = mesh_text.from_text_mesh(mesh, dim=g.dimension, thickness=g.thickness,
-                                       plane=g.plane if g.dimension == 2 else None)
+        body = mesh_text.from_text_mesh(
+            mesh, dim=g.dimension, thickness=g.thickness, plane=g.plane if g.dimension == 2 else None
+        )
     for k, region in enumerate(case.removals):
         body = body.remove(region_mask(body, region, f"removals[{k}]"))
     body = body.with_node_set("all", np.ones(body.n_points, dtype=bool))
     for name, region in case.node_sets.items():
         mask = region_mask(body, region, f"node_sets.{name}")
         if not mask.any():
-            raise CaseFileError(case.name, f"node_sets.{name}", region.model_dump(exclude_none=True),
-                                "a region that contains at least one point")
+            raise CaseFileError(
+                case.name,
+                f"node_sets.{name}",
+                region.model_dump(exclude_none=True),
+                "a region that contains at least one point",
+            )
         body = body.with_node_set(name, mask)
     return body
 
@@ -96,11 +110,14 @@ def build_bonds(case: Case, body: Body) -> Bonds:
     bonds = find_bonds(body, horizon, d.influence, d.partial_volumes)
     for crack in case.precracks:
         if crack.type == "rectangle":
+
             def crossing(a, b, c=crack):
                 return crossing_rectangle(a, b, c.origin, c.edge_u, c.edge_v)
         else:
+
             def crossing(a, b, c=crack):
                 return crossing_segment(a, b, c.start, c.end)
+
         cut_bonds(body, bonds, crossing)
     return bonds
 
@@ -111,22 +128,33 @@ def add_actuators(case: Case, body: Body) -> tuple[Body, list[BoundaryCondition]
     for name, a in case.actuators.items():
         signal = from_spec(a.signal, f"actuators.{name}.signal")
         if a.type == "pzt_radial":
-            body, bcs = pzt_radial_actuator(body, a.center, a.size, signal, shape=a.shape,
-                                            layer=a.layer, amplitude=a.amplitude, name=name)
+            body, bcs = pzt_radial_actuator(
+                body, a.center, a.size, signal, shape=a.shape, layer=a.layer, amplitude=a.amplitude, name=name
+            )
         else:
-            body, bcs = pin_force_actuator(body, a.center, a.size, signal, shape=a.shape,
-                                           layer=a.layer, line_force=a.line_force, name=name)
+            body, bcs = pin_force_actuator(
+                body,
+                a.center,
+                a.size,
+                signal,
+                shape=a.shape,
+                layer=a.layer,
+                line_force=a.line_force,
+                name=name,
+            )
         conditions += bcs
     return body, conditions
 
 
 def build_loading(case: Case, body: Body, extra=()) -> Loading:
     """Boundary and initial conditions of the case (plus ``extra`` ones), checked for conflicts."""
-    bcs = [BoundaryCondition(bc.set, bc.kind, bc.components,
-                             from_spec(bc.value, f"boundary_conditions[{k}].value"))
-           for k, bc in enumerate(case.boundary_conditions)]
-    ics = [InitialCondition(ic.set, ic.kind, ic.components, ic.value)
-           for ic in case.initial_conditions]
+    bcs = [
+        BoundaryCondition(
+            bc.set, bc.kind, bc.components, from_spec(bc.value, f"boundary_conditions[{k}].value")
+        )
+        for k, bc in enumerate(case.boundary_conditions)
+    ]
+    ics = [InitialCondition(ic.set, ic.kind, ic.components, ic.value) for ic in case.initial_conditions]
     return Loading(body, [*extra, *bcs], ics)
 
 
@@ -135,24 +163,38 @@ def build(case: Case, base_dir=".") -> Setup:
     body, actuation = add_actuators(case, build_body(case, base_dir))
     bonds = build_bonds(case, body)
     mat = case.material
-    model = make_model(mat.model, body, bonds, E=mat.E, density=mat.density, nu=mat.nu,
-                       surface_correction=mat.surface_correction, dtype=case.solver.dtype)
+    model = make_model(
+        mat.model,
+        body,
+        bonds,
+        E=mat.E,
+        density=mat.density,
+        nu=mat.nu,
+        surface_correction=mat.surface_correction,
+        dtype=case.solver.dtype,
+    )
     damage = None
     if mat.damage is not None:
-        damage = BondDamage(model, mat.damage.critical_stretch, mat.damage.fracture_energy,
-                            mat.damage.no_damage_sets,
-                            critical_bond_stress=mat.damage.critical_bond_stress)
+        damage = BondDamage(
+            model,
+            mat.damage.critical_stretch,
+            mat.damage.fracture_energy,
+            mat.damage.no_damage_sets,
+            critical_bond_stress=mat.damage.critical_bond_stress,
+        )
     loading = build_loading(case, body, actuation)
     if case.solver.type == "static" and not loading.has_loads:
         raise CaseFileError(case.name, "boundary_conditions", [], "at least one load for a static run")
     if case.solver.type == "newmark" and not (loading.has_loads or loading.initial):
-        raise CaseFileError(case.name, "boundary_conditions", [],
-                            "a load or an initial condition: nothing would move")
+        raise CaseFileError(
+            case.name, "boundary_conditions", [], "a load or an initial condition: nothing would move"
+        )
     if case.solver.type == "newton" and not loading.has_loads:
         raise CaseFileError(case.name, "boundary_conditions", [], "at least one load for a newton run")
     if case.solver.type == "explicit" and not (loading.has_loads or loading.initial):
-        raise CaseFileError(case.name, "boundary_conditions", [],
-                            "a load or an initial condition: nothing would move")
+        raise CaseFileError(
+            case.name, "boundary_conditions", [], "a load or an initial condition: nothing would move"
+        )
     return Setup(body, bonds, model, loading, damage, build_contact(case, model))
 
 

@@ -35,21 +35,25 @@ def check_fatigue_case(case: Case) -> None:
     if case.fatigue is None:
         raise CaseFileError(case.name, "fatigue", None, "a fatigue block (parameters, mapping)")
     if not case.boundary_conditions:
-        raise CaseFileError(case.name, "boundary_conditions", [],
-                            "a cyclic load: boundary conditions giving the maximum load")
+        raise CaseFileError(
+            case.name, "boundary_conditions", [], "a cyclic load: boundary conditions giving the maximum load"
+        )
     known = set(case.node_sets) | {"all"}
     for name in case.fatigue.no_damage_sets:
         if name not in known:
-            raise CaseFileError(case.name, "fatigue.no_damage_sets", name,
-                                f"a defined node set{did_you_mean(name, known)}: {sorted(known)}")
+            raise CaseFileError(
+                case.name,
+                "fatigue.no_damage_sets",
+                name,
+                f"a defined node set{did_you_mean(name, known)}: {sorted(known)}",
+            )
 
 
 def fatigue_parameters(case: Case, horizon: float) -> FatigueParameters:
     """The case's parameters with A_II moved to ``horizon`` (m) by eq. 7.15 when its own is given."""
     f = case.fatigue
     a2 = f.A_II if f.A_II_horizon is None else scale_A_II(f.A_II, f.A_II_horizon, horizon, f.m_II)
-    return FatigueParameters(A_I=f.A_I, m_I=f.m_I, eps_inf=f.eps_inf, A_II=a2, m_II=f.m_II,
-                             phi_c=f.phi_c)
+    return FatigueParameters(A_I=f.A_I, m_I=f.m_I, eps_inf=f.eps_inf, A_II=a2, m_II=f.m_II, phi_c=f.phi_c)
 
 
 def specimen_k(case: Case, setup) -> tuple[np.ndarray, np.ndarray] | None:
@@ -64,15 +68,21 @@ def specimen_k(case: Case, setup) -> tuple[np.ndarray, np.ndarray] | None:
     h = body.spacing
     span = np.ptp(body.points[:, axis]) + h
     crack = case.precracks[0]
-    tips = [np.add(crack.origin, crack.edge_u), crack.origin] if crack.type == "rectangle" else [
-        crack.start, crack.end]
+    tips = (
+        [np.add(crack.origin, crack.edge_u), crack.origin]
+        if crack.type == "rectangle"
+        else [crack.start, crack.end]
+    )
     start = max(np.asarray(t, float)[axis] for t in tips) - (body.points[:, axis].min() - 0.5 * h)
     end = min(span - 2.0 * h, p.stop_length or span, p.fit_range[1] if p.fit_range else span)
     lengths = np.arange(start, end + 1.5 * h, h)
     cut = straight_crack_cut(body.points, h, setup.bonds, crack, axis)
     energy = compliance_energy(setup.model, setup.loading, lengths, cut, case.fatigue.max_load_time)
-    depth = case.geometry.thickness if body.dim == 2 else np.ptp(
-        body.points[:, AXES[case.fatigue.tip.depth_axis]]) + h
+    depth = (
+        case.geometry.thickness
+        if body.dim == 2
+        else np.ptp(body.points[:, AXES[case.fatigue.tip.depth_axis]]) + h
+    )
     return lengths, compliance_stress_intensity(lengths, energy, depth, case.material.E)
 
 
@@ -108,8 +118,9 @@ def _stop_length(f) -> float:
     return f.paris.stop_length if f.paris is not None and f.paris.stop_length is not None else np.inf
 
 
-def run_fatigue_case(case: Case, output_dir=None, base_dir=".", modal: bool | None = None,
-                     progress=None) -> dict:
+def run_fatigue_case(
+    case: Case, output_dir=None, base_dir=".", modal: bool | None = None, progress=None
+) -> dict:
     """Run a fatigue case; returns the summary (JSON keys of ``peridyn fatigue --json``)."""
     start = time.perf_counter()
     check_fatigue_case(case)
@@ -126,36 +137,58 @@ def run_fatigue_case(case: Case, output_dir=None, base_dir=".", modal: bool | No
     mapping = CycleMapping(tuple((b.steps, b.tau) for b in f.mapping), f.adaptive)
     if progress is not None:
         progress = progress(mapping.n_steps)
-    result = run_fatigue(setup.model, setup.loading, fatigue_parameters(case, setup.bonds.horizon),
-                         mapping, f.load_ratio, f.max_load_time, f.no_damage_sets, f.tip.axis,
-                         f.tip.depth_axis, f.tip.damage, f.solver, progress,
-                         _stop_length(f), f.tip.start, f.tip.sense)
+    result = run_fatigue(
+        setup.model,
+        setup.loading,
+        fatigue_parameters(case, setup.bonds.horizon),
+        mapping,
+        f.load_ratio,
+        f.max_load_time,
+        f.no_damage_sets,
+        f.tip.axis,
+        f.tip.depth_axis,
+        f.tip.damage,
+        f.solver,
+        progress,
+        _stop_length(f),
+        f.tip.start,
+        f.tip.sense,
+    )
     if progress is not None:
         progress.close()
-    summary = {"cycles": float(result.cycles[-1]), "crack_length_m": float(result.crack_length[-1]),
-               "paris_slope": paris_slope(case, result, k_curve),
-               "paris_rates": int(paris_rates(case, result)[1].size) if f.paris is not None else 0,
-               "bonds_broken": int(result.broken[-1]),
-               "points": setup.body.n_points, "bonds": setup.bonds.n_bonds // 2,
-               "output_dir": str(out)}
+    summary = {
+        "cycles": float(result.cycles[-1]),
+        "crack_length_m": float(result.crack_length[-1]),
+        "paris_slope": paris_slope(case, result, k_curve),
+        "paris_rates": int(paris_rates(case, result)[1].size) if f.paris is not None else 0,
+        "bonds_broken": int(result.broken[-1]),
+        "points": setup.body.n_points,
+        "bonds": setup.bonds.n_bonds // 2,
+        "output_dir": str(out),
+    }
     if do_modal:
         after, _, after_rows = modal_table(setup.model, n_modes)
         masses = setup.model.density * setup.body.volumes
         mac, pairs = match_modes(before, after, masses)
-        summary["modal"] = {"before": setup_rows, "after": after_rows, "mac": mac.tolist(),
-                            "matches": pairs}
+        summary["modal"] = {"before": setup_rows, "after": after_rows, "mac": mac.tolist(), "matches": pairs}
         (out / "modal.json").write_text(json.dumps(summary["modal"], indent=1))
     _write_history(out / "crack_length.csv", result)
     body = setup.body
-    write_vtu(out / "damage.vtu", body.points[:, : body.dim],
-              {"damage": result.damage, "first_break_cycle": np.where(
-                  np.isfinite(result.first_break), result.first_break, -1.0),
-               "u_max": result.u_max[:, : body.dim]})
+    write_vtu(
+        out / "damage.vtu",
+        body.points[:, : body.dim],
+        {
+            "damage": result.damage,
+            "first_break_cycle": np.where(np.isfinite(result.first_break), result.first_break, -1.0),
+            "u_max": result.u_max[:, : body.dim],
+        },
+    )
     if case.output.plots:
         from peridyn.plotting.fatigue import plot_crack_length
 
-        summary["plots"] = [str(plot_crack_length(result.cycles, result.crack_length,
-                                                  out / "crack_length.png"))]
+        summary["plots"] = [
+            str(plot_crack_length(result.cycles, result.crack_length, out / "crack_length.png"))
+        ]
     summary["seconds"] = time.perf_counter() - start
     summary["peak_memory_bytes"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
     (out / "fatigue.json").write_text(json.dumps(summary, indent=1))

@@ -26,8 +26,7 @@ def draw_run_figures(case: Case, body: Body, out: Path) -> list[Path]:
         _, times, _ = read_series(out / "results.h5", "field_u")
         reached = [t for t in case.output.snapshot_times if t <= times[-1] * (1 + 1e-9)]
         if reached:
-            figures.append(plot_wavefield_snapshots(out / "results.h5", out / "wavefield.png",
-                                                    reached))
+            figures.append(plot_wavefield_snapshots(out / "results.h5", out / "wavefield.png", reached))
         figures += _actuator_figures(case, out, reached)
     return figures
 
@@ -43,16 +42,21 @@ def _actuator_figures(case: Case, out: Path, snapshot_times) -> list[Path]:
         if snapshot_times:
             cx = actuator.center[0]
             x_range = (max(0.0, cx - 0.050), min(length, cx + 0.050))
-            figures.append(plot_through_thickness(
-                out / "results.h5", out / f"cut_{name}.png",
-                snapshot_times[len(snapshot_times) // 2], actuator.center, x_range))
+            figures.append(
+                plot_through_thickness(
+                    out / "results.h5",
+                    out / f"cut_{name}.png",
+                    snapshot_times[len(snapshot_times) // 2],
+                    actuator.center,
+                    x_range,
+                )
+            )
     if case.output.pzt_sensors and case.actuators:
         _, times, data = read_series(out / "results.h5", "pzt_signal")
         first = next(iter(case.actuators.values()))
         excitation = from_spec(first.signal, "actuators.signal")(times)
         signals = {n: data[:, k] for k, n in enumerate(case.output.pzt_sensors)}
-        figures.append(plot_sensor_signals(times, signals, out / "pzt_sensors.png",
-                                           excitation=excitation))
+        figures.append(plot_sensor_signals(times, signals, out / "pzt_sensors.png", excitation=excitation))
     return figures
 
 
@@ -62,8 +66,7 @@ def final_crack_paths(case: Case, body: Body, phi: np.ndarray):
     from peridyn.analysis.crack import crack_paths
 
     lines = [(c.start, c.end) for c in case.precracks if c.type == "segment"]
-    lines += [(c.origin, np.add(c.origin, c.edge_u)) for c in case.precracks
-              if c.type == "rectangle"]
+    lines += [(c.origin, np.add(c.origin, c.edge_u)) for c in case.precracks if c.type == "rectangle"]
     return crack_paths(body.points, phi, body.spacing, reference_lines=lines)
 
 
@@ -79,8 +82,7 @@ def draw_crack_figures(body: Body, out: Path, paths, summary: dict) -> list[Path
     figures = [plot_damage_map(body.points, u, phi, paths, out / "crack_paths.png")]
     history = summary.get("crack_length_history")
     if history and len(history["time_s"]) > 1:
-        figures.append(plot_crack_length(history["time_s"], history["length_m"],
-                                         out / "crack_length.png"))
+        figures.append(plot_crack_length(history["time_s"], history["length_m"], out / "crack_length.png"))
     return figures
 
 

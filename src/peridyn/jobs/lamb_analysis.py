@@ -38,8 +38,12 @@ def centre_frequency(case: Case) -> float:
     for name, actuator in case.actuators.items():
         if "frequency" in actuator.signal:
             return float(actuator.signal["frequency"])
-        raise CaseFileError(case.name, f"actuators.{name}.signal", actuator.signal,
-                            "a signal with a frequency, or analysis.fk.frequency")
+        raise CaseFileError(
+            case.name,
+            f"actuators.{name}.signal",
+            actuator.signal,
+            "a signal with a frequency, or analysis.fk.frequency",
+        )
     raise CaseFileError(case.name, "analysis.fk.frequency", None, "a frequency (Hz)")
 
 
@@ -85,29 +89,42 @@ def _fk(case: Case, body: Body, results: Path, directory, plots: bool) -> tuple[
     maps = {}
     for mode, component in fk.components.items():
         if mode not in theory:
-            raise CaseFileError(case.name, f"analysis.fk.components.{mode}", component,
-                                f"a mode that exists at {f0:g} Hz: {sorted(theory)}")
-        freq, k, mag = line_fk(results, f"line_{fk.line}", spacing, component,
-                               window=None if fk.window == "none" else fk.window,
-                               pad_time=fk.pad, pad_space=fk.pad, f_max=3 * f0)
+            raise CaseFileError(
+                case.name,
+                f"analysis.fk.components.{mode}",
+                component,
+                f"a mode that exists at {f0:g} Hz: {sorted(theory)}",
+            )
+        freq, k, mag = line_fk(
+            results,
+            f"line_{fk.line}",
+            spacing,
+            component,
+            window=None if fk.window == "none" else fk.window,
+            pad_time=fk.pad,
+            pad_space=fk.pad,
+            f_max=3 * f0,
+        )
         maps[component] = (freq, k, mag)
         found = pick_wavenumbers(freq, k, mag, f0, {mode: theory[mode]}, tolerance=fk.tolerance)
         peaks[mode] = None if np.isnan(found[mode]) else float(found[mode])
-    out = {"fk_frequency_hz": f0, "fk_peaks_rad_m": peaks,
-           "fk_theory_rad_m": {m: theory[m] for m in peaks},
-           "fk_error": {m: (None if peaks[m] is None else peaks[m] / theory[m] - 1)
-                        for m in peaks}}
+    out = {
+        "fk_frequency_hz": f0,
+        "fk_peaks_rad_m": peaks,
+        "fk_theory_rad_m": {m: theory[m] for m in peaks},
+        "fk_error": {m: (None if peaks[m] is None else peaks[m] / theory[m] - 1) for m in peaks},
+    }
     figures = []
     if plots:
         from peridyn.plotting.lamb_wavefield import plot_fk_map
 
         curves = dispersion_curves(E, nu, rho, thickness, f_max=2 * f0, max_order=1)
         for component, (freq, k, mag) in maps.items():
-            marks = {m: (f0, peaks[m]) for m, c in fk.components.items()
-                     if c == component and peaks[m] is not None}
+            marks = {
+                m: (f0, peaks[m]) for m, c in fk.components.items() if c == component and peaks[m] is not None
+            }
             path = Path(directory) / f"fk_{fk.line}_u{component}.png"
-            figures.append(plot_fk_map(freq, k, mag, path, theory=curves, peaks=marks,
-                                       f_max=2 * f0))
+            figures.append(plot_fk_map(freq, k, mag, path, theory=curves, peaks=marks, f_max=2 * f0))
     return out, figures
 
 
@@ -116,17 +133,16 @@ def _kxky(case: Case, body: Body, results: Path, directory, plots: bool) -> tupl
     E, nu, rho, thickness = plate_theory(case)
     set_name = case.output.planes[spec.plane]
     grid = point_grid(body.points[body.node_set(set_name)])
-    kx, ky, maps = kxky_from_hdf5(results, f"plane_{spec.plane}", grid, spec.frequencies,
-                                  spec.component)
+    kx, ky, maps = kxky_from_hdf5(results, f"plane_{spec.plane}", grid, spec.frequencies, spec.component)
     modes = lamb_modes(E, nu, rho, thickness, spec.frequencies, max_order=0)
     rings = {}
     for f, kmap in zip(spec.frequencies, maps, strict=True):
-        guess = {m.mode: m.wavenumber_rad_m for m in modes
-                 if m.frequency_hz == f and m.mode in FUNDAMENTAL_MODES}
+        guess = {
+            m.mode: m.wavenumber_rad_m for m in modes if m.frequency_hz == f and m.mode in FUNDAMENTAL_MODES
+        }
         found = ring_radius(kx, ky, kmap, guess)
         rings[f"{f:g}"] = {m: (None if np.isnan(v) else float(v)) for m, v in found.items()}
-    out = {"kxky_rings_rad_m": rings,
-           "kxky_theory_rad_m": {f"{m.frequency_hz:g}": {} for m in modes}}
+    out = {"kxky_rings_rad_m": rings, "kxky_theory_rad_m": {f"{m.frequency_hz:g}": {} for m in modes}}
     for m in modes:
         if m.mode in FUNDAMENTAL_MODES:
             out["kxky_theory_rad_m"][f"{m.frequency_hz:g}"][m.mode] = m.wavenumber_rad_m

@@ -17,7 +17,7 @@ import numpy as np
 from peridyn.analysis.modes import classify_modes, mac_matrix
 from peridyn.errors import InputError
 from peridyn.io.hdf5 import HDF5Writer
-from peridyn.io.recorder import provenance
+from peridyn.io.provenance import provenance
 from peridyn.io.vtk import write_vtu
 from peridyn.linalg.ordering import estimated_factor_entries
 from peridyn.physics.materials import LPSModel
@@ -33,22 +33,32 @@ FACTOR_BUDGET = 2**30
 def run_modal(case, setup, out: Path, case_path=None) -> dict:
     """Modal analysis of a built case; returns the summary (VALIDATION.md JSON keys)."""
     fixed = setup.loading.constrained if setup.loading.has_loads else None
-    result, types, modes = modal_table(setup.model, case.solver.modes, fixed=fixed,
-                                       eigensolver=case.solver.eigensolver)
+    result, types, modes = modal_table(
+        setup.model, case.solver.modes, fixed=fixed, eigensolver=case.solver.eigensolver
+    )
     _write_tables(out, modes)
     body = setup.body
-    with HDF5Writer(out / "results.h5", body.points[:, : body.dim], body.volumes,
-                    provenance(case_path, case=case)) as h5:
+    with HDF5Writer(
+        out / "results.h5", body.points[:, : body.dim], body.volumes, provenance(case_path, case=case)
+    ) as h5:
         h5.write_array("modes/frequencies", result.frequencies)
         h5.write_array("modes/shapes", result.shapes)
         h5.write_array("modes/rigid", result.rigid)
     (out / "modes").mkdir(exist_ok=True)
     for i, shape in enumerate(result.shapes):
-        write_vtu(out / "modes" / f"mode_{i:02d}.vtu", body.points[:, : body.dim],
-                  {"mode_shape": shape[:, : body.dim]})
-    summary = {"output_dir": str(out), "rigid_modes": result.n_rigid, "modes": modes,
-               "points": body.n_points, "bonds": setup.bonds.n_bonds,
-               "peak_memory_bytes": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024}
+        write_vtu(
+            out / "modes" / f"mode_{i:02d}.vtu",
+            body.points[:, : body.dim],
+            {"mode_shape": shape[:, : body.dim]},
+        )
+    summary = {
+        "output_dir": str(out),
+        "rigid_modes": result.n_rigid,
+        "modes": modes,
+        "points": body.n_points,
+        "bonds": setup.bonds.n_bonds,
+        "peak_memory_bytes": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024,
+    }
     if case.output.plots:
         from peridyn.plotting.modes import plot_mode_shapes
 
@@ -64,10 +74,10 @@ def modal_table(model, n_modes: int, fixed=None, eigensolver: str = "auto"):
     result = modal_analysis(model, n_modes, fixed=fixed, method=method)
     masses = model.density * model.body.volumes
     types = classify_modes(model.body.points, result.shapes, masses, result.rigid)
-    rows = [{"index": i, "frequency_hz": float(f), "type": t.type, "order": t.order,
-             "residual": float(r)}
-            for i, (f, t, r) in enumerate(zip(result.frequencies, types, result.residuals,
-                                               strict=True))]
+    rows = [
+        {"index": i, "frequency_hz": float(f), "type": t.type, "order": t.order, "residual": float(r)}
+        for i, (f, t, r) in enumerate(zip(result.frequencies, types, result.residuals, strict=True))
+    ]
     return result, types, rows
 
 
@@ -82,8 +92,14 @@ def match_modes(before, after, masses) -> tuple[np.ndarray, list[dict]]:
     pairs = []
     for i in range(mac.shape[0]):
         j = int(np.argmax(mac[i]))
-        pairs.append({"before": i, "after": j, "mac": float(mac[i, j]),
-                      "frequency_change": float(a.frequencies[j] / b.frequencies[i] - 1.0)})
+        pairs.append(
+            {
+                "before": i,
+                "after": j,
+                "mac": float(mac[i, j]),
+                "frequency_change": float(a.frequencies[j] / b.frequencies[i] - 1.0),
+            }
+        )
     return mac, pairs
 
 
@@ -101,17 +117,23 @@ def compare_with_run(run_dir: Path, reference_dir: Path) -> list[dict]:
         h5 = d / "results.h5"
         if not h5.is_file():
             raise InputError(f"--compare: {h5} not found (give the folder of a modal run)")
-        runs.append({"points": read_array(h5, "geometry/points"),
-                     "volumes": read_array(h5, "geometry/volumes"),
-                     "frequencies": read_array(h5, "modes/frequencies"),
-                     "shapes": read_array(h5, "modes/shapes"),
-                     "rigid": read_array(h5, "modes/rigid").astype(bool),
-                     "types": json.loads((d / "modes.json").read_text())})
+        runs.append(
+            {
+                "points": read_array(h5, "geometry/points"),
+                "volumes": read_array(h5, "geometry/volumes"),
+                "frequencies": read_array(h5, "modes/frequencies"),
+                "shapes": read_array(h5, "modes/shapes"),
+                "rigid": read_array(h5, "modes/rigid").astype(bool),
+                "types": json.loads((d / "modes.json").read_text()),
+            }
+        )
     ref, new = runs
     if ref["points"].shape != new["points"].shape or not np.allclose(ref["points"], new["points"]):
-        raise InputError(f"--compare: {reference_dir} has other points than this run "
-                         f"({len(ref['points'])} against {len(new['points'])}): MAC needs the "
-                         "same grid")
+        raise InputError(
+            f"--compare: {reference_dir} has other points than this run "
+            f"({len(ref['points'])} against {len(new['points'])}): MAC needs the "
+            "same grid"
+        )
     keep_r, keep_n = ~ref["rigid"], ~new["rigid"]
     # uniform density: the volumes weigh the MAC as the masses would
     mac = mac_matrix(ref["shapes"][keep_r], new["shapes"][keep_n], new["volumes"])
@@ -120,12 +142,18 @@ def compare_with_run(run_dir: Path, reference_dir: Path) -> list[dict]:
     rows = []
     for i, ref_row in enumerate(ref_rows):
         j = int(np.argmax(mac[i]))
-        rows.append({"reference_index": ref_row["index"],
-                     "reference_type": mode_label(ref_row),
-                     "reference_frequency_hz": ref_row["frequency_hz"],
-                     "index": new_rows[j]["index"], "type": mode_label(new_rows[j]),
-                     "frequency_hz": new_rows[j]["frequency_hz"], "mac": float(mac[i, j]),
-                     "frequency_change": new_rows[j]["frequency_hz"] / ref_row["frequency_hz"] - 1})
+        rows.append(
+            {
+                "reference_index": ref_row["index"],
+                "reference_type": mode_label(ref_row),
+                "reference_frequency_hz": ref_row["frequency_hz"],
+                "index": new_rows[j]["index"],
+                "type": mode_label(new_rows[j]),
+                "frequency_hz": new_rows[j]["frequency_hz"],
+                "mac": float(mac[i, j]),
+                "frequency_change": new_rows[j]["frequency_hz"] / ref_row["frequency_hz"] - 1,
+            }
+        )
     with open(run_dir / "frequency_shift.csv", "w", newline="") as f:
         writer = csv.DictWriter(f, fieldnames=list(rows[0]))
         writer.writeheader()

@@ -34,8 +34,9 @@ class CrackLengthObserver:
         """Record the crack length of the current damage at ``time`` (s)."""
         body = self.model.body
         self.times.append(float(time))
-        self.lengths.append(total_crack_length(body.points, damage_field(self.model),
-                                               body.spacing, self.threshold))
+        self.lengths.append(
+            total_crack_length(body.points, damage_field(self.model), body.spacing, self.threshold)
+        )
 
     def history(self) -> dict:
         """``{"time_s": [...], "length_m": [...]}``."""

@@ -17,7 +17,8 @@ from peridyn.errors import CaseFileError, InputError
 from peridyn.io.case import Case
 from peridyn.io.checkpoint import Checkpointer, load_checkpoint
 from peridyn.io.hdf5 import HDF5Writer
-from peridyn.io.recorder import LineProbe, Recorder, RecorderSpec, provenance
+from peridyn.io.provenance import provenance
+from peridyn.io.recorder import LineProbe, Recorder, RecorderSpec
 from peridyn.jobs.build import Setup, build, pad3
 from peridyn.jobs.figures import draw_crack_figures, draw_run_figures, final_crack_paths
 from peridyn.jobs.lamb_analysis import analyse
@@ -59,8 +60,15 @@ def output_directory(case: Case, override=None) -> Path:
     return Path(case.output.directory or Path("peridyn-out") / case.name)
 
 
-def run_case(case: Case, output_dir=None, case_path=None, checkpoint_every: int | None = None,
-             restart: bool = False, progress=None, base_dir=".") -> dict:
+def run_case(
+    case: Case,
+    output_dir=None,
+    case_path=None,
+    checkpoint_every: int | None = None,
+    restart: bool = False,
+    progress=None,
+    base_dir=".",
+) -> dict:
     """Run a case and write its results; returns the summary (also stored in results.h5).
 
     Parameters
@@ -80,8 +88,16 @@ def run_case(case: Case, output_dir=None, case_path=None, checkpoint_every: int 
     elif case.solver.type == "newton":
         summary = _run_newton(case, setup, out, case_path)
     elif case.solver.type == "newmark":
-        summary = _run_explicit(case, setup, out, case_path, checkpoint_every, restart, progress,
-                                solver=_newmark_solver(case, setup))
+        summary = _run_explicit(
+            case,
+            setup,
+            out,
+            case_path,
+            checkpoint_every,
+            restart,
+            progress,
+            solver=_newmark_solver(case, setup),
+        )
     elif case.solver.type == "modal":
         from peridyn.jobs.modal import run_modal
 
@@ -90,8 +106,9 @@ def run_case(case: Case, output_dir=None, case_path=None, checkpoint_every: int 
         summary = _run_explicit(case, setup, out, case_path, checkpoint_every, restart, progress)
     analysis, figures = analyse(case, setup.body, out, plots=case.output.plots)
     summary.update(analysis)
-    paths = (final_crack_paths(case, setup.body, damage_field(setup.model))
-             if setup.damage is not None else None)
+    paths = (
+        final_crack_paths(case, setup.body, damage_field(setup.model)) if setup.damage is not None else None
+    )
     if paths is not None:
         summary["crack_paths"] = [p.summary() for p in paths]
     if case.output.plots and case.solver.type != "modal":  # a modal run draws its own
@@ -101,7 +118,6 @@ def run_case(case: Case, output_dir=None, case_path=None, checkpoint_every: int 
     summary["seconds"] = time.perf_counter() - start
     store_summary(out / "results.h5", setup.body, summary)
     return summary
-
 
 
 def store_summary(results, body: Body, summary: dict) -> None:
@@ -116,18 +132,28 @@ def _json_default(obj):
 
 def _base_summary(setup: Setup, out: Path) -> dict:
     phi = damage_field(setup.model)
-    return {"output_dir": str(out), "points": setup.body.n_points, "bonds": setup.bonds.n_bonds,
-            "broken_bonds": int((~setup.bonds.intact).sum()), "max_damage": float(phi.max())}
+    return {
+        "output_dir": str(out),
+        "points": setup.body.n_points,
+        "bonds": setup.bonds.n_bonds,
+        "broken_bonds": int((~setup.bonds.intact).sum()),
+        "max_damage": float(phi.max()),
+    }
 
 
-def _run_explicit(case, setup, out, case_path, checkpoint_every, restart, progress,
-                  solver=None) -> dict:
+def _run_explicit(case, setup, out, case_path, checkpoint_every, restart, progress, solver=None) -> dict:
     """Time integration by ``solver`` (default: velocity Verlet from the case) with recording."""
     s = case.solver
     if solver is None:
-        solver = ExplicitSolver(setup.model, setup.loading, dt=s.dt, safety=s.safety,
-                                damping=explicit_damping(case, setup.body), damage=setup.damage,
-                                contact=setup.contact)
+        solver = ExplicitSolver(
+            setup.model,
+            setup.loading,
+            dt=s.dt,
+            safety=s.safety,
+            damping=explicit_damping(case, setup.body),
+            damage=setup.damage,
+            contact=setup.contact,
+        )
     n_steps = s.steps if s.steps is not None else int(np.ceil(s.time / solver.dt - 1e-9))
     ckpt_path = out / "checkpoint.h5"
     if restart:
@@ -159,10 +185,16 @@ def _run_explicit(case, setup, out, case_path, checkpoint_every, restart, progre
     ):
         recorder.snapshot(state)
     summary = _base_summary(setup, out)
-    summary.update({"steps": state.step, "time_s": state.time, "dt_s": solver.dt,
-                    "stable_dt_s": solver.stable_dt,
-                    "kinetic_energy_j": solver.kinetic_energy(state),
-                    "strain_energy_j": setup.model.strain_energy(state.u)})
+    summary.update(
+        {
+            "steps": state.step,
+            "time_s": state.time,
+            "dt_s": solver.dt,
+            "stable_dt_s": solver.stable_dt,
+            "kinetic_energy_j": solver.kinetic_energy(state),
+            "strain_energy_j": setup.model.strain_energy(state.u),
+        }
+    )
     if setup.contact is not None:
         summary["contact_rebuilds"] = setup.contact.rebuilds
     if cracks is not None:
@@ -194,15 +226,21 @@ def _crack_observer(case, setup, n_steps):
     return CrackLengthObserver(setup.model, every)
 
 
-
 def _run_static(case, setup, out, case_path) -> dict:
     s = case.solver
     u = None
     iterations = 0
     for k in range(1, s.load_steps + 1):
-        result = relax(setup.model, setup.loading, time=k / s.load_steps, u0=u,
-                       tolerance=s.tolerance, max_iterations=s.max_iterations,
-                       damage=setup.damage, contact=setup.contact)
+        result = relax(
+            setup.model,
+            setup.loading,
+            time=k / s.load_steps,
+            u0=u,
+            tolerance=s.tolerance,
+            max_iterations=s.max_iterations,
+            damage=setup.damage,
+            contact=setup.contact,
+        )
         u, iterations = result.u, iterations + result.iterations
         if not result.converged:
             raise InputError(
@@ -210,9 +248,14 @@ def _run_static(case, setup, out, case_path) -> dict:
                 f"iterations (residual {result.residual:.3g} > {s.tolerance:g}): raise "
                 "solver.max_iterations or solver.load_steps"
             )
-    return _record_equilibrium(case, setup, out, case_path, u,
-                               {"steps": s.load_steps, "iterations": iterations,
-                                "residual": result.residual})
+    return _record_equilibrium(
+        case,
+        setup,
+        out,
+        case_path,
+        u,
+        {"steps": s.load_steps, "iterations": iterations, "residual": result.residual},
+    )
 
 
 def _record_equilibrium(case, setup, out, case_path, u, results: dict) -> dict:
@@ -234,9 +277,16 @@ def _newmark_solver(case, setup):
     from peridyn.solvers.newmark import NewmarkSolver
 
     s = case.solver
-    return NewmarkSolver(setup.model, setup.loading, dt=s.dt, tolerance=s.displacement_tolerance,
-                         max_iterations=s.newton_iterations, damping=s.damping,
-                         damage=setup.damage, linear_solver=s.linear_solver)
+    return NewmarkSolver(
+        setup.model,
+        setup.loading,
+        dt=s.dt,
+        tolerance=s.displacement_tolerance,
+        max_iterations=s.newton_iterations,
+        damping=s.damping,
+        damage=setup.damage,
+        linear_solver=s.linear_solver,
+    )
 
 
 def _run_newton(case, setup, out, case_path) -> dict:
@@ -244,9 +294,16 @@ def _run_newton(case, setup, out, case_path) -> dict:
     from peridyn.solvers.newton import newton
 
     s = case.solver
-    result = newton(setup.model, setup.loading, load_steps=s.load_steps, tolerance=s.tolerance,
-                    max_iterations=s.newton_iterations, damage=setup.damage,
-                    max_breaking_rounds=s.breaking_rounds, linear_solver=s.linear_solver)
+    result = newton(
+        setup.model,
+        setup.loading,
+        load_steps=s.load_steps,
+        tolerance=s.tolerance,
+        max_iterations=s.newton_iterations,
+        damage=setup.damage,
+        max_breaking_rounds=s.breaking_rounds,
+        linear_solver=s.linear_solver,
+    )
     if not result.converged:
         step = len(result.steps)
         raise InputError(
@@ -255,7 +312,16 @@ def _run_newton(case, setup, out, case_path) -> dict:
             f"{s.breaking_rounds} breaking rounds): raise solver.load_steps or "
             "solver.newton_iterations"
         )
-    return _record_equilibrium(case, setup, out, case_path, result.u,
-                               {"steps": s.load_steps, "iterations": result.iterations,
-                                "residual": result.residual,
-                                "residual_history": [step.residuals for step in result.steps]})
+    return _record_equilibrium(
+        case,
+        setup,
+        out,
+        case_path,
+        result.u,
+        {
+            "steps": s.load_steps,
+            "iterations": result.iterations,
+            "residual": result.residual,
+            "residual_history": [step.residuals for step in result.steps],
+        },
+    )

@@ -57,13 +57,21 @@ class StudyRun:
         return self.horizon_factor * self.spacing
 
     def to_dict(self) -> dict:
-        return {"spacing_m": self.spacing, "horizon_factor": self.horizon_factor,
-                "horizon_m": self.horizon, "points": self.points, "seconds": self.seconds,
-                "modes": self.modes, "skipped": self.skipped, "notes": self.notes}
+        return {
+            "spacing_m": self.spacing,
+            "horizon_factor": self.horizon_factor,
+            "horizon_m": self.horizon,
+            "points": self.points,
+            "seconds": self.seconds,
+            "modes": self.modes,
+            "skipped": self.skipped,
+            "notes": self.notes,
+        }
 
 
-def run_grid(case_path, spacings, horizon_factors, n_modes: int | None = None, overrides=(),
-             progress=None) -> list[StudyRun]:
+def run_grid(
+    case_path, spacings, horizon_factors, n_modes: int | None = None, overrides=(), progress=None
+) -> list[StudyRun]:
     """Solve the modal problem of every (spacing, horizon factor) combination.
 
     Parameters
@@ -92,10 +100,17 @@ def run_grid(case_path, spacings, horizon_factors, n_modes: int | None = None, o
     for k, (h, m) in enumerate(combos, 1):
         run = StudyRun(float(h), float(m))
         start = time.perf_counter()
-        case = load_case(case_path, [*overrides, "solver.type=modal",
-                                     *([f"solver.modes={n_modes}"] if n_modes is not None else []),
-                                     f"discretization.spacing={h!r}", f"discretization.horizon={m!r}",
-                                     "discretization.horizon_m=null"])
+        case = load_case(
+            case_path,
+            [
+                *overrides,
+                "solver.type=modal",
+                *([f"solver.modes={n_modes}"] if n_modes is not None else []),
+                f"discretization.spacing={h!r}",
+                f"discretization.horizon={m!r}",
+                "discretization.horizon_m=null",
+            ],
+        )
         setup = build(case, Path(case_path).parent)
         run.points = setup.body.n_points
         run.notes += _geometry_notes(case, setup.body)
@@ -118,8 +133,10 @@ def run_grid(case_path, spacings, horizon_factors, n_modes: int | None = None, o
         runs.append(run)
         if progress is not None:
             state = f"skipped: {run.skipped}" if run.skipped else f"{len(run.modes)} modes matched"
-            progress(f"[{k}/{len(combos)}] spacing {h * 1e3:g} mm, horizon {m:g} h: {run.points} "
-                     f"points, {run.seconds:.1f} s, {state}")
+            progress(
+                f"[{k}/{len(combos)}] spacing {h * 1e3:g} mm, horizon {m:g} h: {run.points} "
+                f"points, {run.seconds:.1f} s, {state}"
+            )
             for note in run.notes:
                 progress(f"      note: {note}")
     return runs
@@ -134,13 +151,16 @@ def _geometry_notes(case, body) -> list[str]:
     if np.allclose(grid, size, rtol=1e-6, atol=0.0):
         return []
     dims = " x ".join(f"{v * 1e3:.4g}" for v in grid)
-    return [f"the grid spans {dims} mm, not the case's "
-            f"{' x '.join(f'{v * 1e3:.4g}' for v in size)} mm: the spacing does not divide the box, "
-            "so this run models another body"]
+    return [
+        f"the grid spans {dims} mm, not the case's "
+        f"{' x '.join(f'{v * 1e3:.4g}' for v in size)} mm: the spacing does not divide the box, "
+        "so this run models another body"
+    ]
 
 
-def fit_series(runs: list[StudyRun], series=("delta-m",), references=None,
-               finest: int | None = None) -> list[dict]:
+def fit_series(
+    runs: list[StudyRun], series=("delta-m",), references=None, finest: int | None = None
+) -> list[dict]:
     """Richardson fits of every mode over every series of runs.
 
     Returns one dict per (series, group, mode): ``series``, ``group`` (what is held fixed),
@@ -168,8 +188,14 @@ def fit_series(runs: list[StudyRun], series=("delta-m",), references=None,
                 x = np.array([r.spacing if variable == "spacing_m" else r.horizon for r in having])
                 f = np.array([r.modes[label] for r in having])
                 order = np.argsort(x)
-                row = {"series": kind, "group": group, "mode": label, "variable": variable,
-                       "x": x[order].tolist(), "frequencies_hz": f[order].tolist()}
+                row = {
+                    "series": kind,
+                    "group": group,
+                    "mode": label,
+                    "variable": variable,
+                    "x": x[order].tolist(),
+                    "frequencies_hz": f[order].tolist(),
+                }
                 try:
                     fit = richardson(x[order][:finest], f[order][:finest])
                 except ConvergenceError as exc:
@@ -177,9 +203,14 @@ def fit_series(runs: list[StudyRun], series=("delta-m",), references=None,
                 except InputError as exc:
                     row["error"] = f"{len(having)} run(s) with this mode: {exc}"
                 else:
-                    row.update(fitted_runs=len(fit.spacings), value_hz=fit.value, order=fit.order,
-                               gci=fit.gci, coefficient=fit.coefficient,
-                               rms_residual_hz=fit.rms_residual)
+                    row.update(
+                        fitted_runs=len(fit.spacings),
+                        value_hz=fit.value,
+                        order=fit.order,
+                        gci=fit.gci,
+                        coefficient=fit.coefficient,
+                        rms_residual_hz=fit.rms_residual,
+                    )
                 if references and label in references:
                     ref = references[label]
                     row["reference_hz"] = ref
@@ -223,22 +254,70 @@ def write_study(out: Path, runs: list[StudyRun], fits: list[dict], meta: dict) -
     out.mkdir(parents=True, exist_ok=True)
     with open(out / "runs.csv", "w", newline="") as fh:
         writer = csv.writer(fh)
-        writer.writerow(["spacing_m", "horizon_factor", "horizon_m", "points", "seconds", "mode",
-                         "frequency_hz", "skipped"])
+        writer.writerow(
+            [
+                "spacing_m",
+                "horizon_factor",
+                "horizon_m",
+                "points",
+                "seconds",
+                "mode",
+                "frequency_hz",
+                "skipped",
+            ]
+        )
         for r in runs:
-            for label, freq in (r.modes.items() if r.modes else [("", "")]):
-                writer.writerow([r.spacing, r.horizon_factor, r.horizon, r.points,
-                                 round(r.seconds, 3), label, freq, r.skipped or ""])
-    columns = ["series", "group", "mode", "variable", "x", "frequencies_hz", "fitted_runs",
-               "value_hz", "order", "gci", "coefficient", "rms_residual_hz", "reference_hz", "finest_error",
-               "value_error", "error"]
+            for label, freq in r.modes.items() if r.modes else [("", "")]:
+                writer.writerow(
+                    [
+                        r.spacing,
+                        r.horizon_factor,
+                        r.horizon,
+                        r.points,
+                        round(r.seconds, 3),
+                        label,
+                        freq,
+                        r.skipped or "",
+                    ]
+                )
+    columns = [
+        "series",
+        "group",
+        "mode",
+        "variable",
+        "x",
+        "frequencies_hz",
+        "fitted_runs",
+        "value_hz",
+        "order",
+        "gci",
+        "coefficient",
+        "rms_residual_hz",
+        "reference_hz",
+        "finest_error",
+        "value_error",
+        "error",
+    ]
     with open(out / "study.csv", "w", newline="") as fh:
         writer = csv.DictWriter(fh, fieldnames=columns)
         writer.writeheader()
         for row in fits:
-            writer.writerow({k: (" ".join(f"{v:.10g}" for v in row[k]) if isinstance(row.get(k), list)
-                                 else row.get(k, "")) for k in columns})
-    summary = {**meta, "output_dir": str(out), "runs": [r.to_dict() for r in runs], "fits": fits,
-               "skipped_runs": sum(r.skipped is not None for r in runs)}
+            writer.writerow(
+                {
+                    k: (
+                        " ".join(f"{v:.10g}" for v in row[k])
+                        if isinstance(row.get(k), list)
+                        else row.get(k, "")
+                    )
+                    for k in columns
+                }
+            )
+    summary = {
+        **meta,
+        "output_dir": str(out),
+        "runs": [r.to_dict() for r in runs],
+        "fits": fits,
+        "skipped_runs": sum(r.skipped is not None for r in runs),
+    }
     (out / "study.json").write_text(json.dumps(summary, indent=1))
     return summary
