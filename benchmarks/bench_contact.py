@@ -45,8 +45,7 @@ def shared_model(side: int):
     return model, side_of[bonds.owners()] * side_of[bonds.neighbours] < 0
 
 
-def solver_for(model, precrack, damaged: bool, breaking: bool = True,
-               contact: bool = True) -> ExplicitSolver:
+def solver_for(model, precrack, damaged: bool, breaking: bool = True, contact: bool = True) -> ExplicitSolver:
     """A row's solver on a copy of ``model`` that shares its per-bond arrays (memory) but has
     bonds of its own to break."""
     model = copy.copy(model)
@@ -55,8 +54,9 @@ def solver_for(model, precrack, damaged: bool, breaking: bool = True,
         return ExplicitSolver(model, Loading(model.body))
     model.bonds.intact[precrack] = False
     damage = BondDamage(model, critical_stretch=1e-3) if breaking else None
-    return ExplicitSolver(model, Loading(model.body), damage=damage,
-                          contact=Contact(model, SPACING) if contact else None)
+    return ExplicitSolver(
+        model, Loading(model.body), damage=damage, contact=Contact(model, SPACING) if contact else None
+    )
 
 
 def main():
@@ -64,15 +64,21 @@ def main():
     parser.add_argument("--points-per-side", type=int, default=DEFAULT_POINTS_PER_SIDE)
     parser.add_argument("--steps", type=int, default=10)
     parser.add_argument("--rounds", type=int, default=3)
-    parser.add_argument("--velocity", type=float, default=1.0,
-                        help="rms of the random initial velocities, m/s (2 breaks bonds here and there)")
+    parser.add_argument(
+        "--velocity",
+        type=float,
+        default=1.0,
+        help="rms of the random initial velocities, m/s (2 breaks bonds here and there)",
+    )
     args = parser.parse_args()
     rng = np.random.default_rng(0)
     model, precrack = shared_model(args.points_per_side)
-    rows = {"undamaged": solver_for(model, precrack, False),
-            "damaged + contact": solver_for(model, precrack, True),
-            "contact only": solver_for(model, precrack, True, breaking=False),
-            "damaged, no contact": solver_for(model, precrack, True, contact=False)}
+    rows = {
+        "undamaged": solver_for(model, precrack, False),
+        "damaged + contact": solver_for(model, precrack, True),
+        "contact only": solver_for(model, precrack, True, breaking=False),
+        "damaged, no contact": solver_for(model, precrack, True, contact=False),
+    }
     v0 = rng.normal(scale=args.velocity / np.sqrt(3), size=(args.points_per_side**3, 3))
     states = {}
     for name, solver in rows.items():
@@ -94,11 +100,15 @@ def main():
         print(f"{name:>18}: {args.steps / best[name]:.3f} steps/s")
     contact = rows["damaged + contact"].contact
     broken = int((~rows["damaged + contact"].model.bonds.intact).sum()) - int(precrack.sum())
-    print(f"contact: {contact.n_candidates} candidate pairs, {contact.touching} touching, "
-          f"{contact.rebuilds} list builds; directed bonds broken besides the pre-crack's "
-          f"{int(precrack.sum())}: {broken}")
-    print(f"stretch tests in the timed steps (damaged + contact): {damage.full_tests - untimed[0]} "
-          f"full, {damage.partial_tests - untimed[1]} partial")
+    print(
+        f"contact: {contact.n_candidates} candidate pairs, {contact.touching} touching, "
+        f"{contact.rebuilds} list builds; directed bonds broken besides the pre-crack's "
+        f"{int(precrack.sum())}: {broken}"
+    )
+    print(
+        f"stretch tests in the timed steps (damaged + contact): {damage.full_tests - untimed[0]} "
+        f"full, {damage.partial_tests - untimed[1]} partial"
+    )
     for name in ("damaged + contact", "contact only", "damaged, no contact"):
         print(f"ratio {name} / undamaged: {best['undamaged'] / best[name]:.3f}")
 

@@ -35,8 +35,12 @@ def machine() -> dict:
     fields = dict(line.split(":", 1) for line in out.splitlines() if ":" in line)
     fields = {k.strip(): v.strip() for k, v in fields.items()}
     info["cpu"] = fields.get("Model name", info["cpu"])
-    for key, name in (("Core(s) per socket", "cores_per_socket"), ("Socket(s)", "sockets"),
-                      ("Thread(s) per core", "threads_per_core"), ("L3 cache", "l3_cache")):
+    for key, name in (
+        ("Core(s) per socket", "cores_per_socket"),
+        ("Socket(s)", "sockets"),
+        ("Thread(s) per core", "threads_per_core"),
+        ("L3 cache", "l3_cache"),
+    ):
         if key in fields:
             info[name] = fields[key]
     return info
@@ -50,21 +54,27 @@ def main(argv: list[str] | None = None) -> dict:
     parser.add_argument("--output", "-o", type=Path, default=HERE / "bench_kernels.json")
     args = parser.parse_args(argv)
     load_before = os.getloadavg()[0]
-    result = run_benchmark(points=args.points, repeat=args.repeat,
-                           partial_volumes=args.partial_volumes,
-                           log=lambda msg: print(msg, file=sys.stderr))
+    result = run_benchmark(
+        points=args.points,
+        repeat=args.repeat,
+        partial_volumes=args.partial_volumes,
+        log=lambda msg: print(msg, file=sys.stderr),
+    )
     print(format_table(result))
     record = {
-        "command": " ".join([*(f"{k}={os.environ[k]}" for k in ("NUMBA_NUM_THREADS",)
-                               if k in os.environ),
-                             "python", *(shlex.quote(a) for a in sys.argv)]),
+        "command": " ".join(
+            [
+                *(f"{k}={os.environ[k]}" for k in ("NUMBA_NUM_THREADS",) if k in os.environ),
+                "python",
+                *(shlex.quote(a) for a in sys.argv),
+            ]
+        ),
         "date_utc": datetime.datetime.now(datetime.UTC).strftime("%Y-%m-%dT%H:%M:%SZ"),
         "machine": machine(),
         "numba_num_threads_env": os.environ.get("NUMBA_NUM_THREADS"),
         "partial_volumes": args.partial_volumes,
         # 1-minute load average: the timings are only as clean as the machine was idle
-        "load_average_1min": {"before": round(load_before, 2),
-                              "after": round(os.getloadavg()[0], 2)},
+        "load_average_1min": {"before": round(load_before, 2), "after": round(os.getloadavg()[0], 2)},
         **result,
     }
     args.output.write_text(json.dumps(record, indent=2) + "\n")

@@ -37,19 +37,23 @@ def main(argv=None) -> dict:
     start = time.perf_counter()
     body = geometry.box(SIZE, args.spacing)
     bonds = find_bonds(body, args.horizon * args.spacing, partial_volumes=False)
-    model = make_model("lps", body, bonds, E=E, nu=NU, density=RHO,
-                       surface_correction=args.correction)
+    model = make_model("lps", body, bonds, E=E, nu=NU, density=RHO, surface_correction=args.correction)
     method = choose_eigensolver(model, args.eigensolver)
     built = time.perf_counter()
     result = modal_analysis(model, args.modes, method=method)
     solved = time.perf_counter()
-    summary = {"points": body.n_points, "bonds": bonds.n_bonds, "horizon_spacings": args.horizon,
-               "eigensolver": method, "build_s": round(built - start, 2),
-               "solve_s": round(solved - built, 2),
-               "peak_rss_gb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1e6,
-               "rigid_modes": result.n_rigid,
-               "frequencies_hz": [round(float(f), 4) for f in result.frequencies],
-               "residuals": [float(f"{r:.2e}") for r in result.residuals]}
+    summary = {
+        "points": body.n_points,
+        "bonds": bonds.n_bonds,
+        "horizon_spacings": args.horizon,
+        "eigensolver": method,
+        "build_s": round(built - start, 2),
+        "solve_s": round(solved - built, 2),
+        "peak_rss_gb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1e6,
+        "rigid_modes": result.n_rigid,
+        "frequencies_hz": [round(float(f), 4) for f in result.frequencies],
+        "residuals": [float(f"{r:.2e}") for r in result.residuals],
+    }
     print(json.dumps(summary))
     return summary
 

@@ -22,19 +22,24 @@ def main() -> None:
     disc = Discretisation.from_case(load_case("cases/lamb_plate_converged.yaml"))
     predict(disc, [150e3])  # compile the numba kernels once
     start = time.perf_counter()
-    predict(Discretisation.from_case(load_case("cases/lamb_plate_converged.yaml")),
-            [110e3, 150e3, 225e3])
-    print(f"prediction at three frequencies (converged preset): "
-          f"{time.perf_counter() - start:.2f} s", file=sys.stderr)
+    predict(Discretisation.from_case(load_case("cases/lamb_plate_converged.yaml")), [110e3, 150e3, 225e3])
+    print(
+        f"prediction at three frequencies (converged preset): {time.perf_counter() - start:.2f} s",
+        file=sys.stderr,
+    )
     start = time.perf_counter()
     seed = Discretisation.from_case(load_case("cases/lamb_plate.yaml"))
     predict(seed, [110e3, 150e3, 225e3])
-    print(f"prediction at three frequencies (seed case): {time.perf_counter() - start:.2f} s",
-          file=sys.stderr)
+    print(
+        f"prediction at three frequencies (seed case): {time.perf_counter() - start:.2f} s", file=sys.stderr
+    )
     start = time.perf_counter()
     rows = study(disc, FREQUENCIES)
-    print(f"study of {len(rows)} discretisations at {len(FREQUENCIES)} frequencies: "
-          f"{time.perf_counter() - start:.1f} s", file=sys.stderr)
+    print(
+        f"study of {len(rows)} discretisations at {len(FREQUENCIES)} frequencies: "
+        f"{time.perf_counter() - start:.1f} s",
+        file=sys.stderr,
+    )
     print(format_study(rows))
 
 

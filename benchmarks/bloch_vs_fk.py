@@ -74,8 +74,7 @@ def synthetic_record(signal, times, x, x_source, k_of_f, order: int, edges=None)
     sources = [x_source]
     if edges is not None:
         a, b = edges
-        sources += [2 * a - x_source, 2 * b - x_source, x_source + 2 * (b - a),
-                    x_source - 2 * (b - a)]
+        sources += [2 * a - x_source, 2 * b - x_source, x_source + 2 * (b - a), x_source - 2 * (b - a)]
     field = 0.0
     for xs in sources:
         r = np.maximum(np.abs(x - xs), 0.5 * np.min(np.diff(x)))
@@ -97,8 +96,9 @@ def main() -> None:
     parser.add_argument("case")
     parser.add_argument("run_dir", nargs="?")
     parser.add_argument("--records", type=int, default=1500)
-    parser.add_argument("--r-range", default="0.02,0.09",
-                        help="distances from the source (m) of the phase fit, 'r_min,r_max'")
+    parser.add_argument(
+        "--r-range", default="0.02,0.09", help="distances from the source (m) of the phase fit, 'r_min,r_max'"
+    )
     parser.add_argument("--edges", action="store_true", help="add the plate-edge reflections")
     args = parser.parse_args()
     r_range = tuple(float(v) for v in args.r_range.split(","))
@@ -115,8 +115,10 @@ def main() -> None:
         times = np.linspace(0.0, case.solver.time, args.records + 1)
     actuator = next(iter(case.actuators.values()))
     signal = from_spec(actuator.signal, "actuator signal")
-    theory = {m.mode: m.wavenumber_rad_m for m in lamb_modes(disc.E, disc.nu, disc.density,
-                                                             disc.thickness, [f0], max_order=0)}
+    theory = {
+        m.mode: m.wavenumber_rad_m
+        for m in lamb_modes(disc.E, disc.nu, disc.density, disc.thickness, [f0], max_order=0)
+    }
     bloch = {m["mode"]: m["wavenumber_rad_m"] for m in predict(disc, [f0], cell)}
     edges = None
     if args.edges:
@@ -127,34 +129,47 @@ def main() -> None:
         basis = plate_basis(cell, family)
 
         def record(order, b=basis):
-            return synthetic_record(signal, times, x, actuator.center[0],
-                                    lambda f: branch_wavenumber_of(cell, b, f), order, edges)
+            return synthetic_record(
+                signal, times, x, actuator.center[0], lambda f: branch_wavenumber_of(cell, b, f), order, edges
+            )
 
-        freq, k, mag = fk_transform(record(fk_order), times[1] - times[0], x[1] - x[0],
-                                    window="hann", pad_time=fk.pad, pad_space=fk.pad, f_max=3 * f0)
-        picked = pick_wavenumbers(freq, k, mag, f0, {mode: theory[mode]},
-                                  tolerance=fk.tolerance)[mode]
-        fitted = phase_wavenumber(record(phase_order), times[1] - times[0], x, f0,
-                                  actuator.center[0], r_range, phase_order)
-        out[mode] = {"bloch_rad_m": bloch[mode],
-                     "fk_pick_bias": float(picked) / bloch[mode] - 1,
-                     "phase_fit_bias": fitted / bloch[mode] - 1,
-                     "bloch_error_vs_rayleigh_lamb": bloch[mode] / theory[mode] - 1,
-                     "k_bin_rad_m": float(2 * np.pi / (line.points * (x[1] - x[0])))}
+        freq, k, mag = fk_transform(
+            record(fk_order),
+            times[1] - times[0],
+            x[1] - x[0],
+            window="hann",
+            pad_time=fk.pad,
+            pad_space=fk.pad,
+            f_max=3 * f0,
+        )
+        picked = pick_wavenumbers(freq, k, mag, f0, {mode: theory[mode]}, tolerance=fk.tolerance)[mode]
+        fitted = phase_wavenumber(
+            record(phase_order), times[1] - times[0], x, f0, actuator.center[0], r_range, phase_order
+        )
+        out[mode] = {
+            "bloch_rad_m": bloch[mode],
+            "fk_pick_bias": float(picked) / bloch[mode] - 1,
+            "phase_fit_bias": fitted / bloch[mode] - 1,
+            "bloch_error_vs_rayleigh_lamb": bloch[mode] / theory[mode] - 1,
+            "k_bin_rad_m": float(2 * np.pi / (line.points * (x[1] - x[0]))),
+        }
     result = {"case": case.name, "frequency_hz": f0, "r_range_m": r_range, "modes": out}
     if args.run_dir:
         results = f"{args.run_dir}/results.h5"
         summary = json.loads(read_array(results, "summary/json").tobytes().decode())
-        run = line_mode_wavenumbers(results, fk.line, x, disc.spacing, f0, actuator.center[0],
-                                    r_range)
+        run = line_mode_wavenumbers(results, fk.line, x, disc.spacing, f0, actuator.center[0], r_range)
         shares = time_integration_shares(disc, cell, f0, summary["dt_s"])
         result["omega_dt"] = 2 * np.pi * f0 * summary["dt_s"]
         for mode in MODES:
-            out[mode].update({"run_phase_fit_rad_m": run[mode],
-                              "run_phase_fit_error": run[mode] / bloch[mode] - 1,
-                              "run_fk_pick_rad_m": summary["fk_peaks_rad_m"][mode],
-                              "run_fk_pick_error": summary["fk_peaks_rad_m"][mode] / bloch[mode] - 1,
-                              "time_integration_share": shares[mode]})
+            out[mode].update(
+                {
+                    "run_phase_fit_rad_m": run[mode],
+                    "run_phase_fit_error": run[mode] / bloch[mode] - 1,
+                    "run_fk_pick_rad_m": summary["fk_peaks_rad_m"][mode],
+                    "run_fk_pick_error": summary["fk_peaks_rad_m"][mode] / bloch[mode] - 1,
+                    "time_integration_share": shares[mode],
+                }
+            )
     print(json.dumps(result, indent=1))
 
 

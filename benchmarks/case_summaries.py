@@ -44,16 +44,32 @@ SHORTEN = {
 }
 FATIGUE_SHORT = ["--set", "fatigue.mapping=[{steps: 3, tau: 1.0e-6}]", "--set", "fatigue.paris=null"]
 #: keys that depend on the machine or the folder, not on the numbers
-VOLATILE = {"seconds", "peak_memory_bytes", "plots", "output", "output_dir", "results", "case_file",
-            "build_seconds", "solve_seconds", "wall_seconds", "directory", "files", "figures"}
+VOLATILE = {
+    "seconds",
+    "peak_memory_bytes",
+    "plots",
+    "output",
+    "output_dir",
+    "results",
+    "case_file",
+    "build_seconds",
+    "solve_seconds",
+    "wall_seconds",
+    "directory",
+    "files",
+    "figures",
+}
 FREQUENCY_ATOL, FREQUENCY_RTOL = 1e-2, 1e-9  # Hz, 1
 MODAL_TOL = 1e-9
 
 
 def _strip(value):
     if isinstance(value, dict):
-        return {k: _strip(v) for k, v in sorted(value.items())
-                if k not in VOLATILE and "seconds" not in k and "memory" not in k}
+        return {
+            k: _strip(v)
+            for k, v in sorted(value.items())
+            if k not in VOLATILE and "seconds" not in k and "memory" not in k
+        }
     if isinstance(value, list):
         return [_strip(v) for v in value]
     return value
@@ -62,12 +78,14 @@ def _strip(value):
 def _digests(results: Path) -> dict:
     out = {}
     with h5py.File(results, "r") as f:
+
         def visit(name, obj):
             if name.startswith("modes/"):
                 return
             if isinstance(obj, h5py.Dataset) and obj.dtype.kind in "fiub" and obj.size:
                 data = np.ascontiguousarray(obj[()])
                 out[name] = hashlib.sha256(data.tobytes()).hexdigest()[:16]
+
         f.visititems(visit)
     return out
 
@@ -93,12 +111,12 @@ def record() -> dict:
         spec = yaml.safe_load(path.read_text())
         kind = spec["solver"]["type"]
         with tempfile.TemporaryDirectory() as tmp:
-            table[f"run {path.stem}"] = _run(["run", str(path), "--set", "output.plots=false",
-                                              *SHORTEN[kind]], Path(tmp))
+            table[f"run {path.stem}"] = _run(
+                ["run", str(path), "--set", "output.plots=false", *SHORTEN[kind]], Path(tmp)
+            )
         if "fatigue" in spec:
             with tempfile.TemporaryDirectory() as tmp:
-                table[f"fatigue {path.stem}"] = _run(["fatigue", str(path), *FATIGUE_SHORT],
-                                                     Path(tmp))
+                table[f"fatigue {path.stem}"] = _run(["fatigue", str(path), *FATIGUE_SHORT], Path(tmp))
         print(f"{path.stem}: done", file=sys.stderr)
     return table
 
@@ -138,14 +156,16 @@ def compare(before: dict, after: dict) -> bool:
         flat_a, flat_b = dict(_numbers(a.get("summary", a))), dict(_numbers(b.get("summary", b)))
         keys = sorted(set(flat_a) | set(flat_b))
         missing = [k for k in keys if k not in flat_a or k not in flat_b]
-        values = [f"{k}: {flat_a[k]!r} -> {flat_b[k]!r}" for k in keys
-                  if k not in missing and not _agree(k, flat_a[k], flat_b[k])]
+        values = [
+            f"{k}: {flat_a[k]!r} -> {flat_b[k]!r}"
+            for k in keys
+            if k not in missing and not _agree(k, flat_a[k], flat_b[k])
+        ]
         data_a, data_b = a.get("datasets", {}), b.get("datasets", {})
         changed = sorted(k for k in set(data_a) | set(data_b) if data_a.get(k) != data_b.get(k))
         if missing or values or changed:
             same = False
-            print(f"{name}: DIFFERS: keys on one side only {missing}; values {values}; "
-                  f"datasets {changed}")
+            print(f"{name}: DIFFERS: keys on one side only {missing}; values {values}; datasets {changed}")
         else:
             print(f"{name}: same ({len(flat_a)} summary values, {len(data_a)} datasets bit for bit)")
     return same

@@ -20,16 +20,31 @@ def small_body(dim: int, plane: str = "stress", n: int = 12, h: float = 1e-3):
     return geometry.rectangle(n * h, n * h, h, thickness=h, plane=plane)
 
 
-def small_model(name: str, dim: int = 3, plane: str = "stress", n: int = 12,
-                horizon_factor: float = 3.015, partial_volumes: bool = True,
-                dtype=np.float64, nu: float = 0.25, surface_correction: str = "none"):
+def small_model(
+    name: str,
+    dim: int = 3,
+    plane: str = "stress",
+    n: int = 12,
+    horizon_factor: float = 3.015,
+    partial_volumes: bool = True,
+    dtype=np.float64,
+    nu: float = 0.25,
+    surface_correction: str = "none",
+):
     """A model on ``small_body`` with steel-like constants."""
     body = small_body(dim, plane, n)
     bonds = find_bonds(body, horizon_factor * body.spacing, partial_volumes=partial_volumes)
     implied = 1 / 3 if (dim == 2 and plane == "stress") else 0.25
-    return make_model(name, body, bonds, E=200e9, density=7850.0,
-                      nu=(implied if name == "pmb" else nu),
-                      surface_correction=surface_correction, dtype=dtype)
+    return make_model(
+        name,
+        body,
+        bonds,
+        E=200e9,
+        density=7850.0,
+        nu=(implied if name == "pmb" else nu),
+        surface_correction=surface_correction,
+        dtype=dtype,
+    )
 
 
 MODEL_CASES = [

@@ -12,7 +12,7 @@ from peridyn.physics.damage import damage_field
 from peridyn.solvers import ExplicitSolver
 
 CASE = Path(__file__).parents[2] / "cases" / "plate2d_stretch.yaml"
-CRACK_X = 5.0e-3          # the pre-crack's line (m)
+CRACK_X = 5.0e-3  # the pre-crack's line (m)
 TIPS = (1.815e-3, 2.185e-3)  # its tips (m)
 
 
@@ -20,8 +20,7 @@ def run_stretch(overrides=()):
     """Run the case with the solver's own loop; returns (body, phi)."""
     case = load_case(CASE, overrides)
     setup = build(case)
-    solver = ExplicitSolver(setup.model, setup.loading, safety=case.solver.safety,
-                            damage=setup.damage)
+    solver = ExplicitSolver(setup.model, setup.loading, safety=case.solver.safety, damage=setup.damage)
     state = solver.initial_state()
     solver.run(state, int(np.ceil(case.solver.time / solver.dt)))
     return setup.body, damage_field(setup.model)

@@ -21,8 +21,17 @@ def test_case_runs(path, tmp_path, capsys):
     from peridyn.io.case import load_case
 
     case = load_case(path)
-    args = ["run", str(path), "--json", "--no-progress", "-o", str(tmp_path),
-            "--set", "output.plots=false", *SHORTEN[case.solver.type]]
+    args = [
+        "run",
+        str(path),
+        "--json",
+        "--no-progress",
+        "-o",
+        str(tmp_path),
+        "--set",
+        "output.plots=false",
+        *SHORTEN[case.solver.type],
+    ]
     assert main(args) == 0
     summary = json.loads(capsys.readouterr().out)
     assert summary["points"] > 0 and (tmp_path / "results.h5").is_file()
@@ -41,6 +50,5 @@ def test_demo_runs_shortened(tmp_path, capsys, monkeypatch):
     monkeypatch.setattr(run_cmd, "run", short)
     assert main(["demo", "--json", "--no-progress", "-o", str(tmp_path)]) == 0
     summary = json.loads(capsys.readouterr().out)
-    assert {Path(p).name for p in summary["plots"]} >= {"sensors.png", "bscan_x_axis.png",
-                                                        "displacement.png"}
+    assert {Path(p).name for p in summary["plots"]} >= {"sensors.png", "bscan_x_axis.png", "displacement.png"}
     assert demo_cmd.DEMO_CASE.endswith(".yaml")

@@ -104,11 +104,22 @@ def test_kernel_matches_numpy_reference(case, rng):
     b.intact[rng.random(b.n_bonds) < 0.05] = False  # break some bonds (asymmetrically: fine)
     u = 1e-5 * rng.standard_normal(model.x.shape)
     if model.name == "pmb":
-        ref = reference.pmb_force(model.x, u, b.offsets, b.neighbours, model.inv_length,
-                                  model.bond_stiffness, b.intact)
+        ref = reference.pmb_force(
+            model.x, u, b.offsets, b.neighbours, model.inv_length, model.bond_stiffness, b.intact
+        )
     else:
-        ref = reference.lps_force(model.x, u, b.offsets, b.neighbours, model.length, model.w,
-                                  model.dev, b.intact, model.theta_coef, model._p_coef)
+        ref = reference.lps_force(
+            model.x,
+            u,
+            b.offsets,
+            b.neighbours,
+            model.length,
+            model.w,
+            model.dev,
+            b.intact,
+            model.theta_coef,
+            model._p_coef,
+        )
     got = model.force(u)
     np.testing.assert_allclose(got, ref, rtol=1e-10, atol=1e-12 * np.abs(ref).max())
 
@@ -127,17 +138,21 @@ def test_float32_kernel_close_to_float64(name, amplitude, rng):
     assert np.max(np.abs(f32 - f64)) < 1e-5 * np.max(np.abs(f64))
 
 
-@pytest.mark.parametrize("dim, factor, partial, bulk_is_one", [
-    (3, 1.4143, False, True),   # the 18-neighbour lattice is isotropic to 4th order
-    (3, 2.015, True, False),    # elsewhere the factor also absorbs the lattice's anisotropy
-    (2, 2.015, True, False),
-])
+@pytest.mark.parametrize(
+    "dim, factor, partial, bulk_is_one",
+    [
+        (3, 1.4143, False, True),  # the 18-neighbour lattice is isotropic to 4th order
+        (3, 2.015, True, False),  # elsewhere the factor also absorbs the lattice's anisotropy
+        (2, 2.015, True, False),
+    ],
+)
 def test_shear_factor_in_the_bulk_and_at_surfaces(dim, factor, partial, bulk_is_one):
     """The shear-correction factor compares each point's stiffest pure-shear response with
     the continuum value 4 gamma^2 m / 15 (3D) or / 8 (2D): the same for every interior point
     (exactly 1 on the isotropic 18-neighbour lattice), different near a surface."""
-    model = small_model("lps", dim, n=16, horizon_factor=factor, partial_volumes=partial,
-                        surface_correction="shear-factor")
+    model = small_model(
+        "lps", dim, n=16, horizon_factor=factor, partial_volumes=partial, surface_correction="shear-factor"
+    )
     x = model.body.points[:, :dim]
     depth = np.minimum(x - x.min(axis=0), x.max(axis=0) - x).min(axis=1)
     interior = depth > model.bonds.horizon + model.body.spacing

@@ -22,8 +22,12 @@ def test_stiffness_is_symmetric_and_matches_the_linear_force(case, rng):
     K = assemble_stiffness(model)
     assert abs(K - K.T).max() <= 1e-14 * abs(K).max()
     vol = np.repeat(model.body.volumes, 3)
-    np.testing.assert_allclose(K @ u.ravel(), -vol * linear_force(model, u).ravel(),
-                               rtol=1e-10, atol=1e-12 * np.abs(K @ u.ravel()).max())
+    np.testing.assert_allclose(
+        K @ u.ravel(),
+        -vol * linear_force(model, u).ravel(),
+        rtol=1e-10,
+        atol=1e-12 * np.abs(K @ u.ravel()).max(),
+    )
 
 
 @pytest.mark.parametrize("case", MODEL_CASES)
@@ -68,8 +72,12 @@ def test_rigid_motions_are_in_the_null_space(case):
 def test_operator_equals_matrix_and_mass_is_lumped(name, rng):
     model = small_model(name, 3, n=6, horizon_factor=2.015)
     v = rng.standard_normal(3 * model.body.n_points)
-    np.testing.assert_allclose(stiffness_operator(model) @ v, assemble_stiffness(model) @ v,
-                               rtol=1e-10, atol=1e-10 * np.abs(assemble_stiffness(model) @ v).max())
+    np.testing.assert_allclose(
+        stiffness_operator(model) @ v,
+        assemble_stiffness(model) @ v,
+        rtol=1e-10,
+        atol=1e-10 * np.abs(assemble_stiffness(model) @ v).max(),
+    )
     M = mass_matrix(model)
     assert M.diagonal().sum() == pytest.approx(3 * 7850.0 * model.body.volumes.sum(), rel=1e-12)
 

@@ -43,8 +43,13 @@ def end_load(model, u_end, contact=None, max_iterations=20_000):
     """Static axial force (N) on the right end under an end displacement ``u_end`` (m)
     (left end clamped), and the relaxed displacement."""
     body = model.body
-    loading = Loading(body, [BoundaryCondition("left", "displacement", "xy", Constant(0.0)),
-                             BoundaryCondition("right", "displacement", "x", Constant(u_end))])
+    loading = Loading(
+        body,
+        [
+            BoundaryCondition("left", "displacement", "xy", Constant(0.0)),
+            BoundaryCondition("right", "displacement", "x", Constant(u_end)),
+        ],
+    )
     result = relax(model, loading, tolerance=1e-8, max_iterations=max_iterations, contact=contact)
     f = model.force(result.u)
     if contact is not None:

@@ -16,8 +16,7 @@ def _bar_model(name, n=(12, 4, 4), h=1e-3, horizon=2.015, **kw):
     body = geometry.box(tuple(k * h for k in n), h)
     body = body.with_node_set("all", np.ones(body.n_points, dtype=bool))
     bonds = find_bonds(body, horizon * h, **kw)
-    return make_model(name, body, bonds, E=STEEL_E, nu=0.25 if name == "pmb" else STEEL_NU,
-                      density=STEEL_RHO)
+    return make_model(name, body, bonds, E=STEEL_E, nu=0.25 if name == "pmb" else STEEL_NU, density=STEEL_RHO)
 
 
 def _energy_error(model, fraction: float, n_steps: int = 5000) -> float:
@@ -74,8 +73,12 @@ def test_too_large_step_blows_up_and_is_reported():
     model = _bar_model("pmb", n=(6, 4, 4))
     body = model.body
     rng = np.random.default_rng(1)
-    loading = Loading(body, initial=[InitialCondition("all", "displacement", "xyz",
-                                                      1e-9 * rng.standard_normal((body.n_points, 3)))])
+    loading = Loading(
+        body,
+        initial=[
+            InitialCondition("all", "displacement", "xyz", 1e-9 * rng.standard_normal((body.n_points, 3)))
+        ],
+    )
     solver = ExplicitSolver(model, loading)
     solver.dt = 3.0 * solver.stable_dt  # bypass the check on purpose
     with pytest.raises(InstabilityError, match="unstable at step"):

@@ -22,9 +22,17 @@ def test_crack_nucleates_at_the_notches_not_at_the_loaded_ends():
     case = load_case(CASE)
     setup = build(case)
     f = case.fatigue
-    result = run_fatigue(setup.model, setup.loading, fatigue_parameters(case, setup.bonds.horizon),
-                         CycleMapping(((3, 1e-5),)), f.load_ratio, f.max_load_time,
-                         f.no_damage_sets, "y", "z")
+    result = run_fatigue(
+        setup.model,
+        setup.loading,
+        fatigue_parameters(case, setup.bonds.horizon),
+        CycleMapping(((3, 1e-5),)),
+        f.load_ratio,
+        f.max_load_time,
+        f.no_damage_sets,
+        "y",
+        "z",
+    )
     assert result.broken[-1] > 0
     x = setup.body.points
     first = np.isfinite(result.first_break) & (result.first_break == result.first_break.min())
@@ -48,6 +56,9 @@ def test_first_bending_frequency_falls_with_types_matched(tmp_path):
     for pair in modal["matches"]:
         b, a = before[pair["before"]], after[pair["after"]]
         assert pair["mac"] > 0.9 and (b["type"], b["order"]) == (a["type"], a["order"])
-    bending = [p for p in modal["matches"] if (before[p["before"]]["type"],
-                                               before[p["before"]]["order"]) == ("bending", 1)]
+    bending = [
+        p
+        for p in modal["matches"]
+        if (before[p["before"]]["type"], before[p["before"]]["order"]) == ("bending", 1)
+    ]
     assert len(bending) == 1 and bending[0]["frequency_change"] < -0.005

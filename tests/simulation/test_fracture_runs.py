@@ -17,14 +17,16 @@ def split_plate(tmp_path):
         "name": "split_plate",
         "geometry": {"type": "rectangle", "size": [0.020, 0.020], "thickness": 1e-3},
         "discretization": {"spacing": H, "horizon": 3.015, "partial_volumes": False},
-        "material": {"model": "pmb", "E": 70e9, "density": 2700,
-                     "damage": {"critical_bond_stress": 700e6}},
-        "node_sets": {"top": {"type": "face", "face": "y+", "depth": 1e-3},
-                      "bottom": {"type": "face", "face": "y-", "depth": 1e-3}},
+        "material": {"model": "pmb", "E": 70e9, "density": 2700, "damage": {"critical_bond_stress": 700e6}},
+        "node_sets": {
+            "top": {"type": "face", "face": "y+", "depth": 1e-3},
+            "bottom": {"type": "face", "face": "y-", "depth": 1e-3},
+        },
         "precracks": [{"type": "segment", "start": [-0.001, 0.010], "end": [0.021, 0.010]}],
         "boundary_conditions": [
             {"set": "top", "kind": "velocity", "components": "y", "value": 5.0},
-            {"set": "bottom", "kind": "velocity", "components": "y", "value": -5.0}],
+            {"set": "bottom", "kind": "velocity", "components": "y", "value": -5.0},
+        ],
         "solver": {"type": "explicit", "steps": 200},
         "output": {"snapshot_every": 50, "plots": True, "vtu": False},
     }

@@ -16,12 +16,16 @@ BAR = {
     "discretization": {"spacing": 1e-3, "horizon": 2.015},
     "material": {"model": "pmb", "E": 70e9, "nu": 0.25, "density": 2700},
     "node_sets": {"clamp": {"type": "face", "face": "x-"}, "end": {"type": "face", "face": "x+"}},
-    "boundary_conditions": [{"set": "end", "kind": "displacement", "components": "x",
-                             "value": {"type": "ramp", "start": 0, "end": 1e-6,
-                                       "end_value": 1e-6}}],
+    "boundary_conditions": [
+        {
+            "set": "end",
+            "kind": "displacement",
+            "components": "x",
+            "value": {"type": "ramp", "start": 0, "end": 1e-6, "end_value": 1e-6},
+        }
+    ],
     "solver": {"type": "explicit", "steps": 40},
-    "output": {"every": 1, "sensors": {"mid": [0.006, 0.002, 0.002]}, "plots": False,
-               "vtu": False},
+    "output": {"every": 1, "sensors": {"mid": [0.006, 0.002, 0.002]}, "plots": False, "vtu": False},
 }
 
 
@@ -51,8 +55,10 @@ def test_newmark_case_records_like_the_explicit_one(tmp_path):
 def test_newton_case_matches_the_static_case(tmp_path):
     """Clamped bar with 10 N on its free end: ``newton`` and ``static`` (ADR, tolerance 1e-8)
     give the same final displacement to 1e-5 of its largest value."""
-    bcs = [{"set": "clamp", "kind": "displacement", "components": "xyz", "value": 0.0},
-           {"set": "end", "kind": "force", "components": "x", "value": 10.0}]
+    bcs = [
+        {"set": "clamp", "kind": "displacement", "components": "xyz", "value": 0.0},
+        {"set": "end", "kind": "force", "components": "x", "value": 10.0},
+    ]
     newton = run_case(_case({"type": "newton", "tolerance": 1e-10}, bcs), tmp_path / "n")
     run_case(_case({"type": "static", "tolerance": 1e-8}, bcs), tmp_path / "s")
     u_n = read_array(tmp_path / "n/results.h5", "final/u")
@@ -61,12 +67,15 @@ def test_newton_case_matches_the_static_case(tmp_path):
     assert np.abs(u_n - u_s).max() < 1e-5 * np.abs(u_s).max()
 
 
-@pytest.mark.parametrize("solver, message", [
-    ({"type": "newmark", "steps": 10}, "needs dt"),
-    ({"type": "newmark", "dt": 1e-8}, "exactly one of steps or time"),
-    ({"type": "newmark", "steps": 10, "dt": 1e-8, "displacement_tolerance": -1.0}, "greater than 0"),
-    ({"type": "newton", "newton_iterations": 0}, "greater than or equal to 1"),
-])
+@pytest.mark.parametrize(
+    "solver, message",
+    [
+        ({"type": "newmark", "steps": 10}, "needs dt"),
+        ({"type": "newmark", "dt": 1e-8}, "exactly one of steps or time"),
+        ({"type": "newmark", "steps": 10, "dt": 1e-8, "displacement_tolerance": -1.0}, "greater than 0"),
+        ({"type": "newton", "newton_iterations": 0}, "greater than or equal to 1"),
+    ],
+)
 def test_implicit_solver_keys_are_checked(solver, message):
     """Bad implicit-solver keys are refused with a message naming the problem."""
     with pytest.raises(CaseFileError, match=message):

@@ -12,8 +12,14 @@ from peridyn.solvers.modal import modal_analysis
 #: PMMA plate of VALIDATION.md V4.
 SIZE, E, NU, RHO = (0.10, 0.05, 0.008), 5.35e9, 0.33, 1200.0
 #: Mode types of the 40k model in frequency order, V4 (1B, 1T, 2T, 2B, TB, IPB).
-EXPECTED = ["1st bending", "1st torsional", "2nd torsional", "2nd bending",
-            "1st transverse bending", "1st in-plane bending"]
+EXPECTED = [
+    "1st bending",
+    "1st torsional",
+    "2nd torsional",
+    "2nd bending",
+    "1st transverse bending",
+    "1st in-plane bending",
+]
 
 
 def _plate_model(spacing, correction="none"):
@@ -37,13 +43,18 @@ def test_six_rigid_modes_then_classified_elastic_modes(coarse):
     assert result.n_rigid == 6
     assert np.all(np.abs(result.frequencies[result.rigid]) < 1.0)
     assert np.all(result.residuals[~result.rigid] < 1e-6)
-    types = classify_modes(model.body.points, result.shapes, model.density * model.body.volumes,
-                           result.rigid)
+    types = classify_modes(model.body.points, result.shapes, model.density * model.body.volumes, result.rigid)
     elastic = [str(t) for t, r in zip(types, result.rigid, strict=True) if not r]
     # at 2 mm the 2nd bending (4669 Hz, u_z symmetric about the long axis) comes before the
     # 2nd torsional (4796 Hz, antisymmetric); at 40k points the order flips (V4)
-    assert elastic == ["1st bending", "1st torsional", "2nd bending", "2nd torsional",
-                       "1st transverse bending", "1st in-plane bending"]
+    assert elastic == [
+        "1st bending",
+        "1st torsional",
+        "2nd bending",
+        "2nd torsional",
+        "1st transverse bending",
+        "1st in-plane bending",
+    ]
 
 
 def test_modes_are_mass_orthonormal(coarse):
@@ -62,8 +73,12 @@ def test_modal_command_json_and_outputs(tmp_path, capsys):
     from peridyn.cli import main
 
     case = Path(__file__).resolve().parents[2] / "cases" / "pmma_plate.yaml"
-    assert main(["modal", str(case), "--modes", "8", "--json", "-o", str(tmp_path),
-                 "--set", "output.plots=false"]) == 0
+    assert (
+        main(
+            ["modal", str(case), "--modes", "8", "--json", "-o", str(tmp_path), "--set", "output.plots=false"]
+        )
+        == 0
+    )
     summary = json.loads(capsys.readouterr().out)
     assert summary["rigid_modes"] == 6 and len(summary["modes"]) == 8
     assert {"index", "frequency_hz", "type", "order"} <= set(summary["modes"][6])
@@ -83,15 +98,20 @@ def test_edge_crack_lowers_most_the_mode_whose_bending_stress_it_cuts(coarse):
 
     healthy_model, healthy = coarse
     model = _plate_model(2e-3)
-    cut = cut_bonds(model.body, model.bonds, lambda a, b: crossing_rectangle(
-        a, b, (0.0501, -0.001, -0.001), (0.0, 0.0135, 0.0), (0.0, 0.0, 0.010)))
+    cut = cut_bonds(
+        model.body,
+        model.bonds,
+        lambda a, b: crossing_rectangle(
+            a, b, (0.0501, -0.001, -0.001), (0.0, 0.0135, 0.0), (0.0, 0.0, 0.010)
+        ),
+    )
     assert cut > 0
     cracked = modal_analysis(model, 12)
     masses = model.density * model.body.volumes
-    types_h = [str(t) for t in classify_modes(healthy_model.body.points, healthy.shapes, masses,
-                                              healthy.rigid)][6:]
-    types_c = [str(t) for t in classify_modes(model.body.points, cracked.shapes, masses,
-                                              cracked.rigid)][6:]
+    types_h = [
+        str(t) for t in classify_modes(healthy_model.body.points, healthy.shapes, masses, healthy.rigid)
+    ][6:]
+    types_c = [str(t) for t in classify_modes(model.body.points, cracked.shapes, masses, cracked.rigid)][6:]
     mac = mac_matrix(healthy.shapes[6:], cracked.shapes[6:], masses)
     partner = mac.argmax(axis=0)  # healthy mode most like each cracked one
     assert np.all(mac.max(axis=0) > 0.85)
@@ -143,8 +163,7 @@ def test_40k_points_match_the_independent_lps_assembly():
     elastic = result.frequencies[~result.rigid]
     reference = [1772.86, 2196.50, 4690.93, 4744.36, 6982.92, 7144.56]
     np.testing.assert_allclose(elastic, reference, rtol=0.005)
-    types = classify_modes(model.body.points, result.shapes,
-                           model.density * model.body.volumes, result.rigid)
+    types = classify_modes(model.body.points, result.shapes, model.density * model.body.volumes, result.rigid)
     assert [str(t) for t, r in zip(types, result.rigid, strict=True) if not r] == EXPECTED
 
 
@@ -155,10 +174,8 @@ def test_40k_points_with_the_shear_factor_match_v4_and_the_thesis():
     sqrt(2) h) within 2%."""
     _, result = _plate_modes(1e-3, "shear-factor")
     elastic = result.frequencies[~result.rigid]
-    np.testing.assert_allclose(elastic, [1636.72, 1967.87, 4228.95, 4390.08, 6513.22, 6814.23],
-                               rtol=0.005)
-    np.testing.assert_allclose(elastic, [1656.45, 1961.24, 4213.43, 4421.60, 6463.92, 6855.45],
-                               rtol=0.02)
+    np.testing.assert_allclose(elastic, [1636.72, 1967.87, 4228.95, 4390.08, 6513.22, 6814.23], rtol=0.005)
+    np.testing.assert_allclose(elastic, [1656.45, 1961.24, 4213.43, 4421.60, 6463.92, 6855.45], rtol=0.02)
 
 
 def test_compare_pairs_modes_by_mac_and_refuses_another_grid(tmp_path, capsys):
@@ -174,13 +191,27 @@ def test_compare_pairs_modes_by_mac_and_refuses_another_grid(tmp_path, capsys):
     quiet = ["--modes", "8", "--set", "output.plots=false", "--json"]
     assert main(["modal", case, "-o", str(tmp_path / "a"), *quiet]) == 0
     capsys.readouterr()
-    assert main(["modal", case, "-o", str(tmp_path / "b"), "--compare", str(tmp_path / "a"),
-                 *quiet]) == 0
+    assert main(["modal", case, "-o", str(tmp_path / "b"), "--compare", str(tmp_path / "a"), *quiet]) == 0
     rows = json.loads(capsys.readouterr().out)["comparison"]
-    assert [r["type"] for r in rows] == [r["reference_type"] for r in rows] == [
-        "1st bending", "1st torsional"]
+    assert (
+        [r["type"] for r in rows] == [r["reference_type"] for r in rows] == ["1st bending", "1st torsional"]
+    )
     assert all(abs(r["frequency_change"]) < 1e-9 and r["mac"] > 1 - 1e-9 for r in rows)
     assert (tmp_path / "b" / "frequency_shift.csv").is_file()
-    assert main(["modal", case, "-o", str(tmp_path / "c"), "--compare", str(tmp_path / "a"),
-                 *quiet, "--set", "discretization.spacing=0.0025"]) == 1
+    assert (
+        main(
+            [
+                "modal",
+                case,
+                "-o",
+                str(tmp_path / "c"),
+                "--compare",
+                str(tmp_path / "a"),
+                *quiet,
+                "--set",
+                "discretization.spacing=0.0025",
+            ]
+        )
+        == 1
+    )
     assert "MAC needs the same grid" in capsys.readouterr().err

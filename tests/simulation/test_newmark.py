@@ -21,10 +21,8 @@ def _strip():
     h = 1e-3
     body = geometry.rectangle(0.080, 0.004, h, thickness=h)
     body = body.with_node_set("left", geometry.face(body, "x-"))
-    model = make_model("pmb", body, find_bonds(body, 3.015 * h), E=200e9, density=7850.0,
-                       nu=1 / 3)
-    loading = Loading(body, [BoundaryCondition("left", "displacement", "x",
-                                               ToneBurst(100e3, 1.5, 1e-6))])
+    model = make_model("pmb", body, find_bonds(body, 3.015 * h), E=200e9, density=7850.0, nu=1 / 3)
+    loading = Loading(body, [BoundaryCondition("left", "displacement", "x", ToneBurst(100e3, 1.5, 1e-6))])
     sensor = int(np.argmin(np.linalg.norm(body.points[:, :2] - [0.040, 0.0015], axis=1)))
     return model, loading, sensor
 
@@ -65,8 +63,7 @@ def test_newmark_conserves_energy_of_a_linear_vibration():
     h = 1e-3
     body = geometry.rectangle(0.008, 0.008, h, thickness=h)
     body = body.with_node_set("all", np.ones(body.n_points, dtype=bool))
-    model = make_model("pmb", body, find_bonds(body, 3.015 * h), E=200e9, density=7850.0,
-                       nu=1 / 3)
+    model = make_model("pmb", body, find_bonds(body, 3.015 * h), E=200e9, density=7850.0, nu=1 / 3)
     v0 = 1e-3 * np.random.default_rng(7).standard_normal((body.n_points, 2))
     v0 -= v0.mean(axis=0)  # no rigid translation or rotation: a finite rotation is nonlinear
     r = body.points[:, :2] - body.points[:, :2].mean(axis=0)
@@ -91,13 +88,16 @@ def test_newmark_conserves_energy_of_a_linear_vibration():
     assert np.max(np.abs(drift)) < 1e-6
 
 
-@pytest.mark.parametrize("kwargs, message", [
-    ({"dt": -1e-8}, "time step must be positive"),
-    ({"tolerance": 0.0}, "displacement tolerance must be positive"),
-    ({"max_iterations": 0}, "max_iterations must be a positive integer"),
-    ({"damping": -1.0}, "damping must be non-negative"),
-    ({"linear_solver": "lsu"}, "unknown linear solver 'lsu' \\(did you mean 'lu'\\?\\)"),
-])
+@pytest.mark.parametrize(
+    "kwargs, message",
+    [
+        ({"dt": -1e-8}, "time step must be positive"),
+        ({"tolerance": 0.0}, "displacement tolerance must be positive"),
+        ({"max_iterations": 0}, "max_iterations must be a positive integer"),
+        ({"damping": -1.0}, "damping must be non-negative"),
+        ({"linear_solver": "lsu"}, "unknown linear solver 'lsu' \\(did you mean 'lu'\\?\\)"),
+    ],
+)
 def test_newmark_bad_input(kwargs, message):
     """Bad arguments raise InputError naming the argument."""
     model, loading, _ = _strip()
@@ -122,8 +122,9 @@ def test_newmark_cg_and_lu_agree():
     model, loading, _ = _strip()
     states = []
     for method in ("lu", "cg"):
-        solver = NewmarkSolver(model, loading, dt=2 * model.critical_time_step(), tolerance=1e-14,
-                               linear_solver=method)
+        solver = NewmarkSolver(
+            model, loading, dt=2 * model.critical_time_step(), tolerance=1e-14, linear_solver=method
+        )
         states.append(solver.run(solver.initial_state(), 12))
     scale = np.abs(states[0].u).max()
     assert scale > 0 and np.abs(states[1].u - states[0].u).max() < 1e-8 * scale
@@ -144,11 +145,14 @@ def test_newmark_breaks_the_same_bonds_as_explicit():
     body = body.with_node_set("grips", (x < 0.0045) | (x > 0.0255))
     onsets = []
     for kind in ("explicit", "newmark"):
-        model = make_model("pmb", body, find_bonds(body, 3.015 * h), E=200e9, density=7850.0,
-                           nu=1 / 3)
-        loading = Loading(body, [
-            BoundaryCondition("left", "displacement", "x", Ramp(0, 10e-6, 0, -30e-6)),
-            BoundaryCondition("right", "displacement", "x", Ramp(0, 10e-6, 0, 30e-6))])
+        model = make_model("pmb", body, find_bonds(body, 3.015 * h), E=200e9, density=7850.0, nu=1 / 3)
+        loading = Loading(
+            body,
+            [
+                BoundaryCondition("left", "displacement", "x", Ramp(0, 10e-6, 0, -30e-6)),
+                BoundaryCondition("right", "displacement", "x", Ramp(0, 10e-6, 0, 30e-6)),
+            ],
+        )
         damage = BondDamage(model, critical_stretch=1e-3, no_damage_sets=["grips"])
         solver = ExplicitSolver(model, loading, damage=damage)
         if kind == "newmark":

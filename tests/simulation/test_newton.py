@@ -23,11 +23,15 @@ def _bar(size, name="pmb", correction="energy"):
     body = body.with_node_set("left", geometry.face(body, "x-"))
     body = body.with_node_set("right", geometry.face(body, "x+"))
     bonds = find_bonds(body, 3.015 * h, partial_volumes=False)
-    model = make_model(name, body, bonds, E=E_AL, nu=0.25, density=RHO_AL,
-                       surface_correction=correction)
+    model = make_model(name, body, bonds, E=E_AL, nu=0.25, density=RHO_AL, surface_correction=correction)
     force = 1e6 * size[1] * size[2]
-    loading = Loading(body, [BoundaryCondition("left", "force", "x", Constant(-force)),
-                             BoundaryCondition("right", "force", "x", Constant(force))])
+    loading = Loading(
+        body,
+        [
+            BoundaryCondition("left", "force", "x", Constant(-force)),
+            BoundaryCondition("right", "force", "x", Constant(force)),
+        ],
+    )
     return model, loading
 
 
@@ -51,13 +55,16 @@ def test_newton_matches_adr_on_a_free_bar(linear_solver):
     assert result.converged and reference.converged
     body = model.body
     assert _centre_strain(body, result.u, 3.1e-3) == pytest.approx(
-        _centre_strain(body, reference.u, 3.1e-3), rel=1e-5)
+        _centre_strain(body, reference.u, 3.1e-3), rel=1e-5
+    )
     assert result.iterations <= 3
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("name, correction, tolerance, linear_solver", [
-    ("pmb", "energy", 0.02, "lu"), ("lps", "none", 0.006, "cg")])
+@pytest.mark.parametrize(
+    "name, correction, tolerance, linear_solver",
+    [("pmb", "energy", 0.02, "lu"), ("lps", "none", 0.006, "cg")],
+)
 def test_newton_bar_apparent_modulus(name, correction, tolerance, linear_solver):
     """The 40 x 10 x 10 mm bar of test_statics: E from Newton's centre strain within the
     tolerances of the ADR tests there (PMB with the energy surface correction 2%, plain LPS
@@ -87,9 +94,14 @@ def test_newton_converges_quadratically(name):
     body = body.with_node_set("right", geometry.face(body, "x+"))
     bonds = find_bonds(body, 3.015 * h)
     model = make_model(name, body, bonds, E=E_AL, nu=1 / 3, density=RHO_AL)
-    loading = Loading(body, [BoundaryCondition("left", "displacement", "xy"),
-                             BoundaryCondition("right", "displacement", "x", Ramp(end_value=2e-3)),
-                             BoundaryCondition("right", "displacement", "y", Ramp(end_value=3e-3))])
+    loading = Loading(
+        body,
+        [
+            BoundaryCondition("left", "displacement", "xy"),
+            BoundaryCondition("right", "displacement", "x", Ramp(end_value=2e-3)),
+            BoundaryCondition("right", "displacement", "y", Ramp(end_value=3e-3)),
+        ],
+    )
     result = newton(model, loading, load_steps=2, tolerance=1e-12)
     assert result.converged
     for step in result.steps:
@@ -131,11 +143,15 @@ def test_bond_breaking_reequilibrates_until_no_bond_breaks():
     model = _notched_plate()
     body = model.body
     before = model.bonds.intact.copy()
-    loading = Loading(body, [
-        BoundaryCondition("top", "displacement", "x"),
-        BoundaryCondition("top", "displacement", "y", Ramp(end_value=10e-6)),
-        BoundaryCondition("bottom", "displacement", "x"),
-        BoundaryCondition("bottom", "displacement", "y", Ramp(end_value=-10e-6))])
+    loading = Loading(
+        body,
+        [
+            BoundaryCondition("top", "displacement", "x"),
+            BoundaryCondition("top", "displacement", "y", Ramp(end_value=10e-6)),
+            BoundaryCondition("bottom", "displacement", "x"),
+            BoundaryCondition("bottom", "displacement", "y", Ramp(end_value=-10e-6)),
+        ],
+    )
     damage = BondDamage(model, critical_stretch=1.5e-3, no_damage_sets=["grips"])
     result = newton(model, loading, load_steps=4, tolerance=1e-8, damage=damage)
     assert result.converged
@@ -152,14 +168,17 @@ def test_bond_breaking_reequilibrates_until_no_bond_breaks():
     assert np.all(mid[:, 0] > 0.008 - 3.1e-3)
 
 
-@pytest.mark.parametrize("kwargs, message", [
-    ({"tolerance": -1.0}, "tolerance must be positive"),
-    ({"load_steps": 0}, "load_steps must be a positive integer"),
-    ({"max_iterations": 2.5}, "max_iterations must be a positive integer"),
-    ({"time": 0.0}, "end time must be positive"),
-    ({"u0": np.zeros((3, 3))}, "u0 must have shape"),
-    ({"linear_solver": "gmres"}, "unknown linear solver 'gmres'"),
-])
+@pytest.mark.parametrize(
+    "kwargs, message",
+    [
+        ({"tolerance": -1.0}, "tolerance must be positive"),
+        ({"load_steps": 0}, "load_steps must be a positive integer"),
+        ({"max_iterations": 2.5}, "max_iterations must be a positive integer"),
+        ({"time": 0.0}, "end time must be positive"),
+        ({"u0": np.zeros((3, 3))}, "u0 must have shape"),
+        ({"linear_solver": "gmres"}, "unknown linear solver 'gmres'"),
+    ],
+)
 def test_newton_bad_input(kwargs, message):
     """Bad arguments raise InputError naming the argument."""
     model, loading = _bar((0.006, 0.003, 0.003))

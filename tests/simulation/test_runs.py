@@ -18,14 +18,22 @@ BAR = {
     "discretization": {"spacing": 1e-3, "horizon": 2.015},
     "material": {"model": "lps", "E": 70e9, "nu": 0.3, "density": 2700},
     "node_sets": {"end": {"type": "face", "face": "x+"}},
-    "boundary_conditions": [{"set": "end", "kind": "velocity", "components": "x",
-                             "value": {"type": "ramp", "start": 0, "end": 1e-6,
-                                       "end_value": 1.0}}],
+    "boundary_conditions": [
+        {
+            "set": "end",
+            "kind": "velocity",
+            "components": "x",
+            "value": {"type": "ramp", "start": 0, "end": 1e-6, "end_value": 1.0},
+        }
+    ],
     "solver": {"type": "explicit", "steps": 40},
-    "output": {"every": 2, "snapshot_every": 10, "sensors": {"mid": [0.006, 0.002, 0.002]},
-               "lines": {"axis": {"start": [0, 0.002, 0.002], "end": [0.012, 0.002, 0.002],
-                                  "points": 12}},
-               "plots": False},
+    "output": {
+        "every": 2,
+        "snapshot_every": 10,
+        "sensors": {"mid": [0.006, 0.002, 0.002]},
+        "lines": {"axis": {"start": [0, 0.002, 0.002], "end": [0.012, 0.002, 0.002], "points": 12}},
+        "plots": False,
+    },
 }
 
 
@@ -77,14 +85,16 @@ def test_precracked_plate_separates_with_half_damage(tmp_path):
         "name": "split_plate",
         "geometry": {"type": "rectangle", "size": [0.020, 0.020], "thickness": 1e-3},
         "discretization": {"spacing": 0.5e-3, "horizon": 3.015, "partial_volumes": False},
-        "material": {"model": "pmb", "E": 70e9, "density": 2700,
-                     "damage": {"critical_stretch": 0.01}},
-        "node_sets": {"top": {"type": "face", "face": "y+", "depth": 1e-3},
-                      "bottom": {"type": "face", "face": "y-", "depth": 1e-3}},
+        "material": {"model": "pmb", "E": 70e9, "density": 2700, "damage": {"critical_stretch": 0.01}},
+        "node_sets": {
+            "top": {"type": "face", "face": "y+", "depth": 1e-3},
+            "bottom": {"type": "face", "face": "y-", "depth": 1e-3},
+        },
         "precracks": [{"type": "segment", "start": [-0.001, 0.010], "end": [0.021, 0.010]}],
         "boundary_conditions": [
             {"set": "top", "kind": "velocity", "components": "y", "value": 5.0},
-            {"set": "bottom", "kind": "velocity", "components": "y", "value": -5.0}],
+            {"set": "bottom", "kind": "velocity", "components": "y", "value": -5.0},
+        ],
         "solver": {"type": "explicit", "steps": 300},
         "output": {"snapshot_every": 300, "plots": True},
     }
@@ -107,8 +117,9 @@ def test_cli_run_json(tmp_path, capsys):
     import yaml
 
     path.write_text(yaml.safe_dump(BAR))
-    code = main(["run", str(path), "--json", "--no-progress", "-o", str(tmp_path / "out"),
-                 "--set", "solver.steps=10"])
+    code = main(
+        ["run", str(path), "--json", "--no-progress", "-o", str(tmp_path / "out"), "--set", "solver.steps=10"]
+    )
     assert code == 0
     summary = json.loads(capsys.readouterr().out)
     assert summary["steps"] == 10 and summary["output_dir"] == str(tmp_path / "out")
@@ -128,7 +139,8 @@ def test_static_case_runs(tmp_path):
     raw["node_sets"]["start"] = {"type": "face", "face": "x-"}
     raw["boundary_conditions"] = [
         {"set": "start", "kind": "displacement", "components": "xyz", "value": 0.0},
-        {"set": "end", "kind": "force", "components": "x", "value": 16.0}]
+        {"set": "end", "kind": "force", "components": "x", "value": 16.0},
+    ]
     raw["solver"] = {"type": "static", "tolerance": 1e-7, "load_steps": 2}
     case = validate_case(raw)
     summary = run_case(case, tmp_path)
@@ -149,8 +161,7 @@ def test_plot_command_redraws_a_run(tmp_path, capsys):
         png.unlink()
     assert main(["plot", str(tmp_path), "--json"]) == 0
     plots = json.loads(capsys.readouterr().out)["plots"]
-    assert {p.split("/")[-1] for p in plots} == {"sensors.png", "bscan_axis.png",
-                                                 "displacement.png"}
+    assert {p.split("/")[-1] for p in plots} == {"sensors.png", "bscan_axis.png", "displacement.png"}
     assert all((tmp_path / p.split("/")[-1]).stat().st_size > 0 for p in plots)
 
 

@@ -23,11 +23,17 @@ def _apparent_modulus(name, surface_correction="none", partial_volumes=False):
     body = body.with_node_set("left", geometry.face(body, "x-"))
     body = body.with_node_set("right", geometry.face(body, "x+"))
     bonds = find_bonds(body, 3.015 * h, partial_volumes=partial_volumes)
-    model = make_model(name, body, bonds, E=E_AL, nu=0.25, density=RHO_AL,
-                       surface_correction=surface_correction)
+    model = make_model(
+        name, body, bonds, E=E_AL, nu=0.25, density=RHO_AL, surface_correction=surface_correction
+    )
     sigma, area = 1e6, 0.010 * 0.010
-    loading = Loading(body, [BoundaryCondition("left", "force", "x", Constant(-sigma * area)),
-                             BoundaryCondition("right", "force", "x", Constant(sigma * area))])
+    loading = Loading(
+        body,
+        [
+            BoundaryCondition("left", "force", "x", Constant(-sigma * area)),
+            BoundaryCondition("right", "force", "x", Constant(sigma * area)),
+        ],
+    )
     result = relax(model, loading, tolerance=1e-8)
     assert result.converged
     x = body.points
@@ -56,14 +62,18 @@ def test_pmb_surface_correction_matters():
 
 # -- long-wave limits of the LPS lattice (VALIDATION.md, discretisation facts) ----------------
 
-@pytest.mark.parametrize("factor, partial, p_err, s_err", [
-    (1.4143, False, 0.0, 0.0),
-    (2.015, False, 0.034, -0.053),
-    (3.015, False, -0.038, 0.054),
-    (5.015, False, -0.010, 0.015),
-    (2.015, True, 0.007, -0.011),
-    (3.015, True, 0.002, -0.003),
-])
+
+@pytest.mark.parametrize(
+    "factor, partial, p_err, s_err",
+    [
+        (1.4143, False, 0.0, 0.0),
+        (2.015, False, 0.034, -0.053),
+        (3.015, False, -0.038, 0.054),
+        (5.015, False, -0.010, 0.015),
+        (2.015, True, 0.007, -0.011),
+        (3.015, True, 0.002, -0.003),
+    ],
+)
 def test_lattice_long_wave_speeds(factor, partial, p_err, s_err):
     """Long-wave P (along x) and S speeds of an LPS simple cubic lattice (constant influence, m
     from the discrete family), from the energy of homogeneous uniaxial strain and simple shear

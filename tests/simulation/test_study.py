@@ -24,8 +24,14 @@ SPACINGS = (4e-3, 8e-3 / 3, 2e-3, 1.6e-3)
 #: Continuum (FE) frequencies of the 96 x 48 x 8 mm plate, Hz: 24 x 12 x 2 27-node hexahedra,
 #: ``benchmarks/fe_plate_modes.py`` (which gives issue 9's converged FE values of the V4 plate
 #: to 0.11 % on a coarser 20 x 10 x 2 mesh); types by peridyn's classifier.
-FE = {"1st bending": 1847.8, "1st torsional": 2144.2, "2nd torsional": 4607.7,
-      "2nd bending": 4906.0, "1st transverse bending": 7126.0, "1st in-plane bending": 7154.1}
+FE = {
+    "1st bending": 1847.8,
+    "1st torsional": 2144.2,
+    "2nd torsional": 4607.7,
+    "2nd bending": 4906.0,
+    "1st transverse bending": 7126.0,
+    "1st in-plane bending": 7154.1,
+}
 #: Modes whose frequency is set by bending across the thickness, and torsional modes.
 BENDING = ("1st bending", "2nd bending", "1st transverse bending")
 TORSION = ("1st torsional", "2nd torsional")
@@ -36,9 +42,23 @@ def study(tmp_path_factory):
     out = tmp_path_factory.mktemp("study")
     buffer = io.StringIO()
     with contextlib.redirect_stdout(buffer):
-        status = main(["study", CASE, "--set", SIZE, "--set", PLAIN,
-                       "--spacing", ",".join(map(repr, SPACINGS)),
-                       "--horizon", "1.4143", "--out", str(out), "--json"])
+        status = main(
+            [
+                "study",
+                CASE,
+                "--set",
+                SIZE,
+                "--set",
+                PLAIN,
+                "--spacing",
+                ",".join(map(repr, SPACINGS)),
+                "--horizon",
+                "1.4143",
+                "--out",
+                str(out),
+                "--json",
+            ]
+        )
     assert status == 0
     return out, json.loads(buffer.getvalue())
 
@@ -118,8 +138,7 @@ def test_runs_that_would_not_fit_in_memory_are_skipped_and_reported(tmp_path, mo
     import peridyn.jobs.modal
 
     monkeypatch.setattr(peridyn.jobs.modal, "MEMORY_SHARE", 1e-12)  # nothing fits
-    status = main(["study", CASE, "--spacing", "4e-3", "--horizon", "1.4143,2.001", "--out",
-                   str(tmp_path)])
+    status = main(["study", CASE, "--spacing", "4e-3", "--horizon", "1.4143,2.001", "--out", str(tmp_path)])
     captured = capsys.readouterr()
     assert status == 0
     assert "skipped spacing 4 mm, horizon 1.4143 h: the sparse factorisation" in captured.out
@@ -130,20 +149,24 @@ def test_runs_that_would_not_fit_in_memory_are_skipped_and_reported(tmp_path, mo
 
 def test_a_spacing_that_does_not_divide_the_box_is_noted(tmp_path, capsys):
     # V4 plate at 3 mm: 33 x 17 x 3 cells span 99 x 51 x 9 mm, another body
-    status = main(["study", CASE, "--spacing", "3e-3", "--horizon", "1.4143", "--modes", "7",
-                   "--out", str(tmp_path)])
+    status = main(
+        ["study", CASE, "--spacing", "3e-3", "--horizon", "1.4143", "--modes", "7", "--out", str(tmp_path)]
+    )
     assert status == 0
     assert "the grid spans 99 x 51 x 9 mm, not the case's 100 x 50 x 8 mm" in capsys.readouterr().err
 
 
-@pytest.mark.parametrize("args, message", [
-    (["--spacing", "2e-3,x", "--horizon", "3"], "--spacing = '2e-3,x': 'x' is not a number"),
-    (["--spacing", "2e-3,-1", "--horizon", "3"], "expected positive numbers, got '-1'"),
-    (["--spacing", "2e-3,2e-3", "--horizon", "3"], "a value is repeated"),
-    (["--spacing", "2e-3", "--horizon", "3", "--series", "delta-m,dm"], "expected some of"),
-    (["--spacing", "2e-3", "--horizon", "3", "--reference", "1st bending"], "expected MODE=HZ"),
-    (["--spacing", "2e-3", "--horizon", "3", "--modes", "0"], "expected a positive integer"),
-])
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (["--spacing", "2e-3,x", "--horizon", "3"], "--spacing = '2e-3,x': 'x' is not a number"),
+        (["--spacing", "2e-3,-1", "--horizon", "3"], "expected positive numbers, got '-1'"),
+        (["--spacing", "2e-3,2e-3", "--horizon", "3"], "a value is repeated"),
+        (["--spacing", "2e-3", "--horizon", "3", "--series", "delta-m,dm"], "expected some of"),
+        (["--spacing", "2e-3", "--horizon", "3", "--reference", "1st bending"], "expected MODE=HZ"),
+        (["--spacing", "2e-3", "--horizon", "3", "--modes", "0"], "expected a positive integer"),
+    ],
+)
 def test_bad_arguments_are_named(args, message, capsys):
     assert main(["study", CASE, *args]) == 1
     assert message in capsys.readouterr().err

@@ -23,7 +23,7 @@ from peridyn.physics.materials import make_model
 from peridyn.solvers import ExplicitSolver
 from peridyn.solvers.explicit import damped_stable_step
 
-H = 1e-3                                  # grid spacing of the strips, m
+H = 1e-3  # grid spacing of the strips, m
 BAR_SPEED = np.sqrt(STEEL_E / STEEL_RHO)  # long-wave speed of a free strip, m/s
 
 
@@ -33,19 +33,22 @@ def test_profile_is_cubic_from_the_inner_edge_to_the_face():
     points = np.column_stack([x, np.zeros_like(x), np.zeros_like(x)])
     c = layer_damping(points, 0.02, 1e6, ["x-", "x+"])
     assert c[0] == c[-1] == pytest.approx(1e6)
-    assert c[10] == pytest.approx(1e6 / 8)          # 10 mm into a 20 mm layer
+    assert c[10] == pytest.approx(1e6 / 8)  # 10 mm into a 20 mm layer
     assert c[90] == pytest.approx(1e6 / 8)
     assert np.all(c[20:81] == 0.0)
     assert layer_damping(points, 0.02, 1e6, ["x+"])[0] == 0.0
 
 
-@pytest.mark.parametrize("width, damping, faces, message", [
-    (0.0, 1e6, ["x-"], "width must be positive"),
-    (0.01, -1.0, ["x-"], "damping must be positive"),
-    (0.01, 1e6, ["x-", "x-"], "faces must be distinct"),
-    (0.01, 1e6, ["z+"], "faces must be distinct names among"),
-    (0.06, 1e6, ["x-", "x+"], "no undamped interior"),
-])
+@pytest.mark.parametrize(
+    "width, damping, faces, message",
+    [
+        (0.0, 1e6, ["x-"], "width must be positive"),
+        (0.01, -1.0, ["x-"], "damping must be positive"),
+        (0.01, 1e6, ["x-", "x-"], "faces must be distinct"),
+        (0.01, 1e6, ["z+"], "faces must be distinct names among"),
+        (0.06, 1e6, ["x-", "x+"], "no undamped interior"),
+    ],
+)
 def test_bad_layers_are_refused(width, damping, faces, message):
     x = np.linspace(0.0, 0.1, 11)
     with pytest.raises(InputError, match=message):
@@ -56,8 +59,7 @@ def _strip_model(length: int, shift: int = 0, width: int = 4):
     """LPS plane-stress strip ``length`` x ``width`` cells of H, starting at x = -shift H."""
     body = geometry.rectangle(length * H, width * H, H, 1e-3, origin=(-shift * H, 0.0))
     body = body.with_node_set("all", np.ones(body.n_points, dtype=bool))
-    return make_model("lps", body, find_bonds(body, 3.015 * H), E=STEEL_E, nu=STEEL_NU,
-                      density=STEEL_RHO)
+    return make_model("lps", body, find_bonds(body, 3.015 * H), E=STEEL_E, nu=STEEL_NU, density=STEEL_RHO)
 
 
 def _strip_record(model, centre, wavelength, damping, dt, n_steps, interior):
@@ -88,12 +90,13 @@ def test_layers_absorb_a_wave_packet_and_leave_the_interior_alone():
     length, wavelength = 300, 30 * H
     width = 1.5 * wavelength
     extra = int(width / H) + 60
-    dt = 0.9e-7                                     # below every strip's stable step
+    dt = 0.9e-7  # below every strip's stable step
     n_steps = int(0.95 * length * H / BAR_SPEED / dt)
     interior = (width, length * H - width)
     centre = 0.5 * length * H
-    free = _strip_record(_strip_model(length + 2 * extra, extra), centre, wavelength, 0.0, dt,
-                         n_steps, interior)
+    free = _strip_record(
+        _strip_model(length + 2 * extra, extra), centre, wavelength, 0.0, dt, n_steps, interior
+    )
     strip = _strip_model(length)
     amplitude = np.abs(free).max()
     no_layer = _strip_record(strip, centre, wavelength, 0.0, dt, n_steps, interior)
@@ -151,7 +154,8 @@ def test_case_block_reaches_the_solver(tmp_path):
         "material: {model: lps, E: 70.0e9, nu: 0.33, density: 2700}\n"
         "absorbing: {width: 0.004, damping: 1.0e6, faces: [x-, x+]}\n"
         "initial_conditions: [{set: all, kind: velocity, components: [x], value: 1.0}]\n"
-        "solver: {type: explicit, steps: 2, damping: 10.0}\n")
+        "solver: {type: explicit, steps: 2, damping: 10.0}\n"
+    )
     case = load_case(case_file)
     setup = build(case)
     damping = explicit_damping(case, setup.body)

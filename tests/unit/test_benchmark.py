@@ -9,8 +9,16 @@ from peridyn.cli import bench_cmd, main
 from peridyn.errors import InputError
 from peridyn.jobs import bench as benchmark
 
-ROW_KEYS = {"model", "dtype", "points", "bonds", "bond_updates_per_s", "bytes_per_bond",
-            "roofline_fraction", "speedup_vs_baseline"}
+ROW_KEYS = {
+    "model",
+    "dtype",
+    "points",
+    "bonds",
+    "bond_updates_per_s",
+    "bytes_per_bond",
+    "roofline_fraction",
+    "speedup_vs_baseline",
+}
 TINY_TRIAD = 1 << 16
 
 
@@ -38,8 +46,9 @@ def test_run_benchmark_tiny_grid():
 
 
 def test_bench_cli_json(monkeypatch, capsys):
-    monkeypatch.setattr(bench_cmd, "run_benchmark",
-                        functools.partial(benchmark.run_benchmark, triad_elements=TINY_TRIAD))
+    monkeypatch.setattr(
+        bench_cmd, "run_benchmark", functools.partial(benchmark.run_benchmark, triad_elements=TINY_TRIAD)
+    )
     assert main(["bench", "--points", "512", "--repeat", "1", "--partial-volumes", "--json"]) == 0
     _check(json.loads(capsys.readouterr().out), 512)
 

@@ -48,7 +48,7 @@ def test_families_are_symmetric_and_sorted():
     np.testing.assert_array_equal(bonds.neighbours[rev], owners)
     np.testing.assert_allclose(bonds.volume_factor[rev], bonds.volume_factor, rtol=1e-12)
     for i in range(body.n_points):
-        fam = bonds.neighbours[bonds.offsets[i]:bonds.offsets[i + 1]]
+        fam = bonds.neighbours[bonds.offsets[i] : bonds.offsets[i + 1]]
         assert np.all(np.diff(fam) > 0)
 
 
@@ -80,8 +80,9 @@ def test_cell_fraction_simple_cases():
     assert half == pytest.approx(0.5, abs=1e-6)
 
 
-@pytest.mark.parametrize("name, at_horizon", [("constant", 1.0), ("inverse", 1.0),
-                                              ("gaussian", np.exp(-1.0)), ("conical", 0.0)])
+@pytest.mark.parametrize(
+    "name, at_horizon", [("constant", 1.0), ("inverse", 1.0), ("gaussian", np.exp(-1.0)), ("conical", 0.0)]
+)
 def test_influence_functions(name, at_horizon):
     body = geometry.box((0.007,) * 3, 1e-3)
     bonds = find_bonds(body, 3.0e-3 * (1 + 1e-9), influence=name, partial_volumes=False)
@@ -129,9 +130,8 @@ def test_segment_precrack_2d():
     cut = cut_bonds(body, bonds, lambda a, b: crossing_segment(a, b, (0.005, 0.0), (0.005, 0.004)))
     owners = bonds.owners()
     xa, xb = body.points[owners], body.points[bonds.neighbours]
-    crosses = ((xa[:, 0] - 0.005) * (xb[:, 0] - 0.005) < 0)
-    y_hit = xa[:, 1] + (0.005 - xa[:, 0]) / np.where(crosses, xb[:, 0] - xa[:, 0], 1) * (
-        xb[:, 1] - xa[:, 1])
+    crosses = (xa[:, 0] - 0.005) * (xb[:, 0] - 0.005) < 0
+    y_hit = xa[:, 1] + (0.005 - xa[:, 0]) / np.where(crosses, xb[:, 0] - xa[:, 0], 1) * (xb[:, 1] - xa[:, 1])
     expected = crosses & (y_hit > 0) & (y_hit < 0.004)
     assert cut == int(expected.sum()) > 0
     np.testing.assert_array_equal(~bonds.intact, expected)

@@ -16,9 +16,10 @@ GOOD = {
     "discretization": {"spacing": 1e-3, "horizon": 2.015},
     "material": {"model": "lps", "E": 70e9, "nu": 0.3, "density": 2700},
     "node_sets": {"left": {"type": "face", "face": "x-"}, "right": {"type": "face", "face": "x+"}},
-    "boundary_conditions": [{"set": "left", "kind": "displacement", "components": "xyz",
-                             "value": 0.0},
-                            {"set": "right", "kind": "force", "components": "x", "value": 10.0}],
+    "boundary_conditions": [
+        {"set": "left", "kind": "displacement", "components": "xyz", "value": 0.0},
+        {"set": "right", "kind": "force", "components": "x", "value": 10.0},
+    ],
     "solver": {"type": "explicit", "steps": 10},
 }
 
@@ -45,16 +46,19 @@ def test_override_sets_nested_values():
 
 def test_yaml_file_with_exponent_floats(tmp_path):
     path = tmp_path / "c.yaml"
-    path.write_text("name: t\ngeometry: {type: box, size: [6e-3, 4e-3, 4e-3]}\n"
-                    "discretization: {spacing: 1e-3, horizon: 2.015}\n"
-                    "material: {model: pmb, E: 70e9, density: 2700}\n"
-                    "initial_conditions: [{set: all, kind: velocity, components: x, value: 1}]\n"
-                    "solver: {steps: 5}\n")
+    path.write_text(
+        "name: t\ngeometry: {type: box, size: [6e-3, 4e-3, 4e-3]}\n"
+        "discretization: {spacing: 1e-3, horizon: 2.015}\n"
+        "material: {model: pmb, E: 70e9, density: 2700}\n"
+        "initial_conditions: [{set: all, kind: velocity, components: x, value: 1}]\n"
+        "solver: {steps: 5}\n"
+    )
     case = load_case(path, ["material.E=71e9"])
     assert case.material.E == 71e9 and case.geometry.size[0] == 6e-3
 
 
 # -- the ten kinds of bad input named by the core issue, each with a clear message -------------
+
 
 def test_unknown_key_suggests_the_right_one():
     raw = _case()
@@ -69,8 +73,9 @@ def test_negative_spacing():
 
 
 def test_horizon_below_spacing_isolates_points():
-    case = validate_case(_case(**{"discretization.horizon": "0.4",
-                                  "discretization.partial_volumes": "false"}))
+    case = validate_case(
+        _case(**{"discretization.horizon": "0.4", "discretization.partial_volumes": "false"})
+    )
     with pytest.raises(InputError, match="horizon"):
         build(case)
 
@@ -124,13 +129,13 @@ def test_unknown_material_model():
 
 def test_overlapping_incompatible_boundary_conditions():
     raw = _case()
-    raw["boundary_conditions"].append({"set": "all", "kind": "velocity", "components": "x",
-                                       "value": 1.0})
+    raw["boundary_conditions"].append({"set": "all", "kind": "velocity", "components": "x", "value": 1.0})
     with pytest.raises(InputError, match="prescribe the same component"):
         build(validate_case(raw))
 
 
 # -- more ------------------------------------------------------------------------------------
+
 
 def test_steps_and_time_conflict():
     with pytest.raises(CaseFileError, match="steps or time, not both"):

@@ -143,8 +143,13 @@ def test_collision_conserves_momentum_and_bounces():
     body = body.with_node_set("left_half", ~right).with_node_set("right_half", right)
     model.body = body
     v0 = 5.0
-    loading = Loading(body, initial=[InitialCondition("left_half", "velocity", "x", v0),
-                                     InitialCondition("right_half", "velocity", "x", -v0)])
+    loading = Loading(
+        body,
+        initial=[
+            InitialCondition("left_half", "velocity", "x", v0),
+            InitialCondition("right_half", "velocity", "x", -v0),
+        ],
+    )
     contact = Contact(model, radius=H)
     solver = ExplicitSolver(model, loading, contact=contact)
     state = solver.initial_state()
@@ -173,13 +178,16 @@ def test_contact_lowers_the_stable_step_by_its_stiffness_bound():
     assert 0.6 * dt_model < dt_contact < dt_model
 
 
-@pytest.mark.parametrize(("kwargs", "message"), [
-    ({"radius": 0.0}, "contact radius must be positive"),
-    ({"radius": -1e-3}, "contact radius must be positive"),
-    ({"radius": 4e-3}, "larger than the horizon"),
-    ({"radius": 1e-3, "stiffness_factor": 0.0}, "stiffness factor must be positive"),
-    ({"radius": 1e-3, "skin": -1.0}, "skin must be positive"),
-])
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [
+        ({"radius": 0.0}, "contact radius must be positive"),
+        ({"radius": -1e-3}, "contact radius must be positive"),
+        ({"radius": 4e-3}, "larger than the horizon"),
+        ({"radius": 1e-3, "stiffness_factor": 0.0}, "stiffness factor must be positive"),
+        ({"radius": 1e-3, "skin": -1.0}, "skin must be positive"),
+    ],
+)
 def test_bad_contact_input(kwargs, message):
     with pytest.raises(InputError, match=message):
         Contact(cut_square(n=6), **kwargs)

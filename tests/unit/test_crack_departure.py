@@ -19,8 +19,7 @@ def kinked_crack(first_deg: float, then_deg: float):
     pts = np.c_[x.ravel(), y.ravel()]
     kink = TIP + 20 * H * np.array([np.cos(np.radians(first_deg)), np.sin(np.radians(first_deg))])
     end = kink + 20 * H * np.array([np.cos(np.radians(then_deg)), np.sin(np.radians(then_deg))])
-    dist = np.min([_distance_to_segment(pts, TIP, kink), _distance_to_segment(pts, kink, end)],
-                  axis=0)
+    dist = np.min([_distance_to_segment(pts, TIP, kink), _distance_to_segment(pts, kink, end)], axis=0)
     return pts, np.where(dist <= 0.7 * H, 0.45, 0.0)
 
 

@@ -78,8 +78,9 @@ def test_threshold_separates_crack_from_tip_damage():
 
 def test_two_separate_cracks_sorted_longest_first():
     pts = grid()
-    phi = np.maximum(band(pts, (5 * H, 10 * H), (25 * H, 10 * H)),
-                     band(pts, (10 * H, 40 * H), (50 * H, 40 * H)))
+    phi = np.maximum(
+        band(pts, (5 * H, 10 * H), (25 * H, 10 * H)), band(pts, (10 * H, 40 * H), (50 * H, 40 * H))
+    )
     lengths = [p.length_m for p in crack_paths(pts, phi, H)]
     assert lengths == pytest.approx([40 * H, 20 * H], abs=2 * H)
     assert total_crack_length(pts, phi, H) == pytest.approx(sum(lengths))

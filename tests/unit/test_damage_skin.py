@@ -26,13 +26,18 @@ def edge_cracked_plate():
     edges unbreakable (``grips``): the crack runs from the pre-crack's tip."""
     body = geometry.rectangle(0.020, 0.010, spacing=H, thickness=1e-3, plane="stress")
     y = body.points[:, 1]
-    body = (body.with_node_set("top", y > 0.010 - 3 * H).with_node_set("bottom", y < 3 * H)
-            .with_node_set("grips", (y > 0.007) | (y < 0.003)))
+    body = (
+        body.with_node_set("top", y > 0.010 - 3 * H)
+        .with_node_set("bottom", y < 3 * H)
+        .with_node_set("grips", (y > 0.007) | (y < 0.003))
+    )
     bonds = find_bonds(body, 3.015 * H, partial_volumes=False)
     cut_bonds(body, bonds, lambda a, b: crossing_segment(a, b, (-0.001, 0.005), (0.007, 0.005)))
     model = make_model("pmb", body, bonds, E=70e9, density=2700)
-    pull = [BoundaryCondition("top", "velocity", "y", Constant(1.0)),
-            BoundaryCondition("bottom", "velocity", "y", Constant(-1.0))]
+    pull = [
+        BoundaryCondition("top", "velocity", "y", Constant(1.0)),
+        BoundaryCondition("bottom", "velocity", "y", Constant(-1.0)),
+    ]
     return model, Loading(body, pull)
 
 
@@ -142,7 +147,7 @@ def test_bond_near_its_limit_is_caught_when_a_far_point_moves_a_lot(mover):
         assert damage.update(u) == 2 * far_bonds + (2 if pair_breaks else 0)
         assert b.intact[bond_index(b, i, j)] == (not pair_breaks)
         assert b.intact[bond_index(b, j, i)] == (not pair_breaks)
-        assert not b.intact[b.offsets[far]:b.offsets[far + 1]].any()
+        assert not b.intact[b.offsets[far] : b.offsets[far + 1]].any()
         assert damage.full_tests == 1 and damage.partial_tests == 1
 
 
@@ -199,5 +204,5 @@ def test_a_non_finite_displacement_falls_back_to_a_full_test():
     family = b.offsets[k + 1] - b.offsets[k]
     assert damage.update(u) == 2 * family
     assert damage.full_tests == 2 and damage.partial_tests == 0
-    assert not b.intact[b.offsets[k]:b.offsets[k + 1]].any()
+    assert not b.intact[b.offsets[k] : b.offsets[k + 1]].any()
     np.testing.assert_array_equal(b.intact, b.intact[b.reverse()])

@@ -43,13 +43,18 @@ def test_bonds_break_exactly_when_uniaxial_stress_passes_the_ultimate():
             np.testing.assert_array_equal(~b.intact, 70e9 * stretch > 40e6)
 
 
-@pytest.mark.parametrize("kwargs", [
-    {}, {"critical_stretch": 1e-3, "critical_bond_stress": 40e6},
-    {"fracture_energy": 1e3, "critical_bond_stress": 40e6},
-])
+@pytest.mark.parametrize(
+    "kwargs",
+    [
+        {},
+        {"critical_stretch": 1e-3, "critical_bond_stress": 40e6},
+        {"fracture_energy": 1e3, "critical_bond_stress": 40e6},
+    ],
+)
 def test_exactly_one_criterion(kwargs):
-    with pytest.raises(InputError, match="exactly one of critical_stretch, fracture_energy or "
-                                         "critical_bond_stress"):
+    with pytest.raises(
+        InputError, match="exactly one of critical_stretch, fracture_energy or critical_bond_stress"
+    ):
         BondDamage(small_model(), **kwargs)
 
 
@@ -59,10 +64,13 @@ def test_non_positive_stress_refused():
 
 
 def _raw(damage):
-    return {"name": "d", "geometry": {"type": "rectangle", "size": [0.004, 0.002], "thickness": 1e-3},
-            "discretization": {"spacing": 0.5e-3, "horizon": 3.015},
-            "material": {"model": "pmb", "E": 70e9, "density": 2100, "damage": damage},
-            "solver": {"type": "explicit", "steps": 1}}
+    return {
+        "name": "d",
+        "geometry": {"type": "rectangle", "size": [0.004, 0.002], "thickness": 1e-3},
+        "discretization": {"spacing": 0.5e-3, "horizon": 3.015},
+        "material": {"model": "pmb", "E": 70e9, "density": 2100, "damage": damage},
+        "solver": {"type": "explicit", "steps": 1},
+    }
 
 
 def test_case_key_and_errors():

@@ -11,18 +11,21 @@ from peridyn.jobs.fatigue import check_fatigue_case
 CASE = Path(__file__).resolve().parents[2] / "cases" / "dogbone_fatigue.yaml"
 
 
-@pytest.mark.parametrize("override, message", [
-    ("fatigue.A_I=-1.0", "fatigue.A_I"),
-    ("fatigue.m_II=0", "fatigue.m_II"),
-    ("fatigue.eps_inf=-0.001", "fatigue.eps_inf"),
-    ("fatigue.load_ratio=1.0", "fatigue.load_ratio"),
-    ("fatigue.load_ratio=-1.5", "fatigue.load_ratio"),
-    ("fatigue.phi_c=0", "fatigue.phi_c"),
-    ("fatigue.mapping=[]", "fatigue.mapping"),
-    ("fatigue.mapping.0.tau=-1e-5", "fatigue.mapping[0].tau"),
-    ("fatigue.tip.depth_axis=y", "tip.axis and tip.depth_axis must differ"),
-    ("fatigue.tip.sense=down", "fatigue.tip.sense"),
-])
+@pytest.mark.parametrize(
+    "override, message",
+    [
+        ("fatigue.A_I=-1.0", "fatigue.A_I"),
+        ("fatigue.m_II=0", "fatigue.m_II"),
+        ("fatigue.eps_inf=-0.001", "fatigue.eps_inf"),
+        ("fatigue.load_ratio=1.0", "fatigue.load_ratio"),
+        ("fatigue.load_ratio=-1.5", "fatigue.load_ratio"),
+        ("fatigue.phi_c=0", "fatigue.phi_c"),
+        ("fatigue.mapping=[]", "fatigue.mapping"),
+        ("fatigue.mapping.0.tau=-1e-5", "fatigue.mapping[0].tau"),
+        ("fatigue.tip.depth_axis=y", "tip.axis and tip.depth_axis must differ"),
+        ("fatigue.tip.sense=down", "fatigue.tip.sense"),
+    ],
+)
 def test_bad_fatigue_values_name_their_key(override, message):
     with pytest.raises(CaseFileError, match=message.replace("[", r"\[").replace("]", r"\]")):
         load_case(CASE, [override])

@@ -105,12 +105,15 @@ def test_crack_tip_from_a_notch_root_inside_the_body_growing_towards_minus_x():
         crack_tip(body.points, phi, SPACING, sense="down")
 
 
-@pytest.mark.parametrize("kwargs, message", [
-    ({"A_I": -1.0}, "A_I must be positive"),
-    ({"m_II": 0.0}, "m_II must be positive"),
-    ({"eps_inf": -1e-3}, "eps_inf must be >= 0"),
-    ({"phi_c": 1.5}, "phi_c must be in (0, 1]"),
-])
+@pytest.mark.parametrize(
+    "kwargs, message",
+    [
+        ({"A_I": -1.0}, "A_I must be positive"),
+        ({"m_II": 0.0}, "m_II must be positive"),
+        ({"eps_inf": -1e-3}, "eps_inf must be >= 0"),
+        ({"phi_c": 1.5}, "phi_c must be in (0, 1]"),
+    ],
+)
 def test_bad_parameters_are_refused(kwargs, message):
     values = dict(A_I=426.0, m_I=2.77, eps_inf=0.00186, A_II=25237.48, m_II=4.0) | kwargs
     with pytest.raises(InputError, match=message.replace("(", r"\(").replace(")", r"\)")):

@@ -37,8 +37,10 @@ def _notched_bar(load: str):
     model = make_model("lps", body, bonds, E=189.9e9, nu=0.3, density=7850.0)
     bcs = [BoundaryCondition("left", "displacement", "xyz", Constant(0.0))]
     if load == "displacement":
-        bcs += [BoundaryCondition("right", "displacement", "x", Constant(1e-5)),
-                BoundaryCondition("right", "displacement", "yz", Constant(0.0))]
+        bcs += [
+            BoundaryCondition("right", "displacement", "x", Constant(1e-5)),
+            BoundaryCondition("right", "displacement", "yz", Constant(0.0)),
+        ]
     else:
         bcs += [BoundaryCondition("right", "force", "x", Constant(2e3))]
     return model, Loading(body, bcs)
@@ -191,12 +193,15 @@ def test_shift_is_a_tiny_fraction_of_the_stiffness():
     assert statics.shift == pytest.approx(SHIFT * diagonal.mean(), rel=1e-12)
 
 
-@pytest.mark.parametrize("kwargs, message", [
-    ({"method": "lu"}, "linear solver must be auto, amg, direct or cg, got 'lu'"),
-    ({"rtol": 0.0}, "rtol must be in (0, 1), got 0.0"),
-    ({"refactor_iterations": 0}, "refactor_iterations must be at least 1, got 0"),
-    ({"recycle": -1}, "recycle (directions kept between solves) must be >= 0, got -1"),
-])
+@pytest.mark.parametrize(
+    "kwargs, message",
+    [
+        ({"method": "lu"}, "linear solver must be auto, amg, direct or cg, got 'lu'"),
+        ({"rtol": 0.0}, "rtol must be in (0, 1), got 0.0"),
+        ({"refactor_iterations": 0}, "refactor_iterations must be at least 1, got 0"),
+        ({"recycle": -1}, "recycle (directions kept between solves) must be >= 0, got -1"),
+    ],
+)
 def test_bad_solver_settings_are_refused(kwargs, message):
     model, loading = _notched_bar("displacement")
     with pytest.raises(InputError, match=message.replace("(", r"\(").replace(")", r"\)")):

@@ -49,8 +49,9 @@ def test_recycled_directions_of_a_first_solve_speed_up_a_perturbed_second():
     plain = deflated_pcg(lambda v: A2 @ v, lambda r: r, b, first.x, 1e-10, 50)
     kept = RecycledDirections(limit=40)
     kept.add(first.directions)
-    recycled = deflated_pcg(lambda v: A2 @ v, lambda r: r, b, first.x, 1e-10, 50,
-                            kept.basis(lambda v: A2 @ v))
+    recycled = deflated_pcg(
+        lambda v: A2 @ v, lambda r: r, b, first.x, 1e-10, 50, kept.basis(lambda v: A2 @ v)
+    )
     assert plain.converged and recycled.converged and recycled.iterations < plain.iterations
     assert np.linalg.norm(A2 @ recycled.x - b) <= 1e-10 * np.linalg.norm(b) * 1.0001
 

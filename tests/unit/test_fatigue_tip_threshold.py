@@ -39,8 +39,7 @@ def _cut_block(horizon: float):
 def test_damage_beside_a_clean_cut_is_the_share_of_bonds_crossing_it(horizon, crossing):
     """Interior points next to the cut plane (not near the outer faces) have phi = crossing share."""
     x, phi = _cut_block(horizon)
-    inner = np.all((x[:, 1:] > 3.4 * SPACING) & (x[:, 1:] < np.array([0.012, 0.008]) - 3.4 * SPACING),
-                   axis=1)
+    inner = np.all((x[:, 1:] > 3.4 * SPACING) & (x[:, 1:] < np.array([0.012, 0.008]) - 3.4 * SPACING), axis=1)
     beside = inner & (np.abs(x[:, 0] - 0.006) < 0.6 * SPACING)
     assert beside.sum() > 0
     np.testing.assert_allclose(phi[beside], crossing, rtol=1e-9)

@@ -16,10 +16,13 @@ def test_box_cells_and_volume():
     assert body.points[:, 2].min() == pytest.approx(0.25e-3)
 
 
-@pytest.mark.parametrize("placement, z_expected", [
-    ("cell", [1 / 3, 1.0, 5 / 3]),      # cell-centred slabs of t / 3
-    ("surface", [0.0, 1.0, 2.0]),      # seed 000: 3 layers 1 mm apart on the faces
-])
+@pytest.mark.parametrize(
+    "placement, z_expected",
+    [
+        ("cell", [1 / 3, 1.0, 5 / 3]),  # cell-centred slabs of t / 3
+        ("surface", [0.0, 1.0, 2.0]),  # seed 000: 3 layers 1 mm apart on the faces
+    ],
+)
 def test_plate_layers(placement, z_expected):
     body = geometry.plate(0.012, 0.006, 0.002, spacing=1.2e-3, layers=3, layer_placement=placement)
     assert body.n_points == 10 * 5 * 3
@@ -56,11 +59,14 @@ def test_text_mesh_round_trip(tmp_path):
     assert list(back.node_sets) == ["block_1"]
 
 
-@pytest.mark.parametrize("kwargs, message", [
-    (dict(points=np.array([[0, 0, np.nan]]), volumes=[1.0]), "non-finite"),
-    (dict(points=np.zeros((1, 3)), volumes=[-1.0]), "positive"),
-    (dict(points=np.zeros((2, 2)), volumes=[1.0, 1.0]), "shape"),
-])
+@pytest.mark.parametrize(
+    "kwargs, message",
+    [
+        (dict(points=np.array([[0, 0, np.nan]]), volumes=[1.0]), "non-finite"),
+        (dict(points=np.zeros((1, 3)), volumes=[-1.0]), "positive"),
+        (dict(points=np.zeros((2, 2)), volumes=[1.0, 1.0]), "shape"),
+    ],
+)
 def test_bad_bodies_are_refused(kwargs, message):
     with pytest.raises(InputError, match=message):
         Body(cells=1.0, dim=3, spacing=1.0, **kwargs)

@@ -116,8 +116,9 @@ def test_rigid_body_modes_follow_the_constraints():
     # a rotation about the x-parallel line: no x component, |u| proportional to the distance
     distance = np.hypot(x[:, 1] - x[axis, 1].min(), x[:, 2] - x[axis, 2].min())
     assert np.abs(field[:, 0]).max() < 1e-12
-    np.testing.assert_allclose(np.linalg.norm(field, axis=1), distance * np.linalg.norm(
-        field[-1]) / distance[-1], atol=1e-12)
+    np.testing.assert_allclose(
+        np.linalg.norm(field, axis=1), distance * np.linalg.norm(field[-1]) / distance[-1], atol=1e-12
+    )
     fixed[axis, 0] = False  # sliding along the line (x) allowed too
     assert rigid_body_modes(x, np.flatnonzero(~fixed.ravel())).shape[1] == 2
 

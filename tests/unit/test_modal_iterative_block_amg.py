@@ -53,8 +53,7 @@ def test_block_v_cycle_equals_pyamgs_column_by_column(aggregation):
     expected = np.column_stack([pyamg_cycle @ col for col in v.T])
     block = BlockVCycle(hierarchy)
     np.testing.assert_allclose(block(v), expected, rtol=0, atol=1e-10 * np.abs(expected).max())
-    np.testing.assert_allclose(block(v[:, 4]), expected[:, 4], rtol=0,
-                               atol=1e-10 * np.abs(expected).max())
+    np.testing.assert_allclose(block(v[:, 4]), expected[:, 4], rtol=0, atol=1e-10 * np.abs(expected).max())
 
 
 def test_block_v_cycle_is_symmetric_positive_definite_on_a_clamped_plate():

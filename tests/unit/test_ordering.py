@@ -17,7 +17,7 @@ def test_order_is_a_permutation_and_the_halves_before_the_last_separator_are_unc
     # the last separator is the slab across the longest axis (x) at the median
     middle = np.median(points[:, 0])
     in_slab = np.abs(points[:, 0] - middle) <= reach / 2
-    assert set(order[-in_slab.sum():]) == set(np.flatnonzero(in_slab))
+    assert set(order[-in_slab.sum() :]) == set(np.flatnonzero(in_slab))
     left, right = points[points[:, 0] < middle - reach / 2], points[points[:, 0] > middle + reach / 2]
     assert cKDTree(left).count_neighbors(cKDTree(right), reach) == 0
 

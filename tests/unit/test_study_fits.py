@@ -47,13 +47,16 @@ def test_finest_leaves_a_pre_asymptotic_coarse_run_out():
 
 def test_m_series_groups_runs_of_equal_horizon_in_metres():
     # 1 mm x 3, 1.5 mm x 2 and 3 mm x 1 share delta = 3 mm: one m-convergence series
-    runs = [StudyRun(h, m, modes={"1st bending": 1706.1 + 1e6 * h**2})
-            for h, m in ((1e-3, 3.0), (1.5e-3, 2.0), (3e-3, 1.0), (2e-3, 3.0))]
+    runs = [
+        StudyRun(h, m, modes={"1st bending": 1706.1 + 1e6 * h**2})
+        for h, m in ((1e-3, 3.0), (1.5e-3, 2.0), (3e-3, 1.0), (2e-3, 3.0))
+    ]
     fits = fit_series(runs, series=("m",))
     (three,) = [f for f in fits if "value_hz" in f]
     assert three["group"] == "horizon 3 mm" and abs(three["value_hz"] - 1706.1) < 1e-8
     assert [f["error"] for f in fits if f is not three] == [
-        "1 run(s) with this mode: richardson: needs at least three resolutions, got 1"]
+        "1 run(s) with this mode: richardson: needs at least three resolutions, got 1"
+    ]
 
 
 def test_references_give_the_errors_of_the_finest_run_and_of_the_limit(tmp_path):
@@ -78,10 +81,13 @@ def test_skipped_runs_are_left_out_of_the_fits():
     assert np.allclose([f["value_hz"] for f in fits], [a for a, _ in LIMITS.values()], rtol=1e-10)
 
 
-@pytest.mark.parametrize("kwargs, message", [
-    ({"series": ("delta-m", "dm")}, "unknown convergence series ['dm']"),
-    ({"finest": 2}, "finest = 2: a Richardson fit needs at least three runs"),
-])
+@pytest.mark.parametrize(
+    "kwargs, message",
+    [
+        ({"series": ("delta-m", "dm")}, "unknown convergence series ['dm']"),
+        ({"finest": 2}, "finest = 2: a Richardson fit needs at least three runs"),
+    ],
+)
 def test_bad_fit_options_are_named(kwargs, message):
     with pytest.raises(InputError, match=message.replace("[", r"\[").replace("]", r"\]")):
         fit_series(_runs([1e-3, 2e-3, 4e-3], [3.0]), **kwargs)

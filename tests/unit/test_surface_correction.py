@@ -55,8 +55,9 @@ def test_face_points_get_the_continuum_shear_energy(dim, factor, partial):
     whole block's shear energy is checked against the continuum within 3.5 % (measured
     0.6-2.0 %), closer than plain LPS (2.8-26 %)."""
     plain = small_model("lps", dim, n=10, horizon_factor=factor, partial_volumes=partial, nu=0.33)
-    model = small_model("lps", dim, n=10, horizon_factor=factor, partial_volumes=partial,
-                        nu=0.33, surface_correction="energy")
+    model = small_model(
+        "lps", dim, n=10, horizon_factor=factor, partial_volumes=partial, nu=0.33, surface_correction="energy"
+    )
     faces = _faces_within_horizon(model)
     ratios = _shear_energy_ratios(model)
     assert np.abs(ratios[:, faces <= 1] - 1.0).max() < 1e-5
@@ -72,8 +73,9 @@ def test_bulk_points_are_unchanged_on_the_isotropic_lattice():
     """With horizon sqrt(2) h (18 neighbours) plain LPS already gives the continuum energy of
     every deviatoric test at interior points, so their factors are 1 to round-off, and the
     factors differ from 1 only within one horizon of a face."""
-    model = small_model("lps", 3, n=10, horizon_factor=1.4143, partial_volumes=False,
-                        surface_correction="energy")
+    model = small_model(
+        "lps", 3, n=10, horizon_factor=1.4143, partial_volumes=False, surface_correction="energy"
+    )
     owners = model.bonds.owners()
     interior = _faces_within_horizon(model)[owners] == 0
     assert np.abs(model.dev_factor[interior] - 1.0).max() < 1e-12
@@ -81,21 +83,20 @@ def test_bulk_points_are_unchanged_on_the_isotropic_lattice():
 
 
 @pytest.mark.parametrize("dim, factor, partial", CASES)
-def test_isotropic_expansion_keeps_the_exact_dilatation_and_no_deviatoric_energy(dim, factor,
-                                                                                 partial):
+def test_isotropic_expansion_keeps_the_exact_dilatation_and_no_deviatoric_energy(dim, factor, partial):
     """u = eps x: theta = d eps at every point (m from each point's own family makes LPS's
     dilatation exact for expansion, surfaces included), and the corrected deviatoric energy
     (alpha / 2) [sum g w e^2 - m~ theta^2 / d^2] vanishes for any factors g, so
     W = kappa theta^2 / 2 exactly (tolerance: the O(eps) nonlinearity, eps = 1e-6)."""
-    model = small_model("lps", dim, n=8, horizon_factor=factor, partial_volumes=partial,
-                        surface_correction="energy")
+    model = small_model(
+        "lps", dim, n=8, horizon_factor=factor, partial_volumes=partial, surface_correction="energy"
+    )
     eps = 1e-6
     u = eps * model.body.points
     if dim == 2:
         u[:, 2] = 0.0
     np.testing.assert_allclose(model.dilatation(u), dim * eps, rtol=1e-5)
-    np.testing.assert_allclose(model.energy_density(u), 0.5 * model.bulk * (dim * eps) ** 2,
-                               rtol=1e-5)
+    np.testing.assert_allclose(model.energy_density(u), 0.5 * model.bulk * (dim * eps) ** 2, rtol=1e-5)
 
 
 @pytest.mark.parametrize("dim", [3, 2])
@@ -113,12 +114,14 @@ def test_corrected_stiffness_is_symmetric_and_matches_the_forces(dim, rng):
     assert abs(K - K.T).max() <= 1e-14 * abs(K).max()
     vol = np.repeat(model.body.volumes, 3)
     ku = K @ u.ravel()
-    np.testing.assert_allclose(ku, -vol * linear_force(model, u).ravel(), rtol=1e-10,
-                               atol=1e-12 * np.abs(ku).max())
+    np.testing.assert_allclose(
+        ku, -vol * linear_force(model, u).ravel(), rtol=1e-10, atol=1e-12 * np.abs(ku).max()
+    )
     assert np.linalg.norm(ku + vol * model.force(u).ravel()) < 1e-5 * np.linalg.norm(ku)
     v = rng.standard_normal(3 * model.body.n_points)
-    np.testing.assert_allclose(stiffness_operator(model) @ v, K @ v, rtol=1e-10,
-                               atol=1e-10 * np.abs(K @ v).max())
+    np.testing.assert_allclose(
+        stiffness_operator(model) @ v, K @ v, rtol=1e-10, atol=1e-10 * np.abs(K @ v).max()
+    )
     k0 = tangent_stiffness(model, np.zeros_like(u))
     assert abs(k0 - K).max() <= 1e-12 * abs(K).max()
     x = model.body.points - model.body.points.mean(axis=0)
@@ -150,24 +153,27 @@ def test_corrected_force_is_minus_the_energy_gradient(dim, rng):
             um[point, comp] -= h
             grad = (model.strain_energy(up) - model.strain_energy(um)) / (2 * h)
             expected = -model.body.volumes[point] * f[point, comp]
-            assert grad == pytest.approx(expected, rel=2e-5, abs=1e-7 * np.abs(f).max()
-                                         * model.body.volumes[point])
+            assert grad == pytest.approx(
+                expected, rel=2e-5, abs=1e-7 * np.abs(f).max() * model.body.volumes[point]
+            )
 
 
 def test_single_precision_force_with_the_correction(rng):
     """The float32 kernels read the same per-bond deviatoric stiffness: within 1e-5 of the
     largest float64 force for strains of 1e-6 (as for the uncorrected model)."""
     m64 = small_model("lps", 3, n=6, horizon_factor=2.015, surface_correction="energy")
-    m32 = small_model("lps", 3, n=6, horizon_factor=2.015, surface_correction="energy",
-                      dtype=np.float32)
+    m32 = small_model("lps", 3, n=6, horizon_factor=2.015, surface_correction="energy", dtype=np.float32)
     u = 1e-9 * rng.standard_normal(m64.x.shape)
     f64 = m64.force(u)
     assert np.max(np.abs(m32.force(u) - f64)) < 1e-5 * np.max(np.abs(f64))
 
 
 def test_unknown_correction_names_the_choices():
-    with pytest.raises(InputError, match=r"surface_correction must be one of .*'energy'.*"
-                                         r"got 'energie'"):
+    with pytest.raises(
+        InputError,
+        match=r"surface_correction must be one of .*'energy'.*"
+        r"got 'energie'",
+    ):
         small_model("lps", 3, n=4, surface_correction="energie")
 
 
@@ -183,9 +189,18 @@ def test_bloch_cell_long_waves_become_classical_on_anisotropic_lattices(horizon_
     young = 9 * bulk * shear / (3 * bulk + shear)
     nu = (3 * bulk - 2 * shear) / (2 * (3 * bulk + shear))
     c_l, c_s = np.sqrt((bulk + 4 * shear / 3) / rho), np.sqrt(shear / rho)
-    cell = bloch_cell(Discretisation(spacing=1e-3, horizon=horizon_dx * 1e-3, model="lps",
-                                     E=young, nu=nu, density=rho, partial_volumes=False,
-                                     surface_correction="energy"))
+    cell = bloch_cell(
+        Discretisation(
+            spacing=1e-3,
+            horizon=horizon_dx * 1e-3,
+            model="lps",
+            E=young,
+            nu=nu,
+            density=rho,
+            partial_volumes=False,
+            surface_correction="energy",
+        )
+    )
     for direction in ((1, 0, 0), (1, 1, 0), (1, 1, 1)):
         speeds = cell.long_wave_speeds(direction)
         np.testing.assert_allclose(speeds, [c_s, c_s, c_l], rtol=1e-5)
@@ -197,10 +212,24 @@ def test_negative_bond_weights_are_reported():
     (min g = 0.475)."""
     body = geometry.box((10e-3, 6e-3, 2e-3), 1e-3)
     with pytest.warns(UserWarning, match=r"\d+ bonds need a negative deviatoric weight"):
-        make_model("lps", body, find_bonds(body, 3.015e-3, partial_volumes=False), E=200e9,
-                   density=7850.0, nu=0.25, surface_correction="energy")
+        make_model(
+            "lps",
+            body,
+            find_bonds(body, 3.015e-3, partial_volumes=False),
+            E=200e9,
+            density=7850.0,
+            nu=0.25,
+            surface_correction="energy",
+        )
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        model = make_model("lps", body, find_bonds(body, 1.4143e-3, partial_volumes=False),
-                           E=200e9, density=7850.0, nu=0.25, surface_correction="energy")
+        model = make_model(
+            "lps",
+            body,
+            find_bonds(body, 1.4143e-3, partial_volumes=False),
+            E=200e9,
+            density=7850.0,
+            nu=0.25,
+            surface_correction="energy",
+        )
     assert model.dev_factor.min() > 0.4

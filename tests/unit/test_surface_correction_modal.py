@@ -15,8 +15,14 @@ from peridyn.physics.materials import make_model
 from peridyn.solvers.modal import modal_analysis
 
 FE = [1706.1, 1982.9, 4268.0, 4542.4, 6607.0, 6868.0]
-TYPES = ["1st bending", "1st torsional", "2nd torsional", "2nd bending",
-         "1st transverse bending", "1st in-plane bending"]
+TYPES = [
+    "1st bending",
+    "1st torsional",
+    "2nd torsional",
+    "2nd bending",
+    "1st transverse bending",
+    "1st in-plane bending",
+]
 CASES = Path(__file__).resolve().parents[2] / "cases"
 
 
@@ -31,13 +37,10 @@ def _elastic_by_type(spacing: float, method: str) -> tuple[dict, int]:
     """Elastic frequencies (Hz) by type of the free PMMA plate, energy correction, 1.4143 h."""
     body = geometry.box((0.10, 0.05, 0.008), spacing)
     bonds = find_bonds(body, 1.4143 * spacing, partial_volumes=False)
-    model = make_model("lps", body, bonds, E=5.35e9, nu=0.33, density=1200.0,
-                       surface_correction="energy")
+    model = make_model("lps", body, bonds, E=5.35e9, nu=0.33, density=1200.0, surface_correction="energy")
     result = modal_analysis(model, 12, method=method)
-    types = classify_modes(body.points, result.shapes, model.density * body.volumes,
-                           result.rigid)
-    by_type = {str(t): f for t, f, r in zip(types, result.frequencies, result.rigid, strict=True)
-               if not r}
+    types = classify_modes(body.points, result.shapes, model.density * body.volumes, result.rigid)
+    by_type = {str(t): f for t, f, r in zip(types, result.frequencies, result.rigid, strict=True) if not r}
     assert np.all(result.residuals[~result.rigid] < 1e-6)
     return by_type, result.n_rigid
 

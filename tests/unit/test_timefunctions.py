@@ -60,14 +60,17 @@ def test_spec_builds_nested_functions():
     assert f(0.5) == pytest.approx(2.0)
 
 
-@pytest.mark.parametrize("spec, message", [
-    ({"type": "tonburst"}, "did you mean 'tone_burst'"),
-    ({"type": "sine", "frequency": 1.0, "amplitud": 2}, "did you mean 'amplitude'"),
-    ({"type": "sine", "frequency": -1.0}, "positive"),
-    ({"type": "ramp", "start": 1.0, "end": 0.5}, "after"),
-    ("1 + 1", "expected a number or a mapping"),
-    ({"type": "table", "file": "/nonexistent/table.csv"}, "does not exist"),
-])
+@pytest.mark.parametrize(
+    "spec, message",
+    [
+        ({"type": "tonburst"}, "did you mean 'tone_burst'"),
+        ({"type": "sine", "frequency": 1.0, "amplitud": 2}, "did you mean 'amplitude'"),
+        ({"type": "sine", "frequency": -1.0}, "positive"),
+        ({"type": "ramp", "start": 1.0, "end": 0.5}, "after"),
+        ("1 + 1", "expected a number or a mapping"),
+        ({"type": "table", "file": "/nonexistent/table.csv"}, "does not exist"),
+    ],
+)
 def test_bad_specs(spec, message):
     with pytest.raises(InputError, match=message):
         from_spec(spec)

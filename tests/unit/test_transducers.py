@@ -26,8 +26,7 @@ CENTER = (10.5 * SPACING, 10.5 * SPACING)
 
 
 def _plate():
-    return geometry.plate(21 * SPACING, 21 * SPACING, 2e-3, SPACING, layers=3,
-                          layer_placement="surface")
+    return geometry.plate(21 * SPACING, 21 * SPACING, 2e-3, SPACING, layers=3, layer_placement="surface")
 
 
 def _offsets(body, name):
@@ -52,8 +51,7 @@ def test_radial_square_patch_is_the_seed_model():
 @pytest.mark.parametrize("shape", ["square", "circular"])
 def test_radial_profile_grows_linearly_along_rays(shape):
     """A patch two spacings in half size: points one spacing out get half the amplitude."""
-    body, (bc,) = pzt_radial_actuator(_plate(), CENTER, 4 * SPACING, BURST, shape=shape,
-                                      amplitude=AMPLITUDE)
+    body, (bc,) = pzt_radial_actuator(_plate(), CENTER, 4 * SPACING, BURST, shape=shape, amplitude=AMPLITUDE)
     d = _offsets(body, "pzt")
     on_axis = (np.abs(d[:, 1]) < 1e-12) & (d[:, 0] > 0)
     x = d[on_axis, 0]
@@ -79,12 +77,15 @@ def test_actuator_on_the_bottom_layer():
     assert np.all(body.points[body.node_set("bottom"), 2] == 0.0)
 
 
-@pytest.mark.parametrize("kwargs", [
-    {"shape": "hexagonal"},
-    {"size": -1.0},
-    {"center": (-1.0, -1.0)},  # no point under the patch
-    {"layer": 3},  # the plate has 3 layers
-])
+@pytest.mark.parametrize(
+    "kwargs",
+    [
+        {"shape": "hexagonal"},
+        {"size": -1.0},
+        {"center": (-1.0, -1.0)},  # no point under the patch
+        {"layer": 3},  # the plate has 3 layers
+    ],
+)
 def test_actuator_rejects_bad_input(kwargs):
     args = {"center": CENTER, "size": PATCH, "function": BURST} | kwargs
     with pytest.raises(InputError):
@@ -117,16 +118,16 @@ def test_pin_force_square_loads_each_edge_with_line_force_times_length():
 
 def test_pin_force_circle_pushes_the_rim_radially():
     line_force, size = 100.0, 8 * SPACING
-    body, (bc,) = pin_force_actuator(_plate(), CENTER, size, BURST, shape="circular",
-                                     line_force=line_force)
+    body, (bc,) = pin_force_actuator(_plate(), CENTER, size, BURST, shape="circular", line_force=line_force)
     idx = body.node_set("pin_force")
     forces = bc.profile * body.volumes[idx, None]
     d = _offsets(body, "pin_force")
     r = np.linalg.norm(d, axis=1)
     assert np.all((r > 0.5 * size - SPACING) & (r <= 0.5 * size + 1e-12))
     assert np.isclose(np.linalg.norm(forces, axis=1).sum(), line_force * np.pi * size, rtol=1e-12)
-    assert np.allclose(forces[:, 0] * d[:, 1] - forces[:, 1] * d[:, 0], 0.0,
-                       atol=1e-12 * line_force * SPACING**2)
+    assert np.allclose(
+        forces[:, 0] * d[:, 1] - forces[:, 1] * d[:, 0], 0.0, atol=1e-12 * line_force * SPACING**2
+    )
     assert np.allclose(forces.sum(axis=0), 0.0, atol=1e-12 * line_force * SPACING)
     density = Loading(body, [bc]).body_force_density(0.3 * BURST.duration, np.zeros((body.n_points, 3)))
     assert np.allclose(density[idx, :2], bc.profile * BURST(0.3 * BURST.duration))
@@ -150,8 +151,7 @@ def test_sensor_is_exact_for_linear_fields(shape, rng):
     expected = gradients[:, 0, 0] + gradients[:, 1, 1]  # eps_xx + eps_yy, exact for linear u
     assert signal.shape == (4,)
     assert np.allclose(signal, expected, rtol=1e-10, atol=1e-16)
-    assert np.isclose(pzt_sensor_signal(points, u[1], CENTER, PATCH, shape), expected[1],
-                      rtol=1e-10)
+    assert np.isclose(pzt_sensor_signal(points, u[1], CENTER, PATCH, shape), expected[1], rtol=1e-10)
 
 
 def _wave_error(h):

@@ -45,20 +45,24 @@ def fit_range(case) -> tuple[float, float]:
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("case_file", ["lamb_plate_absorbing.yaml",
-                                       "lamb_plate_converged_absorbing.yaml"])
+@pytest.mark.parametrize("case_file", ["lamb_plate_absorbing.yaml", "lamb_plate_converged_absorbing.yaml"])
 def test_run_wavenumbers_match_bloch(case_file, tmp_path):
     """S0 and A0 at 150 kHz within 1.5 % of the Bloch wavenumbers of the same discretisation
     (measured: seed S0 +0.11 %, A0 -0.04 %; converged preset S0 -0.91 %, A0 +0.003 %; the
     converged S0 moves by 1-2 % with the fit range, docs/bloch.md)."""
     case = load_case(CASES / case_file, ["output.plots=false"])
     run_case(case, tmp_path)
-    bloch = {m["mode"]: m["wavenumber_rad_m"]
-             for m in predict(Discretisation.from_case(case), [150e3])}
+    bloch = {m["mode"]: m["wavenumber_rad_m"] for m in predict(Discretisation.from_case(case), [150e3])}
     line = case.output.lines["x_axis"]
     x = np.linspace(line.start[0], line.end[0], line.points)
-    found = line_mode_wavenumbers(tmp_path / "results.h5", "x_axis", x,
-                                  case.discretization.spacing, 150e3,
-                                  case.actuators["pzt"].center[0], fit_range(case))
+    found = line_mode_wavenumbers(
+        tmp_path / "results.h5",
+        "x_axis",
+        x,
+        case.discretization.spacing,
+        150e3,
+        case.actuators["pzt"].center[0],
+        fit_range(case),
+    )
     for mode in ("S0", "A0"):
         assert found[mode] == pytest.approx(bloch[mode], rel=0.015), mode

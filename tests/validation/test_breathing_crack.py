@@ -20,7 +20,9 @@ CASE = Path(__file__).resolve().parents[2] / "cases" / "lamb_breathing_crack.yam
 def test_breathing_crack_makes_a_second_harmonic():
     case = load_case(CASE)
     f0 = drive_frequency(case)
-    ratios = {name: second_harmonic_ratio(signal, dt, f0)
-              for name, (signal, dt) in compare(case, "behind_crack").items()}
+    ratios = {
+        name: second_harmonic_ratio(signal, dt, f0)
+        for name, (signal, dt) in compare(case, "behind_crack").items()
+    }
     assert ratios["breathing crack"] >= 10 * ratios["no crack"], ratios
     assert ratios["breathing crack"] >= 10 * ratios["open crack"], ratios

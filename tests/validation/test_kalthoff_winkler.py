@@ -26,8 +26,7 @@ def run_case_file(case_file, overrides=()):
     """Body and final damage index of a Kalthoff-Winkler case run to its end time."""
     case = load_case(case_file, overrides)
     setup = build(case)
-    solver = ExplicitSolver(setup.model, setup.loading, safety=case.solver.safety,
-                            damage=setup.damage)
+    solver = ExplicitSolver(setup.model, setup.loading, safety=case.solver.safety, damage=setup.damage)
     state = solver.initial_state()
     solver.run(state, int(np.ceil(case.solver.time / solver.dt)))
     return setup.body, damage_field(setup.model)

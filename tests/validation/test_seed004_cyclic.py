@@ -22,11 +22,18 @@ def test_cyclic_case_gives_skew_branches(spacing):
     axis x (not the straight vertical crack of the stretching case, 90 degrees); branching:
     more than one such path."""
     grip = 4 * spacing  # the five loaded columns at either resolution
-    case = load_case(CASE, [f"discretization.spacing={spacing}",
-                            f"node_sets.left.depth={grip}", f"node_sets.right.depth={grip}"])
+    case = load_case(
+        CASE,
+        [
+            f"discretization.spacing={spacing}",
+            f"node_sets.left.depth={grip}",
+            f"node_sets.right.depth={grip}",
+        ],
+    )
     setup = build(case)
-    solver = ExplicitSolver(setup.model, setup.loading, safety=case.solver.safety,
-                            damage=setup.damage, contact=setup.contact)
+    solver = ExplicitSolver(
+        setup.model, setup.loading, safety=case.solver.safety, damage=setup.damage, contact=setup.contact
+    )
     state = solver.initial_state()
     solver.run(state, int(np.ceil(case.solver.time / solver.dt)))
     paths = crack_paths(setup.body.points, damage_field(setup.model), spacing)

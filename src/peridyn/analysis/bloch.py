@@ -71,21 +71,30 @@ class Discretisation:
         """The discretisation of a validated ``io.case.Case`` (``box`` or ``plate`` geometry)."""
         g, d, mat = case.geometry, case.discretization, case.material
         if g.type not in ("box", "plate"):
-            raise InputError(f"Bloch analysis needs a box or plate case, got geometry.type "
-                             f"{g.type!r}")
+            raise InputError(f"Bloch analysis needs a box or plate case, got geometry.type {g.type!r}")
         spacing = np.atleast_1d(np.asarray(d.spacing if d.spacing is not None else [], float))
         if spacing.size == 0 or np.ptp(spacing) > 1e-12 * spacing.max():
-            raise InputError(f"Bloch analysis needs one grid spacing (a cubic lattice), got "
-                             f"discretization.spacing = {d.spacing!r}")
+            raise InputError(
+                f"Bloch analysis needs one grid spacing (a cubic lattice), got "
+                f"discretization.spacing = {d.spacing!r}"
+            )
         horizon = d.horizon_m if d.horizon_m is not None else d.horizon * spacing[0]
         plate = g.type == "plate"
-        return cls(spacing=float(spacing[0]), horizon=float(horizon), model=mat.model, E=mat.E,
-                   nu=mat.nu, density=mat.density, kind=g.type if plate else "block",
-                   influence=d.influence, partial_volumes=bool(d.partial_volumes),
-                   surface_correction=mat.surface_correction,
-                   thickness=float(g.size[2]) if plate else None,
-                   layers=int(g.layers) if plate else None,
-                   layer_placement=g.layer_placement if plate else "cell")
+        return cls(
+            spacing=float(spacing[0]),
+            horizon=float(horizon),
+            model=mat.model,
+            E=mat.E,
+            nu=mat.nu,
+            density=mat.density,
+            kind=g.type if plate else "block",
+            influence=d.influence,
+            partial_volumes=bool(d.partial_volumes),
+            surface_correction=mat.surface_correction,
+            thickness=float(g.size[2]) if plate else None,
+            layers=int(g.layers) if plate else None,
+            layer_placement=g.layer_placement if plate else "cell",
+        )
 
 
 @dataclass(frozen=True)
@@ -127,9 +136,9 @@ class BlochCell:
         """D(k) (3 m, 3 m) complex Hermitian, N/m, for the wave vector ``k`` (3,) rad/m."""
         phase = np.exp(1j * (self.shifts @ np.asarray(k, dtype=np.float64)))
         n = self.n_dofs
-        flat = np.bincount(self.rows * n + self.cols, weights=(self.values * phase).real,
-                           minlength=n * n) + 1j * np.bincount(
-            self.rows * n + self.cols, weights=(self.values * phase).imag, minlength=n * n)
+        flat = np.bincount(
+            self.rows * n + self.cols, weights=(self.values * phase).real, minlength=n * n
+        ) + 1j * np.bincount(self.rows * n + self.cols, weights=(self.values * phase).imag, minlength=n * n)
         return flat.reshape(n, n)
 
     def mass_normalised(self, k) -> np.ndarray:
@@ -152,12 +161,17 @@ class BlochCell:
         """dD/dk along the unit vector ``direction`` at ``k`` (3 m, 3 m) complex, N rad^-1."""
         n = np.asarray(direction, dtype=np.float64)
         n = n / np.linalg.norm(n)
-        weights = 1j * (self.shifts @ n) * self.values * np.exp(
-            1j * (self.shifts @ np.asarray(k, dtype=np.float64)))
+        weights = (
+            1j
+            * (self.shifts @ n)
+            * self.values
+            * np.exp(1j * (self.shifts @ np.asarray(k, dtype=np.float64)))
+        )
         idx = self.rows * self.n_dofs + self.cols
         size = self.n_dofs**2
-        flat = (np.bincount(idx, weights=weights.real, minlength=size)
-                + 1j * np.bincount(idx, weights=weights.imag, minlength=size))
+        flat = np.bincount(idx, weights=weights.real, minlength=size) + 1j * np.bincount(
+            idx, weights=weights.imag, minlength=size
+        )
         return flat.reshape(self.n_dofs, self.n_dofs)
 
     def branches(self, k, direction=(1.0, 0.0, 0.0), basis: np.ndarray | None = None):
@@ -219,8 +233,9 @@ def tiled_model(disc: Discretisation, repeat: int = 1):
     n = 2 * t + 1
     h = disc.spacing
     if disc.kind == "plate":
-        body = geometry.plate((n + repeat - 1) * h, n * h, disc.thickness, h, disc.layers,
-                              layer_placement=disc.layer_placement)
+        body = geometry.plate(
+            (n + repeat - 1) * h, n * h, disc.thickness, h, disc.layers, layer_placement=disc.layer_placement
+        )
         per_cell = disc.layers
         layer = body.layer_index
         tile = np.rint(body.points[:, :2] / h - 0.5).astype(np.int64)
@@ -232,8 +247,15 @@ def tiled_model(disc: Discretisation, repeat: int = 1):
     central = (tile[:, 0] >= t) & (tile[:, 0] < t + repeat) & np.all(tile[:, 1:] == t, axis=1)
     cell_index = layer + per_cell * np.mod(tile[:, 0] - t, repeat)
     bonds = find_bonds(body, disc.horizon, disc.influence, disc.partial_volumes)
-    model = make_model(disc.model, body, bonds, E=disc.E, nu=disc.nu, density=disc.density,
-                       surface_correction=disc.surface_correction)
+    model = make_model(
+        disc.model,
+        body,
+        bonds,
+        E=disc.E,
+        nu=disc.nu,
+        density=disc.density,
+        surface_correction=disc.surface_correction,
+    )
     return model, central, cell_index
 
 
@@ -256,16 +278,23 @@ def bloch_cell(disc: Discretisation) -> BlochCell:
     points = x[central][order]
     density = np.broadcast_to(model.density, (model.body.n_points,))
     mass = (density * model.body.volumes)[central][order]
-    return BlochCell(points=points, mass=mass, rows=unique[keep, 0], cols=unique[keep, 1],
-                     values=values[keep], shifts=unique[keep, 2:] * quantum,
-                     bonds_per_point=float(np.mean(np.diff(model.bonds.offsets)[central])),
-                     critical_time_step=model.critical_time_step(points=central))
+    return BlochCell(
+        points=points,
+        mass=mass,
+        rows=unique[keep, 0],
+        cols=unique[keep, 1],
+        values=values[keep],
+        shifts=unique[keep, 2:] * quantum,
+        bonds_per_point=float(np.mean(np.diff(model.bonds.offsets)[central])),
+        critical_time_step=model.critical_time_step(points=central),
+    )
 
 
 def _check(disc: Discretisation) -> None:
     if not (disc.spacing > 0 and disc.horizon > 0):
-        raise InputError(f"spacing and horizon must be positive, got {disc.spacing!r} m and "
-                         f"{disc.horizon!r} m")
+        raise InputError(
+            f"spacing and horizon must be positive, got {disc.spacing!r} m and {disc.horizon!r} m"
+        )
     if disc.kind not in ("block", "plate"):
         raise InputError(f"kind must be 'block' or 'plate', got {disc.kind!r}")
     if disc.kind == "plate" and not (disc.thickness and disc.layers):
@@ -307,8 +336,9 @@ def zone_edge(cell: BlochCell) -> float:
     return float(np.pi / dx)
 
 
-def branch_wavenumber(cell: BlochCell, omega: float, basis: np.ndarray | None = None,
-                      branch: int = 0) -> float | None:
+def branch_wavenumber(
+    cell: BlochCell, omega: float, basis: np.ndarray | None = None, branch: int = 0
+) -> float | None:
     """Smallest k (rad/m, along x) where branch ``branch`` of the subspace reaches ``omega`` (rad/s).
 
     Brackets by a scan up to the zone edge, refines by Brent's method (1e-12 relative);
@@ -329,8 +359,9 @@ def branch_wavenumber(cell: BlochCell, omega: float, basis: np.ndarray | None = 
     return None
 
 
-def negative_group_velocity_from(cell: BlochCell, basis: np.ndarray | None = None,
-                                 branch: int = 0, points: int = 400) -> float | None:
+def negative_group_velocity_from(
+    cell: BlochCell, basis: np.ndarray | None = None, branch: int = 0, points: int = 400
+) -> float | None:
     """First wavenumber (rad/m, along x, sampled on ``points`` up to the zone edge) where
     branch ``branch`` of the subspace has a negative group velocity; None if it never has."""
     for k in np.linspace(0.0, zone_edge(cell), points + 1)[1:]:
@@ -342,8 +373,7 @@ def negative_group_velocity_from(cell: BlochCell, basis: np.ndarray | None = Non
 def plate_wavenumbers(cell: BlochCell, frequencies) -> list[dict]:
     """Discrete wavenumbers of S0, A0 and SH0 at each frequency (Hz): dicts with mode,
     frequency_hz and wavenumber_rad_m (None above the zone edge)."""
-    bases = {"S0": plate_basis(cell, "S"), "A0": plate_basis(cell, "A"),
-             "SH0": plate_basis(cell, "SH", 1)}
+    bases = {"S0": plate_basis(cell, "S"), "A0": plate_basis(cell, "A"), "SH0": plate_basis(cell, "SH", 1)}
     return _mode_wavenumbers(cell, frequencies, bases)
 
 
@@ -358,6 +388,11 @@ def _mode_wavenumbers(cell: BlochCell, frequencies, bases: dict) -> list[dict]:
     out = []
     for f in np.atleast_1d(np.asarray(frequencies, dtype=np.float64)):
         for mode, basis in bases.items():
-            out.append({"mode": mode, "frequency_hz": float(f),
-                        "wavenumber_rad_m": branch_wavenumber(cell, 2 * np.pi * f, basis)})
+            out.append(
+                {
+                    "mode": mode,
+                    "frequency_hz": float(f),
+                    "wavenumber_rad_m": branch_wavenumber(cell, 2 * np.pi * f, basis),
+                }
+            )
     return out

@@ -74,8 +74,14 @@ STUDY_HORIZONS = (1.5, 3.015)
 STUDY_CORRECTIONS = ("none", "shear-factor")
 
 
-def study(base: Discretisation, frequencies, layers=STUDY_LAYERS, spacings=STUDY_SPACINGS,
-          horizons=STUDY_HORIZONS, corrections=STUDY_CORRECTIONS) -> list[dict]:
+def study(
+    base: Discretisation,
+    frequencies,
+    layers=STUDY_LAYERS,
+    spacings=STUDY_SPACINGS,
+    horizons=STUDY_HORIZONS,
+    corrections=STUDY_CORRECTIONS,
+) -> list[dict]:
     """Errors and cost of every plate discretisation of the sweep (cartesian product).
 
     Layers are cell-centred (``layer_placement`` "cell", dz = thickness / layers); the
@@ -88,22 +94,33 @@ def study(base: Discretisation, frequencies, layers=STUDY_LAYERS, spacings=STUDY
         raise InputError("the study sweeps plate discretisations: give a plate case")
     freqs = _check_frequencies(frequencies)
     rows = []
-    for n_layers, dx, horizon, correction in itertools.product(layers, spacings, horizons,
-                                                                corrections):
+    for n_layers, dx, horizon, correction in itertools.product(layers, spacings, horizons, corrections):
         start = time.perf_counter()
-        disc = replace(base, layers=int(n_layers), spacing=float(dx), horizon=float(horizon) * dx,
-                       surface_correction=correction, layer_placement="cell")
+        disc = replace(
+            base,
+            layers=int(n_layers),
+            spacing=float(dx),
+            horizon=float(horizon) * dx,
+            surface_correction=correction,
+            layer_placement="cell",
+        )
         cell = bloch_cell(disc)
         modes = [m for m in predict(disc, freqs, cell) if m["mode"] in ("S0", "A0")]
         errors = [abs(m["error"]) if m["error"] is not None else np.inf for m in modes]
-        rows.append({
-            "layers": int(n_layers), "spacing_m": float(dx), "horizon_dx": float(horizon),
-            "surface_correction": correction, "max_abs_error": float(max(errors)),
-            "errors": {f"{m['mode']}@{m['frequency_hz'] / 1e3:g}kHz": m["error"] for m in modes},
-            "points_per_m2": n_layers / dx**2, "bonds_per_point": cell.bonds_per_point,
-            "stable_step_s": cell.critical_time_step,
-            "seconds": time.perf_counter() - start,
-        })
+        rows.append(
+            {
+                "layers": int(n_layers),
+                "spacing_m": float(dx),
+                "horizon_dx": float(horizon),
+                "surface_correction": correction,
+                "max_abs_error": float(max(errors)),
+                "errors": {f"{m['mode']}@{m['frequency_hz'] / 1e3:g}kHz": m["error"] for m in modes},
+                "points_per_m2": n_layers / dx**2,
+                "bonds_per_point": cell.bonds_per_point,
+                "stable_step_s": cell.critical_time_step,
+                "seconds": time.perf_counter() - start,
+            }
+        )
     return rows
 
 
@@ -113,17 +130,26 @@ def format_study(rows: list[dict]) -> str:
     Work is the bond updates per cm^2 of plate per microsecond simulated at the stable step
     (points per area x bonds per point / step): what a run of the discretisation costs.
     """
-    lines = ["| layers | dx (mm) | horizon (dx) | correction | worst S0 (%) | worst A0 (%) | "
-             "points per cm^2 | bonds per point | stable step (ns) | work (M bond updates "
-             "per cm^2 per us) |",
-             "|---|---|---|---|---|---|---|---|---|---|"]
+    lines = [
+        "| layers | dx (mm) | horizon (dx) | correction | worst S0 (%) | worst A0 (%) | "
+        "points per cm^2 | bonds per point | stable step (ns) | work (M bond updates "
+        "per cm^2 per us) |",
+        "|---|---|---|---|---|---|---|---|---|---|",
+    ]
     for r in sorted(rows, key=lambda r: r["max_abs_error"]):
-        worst = {mode: max((e for key, e in r["errors"].items() if key.startswith(mode)),
-                           key=lambda e: np.inf if e is None else abs(e)) for mode in ("S0", "A0")}
+        worst = {
+            mode: max(
+                (e for key, e in r["errors"].items() if key.startswith(mode)),
+                key=lambda e: np.inf if e is None else abs(e),
+            )
+            for mode in ("S0", "A0")
+        }
         text = {mode: "-" if e is None else f"{100 * e:+.2f}" for mode, e in worst.items()}
         work = r["points_per_m2"] * 1e-4 * r["bonds_per_point"] / (r["stable_step_s"] * 1e6)
-        lines.append(f"| {r['layers']} | {r['spacing_m'] * 1e3:g} | {r['horizon_dx']:g} | "
-                     f"{r['surface_correction']} | {text['S0']} | {text['A0']} | "
-                     f"{r['points_per_m2'] * 1e-4:.0f} | {r['bonds_per_point']:.1f} | "
-                     f"{r['stable_step_s'] * 1e9:.1f} | {work / 1e6:.2f} |")
+        lines.append(
+            f"| {r['layers']} | {r['spacing_m'] * 1e3:g} | {r['horizon_dx']:g} | "
+            f"{r['surface_correction']} | {text['S0']} | {text['A0']} | "
+            f"{r['points_per_m2'] * 1e-4:.0f} | {r['bonds_per_point']:.1f} | "
+            f"{r['stable_step_s'] * 1e9:.1f} | {work / 1e6:.2f} |"
+        )
     return "\n".join(lines)

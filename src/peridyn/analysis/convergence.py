@@ -92,9 +92,15 @@ class Extrapolation:
         return self.value + self.coefficient * np.asarray(h, dtype=float) ** self.order
 
     def to_dict(self) -> dict:
-        return {"spacings": self.spacings.tolist(), "values": self.values.tolist(),
-                "value": self.value, "order": self.order, "coefficient": self.coefficient,
-                "gci": self.gci, "rms_residual": self.rms_residual}
+        return {
+            "spacings": self.spacings.tolist(),
+            "values": self.values.tolist(),
+            "value": self.value,
+            "order": self.order,
+            "coefficient": self.coefficient,
+            "gci": self.gci,
+            "rms_residual": self.rms_residual,
+        }
 
 
 def richardson(spacings, values, safety_factor: float = SAFETY_FACTOR) -> Extrapolation:
@@ -137,8 +143,9 @@ def _checked(spacings, values) -> tuple[np.ndarray, np.ndarray]:
     if h.size < 3:
         raise InputError(f"richardson: needs at least three resolutions, got {h.size}")
     if not (np.all(np.isfinite(h)) and np.all(np.isfinite(f))):
-        raise InputError(f"richardson: spacings and values must be finite numbers, got {h.tolist()} "
-                         f"and {f.tolist()}")
+        raise InputError(
+            f"richardson: spacings and values must be finite numbers, got {h.tolist()} and {f.tolist()}"
+        )
     if np.any(h <= 0):
         raise InputError(f"richardson: spacings must be positive, got {h.tolist()}")
     order = np.argsort(h)
@@ -146,8 +153,7 @@ def _checked(spacings, values) -> tuple[np.ndarray, np.ndarray]:
     close = np.diff(h) <= EQUAL_SPACING * h[1:]
     if np.any(close):
         k = int(np.argmax(close))
-        raise InputError(f"richardson: spacings must differ, got {h[k]:g} twice (each resolution "
-                         "once)")
+        raise InputError(f"richardson: spacings must differ, got {h[k]:g} twice (each resolution once)")
     return h, f
 
 
@@ -156,12 +162,16 @@ def _check_monotone(h: np.ndarray, f: np.ndarray) -> None:
     d = np.diff(f)
     listing = ", ".join(f"{v:.6g} at {s:g}" for s, v in zip(h, f, strict=True))
     if np.any(d == 0):
-        raise ConvergenceError(f"stagnating: two resolutions give the same value ({listing}); the "
-                               "order of convergence is undefined")
+        raise ConvergenceError(
+            f"stagnating: two resolutions give the same value ({listing}); the "
+            "order of convergence is undefined"
+        )
     if not (np.all(d > 0) or np.all(d < 0)):
-        raise ConvergenceError(f"oscillating convergence: the values go up and down as the spacing "
-                               f"shrinks ({listing}); Richardson extrapolation needs a monotone "
-                               "sequence (refine further, into the asymptotic range)")
+        raise ConvergenceError(
+            f"oscillating convergence: the values go up and down as the spacing "
+            f"shrinks ({listing}); Richardson extrapolation needs a monotone "
+            "sequence (refine further, into the asymptotic range)"
+        )
 
 
 def _three_point_order(h: np.ndarray, f: np.ndarray) -> float:
@@ -175,11 +185,13 @@ def _three_point_order(h: np.ndarray, f: np.ndarray) -> float:
     lo, hi = ORDER_BOUNDS
     if mismatch(lo) >= 0:
         listing = ", ".join(f"{v:.6g} at {s:g}" for s, v in zip(h, f, strict=True))
-        raise ConvergenceError(f"diverging: the differences do not shrink with the spacing "
-                               f"({listing}); observed order p <= 0")
+        raise ConvergenceError(
+            f"diverging: the differences do not shrink with the spacing ({listing}); observed order p <= 0"
+        )
     if mismatch(hi) <= 0:
-        raise ConvergenceError(f"the observed order exceeds {hi:g}: the finer values barely change "
-                               "(converged to round-off?)")
+        raise ConvergenceError(
+            f"the observed order exceeds {hi:g}: the finer values barely change (converged to round-off?)"
+        )
     return float(brentq(mismatch, lo, hi, xtol=1e-15, rtol=4 * np.finfo(float).eps))
 
 
@@ -193,8 +205,13 @@ def _least_squares(h: np.ndarray, f: np.ndarray, start) -> tuple[float, float, f
         a, b, p = q
         return a + b * x**p - (f - f_inf0) / scale
 
-    fit = least_squares(residuals, [0.0, c0 * h0**p0 / scale, p0],
-                        bounds=([-np.inf, -np.inf, ORDER_BOUNDS[0]], [np.inf, np.inf, ORDER_BOUNDS[1]]),
-                        xtol=1e-15, ftol=1e-15, gtol=1e-15)
+    fit = least_squares(
+        residuals,
+        [0.0, c0 * h0**p0 / scale, p0],
+        bounds=([-np.inf, -np.inf, ORDER_BOUNDS[0]], [np.inf, np.inf, ORDER_BOUNDS[1]]),
+        xtol=1e-15,
+        ftol=1e-15,
+        gtol=1e-15,
+    )
     a, b, p = fit.x
     return f_inf0 + a * scale, b * scale / h0**p, float(p)

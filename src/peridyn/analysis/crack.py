@@ -38,9 +38,9 @@ from peridyn.errors import InputError
 
 DEFAULT_THRESHOLD = 0.35
 GEODESIC_LINK = 2.5  # spacings: links of the graph for path distances (near-Euclidean)
-BIN_WIDTH = 2.0      # spacings: width of the level-set bins along a crack
-BAND = 3.0           # spacings: half-width of the band of points around a route
-END_SPAN = 3         # bins: the direction in which an end vertex moves out is over this many
+BIN_WIDTH = 2.0  # spacings: width of the level-set bins along a crack
+BAND = 3.0  # spacings: half-width of the band of points around a route
+END_SPAN = 3  # bins: the direction in which an end vertex moves out is over this many
 
 
 @dataclass
@@ -62,13 +62,21 @@ class CrackPath:
 
     def summary(self) -> dict:
         """The run JSON entry: ``{"length_m", "angle_deg", "max_deviation_m"}``."""
-        return {"length_m": self.length_m, "angle_deg": self.angle_deg,
-                "max_deviation_m": self.max_deviation_m}
+        return {
+            "length_m": self.length_m,
+            "angle_deg": self.angle_deg,
+            "max_deviation_m": self.max_deviation_m,
+        }
 
 
-def crack_paths(points: np.ndarray, phi: np.ndarray, spacing: float,
-                threshold: float = DEFAULT_THRESHOLD, reference_lines=(),
-                min_points: int = 3) -> list[CrackPath]:
+def crack_paths(
+    points: np.ndarray,
+    phi: np.ndarray,
+    spacing: float,
+    threshold: float = DEFAULT_THRESHOLD,
+    reference_lines=(),
+    min_points: int = 3,
+) -> list[CrackPath]:
     """Crack paths of a damage field, longest first.
 
     Parameters
@@ -88,8 +96,9 @@ def crack_paths(points: np.ndarray, phi: np.ndarray, spacing: float,
     points = np.asarray(points, dtype=float)
     phi = np.asarray(phi, dtype=float)
     if points.ndim != 2 or points.shape[1] not in (2, 3) or phi.shape != (points.shape[0],):
-        raise InputError(f"crack_paths needs points (n, 2|3) and phi (n,), got {points.shape} "
-                         f"and {phi.shape}")
+        raise InputError(
+            f"crack_paths needs points (n, 2|3) and phi (n,), got {points.shape} and {phi.shape}"
+        )
     if not 0 < threshold <= 1:
         raise InputError(f"crack threshold must be in (0, 1], got {threshold!r}")
     if not spacing > 0:
@@ -179,8 +188,7 @@ def _main_polyline(xy: np.ndarray, link: float, spacing: float) -> np.ndarray:
     level = np.floor(arc[nearest[near]] / (BIN_WIDTH * spacing)).astype(np.int64)
     counts = np.bincount(level)
     used = counts > 0
-    mid = np.stack([np.bincount(level, weights=xy[:, a])[used] / counts[used] for a in (0, 1)],
-                   axis=1)
+    mid = np.stack([np.bincount(level, weights=xy[:, a])[used] / counts[used] for a in (0, 1)], axis=1)
     if len(mid) > 1:
         inner = min(END_SPAN, len(mid) - 1)
         mid[0] = _extended_end(mid[0], mid[inner], xy[level == level.min()])
@@ -254,7 +262,6 @@ def _distance_to_segment(xy, a, b) -> np.ndarray:
 def _distance_to_polyline(xy, polyline) -> np.ndarray:
     if len(polyline) == 1:
         return np.linalg.norm(xy - polyline[0], axis=1)
-    return np.min([_distance_to_segment(xy, a, b) for a, b in zip(polyline[:-1], polyline[1:],
-                                                                 strict=True)], axis=0)
-
-
+    return np.min(
+        [_distance_to_segment(xy, a, b) for a, b in zip(polyline[:-1], polyline[1:], strict=True)], axis=0
+    )

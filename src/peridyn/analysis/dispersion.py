@@ -146,9 +146,11 @@ class Medium:
         for name, value in (("bulk modulus", bulk), ("shear modulus", shear)):
             if not (np.isfinite(value) and value > 0):
                 raise InputError(f"the {name} must be positive and finite, got {value!r} Pa")
-        return cls(E=9.0 * bulk * shear / (3.0 * bulk + shear),
-                   nu=(3.0 * bulk - 2.0 * shear) / (2.0 * (3.0 * bulk + shear)),
-                   density=density)
+        return cls(
+            E=9.0 * bulk * shear / (3.0 * bulk + shear),
+            nu=(3.0 * bulk - 2.0 * shear) / (2.0 * (3.0 * bulk + shear)),
+            density=density,
+        )
 
     @property
     def shear(self) -> float:
@@ -257,8 +259,9 @@ def linear_model(model: str, family: Family, medium: Medium, plane: str = "stres
         if dim == 1:
             c0 = medium.E / radial_moment(family.influence_name, family.horizon, 1)
         else:
-            c0 = pmb_micromodulus(medium.E, dim, family.horizon, family.influence_name,
-                                  plane, family.thickness)
+            c0 = pmb_micromodulus(
+                medium.E, dim, family.horizon, family.influence_name, plane, family.thickness
+            )
         return LinearModel(c0 * w / length, np.zeros_like(w), 0.0)
     m = family.weighted_volume
     alpha = dim * (dim + 2) * medium.shear / m
@@ -282,8 +285,10 @@ def parse_direction(direction, dim: int) -> np.ndarray:
     if isinstance(direction, str):
         letters = direction.strip().lower()
         if not letters or set(letters) - set("xyz") or len(set(letters)) != len(letters):
-            raise InputError(f"direction {direction!r}: expected axis letters such as x, xy or "
-                             "xyz, or a vector of 3 numbers")
+            raise InputError(
+                f"direction {direction!r}: expected axis letters such as x, xy or "
+                "xyz, or a vector of 3 numbers"
+            )
         vector = np.array([float(a in letters) for a in "xyz"])
     else:
         vector = np.asarray(direction, dtype=float).ravel()
@@ -307,8 +312,9 @@ def polarisations(direction: np.ndarray, dim: int) -> np.ndarray:
 # -- families ---------------------------------------------------------------------------
 
 
-def continuum_family(horizon: float, influence: str, dim: int, direction: np.ndarray,
-                     k_max: float, thickness: float = 1.0) -> Family:
+def continuum_family(
+    horizon: float, influence: str, dim: int, direction: np.ndarray, k_max: float, thickness: float = 1.0
+) -> Family:
     """Quadrature family of the continuous horizon (segment, disc or ball), aligned with ``direction``.
 
     Gauss-Legendre in |xi| on [0, delta] (mirrored in 1D) and, in 3D, in the
@@ -334,16 +340,20 @@ def continuum_family(horizon: float, influence: str, dim: int, direction: np.nda
         phi = 2.0 * np.pi * np.arange(4) / 4
         rr, mu, pp = np.meshgrid(r, t, phi, indexing="ij")
         sine = np.sqrt(1.0 - mu**2)
-        xi = sum((rr * c).ravel()[:, None] * b for c, b in
-                 zip((mu, sine * np.cos(pp), sine * np.sin(pp)), basis, strict=True))
+        xi = sum(
+            (rr * c).ravel()[:, None] * b
+            for c, b in zip((mu, sine * np.cos(pp), sine * np.sin(pp)), basis, strict=True)
+        )
         volume = np.einsum("i,j->ij", wr * r**2, wt)[:, :, None].repeat(4, axis=2).ravel() * (np.pi / 2)
     length = np.linalg.norm(xi, axis=1)
-    return Family(xi, volume, omega(length, horizon), dim, float(horizon), influence,
-                  thickness if dim == 2 else None)
+    return Family(
+        xi, volume, omega(length, horizon), dim, float(horizon), influence, thickness if dim == 2 else None
+    )
 
 
-def lattice_family(spacing: float, horizon: float, influence: str = "constant", dim: int = 3,
-                   partial_volumes: bool = True) -> Family:
+def lattice_family(
+    spacing: float, horizon: float, influence: str = "constant", dim: int = 3, partial_volumes: bool = True
+) -> Family:
     """Family of a point of an infinite simple cubic (square, 1D: uniform) lattice.
 
     In 2D and 3D the family of the centre point of a ball-shaped block of
@@ -356,15 +366,22 @@ def lattice_family(spacing: float, horizon: float, influence: str = "constant", 
     if dim == 1:
         xi, volume = _chain_geometry(float(spacing), float(horizon), bool(partial_volumes))
     else:
-        xi, volume = _lattice_geometry(float(spacing), float(horizon), int(dim),
-                                       bool(partial_volumes))
-    return Family(xi, volume, omega(np.linalg.norm(xi, axis=1), horizon), dim, float(horizon),
-                  influence, spacing if dim == 2 else None)
+        xi, volume = _lattice_geometry(float(spacing), float(horizon), int(dim), bool(partial_volumes))
+    return Family(
+        xi,
+        volume,
+        omega(np.linalg.norm(xi, axis=1), horizon),
+        dim,
+        float(horizon),
+        influence,
+        spacing if dim == 2 else None,
+    )
 
 
 @functools.lru_cache(maxsize=32)
-def _lattice_geometry(spacing: float, horizon: float, dim: int,
-                      partial_volumes: bool) -> tuple[np.ndarray, np.ndarray]:
+def _lattice_geometry(
+    spacing: float, horizon: float, dim: int, partial_volumes: bool
+) -> tuple[np.ndarray, np.ndarray]:
     """Bond vectors (n, 3) and volumes (n,) of the centre point of a lattice block (read-only)."""
     reach = horizon + spacing * (np.sqrt(dim) / 2.0 + 1.0)
     n = 2 * int(np.ceil(reach / spacing)) + 1
@@ -378,8 +395,7 @@ def _lattice_geometry(spacing: float, horizon: float, dim: int,
     centre = int(np.argmin(np.linalg.norm(body.points, axis=1)))
     family = slice(bonds.offsets[centre], bonds.offsets[centre + 1])
     nbr = bonds.neighbours[family]
-    return _read_only(body.points[nbr] - body.points[centre],
-                      body.volumes[nbr] * bonds.volume_factor[family])
+    return _read_only(body.points[nbr] - body.points[centre], body.volumes[nbr] * bonds.volume_factor[family])
 
 
 def _read_only(*arrays: np.ndarray) -> tuple[np.ndarray, ...]:
@@ -389,28 +405,30 @@ def _read_only(*arrays: np.ndarray) -> tuple[np.ndarray, ...]:
 
 
 @functools.lru_cache(maxsize=32)
-def _chain_geometry(spacing: float, horizon: float,
-                    partial_volumes: bool) -> tuple[np.ndarray, np.ndarray]:
+def _chain_geometry(spacing: float, horizon: float, partial_volumes: bool) -> tuple[np.ndarray, np.ndarray]:
     """1D lattice family ``xi = j h`` (unit cross-section): bond vectors and volumes."""
     reach = horizon * (1 + HORIZON_RTOL) + (0.5 * spacing if partial_volumes else 0.0)
     j = np.arange(1, int(np.floor(reach / spacing)) + 1)
     if not len(j):
-        raise InputError(f"horizon {horizon:g} m is too small for the spacing {spacing:g} m: "
-                         "the family is empty")
+        raise InputError(
+            f"horizon {horizon:g} m is too small for the spacing {spacing:g} m: the family is empty"
+        )
     xi = np.zeros((2 * len(j), 3))
     xi[:, 0] = np.concatenate([j, -j]) * spacing
     beta = np.ones(len(xi))
     if partial_volumes:
-        beta = cell_fraction_in_ball(xi, np.tile([spacing, 0.0, 0.0], (len(xi), 1)),
-                                     horizon * (1 + HORIZON_RTOL))
+        beta = cell_fraction_in_ball(
+            xi, np.tile([spacing, 0.0, 0.0], (len(xi), 1)), horizon * (1 + HORIZON_RTOL)
+        )
     return _read_only(xi, beta * spacing)
 
 
 # -- acoustic tensor and branches ---------------------------------------------------------
 
 
-def acoustic_tensor(lin: LinearModel, family: Family, basis: np.ndarray,
-                    k: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def acoustic_tensor(
+    lin: LinearModel, family: Family, basis: np.ndarray, k: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
     """D(k) and dD/dk in the polarisation basis.
 
     Parameters
@@ -572,11 +590,9 @@ class DispersionRelation:
         shear branches for the negative group velocity.
         """
         shear = self.shear_branches()
-        onsets = [b.negative_group_velocity_from for b in shear
-                  if b.negative_group_velocity_from is not None]
+        onsets = [b.negative_group_velocity_from for b in shear if b.negative_group_velocity_from is not None]
         long = self.branches["longitudinal"]
-        limits = {"longitudinal": long.long_wave_limit,
-                  "shear": shear[0].long_wave_limit if shear else None}
+        limits = {"longitudinal": long.long_wave_limit, "shear": shear[0].long_wave_limit if shear else None}
         if len(shear) == 2:
             limits["shear_2"] = shear[1].long_wave_limit
         return {
@@ -589,8 +605,10 @@ class DispersionRelation:
             "spacing_m": self.spacing,
             "influence": self.influence,
             "long_wave_limit_m_s": limits,
-            "classical_speeds_m_s": {"longitudinal": self.classical[0],
-                                     "shear": self.classical[1] if self.dim > 1 else None},
+            "classical_speeds_m_s": {
+                "longitudinal": self.classical[0],
+                "shear": self.classical[1] if self.dim > 1 else None,
+            },
             "negative_group_velocity_from_rad_m": {
                 "longitudinal": long.negative_group_velocity_from,
                 "shear": min(onsets) if onsets else None,
@@ -605,11 +623,21 @@ class DispersionRelation:
 # -- the relation ---------------------------------------------------------------------------
 
 
-def dispersion_relation(model: str, medium: Medium, horizon: float, spacing: float,
-                        influence: str = "constant", dim: int = 3, direction="x",
-                        discrete: bool = False, partial_volumes: bool = True,
-                        wavenumbers=None, k_max: float | None = None, points: int = 400,
-                        plane: str = "stress") -> DispersionRelation:
+def dispersion_relation(
+    model: str,
+    medium: Medium,
+    horizon: float,
+    spacing: float,
+    influence: str = "constant",
+    dim: int = 3,
+    direction="x",
+    discrete: bool = False,
+    partial_volumes: bool = True,
+    wavenumbers=None,
+    k_max: float | None = None,
+    points: int = 400,
+    plane: str = "stress",
+) -> DispersionRelation:
     """omega(k), phase and group velocities of every branch.
 
     Parameters
@@ -657,21 +685,43 @@ def dispersion_relation(model: str, medium: Medium, horizon: float, spacing: flo
     lam, slope = eigen(k)
     if np.any(lam < -1e-12 * np.max(np.abs(lam))):
         bad = np.flatnonzero(np.any(lam < 0, axis=1))[0]
-        raise InputError(f"the linearised {model} of this medium is unstable: rho omega^2 < 0 at "
-                         f"k = {k[bad]:g} rad/m (check the elastic constants)")
+        raise InputError(
+            f"the linearised {model} of this medium is unstable: rho omega^2 < 0 at "
+            f"k = {k[bad]:g} rad/m (check the elastic constants)"
+        )
     k0 = np.array([_LONG_WAVE_K_DELTA / horizon])
     limits = np.sqrt(eigen(k0)[0][0] / medium.density) / k0[0]
-    branches = {name: _branch(name, b, basis[b], k, lam[:, b], slope[:, b], limits[b],
-                              medium.density, eigen)
-                for b, name in enumerate(BRANCHES[:dim])}
-    return DispersionRelation(model, dim, d, bool(discrete), bool(partial_volumes and discrete),
-                              float(horizon), float(spacing), influence, float(np.pi / spacing),
-                              zone_edge, medium.as_modelled(model, dim, plane).classical_speeds(dim, plane),
-                              branches)
+    branches = {
+        name: _branch(name, b, basis[b], k, lam[:, b], slope[:, b], limits[b], medium.density, eigen)
+        for b, name in enumerate(BRANCHES[:dim])
+    }
+    return DispersionRelation(
+        model,
+        dim,
+        d,
+        bool(discrete),
+        bool(partial_volumes and discrete),
+        float(horizon),
+        float(spacing),
+        influence,
+        float(np.pi / spacing),
+        zone_edge,
+        medium.as_modelled(model, dim, plane).classical_speeds(dim, plane),
+        branches,
+    )
 
 
-def _branch(name: str, b: int, polarisation: np.ndarray, k: np.ndarray, lam: np.ndarray,
-            slope: np.ndarray, limit: float, rho: float, eigen) -> Branch:
+def _branch(
+    name: str,
+    b: int,
+    polarisation: np.ndarray,
+    k: np.ndarray,
+    lam: np.ndarray,
+    slope: np.ndarray,
+    limit: float,
+    rho: float,
+    eigen,
+) -> Branch:
     """Branch ``b`` from its eigenvalues ``lam`` = rho omega^2 and slopes d lam / dk.
 
     ``eigen(k)`` recomputes (eigenvalues, slopes) at other wavenumbers, for the
@@ -688,6 +738,7 @@ def _branch(name: str, b: int, polarisation: np.ndarray, k: np.ndarray, lam: np.
         i = int(negative[0])
         onset = float(k[i])
         if i > 0:
+
             def shifted_group(kk: float) -> float:
                 lam_k, slope_k = eigen(np.array([kk]))
                 return slope_k[0, b] / (2.0 * np.sqrt(rho * max(lam_k[0, b], 1e-300))) + tol
@@ -753,8 +804,12 @@ class Study:
         rows = []
         for (influence, horizon, spacing), rel in self.relations.items():
             onsets = rel.to_dict()["negative_group_velocity_from_rad_m"]
-            row = {"influence": influence, "horizon_m": horizon, "spacing_m": spacing,
-                   "horizon_over_spacing": horizon / spacing}
+            row = {
+                "influence": influence,
+                "horizon_m": horizon,
+                "spacing_m": spacing,
+                "horizon_over_spacing": horizon / spacing,
+            }
             studied = [("longitudinal", rel.branches["longitudinal"], rel.classical[0])]
             studied += [("shear", b, rel.classical[1]) for b in rel.shear_branches()[:1]]
             for prefix, branch, reference in studied:
@@ -778,28 +833,44 @@ class Study:
             "horizon": lambda i, d, h: i == base and h == self.base_spacing,
             "spacing": lambda i, d, h: i == base and d == self.base_horizon,
         }[parameter]
-        label = {"influence": lambda i, d, h: i,
-                 "horizon": lambda i, d, h: f"delta = {d * 1e3:g} mm",
-                 "spacing": lambda i, d, h: f"h = {h * 1e3:g} mm"}[parameter]
+        label = {
+            "influence": lambda i, d, h: i,
+            "horizon": lambda i, d, h: f"delta = {d * 1e3:g} mm",
+            "spacing": lambda i, d, h: f"h = {h * 1e3:g} mm",
+        }[parameter]
         return {label(*key): rel for key, rel in self.relations.items() if chosen(*key)}
 
     def negative_group_velocity_summary(self) -> str:
         """Which choices give a negative group velocity below the grid's zone edge."""
         lines = []
         for row in self.table:
-            hits = [f"{name} from {row[key]:.0f} rad/m ({row[key] * row['spacing_m']:.2f}/h)"
-                    for name, key in (("P", "negative_longitudinal_rad_m"),
-                                      ("S", "negative_shear_rad_m")) if row[key] is not None]
-            lines.append(f"{row['influence']:>8}, delta {row['horizon_m'] * 1e3:g} mm, "
-                         f"h {row['spacing_m'] * 1e3:g} mm ({row['horizon_over_spacing']:.2f} h): "
-                         + ("; ".join(hits) if hits else "none"))
+            hits = [
+                f"{name} from {row[key]:.0f} rad/m ({row[key] * row['spacing_m']:.2f}/h)"
+                for name, key in (("P", "negative_longitudinal_rad_m"), ("S", "negative_shear_rad_m"))
+                if row[key] is not None
+            ]
+            lines.append(
+                f"{row['influence']:>8}, delta {row['horizon_m'] * 1e3:g} mm, "
+                f"h {row['spacing_m'] * 1e3:g} mm ({row['horizon_over_spacing']:.2f} h): "
+                + ("; ".join(hits) if hits else "none")
+            )
         return "\n".join(lines)
 
 
-def study(model: str = "lps", medium: Medium = MARAGING_STEEL, influences=SEED_INFLUENCES,
-          horizons=SEED_HORIZONS, spacings=SEED_SPACINGS, base_horizon: float = 3e-3,
-          base_spacing: float = 1e-3, discrete: bool = True, partial_volumes: bool = True,
-          dim: int = 3, direction="x", points: int = 400) -> Study:
+def study(
+    model: str = "lps",
+    medium: Medium = MARAGING_STEEL,
+    influences=SEED_INFLUENCES,
+    horizons=SEED_HORIZONS,
+    spacings=SEED_SPACINGS,
+    base_horizon: float = 3e-3,
+    base_spacing: float = 1e-3,
+    discrete: bool = True,
+    partial_volumes: bool = True,
+    dim: int = 3,
+    direction="x",
+    points: int = 400,
+) -> Study:
     """Dispersion relations of seed 001's parameter study (maraging steel by default).
 
     For every influence function: the horizons ``horizons`` at ``base_spacing``
@@ -809,9 +880,18 @@ def study(model: str = "lps", medium: Medium = MARAGING_STEEL, influences=SEED_I
     keys = [(i, float(d), float(base_spacing)) for i in influences for d in horizons]
     keys += [(i, float(base_horizon), float(h)) for i in influences for h in spacings]
     relations = {
-        key: dispersion_relation(model, medium, key[1], key[2], key[0], dim=dim,
-                                 direction=direction, discrete=discrete,
-                                 partial_volumes=partial_volumes, points=points)
+        key: dispersion_relation(
+            model,
+            medium,
+            key[1],
+            key[2],
+            key[0],
+            dim=dim,
+            direction=direction,
+            discrete=discrete,
+            partial_volumes=partial_volumes,
+            points=points,
+        )
         for key in dict.fromkeys(keys)
     }
     return Study(relations, float(base_horizon), float(base_spacing))

@@ -69,8 +69,15 @@ CHUNK_RECORDS = 256
 PEAK_THRESHOLD = 1e-3
 
 
-def fk_transform(signal, dt: float, dx: float, window="hann", pad_time: float = 2.0,
-                 pad_space: float = 2.0, f_max: float | None = None):
+def fk_transform(
+    signal,
+    dt: float,
+    dx: float,
+    window="hann",
+    pad_time: float = 2.0,
+    pad_space: float = 2.0,
+    f_max: float | None = None,
+):
     """Frequency-wavenumber spectrum of a space-time record on a line.
 
     Parameters
@@ -113,8 +120,7 @@ def fk_transform(signal, dt: float, dx: float, window="hann", pad_time: float = 
     return freq[keep], k, np.abs(spectrum) / (wt.sum() * wx.sum())
 
 
-def line_fk(path: str | os.PathLike, series_name: str, spacing: float, component="z",
-            **options):
+def line_fk(path: str | os.PathLike, series_name: str, spacing: float, component="z", **options):
     """:func:`fk_transform` of a line-probe series of a results file.
 
     Parameters
@@ -135,12 +141,12 @@ def line_fk(path: str | os.PathLike, series_name: str, spacing: float, component
         As :func:`fk_transform`.
     """
     _, times, data = read_series(path, series_name)
-    return fk_transform(data[:, :, _component(component)], _uniform_step(times), spacing,
-                        **options)
+    return fk_transform(data[:, :, _component(component)], _uniform_step(times), spacing, **options)
 
 
-def kxky_transform(plane, dt: float, dx: float, dy: float, frequencies, window="hann",
-                   pad_space: float = 2.0):
+def kxky_transform(
+    plane, dt: float, dx: float, dy: float, frequencies, window="hann", pad_space: float = 2.0
+):
     """(kx, ky) maps of a plane record at chosen frequencies.
 
     Parameters
@@ -170,13 +176,19 @@ def kxky_transform(plane, dt: float, dx: float, dy: float, frequencies, window="
     times = np.arange(len(u)) * _positive("dt", dt)
     wt = _window(window, len(u))
     projected = _project(times, wt, u, omega)
-    return _spatial_maps(projected, wt.sum(), _positive("dx", dx), _positive("dy", dy), window,
-                         pad_space)
+    return _spatial_maps(projected, wt.sum(), _positive("dx", dx), _positive("dy", dy), window, pad_space)
 
 
-def kxky_from_hdf5(path: str | os.PathLike, series_name: str, grid: PointGrid, frequencies,
-                   component="z", window="hann", pad_space: float = 2.0,
-                   chunk_records: int = CHUNK_RECORDS):
+def kxky_from_hdf5(
+    path: str | os.PathLike,
+    series_name: str,
+    grid: PointGrid,
+    frequencies,
+    component="z",
+    window="hann",
+    pad_space: float = 2.0,
+    chunk_records: int = CHUNK_RECORDS,
+):
     """:func:`kxky_transform` of a series of a results file, read ``chunk_records`` at a time.
 
     Parameters
@@ -206,14 +218,21 @@ def kxky_from_hdf5(path: str | os.PathLike, series_name: str, grid: PointGrid, f
     start = 0
     for times, data in iter_series_chunks(path, series_name, chunk_records):
         block = grid.scatter(data[:, :, column])
-        projected += _project(times, wt[start:start + len(times)], block, omega)
+        projected += _project(times, wt[start : start + len(times)], block, omega)
         start += len(times)
     return _spatial_maps(projected, wt.sum(), grid.dx, grid.dy, window, pad_space)
 
 
-def pick_wavenumbers(freq, k, magnitude, frequency: float, expected: dict | None = None,
-                     n_peaks: int | None = None, tolerance: float = 0.2,
-                     threshold: float = PEAK_THRESHOLD):
+def pick_wavenumbers(
+    freq,
+    k,
+    magnitude,
+    frequency: float,
+    expected: dict | None = None,
+    n_peaks: int | None = None,
+    tolerance: float = 0.2,
+    threshold: float = PEAK_THRESHOLD,
+):
     """Wavenumbers of the spectral peaks at one frequency.
 
     The spectrum at ``frequency`` is interpolated linearly between the two
@@ -252,8 +271,9 @@ def pick_wavenumbers(freq, k, magnitude, frequency: float, expected: dict | None
     if magnitude.shape != (len(freq), len(k)):
         raise InputError(f"magnitude must have shape ({len(freq)}, {len(k)}), got {magnitude.shape}")
     if not freq[0] <= frequency <= freq[-1]:
-        raise InputError(f"frequency {frequency!r} Hz lies outside the spectrum "
-                         f"[{freq[0]:g}, {freq[-1]:g}] Hz")
+        raise InputError(
+            f"frequency {frequency!r} Hz lies outside the spectrum [{freq[0]:g}, {freq[-1]:g}] Hz"
+        )
     j = int(np.clip(np.searchsorted(freq, frequency), 1, len(freq) - 1))
     share = (frequency - freq[j - 1]) / (freq[j] - freq[j - 1])
     row = (1.0 - share) * magnitude[j - 1] + share * magnitude[j]
@@ -291,8 +311,15 @@ def azimuthal_average(kx, ky, kmap):
     return np.arange(n_r) * step, sums / np.maximum(counts, 1)
 
 
-def ring_radius(kx, ky, kmap, expected: dict | None = None, n_peaks: int | None = None,
-                tolerance: float = 0.2, threshold: float = PEAK_THRESHOLD):
+def ring_radius(
+    kx,
+    ky,
+    kmap,
+    expected: dict | None = None,
+    n_peaks: int | None = None,
+    tolerance: float = 0.2,
+    threshold: float = PEAK_THRESHOLD,
+):
     """Radii of the rings of a (kx, ky) map: peaks of its azimuthal average times ``sqrt(|k|)``.
 
     The 2D transform of a wave spreading from a point source,
@@ -426,15 +453,22 @@ def mirror_parts(top, bottom) -> dict[str, np.ndarray]:
     """
     t, b = np.asarray(top, dtype=float), np.asarray(bottom, dtype=float)
     if t.shape != b.shape or t.shape[-1:] != (3,):
-        raise InputError(f"top and bottom records must have one shape (..., 3), got {t.shape} and "
-                         f"{b.shape}")
+        raise InputError(f"top and bottom records must have one shape (..., 3), got {t.shape} and {b.shape}")
     even, odd = 0.5 * (t + b), 0.5 * (t - b)
     in_plane = np.array([True, True, False])
     return {"S": np.where(in_plane, even, odd), "A": np.where(in_plane, odd, even)}
 
 
-def phase_wavenumber(signal, dt: float, x, frequency: float, source: float, r_range,
-                     order: int | None = 0, iterations: int = 20) -> float:
+def phase_wavenumber(
+    signal,
+    dt: float,
+    x,
+    frequency: float,
+    source: float,
+    r_range,
+    order: int | None = 0,
+    iterations: int = 20,
+) -> float:
     """Wavenumber of an outgoing wave from the phase along a line at one frequency.
 
     ``U(x) = sum_t u(x, t) exp(+i 2 pi f t) dt`` is, for a record that holds the whole
@@ -482,29 +516,37 @@ def phase_wavenumber(signal, dt: float, x, frequency: float, source: float, r_ra
     omega = 2.0 * np.pi * _positive("frequency", frequency)
     times = np.arange(len(u)) * _positive("dt", dt)
     spectrum = np.exp(1j * omega * times) @ u
-    sides = [(x > source) & (np.abs(x - source) >= r_min) & (np.abs(x - source) <= r_max),
-             (x < source) & (np.abs(x - source) >= r_min) & (np.abs(x - source) <= r_max)]
+    sides = [
+        (x > source) & (np.abs(x - source) >= r_min) & (np.abs(x - source) <= r_max),
+        (x < source) & (np.abs(x - source) >= r_min) & (np.abs(x - source) <= r_max),
+    ]
     sides = [side for side in sides if side.sum() >= 2]
     if not sides:
-        raise InputError(f"no two points of the line lie {r_min:g} to {r_max:g} m from the source "
-                         f"at {source:g} m on one side")
+        raise InputError(
+            f"no two points of the line lie {r_min:g} to {r_max:g} m from the source "
+            f"at {source:g} m on one side"
+        )
     r = [np.sort(np.abs(x[side] - source)) for side in sides]
-    phase = [np.unwrap(np.angle(spectrum[side][np.argsort(np.abs(x[side] - source))]))
-             for side in sides]
+    phase = [np.unwrap(np.angle(spectrum[side][np.argsort(np.abs(x[side] - source))])) for side in sides]
     design = np.zeros((sum(len(ri) for ri in r), 1 + len(sides)))
     design[:, 0] = np.concatenate(r)
     start = 0
     for j, ri in enumerate(r):
-        design[start:start + len(ri), 1 + j] = 1.0
+        design[start : start + len(ri), 1 + j] = 1.0
         start += len(ri)
     k = 0.0
     for _ in range(1 if order is None else iterations + 1):
-        spreading = (np.concatenate([np.unwrap(np.angle(hankel1(order, k * ri))) - k * ri for ri in r])
-                     if k > 0 else 0.0)
+        spreading = (
+            np.concatenate([np.unwrap(np.angle(hankel1(order, k * ri))) - k * ri for ri in r])
+            if k > 0
+            else 0.0
+        )
         k = float(np.linalg.lstsq(design, np.concatenate(phase) - spreading, rcond=None)[0][0])
         if not k > 0:
-            raise InputError("the phase does not grow away from the source: no outgoing wave "
-                             f"at {frequency:g} Hz in the fit range")
+            raise InputError(
+                "the phase does not grow away from the source: no outgoing wave "
+                f"at {frequency:g} Hz in the fit range"
+            )
     return abs(k)
 
 
@@ -513,8 +555,9 @@ def phase_wavenumber(signal, dt: float, x, frequency: float, source: float, r_ra
 LINE_SUFFIXES = ("", "_bottom", "_yp", "_ym", "_bottom_yp", "_bottom_ym")
 
 
-def line_mode_wavenumbers(path: str | os.PathLike, line: str, x, dy: float, frequency: float,
-                          source: float, r_range) -> dict[str, float]:
+def line_mode_wavenumbers(
+    path: str | os.PathLike, line: str, x, dy: float, frequency: float, source: float, r_range
+) -> dict[str, float]:
     """S0 and A0 wavenumbers of a run from line probes along x through a source.
 
     The series ``line_<line><suffix>`` (:data:`LINE_SUFFIXES`) hold the line on the top
@@ -552,10 +595,13 @@ def line_mode_wavenumbers(path: str | os.PathLike, line: str, x, dy: float, freq
     centre = mirror_parts(records[""], records["_bottom"])
     plus = mirror_parts(records["_yp"], records["_bottom_yp"])["S"]
     minus = mirror_parts(records["_ym"], records["_bottom_ym"])["S"]
-    divergence = (np.gradient(centre["S"][:, :, 0], x, axis=1)
-                  + (plus[:, :, 1] - minus[:, :, 1]) / (2.0 * _positive("dy", dy)))
-    return {"S0": phase_wavenumber(divergence, dt, x, frequency, source, r_range, 0),
-            "A0": phase_wavenumber(centre["A"][:, :, 2], dt, x, frequency, source, r_range, 0)}
+    divergence = np.gradient(centre["S"][:, :, 0], x, axis=1) + (plus[:, :, 1] - minus[:, :, 1]) / (
+        2.0 * _positive("dy", dy)
+    )
+    return {
+        "S0": phase_wavenumber(divergence, dt, x, frequency, source, r_range, 0),
+        "A0": phase_wavenumber(centre["A"][:, :, 2], dt, x, frequency, source, r_range, 0),
+    }
 
 
 # -- helpers ------------------------------------------------------------------------------
@@ -598,8 +644,7 @@ def _pick(axis: np.ndarray, values: np.ndarray, expected, n_peaks, tolerance, th
         raise InputError("give either expected (mode name -> wavenumber guess) or n_peaks")
     interior = np.arange(1, len(values) - 1)
     middle = values[1:-1]
-    peaks = interior[(middle > values[:-2]) & (middle >= values[2:])
-                     & (middle >= threshold * values.max())]
+    peaks = interior[(middle > values[:-2]) & (middle >= values[2:]) & (middle >= threshold * values.max())]
     if n_peaks is not None:
         if int(n_peaks) != n_peaks or n_peaks < 1:
             raise InputError(f"n_peaks must be a positive integer, got {n_peaks!r}")
@@ -608,14 +653,13 @@ def _pick(axis: np.ndarray, values: np.ndarray, expected, n_peaks, tolerance, th
     found = {}
     for name, guess in expected.items():
         near = peaks[np.abs(axis[peaks] - guess) <= tolerance * abs(guess)]
-        found[name] = (_refine(axis, values, near[np.argmax(values[near])]) if len(near)
-                       else float("nan"))
+        found[name] = _refine(axis, values, near[np.argmax(values[near])]) if len(near) else float("nan")
     return found
 
 
 def _refine(axis: np.ndarray, values: np.ndarray, i: int) -> float:
     """Vertex of the parabola through the log of ``values[i-1:i+2]``."""
-    y0, y1, y2 = np.log(np.maximum(values[i - 1:i + 2], np.finfo(float).tiny))
+    y0, y1, y2 = np.log(np.maximum(values[i - 1 : i + 2], np.finfo(float).tiny))
     curvature = y0 - 2.0 * y1 + y2
     offset = 0.5 * (y0 - y2) / curvature if curvature < 0 else 0.0
     return float(axis[i] + offset * (axis[i + 1] - axis[i]))
@@ -645,8 +689,9 @@ def _positive(name: str, value) -> float:
 def _real_array(data, ndim: int, name: str) -> np.ndarray:
     arr = np.asarray(data, dtype=float)
     if arr.ndim != ndim or min(arr.shape) < 3:
-        raise InputError(f"{name} must be a {ndim}-D array with at least 3 samples per axis, "
-                         f"got shape {arr.shape}")
+        raise InputError(
+            f"{name} must be a {ndim}-D array with at least 3 samples per axis, got shape {arr.shape}"
+        )
     if not np.all(np.isfinite(arr)):
         raise InputError(f"{name} has non-finite values")
     return arr
@@ -668,6 +713,8 @@ def _uniform_step(times: np.ndarray) -> float:
     """The time step of evenly spaced records, s."""
     steps = np.diff(times)
     if len(steps) < 2 or np.ptp(steps) > _UNIFORM_STEP * steps.mean():
-        raise InputError("the records are not evenly spaced in time (or fewer than 3): "
-                         "an f-k transform needs a constant step")
+        raise InputError(
+            "the records are not evenly spaced in time (or fewer than 3): "
+            "an f-k transform needs a constant step"
+        )
     return float(steps.mean())

@@ -44,8 +44,9 @@ def harmonic_amplitude(freq: np.ndarray, spectrum: np.ndarray, f0: float, order:
     target = order * f0
     band = (freq > target - BAND * f0) & (freq < target + BAND * f0)
     if not band.any():
-        raise InputError(f"harmonic {order} of {f0:g} Hz lies above the Nyquist frequency "
-                         f"{freq[-1]:g} Hz of the signal")
+        raise InputError(
+            f"harmonic {order} of {f0:g} Hz lies above the Nyquist frequency {freq[-1]:g} Hz of the signal"
+        )
     return float(spectrum[band].max())
 
 

@@ -74,13 +74,21 @@ class MeasuredDispersion:
         :class:`~peridyn.analysis.dispersion.DispersionRelation` at the same wavenumbers."""
         if not np.allclose(relation.branches["longitudinal"].wavenumber, self.wavenumber):
             raise InputError("the relation must be evaluated at the measured wavenumbers")
-        return {name: omega / relation.branches[name].frequency - 1.0
-                for name, omega in self.frequency.items()}
+        return {
+            name: omega / relation.branches[name].frequency - 1.0 for name, omega in self.frequency.items()
+        }
 
 
-def lattice_block_model(model: str, medium: Medium, horizon: float, spacing: float,
-                        influence: str = "constant", dim: int = 3, partial_volumes: bool = True,
-                        plane: str = "stress") -> tuple[Model, np.ndarray]:
+def lattice_block_model(
+    model: str,
+    medium: Medium,
+    horizon: float,
+    spacing: float,
+    influence: str = "constant",
+    dim: int = 3,
+    partial_volumes: bool = True,
+    plane: str = "stress",
+) -> tuple[Model, np.ndarray]:
     """A model on a block of the lattice and the mask of its interior points.
 
     The block is centred at the origin with ``INTERIOR_POINTS`` interior points
@@ -100,8 +108,9 @@ def lattice_block_model(model: str, medium: Medium, horizon: float, spacing: flo
     if dim == 3:
         body = geometry.box((side,) * 3, spacing, origin=(-side / 2,) * 3)
     else:
-        body = geometry.rectangle(side, side, spacing, thickness=spacing, plane=plane,
-                                  origin=(-side / 2,) * 2)
+        body = geometry.rectangle(
+            side, side, spacing, thickness=spacing, plane=plane, origin=(-side / 2,) * 2
+        )
     bonds = find_bonds(body, horizon, influence, partial_volumes=partial_volumes)
     nu = None if model == "pmb" else medium.nu
     built = make_model(model, body, bonds, E=medium.E, density=medium.density, nu=nu)
@@ -110,9 +119,18 @@ def lattice_block_model(model: str, medium: Medium, horizon: float, spacing: flo
     return built, inside
 
 
-def measure_dispersion(model: str, medium: Medium, horizon: float, spacing: float, wavenumbers,
-                       influence: str = "constant", dim: int = 3, direction="x",
-                       partial_volumes: bool = True, plane: str = "stress") -> MeasuredDispersion:
+def measure_dispersion(
+    model: str,
+    medium: Medium,
+    horizon: float,
+    spacing: float,
+    wavenumbers,
+    influence: str = "constant",
+    dim: int = 3,
+    direction="x",
+    partial_volumes: bool = True,
+    plane: str = "stress",
+) -> MeasuredDispersion:
     """Measure omega(k) of every branch with the model's force on a lattice block.
 
     Parameters
@@ -131,19 +149,22 @@ def measure_dispersion(model: str, medium: Medium, horizon: float, spacing: floa
     k = np.asarray(wavenumbers, dtype=float).ravel()
     if k.size == 0 or not np.all(np.isfinite(k)) or np.any(k <= 0):
         raise InputError("wavenumbers must be positive and finite (rad/m)")
-    built, inside = lattice_block_model(model, medium, horizon, spacing, influence, dim,
-                                        partial_volumes, plane)
+    built, inside = lattice_block_model(
+        model, medium, horizon, spacing, influence, dim, partial_volumes, plane
+    )
     d = parse_direction(direction, dim)
     basis = polarisations(d, dim)
     tensor = np.stack([_measured_tensor(built, inside, basis, kk, AMPLITUDE * spacing) for kk in k])
     lam, _ = branch_eigenvalues(tensor, np.zeros_like(tensor))
-    frequency = {name: np.sqrt(np.maximum(lam[:, b], 0.0) / medium.density)
-                 for b, name in enumerate(BRANCHES[:dim])}
+    frequency = {
+        name: np.sqrt(np.maximum(lam[:, b], 0.0) / medium.density) for b, name in enumerate(BRANCHES[:dim])
+    }
     return MeasuredDispersion(k, frequency, tensor, built.body.n_points, int(inside.sum()))
 
 
-def _measured_tensor(built: Model, inside: np.ndarray, basis: np.ndarray, k: float,
-                     amplitude: float) -> np.ndarray:
+def _measured_tensor(
+    built: Model, inside: np.ndarray, basis: np.ndarray, k: float, amplitude: float
+) -> np.ndarray:
     """(dim, dim) acoustic tensor in the polarisation basis from plane-wave quotients."""
     x = built.body.points
     wave = np.cos(k * (x @ basis[0]))

@@ -38,8 +38,7 @@ class ModeType:
         return self.type if self.order == 0 else f"{_ordinal(self.order)} {self.type}"
 
 
-def classify_mode(points: np.ndarray, shape: np.ndarray, masses: np.ndarray,
-                  rigid: bool = False) -> ModeType:
+def classify_mode(points: np.ndarray, shape: np.ndarray, masses: np.ndarray, rigid: bool = False) -> ModeType:
     """Type of one plate mode.
 
     Parameters

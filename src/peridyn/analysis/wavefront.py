@@ -36,8 +36,16 @@ from peridyn.analysis.dispersion import DispersionRelation
 from peridyn.errors import InputError
 from peridyn.io.hdf5 import read_array, read_series
 
-__all__ = ["FrontSpeed", "axis_signals", "compare_with_relation",
-           "envelope_peak_times", "front_speed", "measure_fronts", "predicted_group_velocity"]
+__all__ = [
+    "FrontSpeed",
+    "axis_signals",
+    "compare_with_relation",
+    "envelope_peak_times",
+    "front_speed",
+    "measure_fronts",
+    "predicted_group_velocity",
+]
+
 
 @dataclass(frozen=True)
 class FrontSpeed:
@@ -96,8 +104,9 @@ def dominant_frequency(times: np.ndarray, signals: np.ndarray) -> float:
     return float(np.sum(freq * power) / np.sum(power))
 
 
-def front_speed(times: np.ndarray, distances: np.ndarray, signals: np.ndarray, axis: str,
-                r_min: float, r_max: float) -> FrontSpeed:
+def front_speed(
+    times: np.ndarray, distances: np.ndarray, signals: np.ndarray, axis: str, r_min: float, r_max: float
+) -> FrontSpeed:
     """Front speed from the signals of the stations along one axis.
 
     Parameters
@@ -113,13 +122,21 @@ def front_speed(times: np.ndarray, distances: np.ndarray, signals: np.ndarray, a
     """
     used = (distances >= r_min) & (distances <= r_max)
     if used.sum() < 3:
-        raise InputError(f"axis {axis!r}: {int(used.sum())} stations between {r_min:g} and "
-                         f"{r_max:g} m from the source; need at least 3")
+        raise InputError(
+            f"axis {axis!r}: {int(used.sum())} stations between {r_min:g} and "
+            f"{r_max:g} m from the source; need at least 3"
+        )
     arrival = envelope_peak_times(times, signals[:, used])
     slope, intercept = np.polyfit(distances[used], arrival, 1)
     residual = float(np.sqrt(np.mean((arrival - (slope * distances[used] + intercept)) ** 2)))
-    return FrontSpeed(axis, float(1.0 / slope), dominant_frequency(times, signals[:, used]),
-                      distances[used], arrival, residual)
+    return FrontSpeed(
+        axis,
+        float(1.0 / slope),
+        dominant_frequency(times, signals[:, used]),
+        distances[used],
+        arrival,
+        residual,
+    )
 
 
 def axis_signals(results, axis: str, centre=(0.0, 0.0, 0.0), pulse: str = "x"):
@@ -156,8 +173,9 @@ def axis_signals(results, axis: str, centre=(0.0, 0.0, 0.0), pulse: str = "x"):
             ijk[a] += station
             ijk[direction] += step
             if tuple(ijk) not in column:
-                raise InputError(f"{results}: tube_{axis} lacks the point {ijk} (spacing "
-                                 f"{h:g} m) around the {axis} axis")
+                raise InputError(
+                    f"{results}: tube_{axis} lacks the point {ijk} (spacing {h:g} m) around the {axis} axis"
+                )
             ends.append(data[:, column[tuple(ijk)], component].astype(np.float64))
         return (ends[0] - ends[1]) / (2.0 * h)
 
@@ -169,8 +187,7 @@ def axis_signals(results, axis: str, centre=(0.0, 0.0, 0.0), pulse: str = "x"):
     return times, np.abs(stations) * h, np.stack(columns, axis=1)
 
 
-def measure_fronts(results, r_min: float, r_max: float, centre=(0.0, 0.0, 0.0),
-                   pulse: str = "x") -> dict:
+def measure_fronts(results, r_min: float, r_max: float, centre=(0.0, 0.0, 0.0), pulse: str = "x") -> dict:
     """P front along the pulse axis and S fronts along the other two.
 
     Parameters
@@ -188,8 +205,9 @@ def measure_fronts(results, r_min: float, r_max: float, centre=(0.0, 0.0, 0.0),
     -------
     dict of axis to FrontSpeed
     """
-    return {axis: front_speed(*axis_signals(results, axis, centre, pulse), axis, r_min, r_max)
-            for axis in "xyz"}
+    return {
+        axis: front_speed(*axis_signals(results, axis, centre, pulse), axis, r_min, r_max) for axis in "xyz"
+    }
 
 
 def predicted_group_velocity(relation: DispersionRelation, frequency: float) -> dict:
@@ -208,10 +226,12 @@ def predicted_group_velocity(relation: DispersionRelation, frequency: float) -> 
     for name, branch in relation.branches.items():
         above = np.flatnonzero(branch.frequency >= omega)
         if not len(above):
-            raise InputError(f"{frequency:g} Hz is above the {name} branch's highest frequency "
-                             f"{branch.frequency.max() / (2 * np.pi):g} Hz on this grid")
-        k_pair = np.concatenate([[0.0], branch.wavenumber])[above[0]:above[0] + 2]
-        w_pair = np.concatenate([[0.0], branch.frequency])[above[0]:above[0] + 2]
+            raise InputError(
+                f"{frequency:g} Hz is above the {name} branch's highest frequency "
+                f"{branch.frequency.max() / (2 * np.pi):g} Hz on this grid"
+            )
+        k_pair = np.concatenate([[0.0], branch.wavenumber])[above[0] : above[0] + 2]
+        w_pair = np.concatenate([[0.0], branch.frequency])[above[0] : above[0] + 2]
         k = float(np.interp(omega, w_pair, k_pair))
         out[name] = (k, float(np.interp(k, branch.wavenumber, branch.group_velocity)))
     return out
@@ -239,7 +259,11 @@ def compare_with_relation(fronts: dict, relation: DispersionRelation, pulse: str
     rows = {}
     for axis, front in fronts.items():
         k, group = predicted_group_velocity(relation, front.frequency)[branch_of[axis]]
-        rows[axis] = {"speed_m_s": front.speed, "frequency_hz": front.frequency,
-                      "wavenumber_rad_m": k, "group_velocity_m_s": group,
-                      "error": front.speed / group - 1.0}
+        rows[axis] = {
+            "speed_m_s": front.speed,
+            "frequency_hz": front.frequency,
+            "wavenumber_rad_m": k,
+            "group_velocity_m_s": group,
+            "error": front.speed / group - 1.0,
+        }
     return rows

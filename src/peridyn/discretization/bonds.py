@@ -115,8 +115,7 @@ class Bonds:
         )
 
 
-def resolve_horizon(body: Body, horizon: float | None = None,
-                    horizon_factor: float | None = None) -> float:
+def resolve_horizon(body: Body, horizon: float | None = None, horizon_factor: float | None = None) -> float:
     """The horizon in metres from either metres or a multiple of ``body.spacing``."""
     if (horizon is None) == (horizon_factor is None):
         raise InputError("give exactly one of horizon (m) or horizon_factor (multiple of spacing)")
@@ -126,8 +125,13 @@ def resolve_horizon(body: Body, horizon: float | None = None,
     return float(delta)
 
 
-def find_bonds(body: Body, horizon: float, influence: str = "constant",
-               partial_volumes: bool = True, quadrature_points: int = 8) -> Bonds:
+def find_bonds(
+    body: Body,
+    horizon: float,
+    influence: str = "constant",
+    partial_volumes: bool = True,
+    quadrature_points: int = 8,
+) -> Bonds:
     """Search the families of all points and build the CSR bond arrays.
 
     Parameters
@@ -164,8 +168,9 @@ def find_bonds(body: Body, horizon: float, influence: str = "constant",
         reach += 0.5 * float(np.max(np.linalg.norm(cells, axis=1)))
     pairs = cKDTree(x).query_pairs(reach, output_type="ndarray")
     offsets, j = bond_families(pairs, body.n_points)
-    length, factor = bond_geometry(x, cells, offsets, j, horizon * (1 + HORIZON_RTOL),
-                                    partial_volumes, quadrature_points)
+    length, factor = bond_geometry(
+        x, cells, offsets, j, horizon * (1 + HORIZON_RTOL), partial_volumes, quadrature_points
+    )
     if partial_volumes:  # drop neighbours whose cell lies wholly outside the sphere
         keep = factor > 0
         counts = family_sums(offsets, keep).astype(np.int64)
@@ -190,9 +195,9 @@ def find_bonds(body: Body, horizon: float, influence: str = "constant",
     )
 
 
-
-def cell_fraction_in_ball(xi: np.ndarray, cell: np.ndarray, radius: float,
-                          quadrature_points: int = 8) -> np.ndarray:
+def cell_fraction_in_ball(
+    xi: np.ndarray, cell: np.ndarray, radius: float, quadrature_points: int = 8
+) -> np.ndarray:
     """Fraction of each box cell (centre ``xi``, sides ``cell``) inside a ball at the origin.
 
     Parameters
@@ -209,9 +214,9 @@ def cell_fraction_in_ball(xi: np.ndarray, cell: np.ndarray, radius: float,
     -------
     (n,) float64 in [0, 1]
     """
-    return np.array([
-        box_fraction_in_ball(*xi[k], *cell[k], radius, quadrature_points) for k in range(len(xi))
-    ])
+    return np.array(
+        [box_fraction_in_ball(*xi[k], *cell[k], radius, quadrature_points) for k in range(len(xi))]
+    )
 
 
 # -- pre-cracks ---------------------------------------------------------------------------

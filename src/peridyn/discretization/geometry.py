@@ -29,16 +29,16 @@ def _cell_counts(lengths: np.ndarray, spacing: np.ndarray) -> np.ndarray:
     """Whole cells along each side (the nearest count); warns when a side changes length."""
     counts = np.rint(lengths / spacing).astype(np.int64)
     if np.any(counts < 1):
-        raise InputError(
-            f"spacing {spacing.tolist()} m is larger than the body {lengths.tolist()} m"
-        )
+        raise InputError(f"spacing {spacing.tolist()} m is larger than the body {lengths.tolist()} m")
     built = counts * spacing
     changed = np.abs(built - lengths) > ROUNDING_WARNING * lengths
     if np.any(changed):
-        sides = ", ".join(f"{lengths[a]:g} m -> {built[a]:g} m ({counts[a]} cells)"
-                          for a in np.flatnonzero(changed))
-        warnings.warn(f"the spacing does not divide the body: sides rounded to whole cells: "
-                      f"{sides}", stacklevel=3)
+        sides = ", ".join(
+            f"{lengths[a]:g} m -> {built[a]:g} m ({counts[a]} cells)" for a in np.flatnonzero(changed)
+        )
+        warnings.warn(
+            f"the spacing does not divide the body: sides rounded to whole cells: {sides}", stacklevel=3
+        )
     return counts
 
 
@@ -64,12 +64,12 @@ def box(lengths, spacing, origin=(0.0, 0.0, 0.0)) -> Body:
     lengths = _positive_triplet("lengths", lengths)
     counts = _cell_counts(lengths, h)
     points = _grid(counts, h, np.asarray(origin, dtype=float))
-    return Body(points=points, volumes=np.full(len(points), h.prod()), cells=h, dim=3,
-                spacing=float(h.max()))
+    return Body(points=points, volumes=np.full(len(points), h.prod()), cells=h, dim=3, spacing=float(h.max()))
 
 
-def plate(length, width, thickness, spacing, layers, origin=(0.0, 0.0, 0.0),
-          layer_placement: str = "cell") -> Body:
+def plate(
+    length, width, thickness, spacing, layers, origin=(0.0, 0.0, 0.0), layer_placement: str = "cell"
+) -> Body:
     """A 3D plate in the x-y plane with ``layers`` layers of points through its thickness.
 
     Parameters
@@ -113,12 +113,17 @@ def plate(length, width, thickness, spacing, layers, origin=(0.0, 0.0, 0.0),
     points[:, 2] = origin[2] + np.tile(z, n_xy)
     layer_index = np.tile(np.arange(layers, dtype=np.int64), n_xy)
     cell = np.array([h, h, dz])
-    return Body(points=points, volumes=np.full(len(points), cell.prod()), cells=cell, dim=3,
-                spacing=h, layer_index=layer_index)
+    return Body(
+        points=points,
+        volumes=np.full(len(points), cell.prod()),
+        cells=cell,
+        dim=3,
+        spacing=h,
+        layer_index=layer_index,
+    )
 
 
-def rectangle(length, width, spacing, thickness, plane: str = "stress",
-              origin=(0.0, 0.0)) -> Body:
+def rectangle(length, width, spacing, thickness, plane: str = "stress", origin=(0.0, 0.0)) -> Body:
     """A 2D rectangle (plane stress or plane strain) of square cells.
 
     Parameters
@@ -137,9 +142,15 @@ def rectangle(length, width, spacing, thickness, plane: str = "stress",
     xy = _grid(counts, np.array([h, h]), np.asarray(origin, dtype=float))
     points = np.zeros((len(xy), 3))
     points[:, :2] = xy
-    return Body(points=points, volumes=np.full(len(points), h * h * t), cells=np.array([h, h, t]),
-                dim=2, spacing=h, thickness=t, plane=plane)
-
+    return Body(
+        points=points,
+        volumes=np.full(len(points), h * h * t),
+        cells=np.array([h, h, t]),
+        dim=2,
+        spacing=h,
+        thickness=t,
+        plane=plane,
+    )
 
 
 def face(body: Body, which: str, depth: float | None = None) -> np.ndarray:

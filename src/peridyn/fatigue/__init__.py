@@ -10,5 +10,13 @@ from peridyn.fatigue.model import FatigueParameters, RemainingLife, cyclic_bond_
 from peridyn.fatigue.run import FatigueResult, run_fatigue
 from peridyn.fatigue.tip import crack_tip
 
-__all__ = ["CycleMapping", "FatigueParameters", "FatigueResult", "RemainingLife", "crack_tip",
-           "cyclic_bond_strain", "run_fatigue", "scale_A_II"]
+__all__ = [
+    "CycleMapping",
+    "FatigueParameters",
+    "FatigueResult",
+    "RemainingLife",
+    "crack_tip",
+    "cyclic_bond_strain",
+    "run_fatigue",
+    "scale_A_II",
+]

@@ -111,7 +111,9 @@ def calibrate_A_II(A_trial: float, delta_k_sim, rate_sim, delta_k_exp, rate_exp)
     dk_s, r_s = dk_s[order], r_s[order]
     inside = (dk_e >= dk_s[0]) & (dk_e <= dk_s[-1])
     if not inside.any():
-        raise InputError(f"no experimental dK lies in the simulated range {dk_s[0]:.3g}-"
-                         f"{dk_s[-1]:.3g} Pa m^0.5: run the trial longer or give more data")
+        raise InputError(
+            f"no experimental dK lies in the simulated range {dk_s[0]:.3g}-"
+            f"{dk_s[-1]:.3g} Pa m^0.5: run the trial longer or give more data"
+        )
     r_at = np.exp(np.interp(np.log(dk_e[inside]), np.log(dk_s), np.log(r_s)))
     return float(A_trial * np.mean(r_e[inside] / r_at))

@@ -35,8 +35,9 @@ class CycleMapping:
             raise InputError("fatigue mapping needs at least one (steps, tau) block")
         for steps, tau in self.schedule:
             if int(steps) < 1 or not (np.isfinite(tau) and tau > 0):
-                raise InputError(f"fatigue mapping block needs steps >= 1 and tau > 0, got "
-                                 f"steps={steps!r}, tau={tau!r}")
+                raise InputError(
+                    f"fatigue mapping block needs steps >= 1 and tau > 0, got steps={steps!r}, tau={tau!r}"
+                )
 
     @property
     def n_steps(self) -> int:

@@ -38,7 +38,7 @@ class RecycledDirections:
 
     def add(self, directions: list) -> None:
         """Keep ``directions`` (newest last), dropping the oldest beyond ``limit``."""
-        self.vectors = (self.vectors + list(directions))[-self.limit:] if self.limit else []
+        self.vectors = (self.vectors + list(directions))[-self.limit :] if self.limit else []
 
     def clear(self) -> None:
         """Forget every direction (e.g. after a new factorisation)."""
@@ -67,9 +67,15 @@ class PCGResult:
     directions: list
 
 
-def deflated_pcg(matvec: Callable, precondition: Callable, b: np.ndarray, x0: np.ndarray | None,
-                 rtol: float, maxiter: int, deflation: tuple[np.ndarray, np.ndarray] | None = None
-                 ) -> PCGResult:
+def deflated_pcg(
+    matvec: Callable,
+    precondition: Callable,
+    b: np.ndarray,
+    x0: np.ndarray | None,
+    rtol: float,
+    maxiter: int,
+    deflation: tuple[np.ndarray, np.ndarray] | None = None,
+) -> PCGResult:
     """Solve A x = b (A symmetric positive definite) by preconditioned CG deflated by W.
 
     Parameters

@@ -54,11 +54,23 @@ def breakable_bonds(model: Model, no_damage_sets=()) -> np.ndarray:
     return ~(protected[b.owners()] | protected[b.neighbours])
 
 
-def run_fatigue(model: Model, loading: Loading, params: FatigueParameters, mapping: CycleMapping,
-                load_ratio: float = 0.0, max_load_time: float = 1.0, no_damage_sets=(),
-                tip_axis: str = "x", depth_axis: str = "z", tip_damage: float = TIP_DAMAGE,
-                solver: str = "auto", progress=None, stop_length: float = np.inf,
-                tip_start: float | None = None, tip_sense: str = "+") -> FatigueResult:
+def run_fatigue(
+    model: Model,
+    loading: Loading,
+    params: FatigueParameters,
+    mapping: CycleMapping,
+    load_ratio: float = 0.0,
+    max_load_time: float = 1.0,
+    no_damage_sets=(),
+    tip_axis: str = "x",
+    depth_axis: str = "z",
+    tip_damage: float = TIP_DAMAGE,
+    solver: str = "auto",
+    progress=None,
+    stop_length: float = np.inf,
+    tip_start: float | None = None,
+    tip_sense: str = "+",
+) -> FatigueResult:
     """Run the fatigue loop on ``model`` (its ``bonds.intact`` is updated in place).
 
     Parameters
@@ -80,6 +92,7 @@ def run_fatigue(model: Model, loading: Loading, params: FatigueParameters, mappi
     first_break = np.full(model.body.n_points, np.inf)
     life.update_phase(damage_field(model))  # pre-cracks may start families in phase II
     cycles, lengths, broken = [0.0], [], [0]
+
     def crack_length(phi):
         return crack_tip(points, phi, spacing, tip_axis, depth_axis, tip_damage, tip_start, tip_sense)
 
@@ -110,6 +123,11 @@ def run_fatigue(model: Model, loading: Loading, params: FatigueParameters, mappi
             progress.update(1)
         if lengths[-1] >= stop_length:
             break
-    return FatigueResult(np.array(cycles), np.array(lengths), np.array(broken, dtype=np.int64),
-                         (statics.solve() if changed else u) if u is not None else np.zeros_like(points),
-                         damage_field(model), first_break)
+    return FatigueResult(
+        np.array(cycles),
+        np.array(lengths),
+        np.array(broken, dtype=np.int64),
+        (statics.solve() if changed else u) if u is not None else np.zeros_like(points),
+        damage_field(model),
+        first_break,
+    )

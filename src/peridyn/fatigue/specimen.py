@@ -21,8 +21,9 @@ from peridyn.physics.loads import Loading
 from peridyn.physics.materials.base import Model
 
 
-def compliance_energy(model: Model, loading: Loading, crack_lengths, cut: Callable[[float], np.ndarray],
-                      time: float = 1.0) -> np.ndarray:
+def compliance_energy(
+    model: Model, loading: Loading, crack_lengths, cut: Callable[[float], np.ndarray], time: float = 1.0
+) -> np.ndarray:
     """Complementary energy U(a) = f . u / 2 (J) at each crack length (m).
 
     Parameters
@@ -65,8 +66,9 @@ def compliance_stress_intensity(crack_lengths, energy, thickness: float, modulus
     return np.sqrt(modulus * g)
 
 
-def straight_crack_cut(points: np.ndarray, spacing: float, bonds, precrack,
-                       axis: int) -> Callable[[float], np.ndarray]:
+def straight_crack_cut(
+    points: np.ndarray, spacing: float, bonds, precrack, axis: int
+) -> Callable[[float], np.ndarray]:
     """The pre-crack ``precrack`` (a case's rectangle or segment) lengthened along ``axis`` (0, 1, 2):
     a -> (n_bonds,) bool, the bonds crossing it when it runs to length a (m) from the body's low
     edge (its outermost points minus half a spacing, as ``crack_tip`` measures).

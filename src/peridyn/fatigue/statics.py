@@ -96,9 +96,16 @@ class LinearStatics:
     records : list of SolveRecord, one per ``solve()``
     """
 
-    def __init__(self, model: Model, loading: Loading, time: float = 1.0, method: str = "auto",
-                 rtol: float = 1e-8, refactor_iterations: int = REFACTOR_ITERATIONS,
-                 recycle: int = RECYCLE):
+    def __init__(
+        self,
+        model: Model,
+        loading: Loading,
+        time: float = 1.0,
+        method: str = "auto",
+        rtol: float = 1e-8,
+        refactor_iterations: int = REFACTOR_ITERATIONS,
+        recycle: int = RECYCLE,
+    ):
         if method not in ("auto", "amg", "direct", "cg"):
             raise InputError(f"linear solver must be auto, amg, direct or cg, got {method!r}")
         if not 0.0 < rtol < 1.0:
@@ -119,8 +126,10 @@ class LinearStatics:
         force = loading.body_force_density(self.time, np.zeros((n, 3)))
         self.force = (force * model.body.volumes[:, None]).ravel()
         if not (np.any(self.u_prescribed) or np.any(self.force)):
-            raise InputError(f"the loads at t = {self.time:g} s are all zero: a fatigue run needs a "
-                             "cyclic load (non-zero displacement or force at the maximum load)")
+            raise InputError(
+                f"the loads at t = {self.time:g} s are all zero: a fatigue run needs a "
+                "cyclic load (non-zero displacement or force at the maximum load)"
+            )
         self.stiffness = stiffness_operator(model)  # reads model.bonds.intact at every product
         self.block_stiffness = block_stiffness_operator(model, self.free)  # likewise, on the free dofs
         diagonal = stiffness_parts(model).diagonal()[self.free]
@@ -140,8 +149,9 @@ class LinearStatics:
         factorised = False
         if self.method == "cg":
             diagonal = self._diagonal()
-            result = deflated_pcg(self._free_product, lambda r: r / diagonal, rhs, self._last,
-                                  self.rtol, 20 * len(rhs))
+            result = deflated_pcg(
+                self._free_product, lambda r: r / diagonal, rhs, self._last, self.rtol, 20 * len(rhs)
+            )
         else:
             if self._preconditioner is None:
                 self._build_preconditioner()
@@ -151,17 +161,21 @@ class LinearStatics:
                 self._build_preconditioner()
                 factorised = True
                 more = self._preconditioned_cg(rhs, result.x, True)
-                result = PCGResult(more.x, result.iterations + more.iterations, more.converged,
-                                   more.directions)
+                result = PCGResult(
+                    more.x, result.iterations + more.iterations, more.converged, more.directions
+                )
             self.recycled.add(result.directions)
         if not result.converged:
-            raise InputError(f"fatigue static solve: CG did not converge in {result.iterations} "
-                             f"iterations to the relative residual {self.rtol:g}")
+            raise InputError(
+                f"fatigue static solve: CG did not converge in {result.iterations} "
+                f"iterations to the relative residual {self.rtol:g}"
+            )
         self._last = result.x
         u[self.free] = result.x
         residual = np.linalg.norm(rhs - self._free_product(result.x)) / max(np.linalg.norm(rhs), 1e-300)
-        self.records.append(SolveRecord(result.iterations, factorised, float(residual),
-                                        clock.perf_counter() - start))
+        self.records.append(
+            SolveRecord(result.iterations, factorised, float(residual), clock.perf_counter() - start)
+        )
         return u.reshape(-1, 3)
 
     def _product(self, u: np.ndarray) -> np.ndarray:
@@ -178,16 +192,23 @@ class LinearStatics:
         """(K + shift I) V on the free dofs for a block V (free, k), BLOCK columns per bond pass."""
         out = np.empty_like(V)
         for start in range(0, V.shape[1], BLOCK):
-            part = V[:, start:start + BLOCK]
-            out[:, start:start + BLOCK] = self.block_stiffness.matmat(part) + self.shift * part
+            part = V[:, start : start + BLOCK]
+            out[:, start : start + BLOCK] = self.block_stiffness.matmat(part) + self.shift * part
         return out
 
     def _preconditioned_cg(self, rhs: np.ndarray, x0: np.ndarray | None, fresh: bool) -> PCGResult:
         """CG with the kept preconditioner, deflated by the recycled directions; at most
         FRESH_ITERATIONS iterations when the preconditioner is ``fresh``, else refactor_iterations."""
         maxiter = FRESH_ITERATIONS if fresh else self.refactor_iterations
-        return deflated_pcg(self._free_product, self._preconditioner.matvec, rhs, x0, self.rtol,
-                            maxiter, self.recycled.basis(self._free_block_product))
+        return deflated_pcg(
+            self._free_product,
+            self._preconditioner.matvec,
+            rhs,
+            x0,
+            self.rtol,
+            maxiter,
+            self.recycled.basis(self._free_block_product),
+        )
 
     def _diagonal(self) -> np.ndarray:
         """Diagonal of the free system with the bonds intact now (free,)."""
@@ -200,11 +221,18 @@ class LinearStatics:
         self.recycled.clear()
         body = self.model.body
         if self.method == "direct":
-            self._preconditioner = shifted_inverse(stiffness_parts(self.model), self.free,
-                                                   np.full(len(self.free), self.shift), body.points,
-                                                   self.model.bonds.horizon)
+            self._preconditioner = shifted_inverse(
+                stiffness_parts(self.model),
+                self.free,
+                np.full(len(self.free), self.shift),
+                body.points,
+                self.model.bonds.horizon,
+            )
             return
         proxy = proxy_stiffness(self.model, self.free)
-        self._preconditioner = amg_preconditioner(proxy, np.ones(len(self.free)),
-                                                  rigid_fields(body.points)[self.free],
-                                                  SHIFT * float(proxy.diagonal().mean()))
+        self._preconditioner = amg_preconditioner(
+            proxy,
+            np.ones(len(self.free)),
+            rigid_fields(body.points)[self.free],
+            SHIFT * float(proxy.diagonal().mean()),
+        )

@@ -19,9 +19,16 @@ AXES = {"x": 0, "y": 1, "z": 2}
 TIP_DAMAGE = 0.385
 
 
-def crack_tip(points: np.ndarray, phi: np.ndarray, spacing: float, axis: str = "x",
-              depth_axis: str = "z", threshold: float = TIP_DAMAGE, start: float | None = None,
-              sense: str = "+") -> float:
+def crack_tip(
+    points: np.ndarray,
+    phi: np.ndarray,
+    spacing: float,
+    axis: str = "x",
+    depth_axis: str = "z",
+    threshold: float = TIP_DAMAGE,
+    start: float | None = None,
+    sense: str = "+",
+) -> float:
     """Crack length (m) along ``axis``; 0 when no column is cracked through.
 
     Parameters
@@ -36,8 +43,7 @@ def crack_tip(points: np.ndarray, phi: np.ndarray, spacing: float, axis: str = "
     sense : "+" (the crack grows towards +axis) or "-"
     """
     if axis not in AXES or depth_axis not in AXES or axis == depth_axis:
-        raise InputError(f"crack tip needs two different axes among x, y, z; got {axis!r}, "
-                         f"{depth_axis!r}")
+        raise InputError(f"crack tip needs two different axes among x, y, z; got {axis!r}, {depth_axis!r}")
     if sense not in ("+", "-"):
         raise InputError(f"crack tip sense must be '+' or '-', got {sense!r}")
     a, d = AXES[axis], AXES[depth_axis]
@@ -52,8 +58,11 @@ def crack_tip(points: np.ndarray, phi: np.ndarray, spacing: float, axis: str = "
     position[column] = points[:, a]
     grow = 1.0 if sense == "+" else -1.0
     # distance along the growth sense from the start (the edge: outermost points + half a cell)
-    origin = start if start is not None else (
-        points[:, a].min() - 0.5 * spacing if sense == "+" else points[:, a].max() + 0.5 * spacing)
+    origin = (
+        start
+        if start is not None
+        else (points[:, a].min() - 0.5 * spacing if sense == "+" else points[:, a].max() + 0.5 * spacing)
+    )
     run = grow * (position - origin)
     cracked = (low >= threshold) & (run > 0.0)
     return float(run[cracked].max()) if cracked.any() else 0.0

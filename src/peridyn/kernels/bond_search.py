@@ -22,7 +22,7 @@ def bond_families(pairs, n):
         nbr[cursor[b]] = a
         cursor[b] += 1
     for i in range(n):
-        nbr[offsets[i]:offsets[i + 1]].sort()
+        nbr[offsets[i] : offsets[i + 1]].sort()
     return offsets, nbr
 
 
@@ -40,8 +40,7 @@ def bond_geometry(x, cells, offsets, nbr, radius, partial, q):
             d2 = x[j, 2] - x[i, 2]
             length[b] = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
             if partial:
-                factor[b] = box_fraction_in_ball(d0, d1, d2, cells[j, 0], cells[j, 1],
-                                                  cells[j, 2], radius, q)
+                factor[b] = box_fraction_in_ball(d0, d1, d2, cells[j, 0], cells[j, 1], cells[j, 2], radius, q)
             else:
                 factor[b] = 1.0 if length[b] <= radius else 0.0
     return length, factor

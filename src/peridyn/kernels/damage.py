@@ -46,8 +46,7 @@ def stretch_test_families(x, u, offsets, nbr, limit, intact, points, tested, mov
     """
     count = np.zeros(points.shape[0], dtype=np.int64)
     for p in numba.prange(points.shape[0]):
-        count[p] = _test_family(points[p], x, u, offsets, nbr, limit, intact, tested, moved,
-                                quantum, margin)
+        count[p] = _test_family(points[p], x, u, offsets, nbr, limit, intact, tested, moved, quantum, margin)
     return count.sum()
 
 

@@ -25,8 +25,7 @@ def lps_force(x, u, offsets, nbr, length, w, dev, intact, theta_coef, p_coef):
     """LPS force density from its definition (see ``peridyn.kernels.lps``)."""
     owners, y, r = _deformed_bonds(x, u, offsets, nbr)
     e = r - length
-    theta = theta_coef * np.bincount(owners, np.where(intact, w * length * e, 0.0),
-                                     minlength=len(x))
+    theta = theta_coef * np.bincount(owners, np.where(intact, w * length * e, 0.0), minlength=len(x))
     p = theta * p_coef
     t = (w * length * (p[owners] + p[nbr]) + dev * e) / r
     t = np.where(intact, t, 0.0)

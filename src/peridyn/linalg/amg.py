@@ -102,8 +102,7 @@ def proxy_aggregates(model: Model, dofs: np.ndarray) -> sp.csr_matrix:
     b = model.bonds
     short = _short_bonds(model)
     n = model.body.n_points
-    graph = sp.csr_matrix((np.ones(int(short.sum())), (b.owners()[short], b.neighbours[short])),
-                          shape=(n, n))
+    graph = sp.csr_matrix((np.ones(int(short.sum())), (b.owners()[short], b.neighbours[short])), shape=(n, n))
     two_bonds = (graph @ graph + graph).tocsr()
     two_bonds.data[:] = 1.0
     found = standard_aggregation(two_bonds)[0].tocsr()
@@ -112,12 +111,18 @@ def proxy_aggregates(model: Model, dofs: np.ndarray) -> sp.csr_matrix:
     lonely = point_aggregate < 0  # a point whose short bonds are all cut: its own aggregate
     point_aggregate[lonely] = found.shape[1] + np.arange(int(lonely.sum()))
     used, dof_aggregate = np.unique(point_aggregate[dofs // 3], return_inverse=True)
-    return sp.csr_matrix((np.ones(len(dofs)), (np.arange(len(dofs)), dof_aggregate)),
-                         shape=(len(dofs), len(used)))
+    return sp.csr_matrix(
+        (np.ones(len(dofs)), (np.arange(len(dofs)), dof_aggregate)), shape=(len(dofs), len(used))
+    )
 
 
-def amg_preconditioner(proxy: sp.csr_matrix, mass: np.ndarray, near_null: np.ndarray,
-                       shift: float, aggregates: sp.csr_matrix | None = None) -> LinearOperator:
+def amg_preconditioner(
+    proxy: sp.csr_matrix,
+    mass: np.ndarray,
+    near_null: np.ndarray,
+    shift: float,
+    aggregates: sp.csr_matrix | None = None,
+) -> LinearOperator:
     """One smoothed-aggregation V-cycle on ``proxy + shift * diag(mass)``, applied to the whole
     block at once (``linalg.block_amg``)."""
     a = (proxy + sp.diags(shift * mass)).tocsr()

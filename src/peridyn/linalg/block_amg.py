@@ -31,21 +31,30 @@ SMOOTHER = ("block_gauss_seidel", {"sweep": "symmetric", "iterations": 1})
 COARSE_SOLVER = "pinv"
 
 
-def smoothed_aggregation_hierarchy(a: sp.bsr_matrix, near_null: np.ndarray, first_aggregates=None,
-                                   max_coarse: int = 500):
+def smoothed_aggregation_hierarchy(
+    a: sp.bsr_matrix, near_null: np.ndarray, first_aggregates=None, max_coarse: int = 500
+):
     """pyamg smoothed-aggregation hierarchy of the SPD ``a`` with the smoother and coarse solver
     that ``BlockVCycle`` applies; ``first_aggregates`` (n_block_rows, n_aggregates) sparse, or
     None for pyamg's standard aggregation on the first level too."""
     import pyamg
 
-    aggregate = "standard" if first_aggregates is None else \
-        [("predefined", {"AggOp": first_aggregates.tocsr()}), "standard"]
-    return pyamg.smoothed_aggregation_solver(a, B=near_null, symmetry="hermitian",
-                                             strength=("symmetric", {"theta": 0.0}),
-                                             aggregate=aggregate, presmoother=SMOOTHER,
-                                             postsmoother=SMOOTHER, coarse_solver=COARSE_SOLVER,
-                                             max_coarse=max_coarse)
-
+    aggregate = (
+        "standard"
+        if first_aggregates is None
+        else [("predefined", {"AggOp": first_aggregates.tocsr()}), "standard"]
+    )
+    return pyamg.smoothed_aggregation_solver(
+        a,
+        B=near_null,
+        symmetry="hermitian",
+        strength=("symmetric", {"theta": 0.0}),
+        aggregate=aggregate,
+        presmoother=SMOOTHER,
+        postsmoother=SMOOTHER,
+        coarse_solver=COARSE_SOLVER,
+        max_coarse=max_coarse,
+    )
 
 
 class _BSR:
@@ -60,8 +69,9 @@ class _BSR:
         self.shape = m.shape
 
     def __matmul__(self, x):
-        out = np.empty((x.shape[0], self.shape[0] // self.blocksize[0], self.blocksize[0], x.shape[3]),
-                       dtype=x.dtype)
+        out = np.empty(
+            (x.shape[0], self.shape[0] // self.blocksize[0], self.blocksize[0], x.shape[3]), dtype=x.dtype
+        )
         return bsr_matmat(self.indptr, self.indices, self.data, x, out)
 
 
@@ -94,8 +104,9 @@ class BlockVCycle:
         for level, fine, coarse in zip(hierarchy.levels[:-1], blocks[:-1], blocks[1:], strict=True):
             a = sp.bsr_matrix(level.A)
             self.A.append(_BSR(a))
-            self.diag_inv.append(np.ascontiguousarray(
-                get_block_diag(a, blocksize=fine, inv_flag=True), dtype=np.float64))
+            self.diag_inv.append(
+                np.ascontiguousarray(get_block_diag(a, blocksize=fine, inv_flag=True), dtype=np.float64)
+            )
             self.P.append(_BSR(level.P, (fine, coarse)))
             self.R.append(_BSR(level.R, (coarse, fine)))
         self.coarse = _CoarseSolver(hierarchy.levels[-1].A.toarray())

@@ -31,15 +31,25 @@ def block_linear_force(model: Model, u: np.ndarray, extension: np.ndarray | None
     f = np.empty_like(u)
     if isinstance(model, PMBModel):
         no_dilatation = np.zeros((len(x), u.shape[2]))
-        return block_bond_force(x, e, b.offsets, b.neighbours, b.length, np.zeros(b.n_bonds),
-                                model.bond_stiffness.astype(np.float64) / b.length, b.intact,
-                                no_dilatation, f)
+        return block_bond_force(
+            x,
+            e,
+            b.offsets,
+            b.neighbours,
+            b.length,
+            np.zeros(b.n_bonds),
+            model.bond_stiffness.astype(np.float64) / b.length,
+            b.intact,
+            no_dilatation,
+            f,
+        )
     if isinstance(model, LPSModel):
         axial = model.w.astype(np.float64) * b.length
         theta = block_family_sum(b.offsets, axial, e, np.empty((len(x), u.shape[2])))
         p = theta * (model.theta_coef * model._p_coef.astype(np.float64))[:, None]
-        return block_bond_force(x, e, b.offsets, b.neighbours, b.length, axial,
-                                model.dev.astype(np.float64), b.intact, p, f)
+        return block_bond_force(
+            x, e, b.offsets, b.neighbours, b.length, axial, model.dev.astype(np.float64), b.intact, p, f
+        )
     raise TypeError(f"no linearisation for {type(model).__name__}")
 
 
@@ -63,5 +73,4 @@ def block_stiffness_operator(model: Model, dofs: np.ndarray) -> LinearOperator:
         out = (-vol[:, None, None] * f).reshape(3 * n, -1)[dofs]
         return out.reshape(v.shape)
 
-    return LinearOperator((size, size), matvec=matmat, matmat=matmat, rmatvec=matmat,
-                          dtype=np.float64)
+    return LinearOperator((size, size), matvec=matmat, matmat=matmat, rmatvec=matmat, dtype=np.float64)

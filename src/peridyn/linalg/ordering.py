@@ -64,6 +64,8 @@ def estimated_factor_entries(points: np.ndarray, reach: float, unknowns_per_poin
     """
     sizes = np.array([len(part) for part in dissection_parts(points, reach)], dtype=np.float64)
     return FILL_PER_PART_SQUARED * float(np.sum((unknowns_per_point * sizes) ** 2))
+
+
 def order_unknowns(unknown_points: np.ndarray, points: np.ndarray, reach: float) -> np.ndarray:
     """Permutation of unknowns (m,) int64 following the nested-dissection rank of their point.
 

@@ -16,8 +16,9 @@ from peridyn.linalg.ordering import order_unknowns
 from peridyn.linalg.stiffness import StiffnessParts
 
 
-def shifted_inverse(parts: StiffnessParts, dofs: np.ndarray, shift_mass: np.ndarray,
-                    points: np.ndarray, reach: float) -> LinearOperator:
+def shifted_inverse(
+    parts: StiffnessParts, dofs: np.ndarray, shift_mass: np.ndarray, points: np.ndarray, reach: float
+) -> LinearOperator:
     """(K + s M)^-1 on the ``dofs`` as an operator, factorised once (``factorise_shifted``)."""
     lu, perm = factorise_shifted(parts, dofs, shift_mass, points, reach)
     n = len(dofs)
@@ -32,8 +33,9 @@ def shifted_inverse(parts: StiffnessParts, dofs: np.ndarray, shift_mass: np.ndar
     return LinearOperator((n, n), matvec=solve, dtype=np.float64)
 
 
-def factorise_shifted(parts: StiffnessParts, dofs: np.ndarray, shift_mass: np.ndarray,
-                      points: np.ndarray, reach: float):
+def factorise_shifted(
+    parts: StiffnessParts, dofs: np.ndarray, shift_mass: np.ndarray, points: np.ndarray, reach: float
+):
     """Sparse LU of K + s M on the ``dofs`` (or of the augmented system), and its order.
 
     ``shift_mass`` ((len(dofs),) N/m) is s M on those dofs; ``points`` (n, 3) m and
@@ -58,6 +60,10 @@ def factorise_shifted(parts: StiffnessParts, dofs: np.ndarray, shift_mass: np.nd
         A = sp.bmat([[P, SG.T], [SG, sp.diags(-(scale**2) / parts.dilatation[active])]])
         unknown_points = np.concatenate([unknown_points, active])
     perm = order_unknowns(unknown_points, points, reach)
-    lu = splu(A.tocsr()[perm][:, perm].tocsc(), permc_spec="NATURAL", diag_pivot_thresh=0.1,
-              options={"SymmetricMode": True})
+    lu = splu(
+        A.tocsr()[perm][:, perm].tocsc(),
+        permc_spec="NATURAL",
+        diag_pivot_thresh=0.1,
+        options={"SymmetricMode": True},
+    )
     return lu, perm

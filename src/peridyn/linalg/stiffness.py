@@ -41,12 +41,22 @@ def linear_force(model: Model, u: np.ndarray) -> np.ndarray:
     x = model.body.points
     u = np.ascontiguousarray(u, dtype=np.float64)
     if isinstance(model, PMBModel):
-        return pmb_linear_force(x, u, b.offsets, b.neighbours, b.length,
-                                model.bond_stiffness.astype(np.float64), b.intact)
+        return pmb_linear_force(
+            x, u, b.offsets, b.neighbours, b.length, model.bond_stiffness.astype(np.float64), b.intact
+        )
     if isinstance(model, LPSModel):
-        return lps_linear_force(x, u, b.offsets, b.neighbours, b.length,
-                                model.w.astype(np.float64), model.dev.astype(np.float64), b.intact,
-                                model.theta_coef, model._p_coef.astype(np.float64))
+        return lps_linear_force(
+            x,
+            u,
+            b.offsets,
+            b.neighbours,
+            b.length,
+            model.w.astype(np.float64),
+            model.dev.astype(np.float64),
+            b.intact,
+            model.theta_coef,
+            model._p_coef.astype(np.float64),
+        )
     raise TypeError(f"no linearisation for {type(model).__name__}")
 
 
@@ -125,8 +135,9 @@ def stiffness_parts(model: Model, energy_of: np.ndarray | None = None) -> Stiffn
     n = model.body.n_points
     if isinstance(model, PMBModel):
         pair = vol[owners] * model.bond_stiffness.astype(np.float64) / b.length  # W = k e^2 / 4L
-        return StiffnessParts(pair_matrix(owners[counted], b.neighbours[counted], n_vec[counted],
-                                           pair[counted], n))
+        return StiffnessParts(
+            pair_matrix(owners[counted], b.neighbours[counted], n_vec[counted], pair[counted], n)
+        )
     if isinstance(model, LPSModel):
         w = np.where(counted, model.w.astype(np.float64), 0.0)
         # (V alpha g w / 2) e^2 per bond
@@ -135,8 +146,7 @@ def stiffness_parts(model: Model, energy_of: np.ndarray | None = None) -> Stiffn
         d = model.dim
         c = 0.5 * model.bulk - model.alpha * model.dev_weighted_volume / (2 * d * d)
         a = model.theta_coef[owners] * w * b.length  # d theta_p / d e_pj
-        return StiffnessParts(k_pair, _dilatation_gradients(owners, b.neighbours, n_vec, a, n),
-                              2.0 * c * vol)
+        return StiffnessParts(k_pair, _dilatation_gradients(owners, b.neighbours, n_vec, a, n), 2.0 * c * vol)
     raise TypeError(f"no stiffness for {type(model).__name__}")
 
 
@@ -160,8 +170,9 @@ def pair_matrix(i, j, n_vec, coef, n_points) -> sp.csr_matrix:
         cols.append((3 * q[:, None, None] + a[None, None, :]).repeat(3, axis=1).ravel())
         vals.append(sign * 0.5 * outer.ravel())
     shape = (3 * n_points, 3 * n_points)
-    return sp.coo_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-                         shape=shape).tocsr()
+    return sp.coo_matrix(
+        (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=shape
+    ).tocsr()
 
 
 def _dilatation_gradients(owners, nbr, n_vec, a, n_points) -> sp.csr_matrix:

@@ -74,7 +74,6 @@ def _bond_blocks(offsets, nbr, n_vec, stretch, geometric) -> sp.csr_matrix:
     return sp.csr_matrix((data, indices, indptr), shape=(3 * n, 3 * n))
 
 
-
 def _dilatation_jacobian(model: LPSModel, owners, nbr, n_vec, w, p_coef) -> sp.csr_matrix:
     """LPS: d f_i = sum_j w_ij L_ij n_ij (dP_i + dP_j) as the product H G (see module)."""
     n = model.body.n_points
@@ -90,7 +89,11 @@ def _dilatation_jacobian(model: LPSModel, owners, nbr, n_vec, w, p_coef) -> sp.c
     g_cols_j = (3 * nbr[:, None] + a).ravel()
     g_cols_i = (3 * owners[:, None] + a).ravel()
     g_rows = np.repeat(owners, 3)
-    g = sp.coo_matrix((np.concatenate([g_vals, -g_vals]),
-                       (np.concatenate([g_rows, g_rows]), np.concatenate([g_cols_j, g_cols_i]))),
-                      shape=(n, 3 * n)).tocsr()
+    g = sp.coo_matrix(
+        (
+            np.concatenate([g_vals, -g_vals]),
+            (np.concatenate([g_rows, g_rows]), np.concatenate([g_cols_j, g_cols_i])),
+        ),
+        shape=(n, 3 * n),
+    ).tocsr()
     return (h @ g).tocsr()

@@ -63,14 +63,18 @@ def layer_damping(points, width: float, damping: float, faces=LATERAL_FACES) -> 
     faces = list(faces)
     unknown = [f for f in faces if f not in FACES[: 2 * pts.shape[1]]]
     if unknown or not faces or len(set(faces)) < len(faces):
-        raise InputError(f"absorbing layer faces must be distinct names among "
-                         f"{list(FACES[: 2 * pts.shape[1]])}, got {faces}")
+        raise InputError(
+            f"absorbing layer faces must be distinct names among "
+            f"{list(FACES[: 2 * pts.shape[1]])}, got {faces}"
+        )
     distance = np.full(len(pts), np.inf)
     for face in faces:
         coord = pts[:, "xyz".index(face[0])]
         distance = np.minimum(distance, coord - coord.min() if face[1] == "-" else coord.max() - coord)
     if np.all(distance < width):
-        raise InputError(f"absorbing layers {width:g} m wide on faces {faces} cover the whole body: "
-                         "no undamped interior is left (narrow them)")
+        raise InputError(
+            f"absorbing layers {width:g} m wide on faces {faces} cover the whole body: "
+            "no undamped interior is left (narrow them)"
+        )
     depth = np.clip((width - distance) / width, 0.0, 1.0)
     return damping * depth**3

@@ -52,15 +52,22 @@ class Contact:
         Verlet skin added to d_c for the candidate list (default 0.5 d_c).
     """
 
-    def __init__(self, model: Model, radius: float, stiffness_factor: float = DEFAULT_STIFFNESS_FACTOR,
-                 skin: float | None = None):
+    def __init__(
+        self,
+        model: Model,
+        radius: float,
+        stiffness_factor: float = DEFAULT_STIFFNESS_FACTOR,
+        skin: float | None = None,
+    ):
         body, bonds = model.body, model.bonds
         delta = bonds.horizon
         if not (np.isfinite(radius) and radius > 0):
             raise InputError(f"contact radius must be positive, got {radius!r} m")
         if radius > delta * (1 + 1e-12):
-            raise InputError(f"contact radius {radius:g} m is larger than the horizon {delta:g} m: "
-                             "short-range forces act within the horizon (use radius <= horizon)")
+            raise InputError(
+                f"contact radius {radius:g} m is larger than the horizon {delta:g} m: "
+                "short-range forces act within the horizon (use radius <= horizon)"
+            )
         if not (np.isfinite(stiffness_factor) and stiffness_factor > 0):
             raise InputError(f"contact stiffness factor must be positive, got {stiffness_factor!r}")
         skin = 0.5 * radius if skin is None else skin
@@ -70,8 +77,7 @@ class Contact:
         self.radius = float(radius)
         self.skin = float(skin)
         self.stiffness_factor = float(stiffness_factor)
-        micromodulus = pmb_micromodulus(model.E, body.dim, delta, "constant", body.plane,
-                                        body.thickness)
+        micromodulus = pmb_micromodulus(model.E, body.dim, delta, "constant", body.plane, body.thickness)
         #: c_sr / delta, N/m^7 (3D) — multiplies (d_c - |Y|) V_j
         self.stiffness = self.stiffness_factor * micromodulus / delta
         self.volumes = np.ascontiguousarray(body.volumes, dtype=np.float64)
@@ -82,8 +88,10 @@ class Contact:
         self._first = self._second = self._bond = np.zeros(0, dtype=np.int64)
 
     def __repr__(self) -> str:
-        return (f"Contact(radius={self.radius:g} m, stiffness_factor={self.stiffness_factor:g}, "
-                f"skin={self.skin:g} m, rebuilds={self.rebuilds})")
+        return (
+            f"Contact(radius={self.radius:g} m, stiffness_factor={self.stiffness_factor:g}, "
+            f"skin={self.skin:g} m, rebuilds={self.rebuilds})"
+        )
 
     @property
     def n_candidates(self) -> int:
@@ -117,9 +125,17 @@ class Contact:
         if self.needs_rebuild(u):
             self.rebuild(u)
         y = self.x + u
-        self.touching = add_contact_force(y, self._first, self._second, self._bond,
-                                          self.model.bonds.intact, self.volumes, self.stiffness,
-                                          self.radius, out)
+        self.touching = add_contact_force(
+            y,
+            self._first,
+            self._second,
+            self._bond,
+            self.model.bonds.intact,
+            self.volumes,
+            self.stiffness,
+            self.radius,
+            out,
+        )
         return out
 
     def stiffness_bound(self) -> np.ndarray:

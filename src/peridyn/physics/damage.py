@@ -78,13 +78,20 @@ class BondDamage:
     #: families (and resets the skin's reference displacement).
     FULL_TEST_SHARE = 0.25
 
-    def __init__(self, model: Model, critical_stretch: float | None = None,
-                 fracture_energy: float | None = None, no_damage_sets=(),
-                 critical_bond_stress: float | None = None):
+    def __init__(
+        self,
+        model: Model,
+        critical_stretch: float | None = None,
+        fracture_energy: float | None = None,
+        no_damage_sets=(),
+        critical_bond_stress: float | None = None,
+    ):
         given = [v is not None for v in (critical_stretch, fracture_energy, critical_bond_stress)]
         if sum(given) != 1:
-            raise InputError("damage needs exactly one of critical_stretch, fracture_energy or "
-                             f"critical_bond_stress (got {sum(given)})")
+            raise InputError(
+                "damage needs exactly one of critical_stretch, fracture_energy or "
+                f"critical_bond_stress (got {sum(given)})"
+            )
         if critical_bond_stress is not None:
             critical_stretch = stretch_from_bond_stress(critical_bond_stress, model.E)
         if fracture_energy is not None:
@@ -135,8 +142,19 @@ class BondDamage:
         if n_tested == 0:
             return 0
         flagged = np.flatnonzero(self._tested)
-        broken = stretch_test_families(m.body.points, u, b.offsets, b.neighbours, self._limit, b.intact,
-                                       flagged, self._tested, self._moved, self._quantum, self._fresh)
+        broken = stretch_test_families(
+            m.body.points,
+            u,
+            b.offsets,
+            b.neighbours,
+            self._limit,
+            b.intact,
+            flagged,
+            self._tested,
+            self._moved,
+            self._quantum,
+            self._fresh,
+        )
         self._margin[flagged] = np.maximum(self._margin[flagged], self._fresh[flagged])
         return int(broken)
 
@@ -155,9 +173,19 @@ class BondDamage:
             self._limit = np.where(self.breakable, b.length * (1.0 + self.critical_stretch), np.inf)
             self.critical_stretch.flags.writeable = False
             self.breakable.flags.writeable = False
-        broken = stretch_test_families(m.body.points, u, b.offsets, b.neighbours, self._limit,
-                                       b.intact, self._everyone, self._all_tested, self._none_moved,
-                                       self._quantum, self._margin)
+        broken = stretch_test_families(
+            m.body.points,
+            u,
+            b.offsets,
+            b.neighbours,
+            self._limit,
+            b.intact,
+            self._everyone,
+            self._all_tested,
+            self._none_moved,
+            self._quantum,
+            self._margin,
+        )
         self._u_ref = u.copy()
         self.full_tests += 1
         return int(broken)

@@ -58,8 +58,10 @@ class BoundaryCondition:
 
     def __post_init__(self):
         if self.kind not in BC_KINDS:
-            raise InputError(f"unknown boundary condition kind {self.kind!r}"
-                             f"{did_you_mean(self.kind, BC_KINDS)}; choose one of {BC_KINDS}")
+            raise InputError(
+                f"unknown boundary condition kind {self.kind!r}"
+                f"{did_you_mean(self.kind, BC_KINDS)}; choose one of {BC_KINDS}"
+            )
         object.__setattr__(self, "components", parse_components(self.components))
 
 
@@ -134,8 +136,9 @@ class Loading:
 
     def _bind(self, bc: BoundaryCondition) -> _Bound:
         idx = self.body.node_set(bc.node_set)
-        return _Bound(idx, bc.components, bc.function,
-                      _amplitude(bc.profile, len(idx), len(bc.components), bc.node_set))
+        return _Bound(
+            idx, bc.components, bc.function, _amplitude(bc.profile, len(idx), len(bc.components), bc.node_set)
+        )
 
     @property
     def has_loads(self) -> bool:

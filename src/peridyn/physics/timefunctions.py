@@ -239,8 +239,10 @@ def from_spec(spec, where: str = "value") -> TimeFunction:
         return _construct(Tabulated, where, {k: tuple(v) for k, v in params.items()})
     if kind not in _SIMPLE:
         choices = [*_SIMPLE, "table", "sum", "product"]
-        raise InputError(f"{where}.type: unknown time function {kind!r}{did_you_mean(kind, choices)}"
-                         f"; choose one of {choices}")
+        raise InputError(
+            f"{where}.type: unknown time function {kind!r}{did_you_mean(kind, choices)}"
+            f"; choose one of {choices}"
+        )
     return _construct(_SIMPLE[kind], where, params)
 
 
@@ -248,9 +250,11 @@ def _construct(cls, where: str, params: dict) -> TimeFunction:
     fields = cls.__dataclass_fields__
     unknown = [k for k in params if k not in fields]
     if unknown:
-        raise InputError(f"{where}: unknown parameter {unknown[0]!r}"
-                         f"{did_you_mean(unknown[0], fields)} for {cls.__name__}; "
-                         f"allowed: {sorted(fields)}")
+        raise InputError(
+            f"{where}: unknown parameter {unknown[0]!r}"
+            f"{did_you_mean(unknown[0], fields)} for {cls.__name__}; "
+            f"allowed: {sorted(fields)}"
+        )
     try:
         return cls(**params)
     except TypeError as exc:

@@ -69,9 +69,16 @@ _NODES_ON_CIRCLE = 1024
 _SPACING_SAMPLE = 32
 
 
-def pzt_radial_actuator(body: Body, center, size: float, function: TimeFunction,
-                        shape: str = "square", layer: int | None = -1, amplitude: float = 1e-6,
-                        name: str = "pzt") -> tuple[Body, list[BoundaryCondition]]:
+def pzt_radial_actuator(
+    body: Body,
+    center,
+    size: float,
+    function: TimeFunction,
+    shape: str = "square",
+    layer: int | None = -1,
+    amplitude: float = 1e-6,
+    name: str = "pzt",
+) -> tuple[Body, list[BoundaryCondition]]:
     """Radial in-plane displacement of a PZT patch (seed 000), see the module docstring.
 
     Parameters
@@ -116,9 +123,16 @@ def pzt_radial_actuator(body: Body, center, size: float, function: TimeFunction,
     return body, [BoundaryCondition(name, "displacement", "xy", function, profile)]
 
 
-def pin_force_actuator(body: Body, center, size: float, function: TimeFunction,
-                       shape: str = "square", layer: int | None = -1, line_force: float = 1.0,
-                       name: str = "pin_force") -> tuple[Body, list[BoundaryCondition]]:
+def pin_force_actuator(
+    body: Body,
+    center,
+    size: float,
+    function: TimeFunction,
+    shape: str = "square",
+    layer: int | None = -1,
+    line_force: float = 1.0,
+    name: str = "pin_force",
+) -> tuple[Body, list[BoundaryCondition]]:
     """Pin-force model of a PZT patch: outward line forces along its perimeter.
 
     Square: each edge carries ``line_force * size`` (N) normal to it, shared by
@@ -188,14 +202,18 @@ def pzt_sensor_weights(points, center, size: float, shape: str = "square") -> np
     _check_patch(size, shape)
     local = _local_points(xy, center, size)
     if pts.shape[1] == 3 and np.ptp(pts[local, 2]) > 0.0:
-        raise InputError("pzt sensor: the points around the patch lie on several layers; "
-                         "pass the points of one surface layer")
+        raise InputError(
+            "pzt sensor: the points around the patch lie on several layers; "
+            "pass the points of one surface layer"
+        )
     nodes, normals_ds = _perimeter_quadrature(center, size, shape)
     triangulation = Delaunay(xy[local])
     simplex = triangulation.find_simplex(nodes)
     if np.any(simplex < 0):
-        raise InputError("pzt sensor: the patch perimeter is not inside the region of the points; "
-                         "the patch must lie on the plate, away from its edges")
+        raise InputError(
+            "pzt sensor: the patch perimeter is not inside the region of the points; "
+            "the patch must lie on the plate, away from its edges"
+        )
     vertices = triangulation.simplices[simplex]
     barycentric = _barycentric(triangulation, simplex, nodes)
     weights = np.zeros((len(xy), 2))
@@ -267,8 +285,10 @@ def _footprint(body: Body, center, size: float, shape: str, layer: int | None) -
     rho = _patch_radius(_offsets(body.points, center), shape)
     mask = on_layer & (rho <= 0.5 * size + _ON_PERIMETER * body.spacing)
     if not mask.any():
-        raise InputError(f"no point of the body lies under the {shape} patch of size {size} m "
-                         f"at {list(center)} (layer {layer})")
+        raise InputError(
+            f"no point of the body lies under the {shape} patch of size {size} m "
+            f"at {list(center)} (layer {layer})"
+        )
     return mask
 
 

@@ -38,20 +38,30 @@ def plot_convergence(runs, fits, path=None, title: str | None = None) -> Figure:
     for ax, label in zip(axes, labels, strict=False):
         for i, m in enumerate(factors):
             colour = f"C{i % 10}"
-            fit = next((f for f in fits if f["mode"] == label and f["group"] == f"horizon {m:g} h"),
-                       None)
+            fit = next((f for f in fits if f["mode"] == label and f["group"] == f"horizon {m:g} h"), None)
             if fit is None or not fit["x"]:
                 continue
-            ax.plot(np.array(fit["x"]) * 1e3, fit["frequencies_hz"], "o-", color=colour,
-                    label=f"{m:g} h")
+            ax.plot(np.array(fit["x"]) * 1e3, fit["frequencies_hz"], "o-", color=colour, label=f"{m:g} h")
             if "value_hz" in fit:
                 h = np.linspace(0.0, h_max, 100)
-                ax.plot(h * 1e3, fit["value_hz"] + fit["coefficient"] * h ** fit["order"], "--",
-                        color=colour, lw=1)
-                ax.plot([0.0], [fit["value_hz"]], "s", color=colour, mfc="none",
-                        label=f"f_inf {fit['value_hz']:.1f} Hz, p = {fit['order']:.2f}")
-        reference = next((f["reference_hz"] for f in fits if f["mode"] == label
-                          and "reference_hz" in f), None)
+                ax.plot(
+                    h * 1e3,
+                    fit["value_hz"] + fit["coefficient"] * h ** fit["order"],
+                    "--",
+                    color=colour,
+                    lw=1,
+                )
+                ax.plot(
+                    [0.0],
+                    [fit["value_hz"]],
+                    "s",
+                    color=colour,
+                    mfc="none",
+                    label=f"f_inf {fit['value_hz']:.1f} Hz, p = {fit['order']:.2f}",
+                )
+        reference = next(
+            (f["reference_hz"] for f in fits if f["mode"] == label and "reference_hz" in f), None
+        )
         if reference is not None:
             ax.axhline(reference, color="k", ls=":", lw=1, label=f"reference {reference:.1f} Hz")
         ax.set_title(label)
@@ -59,7 +69,7 @@ def plot_convergence(runs, fits, path=None, title: str | None = None) -> Figure:
         ax.set_xlabel("spacing h (mm)")
         ax.set_ylabel("frequency (Hz)")
         ax.legend(fontsize="x-small")
-    for ax in axes[len(labels):]:
+    for ax in axes[len(labels) :]:
         ax.set_visible(False)
     if title:
         fig.suptitle(title)

@@ -16,8 +16,15 @@ from peridyn.analysis.crack import CrackPath  # noqa: E402
 from peridyn.plotting.fields import _save  # noqa: E402
 
 
-def plot_damage_map(points: np.ndarray, u: np.ndarray, phi: np.ndarray, paths: list[CrackPath],
-                    path: Path, scale: float | None = None, title: str = "damage") -> Path:
+def plot_damage_map(
+    points: np.ndarray,
+    u: np.ndarray,
+    phi: np.ndarray,
+    paths: list[CrackPath],
+    path: Path,
+    scale: float | None = None,
+    title: str = "damage",
+) -> Path:
     """Damage index on the deformed configuration x + scale * u with the crack polylines
     (``displaced_polylines``) over it.
 
@@ -36,11 +43,18 @@ def plot_damage_map(points: np.ndarray, u: np.ndarray, phi: np.ndarray, paths: l
     xy = (xy0 + scale * uv) * 1e3
     fig, ax = plt.subplots(figsize=(7, 5))
     order = np.argsort(phi)  # damaged points on top
-    sc = ax.scatter(xy[order, 0], xy[order, 1], c=phi[order], s=4, cmap="inferno_r",
-                    vmin=0.0, vmax=1.0, linewidths=0)
+    sc = ax.scatter(
+        xy[order, 0], xy[order, 1], c=phi[order], s=4, cmap="inferno_r", vmin=0.0, vmax=1.0, linewidths=0
+    )
     for k, line in enumerate(displaced_polylines(xy0, uv, paths, scale)):
-        ax.plot(line[:, 0] * 1e3, line[:, 1] * 1e3, "-", color="tab:cyan", lw=1.5,
-                label="crack paths" if k == 0 else None)
+        ax.plot(
+            line[:, 0] * 1e3,
+            line[:, 1] * 1e3,
+            "-",
+            color="tab:cyan",
+            lw=1.5,
+            label="crack paths" if k == 0 else None,
+        )
     if paths:
         ax.legend(loc="upper right", fontsize=8)
     ax.set_aspect("equal")
@@ -51,8 +65,9 @@ def plot_damage_map(points: np.ndarray, u: np.ndarray, phi: np.ndarray, paths: l
     return _save(fig, path)
 
 
-def displaced_polylines(xy: np.ndarray, uv: np.ndarray, paths: list[CrackPath],
-                        scale: float) -> list[np.ndarray]:
+def displaced_polylines(
+    xy: np.ndarray, uv: np.ndarray, paths: list[CrackPath], scale: float
+) -> list[np.ndarray]:
     """Each path's polyline ((m, 2), m) moved by ``scale`` times the mean in-plane
     displacement of the points of its vertex's 8 nearest (x, y) positions: both faces of the
     crack, so it stays on the opened crack's mid-line. In 3D every point of those positions'

@@ -50,8 +50,7 @@ def plot_dispersion(relations, path=None, title: str | None = None) -> Figure:
         for i, (label, rel) in enumerate(relations.items()):
             branch = rel.branches[name]
             for ax, (attr, _, scale) in zip(row, _PANELS, strict=True):
-                ax.plot(branch.wavenumber, getattr(branch, attr) * scale, color=f"C{i % 10}",
-                        label=label)
+                ax.plot(branch.wavenumber, getattr(branch, attr) * scale, color=f"C{i % 10}", label=label)
         _decorate(row, name, next(iter(relations.values())))
     if len(relations) > 1:
         axes[0, -1].legend(fontsize="small", loc="upper right")
@@ -72,8 +71,7 @@ def plot_study(study: Study, directory, prefix: str = "dispersion") -> list[Path
         curves = study.sweep(parameter)
         if len(curves) > 1:
             path = directory / f"{prefix}_{parameter}.png"
-            plot_dispersion(curves, path,
-                            title=f"{_kind(next(iter(curves.values())))}: {parameter} sweep")
+            plot_dispersion(curves, path, title=f"{_kind(next(iter(curves.values())))}: {parameter} sweep")
             written.append(path)
     return written
 
@@ -83,8 +81,9 @@ def _branches_to_draw(relations) -> list[str]:
     relations = list(relations)
     names = [n for n in ("longitudinal", "shear_1") if n in relations[0].branches]
     if "shear_2" in relations[0].branches and any(
-        not np.allclose(r.branches["shear_2"].frequency, r.branches["shear_1"].frequency,
-                        rtol=1e-9) for r in relations):
+        not np.allclose(r.branches["shear_2"].frequency, r.branches["shear_1"].frequency, rtol=1e-9)
+        for r in relations
+    ):
         names.append("shear_2")
     return names
 
@@ -110,12 +109,18 @@ def _kind(rel: DispersionRelation) -> str:
 
 
 def _describe(rel: DispersionRelation) -> str:
-    return (f"{_kind(rel)}, {rel.influence}, delta = {rel.horizon * 1e3:g} mm, "
-            f"h = {rel.spacing * 1e3:g} mm")
+    return f"{_kind(rel)}, {rel.influence}, delta = {rel.horizon * 1e3:g} mm, h = {rel.spacing * 1e3:g} mm"
 
 
-def plot_mid_planes(results, path, times=None, component: str = "x",
-                    planes=("mid_z", "mid_y"), near: float = 5e-3, clip: float = 0.3) -> Figure:
+def plot_mid_planes(
+    results,
+    path,
+    times=None,
+    component: str = "x",
+    planes=("mid_z", "mid_y"),
+    near: float = 5e-3,
+    clip: float = 0.3,
+) -> Figure:
     """Displacement on the mid planes of a point-excitation run: the ellipsoidal front.
 
     One row per plane probe (``plane_<name>`` series of ``results.h5``, a single
@@ -138,8 +143,9 @@ def plot_mid_planes(results, path, times=None, component: str = "x",
     from peridyn.io.hdf5 import read_array, read_series
 
     points = read_array(results, "geometry/points")
-    fig = Figure(figsize=(4.2 * (3 if times is None else len(times)) + 1, 4.0 * len(planes)),
-                 layout="constrained")
+    fig = Figure(
+        figsize=(4.2 * (3 if times is None else len(times)) + 1, 4.0 * len(planes)), layout="constrained"
+    )
     FigureCanvasAgg(fig)
     axes = None
     for row, name in enumerate(planes):
@@ -161,10 +167,12 @@ def plot_mid_planes(results, path, times=None, component: str = "x",
             image[ib, ia] = values[k]
             lim = clip * float(np.max(np.abs(values[k][far]))) or 1.0
             extent = (grid_a[0] * 1e3, grid_a[-1] * 1e3, grid_b[0] * 1e3, grid_b[-1] * 1e3)
-            shown = ax.imshow(image, origin="lower", extent=extent, cmap="RdBu_r", vmin=-lim,
-                              vmax=lim)
-            ax.set(xlabel=f"{'xyz'[a]} (mm)", ylabel=f"{'xyz'[b]} (mm)",
-                   title=f"u{component} on {name}, t = {t[k] * 1e6:.1f} us")
+            shown = ax.imshow(image, origin="lower", extent=extent, cmap="RdBu_r", vmin=-lim, vmax=lim)
+            ax.set(
+                xlabel=f"{'xyz'[a]} (mm)",
+                ylabel=f"{'xyz'[b]} (mm)",
+                title=f"u{component} on {name}, t = {t[k] * 1e6:.1f} us",
+            )
             fig.colorbar(shown, ax=ax, shrink=0.8, label="m")
     if path is not None:
         fig.savefig(path, format="png", dpi=110)

@@ -33,14 +33,21 @@ def plot_run(directory, body: Body) -> list[Path]:
         u = f["final/u"][...]
         damage = f["final/damage"][...] if "final/damage" in f else None
     if body.dim == 3:
-        written.append(plot_field(body, u[:, 2], "final u_z (m)", directory / "displacement.png",
-                                  cmap="RdBu_r", symmetric=True))
+        written.append(
+            plot_field(
+                body, u[:, 2], "final u_z (m)", directory / "displacement.png", cmap="RdBu_r", symmetric=True
+            )
+        )
     else:
-        written.append(plot_field(body, np.linalg.norm(u, axis=1), "final |u| (m)",
-                                  directory / "displacement.png"))
+        written.append(
+            plot_field(body, np.linalg.norm(u, axis=1), "final |u| (m)", directory / "displacement.png")
+        )
     if damage is not None and damage.max() > 0:
-        written.append(plot_field(body, damage, "damage index", directory / "damage.png",
-                                  cmap="inferno", limits=(0.0, 1.0)))
+        written.append(
+            plot_field(
+                body, damage, "damage index", directory / "damage.png", cmap="inferno", limits=(0.0, 1.0)
+            )
+        )
     return written
 
 
@@ -50,8 +57,7 @@ def plot_sensors(f: h5py.File, path: Path) -> Path:
     names = _names(group)
     t = group["time"][...] * 1e6
     data = group["data"][...]
-    fig, axes = plt.subplots(len(names), 1, figsize=(7, 1.8 + 1.6 * len(names)), squeeze=False,
-                             sharex=True)
+    fig, axes = plt.subplots(len(names), 1, figsize=(7, 1.8 + 1.6 * len(names)), squeeze=False, sharex=True)
     for k, (ax, name) in enumerate(zip(axes[:, 0], names, strict=True)):
         for c in range(3):
             ax.plot(t, data[:, k, c], label=f"u{COMPONENT_NAMES[c]}")
@@ -84,16 +90,30 @@ def plot_bscan(f: h5py.File, name: str, path: Path) -> Path:
     for c, ax in enumerate(axes):
         field = data[:, :, c]
         lim = np.max(np.abs(field)) or 1.0
-        ax.imshow(field, aspect="auto", origin="lower", cmap="RdBu_r", vmin=-lim, vmax=lim,
-                  extent=(distance[0], distance[-1], t[0], t[-1]))
+        ax.imshow(
+            field,
+            aspect="auto",
+            origin="lower",
+            cmap="RdBu_r",
+            vmin=-lim,
+            vmax=lim,
+            extent=(distance[0], distance[-1], t[0], t[-1]),
+        )
         ax.set_title(f"u{COMPONENT_NAMES[c]} along line '{name}'")
         ax.set_xlabel("distance along the line (mm)")
     axes[0].set_ylabel("time (us)")
     return _save(fig, path)
 
 
-def plot_field(body: Body, values: np.ndarray, label: str, path: Path, cmap="viridis",
-               limits=None, symmetric: bool = False) -> Path:
+def plot_field(
+    body: Body,
+    values: np.ndarray,
+    label: str,
+    path: Path,
+    cmap="viridis",
+    limits=None,
+    symmetric: bool = False,
+) -> Path:
     """Colour map of a point field: the whole body in 2D, the top layer (largest z) in 3D.
 
     The points are triangulated; triangles longer than two spacings (holes, cracks'
@@ -105,8 +125,10 @@ def plot_field(body: Body, values: np.ndarray, label: str, path: Path, cmap="vir
         sel = x[:, 2] >= x[:, 2].max() - 0.5 * np.min(body.cells[:, 2])
     xs, ys, vs = x[sel, 0] * 1e3, x[sel, 1] * 1e3, values[sel]
     tri = Triangulation(xs, ys)
-    edges = np.hypot(np.diff(xs[tri.triangles], axis=1, append=xs[tri.triangles][:, :1]),
-                     np.diff(ys[tri.triangles], axis=1, append=ys[tri.triangles][:, :1]))
+    edges = np.hypot(
+        np.diff(xs[tri.triangles], axis=1, append=xs[tri.triangles][:, :1]),
+        np.diff(ys[tri.triangles], axis=1, append=ys[tri.triangles][:, :1]),
+    )
     tri.set_mask(edges.max(axis=1) > 2.01 * body.spacing * 1e3 * np.sqrt(2))
     if limits is None and symmetric:
         lim = float(np.max(np.abs(vs))) or 1.0

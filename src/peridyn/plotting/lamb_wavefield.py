@@ -39,9 +39,14 @@ _COORD_DECIMALS = 9
 DYNAMIC_RANGE_DB = 40.0
 
 
-def plot_wavefield_snapshots(results: str | os.PathLike, path: str | os.PathLike, times,
-                             components: str = "xyz", layers=None,
-                             series: str = "field_u") -> Path:
+def plot_wavefield_snapshots(
+    results: str | os.PathLike,
+    path: str | os.PathLike,
+    times,
+    components: str = "xyz",
+    layers=None,
+    series: str = "field_u",
+) -> Path:
     """Maps of displacement components on each layer at chosen times.
 
     One row per (time, layer), one column per component; each column shares
@@ -78,16 +83,22 @@ def plot_wavefield_snapshots(results: str | os.PathLike, path: str | os.PathLike
         limit = float(np.max(np.abs(records[:, :, c]))) or 1.0
         for row, (t, record, i) in enumerate(rows):
             image = _draw_layer(axes[row, col], grids[i], record[:, c], limit)
-            axes[row, col].set_title(f"u{COMPONENTS[c]}, layer {i}, t = {t * 1e6:.1f} us",
-                                     fontsize=9)
+            axes[row, col].set_title(f"u{COMPONENTS[c]}, layer {i}, t = {t * 1e6:.1f} us", fontsize=9)
         fig.colorbar(image, ax=axes[:, col].tolist(), label=f"u{COMPONENTS[c]} (m)", shrink=0.6)
     return _save(fig, path)
 
 
-def plot_fk_map(freq, k, magnitude, path: str | os.PathLike,
-                theory: dict[str, DispersionBranch] | None = None,
-                peaks: dict[str, tuple[float, float]] | None = None, f_max: float | None = None,
-                k_max: float | None = None, dynamic_range_db: float = DYNAMIC_RANGE_DB) -> Path:
+def plot_fk_map(
+    freq,
+    k,
+    magnitude,
+    path: str | os.PathLike,
+    theory: dict[str, DispersionBranch] | None = None,
+    peaks: dict[str, tuple[float, float]] | None = None,
+    f_max: float | None = None,
+    k_max: float | None = None,
+    dynamic_range_db: float = DYNAMIC_RANGE_DB,
+) -> Path:
     """Frequency-wavenumber map (dB) with Rayleigh-Lamb curves overlaid.
 
     Parameters
@@ -116,30 +127,52 @@ def plot_fk_map(freq, k, magnitude, path: str | os.PathLike,
     freq, k = np.asarray(freq, dtype=float), np.asarray(k, dtype=float)
     fig, axes = _figure(1, 1, (7.5, 5.5))
     ax = axes[0, 0]
-    image = ax.pcolormesh(k, freq / 1e3, _decibels(magnitude, dynamic_range_db), cmap="viridis",
-                          shading="nearest", rasterized=True)
+    image = ax.pcolormesh(
+        k,
+        freq / 1e3,
+        _decibels(magnitude, dynamic_range_db),
+        cmap="viridis",
+        shading="nearest",
+        rasterized=True,
+    )
     fig.colorbar(image, ax=ax, label="magnitude (dB)")
     signs = (1.0, -1.0) if k.min() < 0 else (1.0,)
     for n, (label, branch) in enumerate((theory or {}).items()):
         for sign in signs:
-            ax.plot(sign * branch.wavenumber_rad_m, branch.frequency_hz / 1e3, color=f"C{n % 10}",
-                    lw=1.0, ls="-" if label.startswith("S") else "--",
-                    label=label if sign > 0 else None)
+            ax.plot(
+                sign * branch.wavenumber_rad_m,
+                branch.frequency_hz / 1e3,
+                color=f"C{n % 10}",
+                lw=1.0,
+                ls="-" if label.startswith("S") else "--",
+                label=label if sign > 0 else None,
+            )
     for label, (f, kp) in (peaks or {}).items():
         ax.plot(kp, f / 1e3, "w+", ms=12, mew=2)
         ax.annotate(label, (kp, f / 1e3), color="w", xytext=(5, 5), textcoords="offset points")
     k_max = k_max if k_max is not None else float(np.max(np.abs(k)))
-    ax.set(xlim=(-k_max if len(signs) == 2 else 0.0, k_max),
-           ylim=(0.0, (f_max if f_max is not None else freq[-1]) / 1e3),
-           xlabel="wavenumber (rad/m)", ylabel="frequency (kHz)", title="Frequency-wavenumber map")
+    ax.set(
+        xlim=(-k_max if len(signs) == 2 else 0.0, k_max),
+        ylim=(0.0, (f_max if f_max is not None else freq[-1]) / 1e3),
+        xlabel="wavenumber (rad/m)",
+        ylabel="frequency (kHz)",
+        title="Frequency-wavenumber map",
+    )
     if theory:
         ax.legend(fontsize="small", loc="upper right", title="Rayleigh-Lamb")
     return _save(fig, path)
 
 
-def plot_kxky_maps(kx, ky, maps, frequencies, path: str | os.PathLike,
-                   theory: list[LambMode] | None = None, k_max: float | None = None,
-                   dynamic_range_db: float = DYNAMIC_RANGE_DB) -> Path:
+def plot_kxky_maps(
+    kx,
+    ky,
+    maps,
+    frequencies,
+    path: str | os.PathLike,
+    theory: list[LambMode] | None = None,
+    k_max: float | None = None,
+    dynamic_range_db: float = DYNAMIC_RANGE_DB,
+) -> Path:
     """(kx, ky) maps (dB) at several frequencies with the theoretical rings.
 
     Parameters
@@ -166,24 +199,36 @@ def plot_kxky_maps(kx, ky, maps, frequencies, path: str | os.PathLike,
     maps = np.asarray(maps, dtype=float)
     frequencies = np.atleast_1d(np.asarray(frequencies, dtype=float))
     if maps.shape != (len(frequencies), len(kx), len(ky)):
-        raise InputError(f"maps must have shape ({len(frequencies)}, {len(kx)}, {len(ky)}), "
-                         f"got {maps.shape}")
+        raise InputError(f"maps must have shape ({len(frequencies)}, {len(kx)}, {len(ky)}), got {maps.shape}")
     fig, axes = _figure(1, len(frequencies), (4.2 * len(frequencies), 4.2))
     for ax, f, kmap in zip(axes[0], frequencies, maps, strict=True):
-        ax.pcolormesh(kx, ky, _decibels(kmap, dynamic_range_db).T, cmap="viridis",
-                      shading="nearest", rasterized=True)
+        ax.pcolormesh(
+            kx, ky, _decibels(kmap, dynamic_range_db).T, cmap="viridis", shading="nearest", rasterized=True
+        )
         for n, mode in enumerate(m for m in theory or [] if np.isclose(m.frequency_hz, f)):
             k = mode.wavenumber_rad_m
             ax.add_patch(Circle((0.0, 0.0), k, fill=False, ls="--", lw=1.0, color=f"C{n + 1}"))
             ax.annotate(mode.mode, (k / np.sqrt(2.0), k / np.sqrt(2.0)), color=f"C{n + 1}")
         half = k_max if k_max is not None else float(min(np.max(np.abs(kx)), np.max(np.abs(ky))))
-        ax.set(xlim=(-half, half), ylim=(-half, half), aspect="equal", title=f"{f / 1e3:g} kHz",
-               xlabel="kx (rad/m)", ylabel="ky (rad/m)")
+        ax.set(
+            xlim=(-half, half),
+            ylim=(-half, half),
+            aspect="equal",
+            title=f"{f / 1e3:g} kHz",
+            xlabel="kx (rad/m)",
+            ylabel="ky (rad/m)",
+        )
     return _save(fig, path)
 
 
-def plot_through_thickness(results: str | os.PathLike, path: str | os.PathLike, time: float,
-                           center, x_range=None, series: str = "field_u") -> Path:
+def plot_through_thickness(
+    results: str | os.PathLike,
+    path: str | os.PathLike,
+    time: float,
+    center,
+    x_range=None,
+    series: str = "field_u",
+) -> Path:
     """Displacement on the x-z cut through a point (the actuator): vectors and profiles.
 
     The top panel shows (ux, uz) arrows at the points of the cut (z
@@ -222,8 +267,9 @@ def plot_through_thickness(results: str | os.PathLike, path: str | os.PathLike, 
         raise InputError(f"no point on the cut through {list(center)} within x_range {x_range}")
     x, z, u = points[cut, 0] * 1e3, points[cut, 2] * 1e3, records[0][cut]
     fig, axes = _figure(3, 1, (9.0, 8.0))
-    axes[0, 0].quiver(x, z, u[:, 0], u[:, 2], np.hypot(u[:, 0], u[:, 2]), cmap="viridis",
-                      angles="xy", pivot="middle")
+    axes[0, 0].quiver(
+        x, z, u[:, 0], u[:, 2], np.hypot(u[:, 0], u[:, 2]), cmap="viridis", angles="xy", pivot="middle"
+    )
     axes[0, 0].set(ylabel="z (mm)", title=f"(ux, uz) on the x-z cut, t = {found[0] * 1e6:.1f} us")
     layer, n_layers = _layers(points[cut])
     for i in range(n_layers):
@@ -319,11 +365,13 @@ def _records_near(results, series: str, times) -> tuple[np.ndarray, np.ndarray]:
 def _draw_layer(ax, grid, values: np.ndarray, limit: float):
     """Image of one layer's values (record order) on its grid, mm axes."""
     image = grid.scatter(values, fill=np.nan).T
-    extent = 1e3 * np.array([grid.x[0] - grid.dx / 2, grid.x[-1] + grid.dx / 2,
-                             grid.y[0] - grid.dy / 2, grid.y[-1] + grid.dy / 2])
+    extent = 1e3 * np.array(
+        [grid.x[0] - grid.dx / 2, grid.x[-1] + grid.dx / 2, grid.y[0] - grid.dy / 2, grid.y[-1] + grid.dy / 2]
+    )
     ax.set(xlabel="x (mm)", ylabel="y (mm)")
-    return ax.imshow(image, origin="lower", extent=extent, cmap="RdBu_r", vmin=-limit, vmax=limit,
-                     interpolation="nearest")
+    return ax.imshow(
+        image, origin="lower", extent=extent, cmap="RdBu_r", vmin=-limit, vmax=limit, interpolation="nearest"
+    )
 
 
 def _decibels(magnitude, dynamic_range_db: float) -> np.ndarray:

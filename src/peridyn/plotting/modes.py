@@ -35,8 +35,14 @@ def plot_mode_shapes(body, result, types, path) -> Path:
         in_plane = types[i].type in ("in-plane bending", "other")
         values = np.linalg.norm(shape[top, :2], axis=1) if in_plane else shape[top, 2]
         lim = float(np.max(np.abs(values))) or 1.0
-        ax.tripcolor(tri, values, cmap="viridis" if in_plane else "RdBu_r",
-                     vmin=0 if in_plane else -lim, vmax=lim, shading="gouraud")
+        ax.tripcolor(
+            tri,
+            values,
+            cmap="viridis" if in_plane else "RdBu_r",
+            vmin=0 if in_plane else -lim,
+            vmax=lim,
+            shading="gouraud",
+        )
         ax.set_aspect("equal")
         ax.set_title(f"{result.frequencies[i]:.1f} Hz: {types[i]}", fontsize=9)
         ax.set_xticks([])

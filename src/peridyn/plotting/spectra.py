@@ -20,8 +20,7 @@ def plot_spectra(signals: dict, dt: float, f0: float, path, title: str = "") -> 
         freq, spectrum = amplitude_spectrum(signal, dt)
         ratio = second_harmonic_ratio(signal, dt, f0)
         keep = freq <= 4 * f0
-        ax.semilogy(freq[keep] / 1e3, spectrum[keep] / spectrum.max(),
-                    label=f"{label} (A2/A1 = {ratio:.3g})")
+        ax.semilogy(freq[keep] / 1e3, spectrum[keep] / spectrum.max(), label=f"{label} (A2/A1 = {ratio:.3g})")
     for n in (1, 2, 3):
         ax.axvline(n * f0 / 1e3, color="0.6", ls="--", lw=0.8)
     ax.set_ylim(1e-5, 2.0)

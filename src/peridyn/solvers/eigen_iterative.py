@@ -48,9 +48,7 @@ FIRST_PASS = 15
 TOLERANCE_ROUNDS = 4
 
 
-
-def lobpcg_modes(model: Model, n_modes: int, dofs: np.ndarray, max_iterations: int = 1000,
-                 seed: int = 0):
+def lobpcg_modes(model: Model, n_modes: int, dofs: np.ndarray, max_iterations: int = 1000, seed: int = 0):
     """The ``n_modes`` lowest eigenpairs on the ``dofs``, rigid modes first.
 
     Returns
@@ -77,8 +75,10 @@ def lobpcg_modes(model: Model, n_modes: int, dofs: np.ndarray, max_iterations: i
     precond = amg_preconditioner(proxy, m, near_null, shift, proxy_aggregates(model, dofs))
     block = min(n_elastic + GUARD_VECTORS, len(dofs) // 5)
     if block < n_elastic:
-        raise InputError(f"lobpcg: {n_elastic} elastic modes need at least {5 * n_elastic} free "
-                         f"dofs, the model has {len(dofs)}; use eigensolver shift-invert")
+        raise InputError(
+            f"lobpcg: {n_elastic} elastic modes need at least {5 * n_elastic} free "
+            f"dofs, the model has {len(dofs)}; use eigensolver shift-invert"
+        )
     x = np.random.default_rng(seed).standard_normal((len(dofs), block))
     M = sp.diags(m)
     y = rigid if rigid.shape[1] else None
@@ -91,18 +91,25 @@ def lobpcg_modes(model: Model, n_modes: int, dofs: np.ndarray, max_iterations: i
         lam, x = lam[order], x[:, order]
         mx = np.linalg.norm(M @ x[:, :n_elastic], axis=0)
         kx = K @ x[:, :n_elastic]
-        relative = np.linalg.norm(kx - (M @ x[:, :n_elastic]) * lam[:n_elastic], axis=0) / \
-            np.linalg.norm(kx, axis=0)
+        relative = np.linalg.norm(kx - (M @ x[:, :n_elastic]) * lam[:n_elastic], axis=0) / np.linalg.norm(
+            kx, axis=0
+        )
         if relative.max() < RESIDUAL_TARGET:
             break
         tol = 0.3 * RESIDUAL_TARGET * float(np.min(np.abs(lam[:n_elastic]) * mx))
         lam, x = _quiet_lobpcg(K, x, M, precond, y, tol, max_iterations)
     else:
-        raise InputError(f"lobpcg did not reach the residual {RESIDUAL_TARGET:g} in "
-                         f"{TOLERANCE_ROUNDS} rounds of {max_iterations} iterations (worst "
-                         f"{relative.max():.2e}); use eigensolver shift-invert")
-    return (np.concatenate([lam_rigid, lam[:n_elastic]]),
-            np.hstack([rigid[:, :n_rigid], x[:, :n_elastic]]), n_rigid, K)
+        raise InputError(
+            f"lobpcg did not reach the residual {RESIDUAL_TARGET:g} in "
+            f"{TOLERANCE_ROUNDS} rounds of {max_iterations} iterations (worst "
+            f"{relative.max():.2e}); use eigensolver shift-invert"
+        )
+    return (
+        np.concatenate([lam_rigid, lam[:n_elastic]]),
+        np.hstack([rigid[:, :n_rigid], x[:, :n_elastic]]),
+        n_rigid,
+        K,
+    )
 
 
 def _quiet_lobpcg(K, x, M, precond, y, tol, max_iterations):

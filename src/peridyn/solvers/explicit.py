@@ -48,9 +48,17 @@ class ExplicitSolver:
         Short-range forces added to the model's force; their stiffness lowers the stable step.
     """
 
-    def __init__(self, model: Model, loading: Loading | None = None, dt: float | None = None,
-                 safety: float = 0.8, damping: float = 0.0, damage: BondDamage | None = None,
-                 check_every: int = 50, contact: Contact | None = None):
+    def __init__(
+        self,
+        model: Model,
+        loading: Loading | None = None,
+        dt: float | None = None,
+        safety: float = 0.8,
+        damping: float = 0.0,
+        damage: BondDamage | None = None,
+        check_every: int = 50,
+        contact: Contact | None = None,
+    ):
         if not 0 < safety <= 1:
             raise InputError(f"time-step safety factor must lie in (0, 1], got {safety!r}")
         damping = _damping_coefficients(damping, model.body.n_points)
@@ -159,11 +167,13 @@ def _damping_coefficients(damping, n_points: int) -> np.ndarray:
     """``damping`` as a (1,) or (n_points,) float64 array, checked."""
     c = np.atleast_1d(np.asarray(damping, dtype=float))
     if c.ndim != 1 or c.size not in (1, n_points):
-        raise InputError(f"damping must be a number or one value per point ({n_points}), got "
-                         f"shape {np.shape(damping)}")
+        raise InputError(
+            f"damping must be a number or one value per point ({n_points}), got shape {np.shape(damping)}"
+        )
     if not np.all(np.isfinite(c) & (c >= 0)):
-        raise InputError("damping must be non-negative and finite (1/s)"
-                         + (f", got {damping!r}" if c.size == 1 else ""))
+        raise InputError(
+            "damping must be non-negative and finite (1/s)" + (f", got {damping!r}" if c.size == 1 else "")
+        )
     return c
 
 
@@ -172,6 +182,10 @@ def check_finite(state: State) -> None:
     bad = ~np.isfinite(state.u).all(axis=1) | ~np.isfinite(state.v).all(axis=1)
     if bad.any():
         point = int(np.flatnonzero(bad)[0])
-        raise InstabilityError(state.step, state.time, point,
-                               "non-finite displacement or velocity (time step too large, or a "
-                               "load too violent for the discretisation?)")
+        raise InstabilityError(
+            state.step,
+            state.time,
+            point,
+            "non-finite displacement or velocity (time step too large, or a "
+            "load too violent for the discretisation?)",
+        )

@@ -68,18 +68,21 @@ class ModalResult:
     def elastic(self) -> ModalResult:
         """The elastic modes only."""
         keep = ~self.rigid
-        return ModalResult(self.frequencies[keep], self.shapes[keep], self.residuals[keep],
-                           self.rigid[keep])
-
+        return ModalResult(self.frequencies[keep], self.shapes[keep], self.residuals[keep], self.rigid[keep])
 
 
 #: Eigensolvers of ``modal_analysis``.
 EIGENSOLVERS = ("shift-invert", "lobpcg")
 
 
-def modal_analysis(model: Model, n_modes: int = 12, fixed: np.ndarray | None = None,
-                   shift: float | None = None, tol: float = 1e-10,
-                   method: str = "shift-invert") -> ModalResult:
+def modal_analysis(
+    model: Model,
+    n_modes: int = 12,
+    fixed: np.ndarray | None = None,
+    shift: float | None = None,
+    tol: float = 1e-10,
+    method: str = "shift-invert",
+) -> ModalResult:
     """The ``n_modes`` lowest modes of ``model`` (free-free unless ``fixed`` dofs are given).
 
     Parameters
@@ -138,7 +141,4 @@ def _result(lam, vecs, K, m, dofs, n_points, k_max, known_rigid) -> ModalResult:
     scale = np.where(rigid, k_max * np.linalg.norm(vecs, axis=0), np.linalg.norm(kx, axis=0))
     shapes = np.zeros((len(lam), n_points * 3))
     shapes[:, dofs] = vecs.T
-    return ModalResult(freqs, shapes.reshape(len(lam), -1, 3), resid / np.maximum(scale, 1e-300),
-                       rigid)
-
-
+    return ModalResult(freqs, shapes.reshape(len(lam), -1, 3), resid / np.maximum(scale, 1e-300), rigid)

@@ -59,16 +59,23 @@ class NewmarkSolver:
         effective tangent well conditioned, so CG needs few iterations on large bodies).
     """
 
-    def __init__(self, model: Model, loading: Loading | None = None, dt: float = 20e-9,
-                 tolerance: float = 1e-10, max_iterations: int = 20, damping: float = 0.0,
-                 damage: BondDamage | None = None, linear_solver: str = "lu"):
+    def __init__(
+        self,
+        model: Model,
+        loading: Loading | None = None,
+        dt: float = 20e-9,
+        tolerance: float = 1e-10,
+        max_iterations: int = 20,
+        damping: float = 0.0,
+        damage: BondDamage | None = None,
+        linear_solver: str = "lu",
+    ):
         if not dt > 0:
             raise InputError(f"time step must be positive, got {dt!r}")
         if not tolerance > 0:
             raise InputError(f"Newmark displacement tolerance must be positive, got {tolerance!r}")
         if int(max_iterations) != max_iterations or max_iterations < 1:
-            raise InputError(f"Newmark max_iterations must be a positive integer, got "
-                             f"{max_iterations!r}")
+            raise InputError(f"Newmark max_iterations must be a positive integer, got {max_iterations!r}")
         if damping < 0:
             raise InputError(f"damping must be non-negative, got {damping!r}")
         check_linear_solver(linear_solver)

@@ -85,10 +85,18 @@ class NewtonResult:
     steps: list
 
 
-def newton(model: Model, loading: Loading, load_steps: int = 1, time: float = 1.0,
-           u0: np.ndarray | None = None, tolerance: float = 1e-8, max_iterations: int = 30,
-           damage: BondDamage | None = None, max_breaking_rounds: int = 100,
-           linear_solver: str = "lu") -> NewtonResult:
+def newton(
+    model: Model,
+    loading: Loading,
+    load_steps: int = 1,
+    time: float = 1.0,
+    u0: np.ndarray | None = None,
+    tolerance: float = 1e-8,
+    max_iterations: int = 30,
+    damage: BondDamage | None = None,
+    max_breaking_rounds: int = 100,
+    linear_solver: str = "lu",
+) -> NewtonResult:
     """Equilibrium under the loads ramped in ``load_steps`` steps up to ``time`` (s).
 
     Parameters
@@ -108,8 +116,11 @@ def newton(model: Model, loading: Loading, load_steps: int = 1, time: float = 1.
     """
     if not tolerance > 0:
         raise InputError(f"Newton tolerance must be positive, got {tolerance!r}")
-    for name, value in (("load_steps", load_steps), ("max_iterations", max_iterations),
-                        ("max_breaking_rounds", max_breaking_rounds)):
+    for name, value in (
+        ("load_steps", load_steps),
+        ("max_iterations", max_iterations),
+        ("max_breaking_rounds", max_breaking_rounds),
+    ):
         if int(value) != value or value < 1:
             raise InputError(f"Newton {name} must be a positive integer, got {value!r}")
     check_linear_solver(linear_solver)
@@ -128,8 +139,9 @@ def newton(model: Model, loading: Loading, load_steps: int = 1, time: float = 1.
         b = loading.body_force_density(t, np.zeros((n, 3)))
         step = NewtonStep(t)
         for _ in range(max_breaking_rounds + 1):
-            u, history, converged = equilibrate(model, u, b, loading.constrained, tolerance,
-                                                max_iterations, linear_solver)
+            u, history, converged = equilibrate(
+                model, u, b, loading.constrained, tolerance, max_iterations, linear_solver
+            )
             step.residuals.append(history)
             iterations += len(history) - 1
             residual = history[-1]
@@ -148,9 +160,15 @@ def newton(model: Model, loading: Loading, load_steps: int = 1, time: float = 1.
     return NewtonResult(u, float(residual), iterations, converged, broken_total, steps)
 
 
-def equilibrate(model: Model, u: np.ndarray, b: np.ndarray, constrained: np.ndarray,
-                tolerance: float, max_iterations: int,
-                linear_solver: str = "lu") -> tuple[np.ndarray, list, bool]:
+def equilibrate(
+    model: Model,
+    u: np.ndarray,
+    b: np.ndarray,
+    constrained: np.ndarray,
+    tolerance: float,
+    max_iterations: int,
+    linear_solver: str = "lu",
+) -> tuple[np.ndarray, list, bool]:
     """Newton iterations at fixed loads from ``u`` (n, 3), m; ``b`` body force density N/m^3.
 
     Returns the displacement, the relative residual before each iteration and at the
@@ -191,8 +209,10 @@ CG_RTOL = 1e-12
 def check_linear_solver(name: str) -> None:
     """Raise InputError unless ``name`` is one of ``LINEAR_SOLVERS``."""
     if name not in LINEAR_SOLVERS:
-        raise InputError(f"unknown linear solver {name!r}{did_you_mean(name, LINEAR_SOLVERS)}; "
-                         f"choose one of {LINEAR_SOLVERS}")
+        raise InputError(
+            f"unknown linear solver {name!r}{did_you_mean(name, LINEAR_SOLVERS)}; "
+            f"choose one of {LINEAR_SOLVERS}"
+        )
 
 
 def solve_held(k_ff: sp.spmatrix, rhs: np.ndarray, method: str = "lu") -> np.ndarray:
@@ -231,8 +251,10 @@ def _jacobi_cg(a: sp.csr_matrix, rhs: np.ndarray) -> np.ndarray:
         z = inv_diag * r
         rz, rz_old = r @ z, rz
         p = z + (rz / rz_old) * p
-    raise InputError(f"conjugate gradients did not reach {CG_RTOL:g} in {10 * len(rhs)} "
-                     "iterations (is the tangent indefinite?): use linear_solver 'lu'")
+    raise InputError(
+        f"conjugate gradients did not reach {CG_RTOL:g} in {10 * len(rhs)} "
+        "iterations (is the tangent indefinite?): use linear_solver 'lu'"
+    )
 
 
 def rigid_support(model: Model) -> np.ndarray:

@@ -49,10 +49,17 @@ class RelaxationResult:
     bonds_broken: int = 0
 
 
-def relax(model: Model, loading: Loading, time: float = 0.0, u0: np.ndarray | None = None,
-          tolerance: float = 1e-6, max_iterations: int = 200_000,
-          damage: BondDamage | None = None, check_every: int = 20,
-          contact: Contact | None = None) -> RelaxationResult:
+def relax(
+    model: Model,
+    loading: Loading,
+    time: float = 0.0,
+    u0: np.ndarray | None = None,
+    tolerance: float = 1e-6,
+    max_iterations: int = 200_000,
+    damage: BondDamage | None = None,
+    check_every: int = 20,
+    contact: Contact | None = None,
+) -> RelaxationResult:
     """Find the static equilibrium under the loads evaluated at ``time`` (s).
 
     Parameters
@@ -76,7 +83,7 @@ def relax(model: Model, loading: Loading, time: float = 0.0, u0: np.ndarray | No
     loading.apply_kinematics(time, 1.0, u, v)
     v[:] = 0.0
     free = ~loading.constrained
-    free[:, model.body.dim:] = False
+    free[:, model.body.dim :] = False
     bound = model.stiffness_bound()
     if contact is not None:
         bound = bound + contact.stiffness_bound()

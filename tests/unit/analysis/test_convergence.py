@@ -19,11 +19,14 @@ def _exact(h):
     return A + B * np.asarray(h) ** P
 
 
-@pytest.mark.parametrize("spacings", [
-    [1e-3, 1.5e-3, 2.25e-3],            # constant ratio 1.5
-    [0.4e-3, 0.667e-3, 1e-3],           # varying ratio (the thesis's 625k, 135k, 40k grids)
-    [2.25e-3, 1e-3, 1.5e-3],            # any order in
-])
+@pytest.mark.parametrize(
+    "spacings",
+    [
+        [1e-3, 1.5e-3, 2.25e-3],  # constant ratio 1.5
+        [0.4e-3, 0.667e-3, 1e-3],  # varying ratio (the thesis's 625k, 135k, 40k grids)
+        [2.25e-3, 1e-3, 1.5e-3],  # any order in
+    ],
+)
 def test_three_points_recover_order_and_limit_exactly(spacings):
     fit = richardson(spacings, _exact(spacings))
     assert abs(fit.order - P) < 1e-10
@@ -87,13 +90,16 @@ def test_stagnating_values_are_refused():
         richardson([1.0, 2.0, 4.0], [5.0, 5.0, 6.0])
 
 
-@pytest.mark.parametrize("spacings, values, message", [
-    ([1.0, 2.0], [1.0, 2.0], "at least three resolutions, got 2"),
-    ([1.0, 2.0, 2.0], [1.0, 2.0, 3.0], "spacings must differ, got 2 twice"),
-    ([1.0, -2.0, 3.0], [1.0, 2.0, 3.0], "spacings must be positive"),
-    ([1.0, 2.0, 3.0], [1.0, np.nan, 3.0], "finite numbers"),
-    ([1.0, 2.0, 3.0], [1.0, 2.0], "3 spacings but 2 values"),
-])
+@pytest.mark.parametrize(
+    "spacings, values, message",
+    [
+        ([1.0, 2.0], [1.0, 2.0], "at least three resolutions, got 2"),
+        ([1.0, 2.0, 2.0], [1.0, 2.0, 3.0], "spacings must differ, got 2 twice"),
+        ([1.0, -2.0, 3.0], [1.0, 2.0, 3.0], "spacings must be positive"),
+        ([1.0, 2.0, 3.0], [1.0, np.nan, 3.0], "finite numbers"),
+        ([1.0, 2.0, 3.0], [1.0, 2.0], "3 spacings but 2 values"),
+    ],
+)
 def test_bad_input_is_named(spacings, values, message):
     with pytest.raises(InputError, match=message):
         richardson(spacings, values)

@@ -52,18 +52,26 @@ def test_continuous_lps_long_wave_limits_are_classical(influence, horizon):
     assert rel.branches["shear_2"].long_wave_limit == pytest.approx(CS, rel=1e-4)
 
 
-@pytest.mark.parametrize(("model", "dim", "plane", "expected"), [
-    # PMB implies nu = 1/4 (3D, plane strain) or 1/3 (plane stress): rho c^2 = (9/5) K and
-    # (3/5) K with K = 2E/3 in 3D; 2D (3/2) kappa and kappa/2; 1D rho c^2 = E.
-    ("pmb", 3, "stress", (np.sqrt(1.2 * MARAGING_STEEL.E / RHO), np.sqrt(0.4 * MARAGING_STEEL.E / RHO))),
-    ("pmb", 2, "stress", (np.sqrt(9 / 8 * MARAGING_STEEL.E / RHO), np.sqrt(3 / 8 * MARAGING_STEEL.E / RHO))),
-    ("pmb", 2, "strain", (np.sqrt(1.2 * MARAGING_STEEL.E / RHO), np.sqrt(0.4 * MARAGING_STEEL.E / RHO))),
-    ("pmb", 1, "stress", (np.sqrt(MARAGING_STEEL.E / RHO), None)),
-    # LPS 2D: rho cL^2 = kappa + mu with the in-plane bulk modulus; 1D: the bar speed.
-    ("lps", 2, "stress", MARAGING_STEEL.classical_speeds(2, "stress")),
-    ("lps", 2, "strain", MARAGING_STEEL.classical_speeds(2, "strain")),
-    ("lps", 1, "stress", (np.sqrt(MARAGING_STEEL.E / RHO), None)),
-])
+@pytest.mark.parametrize(
+    ("model", "dim", "plane", "expected"),
+    [
+        # PMB implies nu = 1/4 (3D, plane strain) or 1/3 (plane stress): rho c^2 = (9/5) K and
+        # (3/5) K with K = 2E/3 in 3D; 2D (3/2) kappa and kappa/2; 1D rho c^2 = E.
+        ("pmb", 3, "stress", (np.sqrt(1.2 * MARAGING_STEEL.E / RHO), np.sqrt(0.4 * MARAGING_STEEL.E / RHO))),
+        (
+            "pmb",
+            2,
+            "stress",
+            (np.sqrt(9 / 8 * MARAGING_STEEL.E / RHO), np.sqrt(3 / 8 * MARAGING_STEEL.E / RHO)),
+        ),
+        ("pmb", 2, "strain", (np.sqrt(1.2 * MARAGING_STEEL.E / RHO), np.sqrt(0.4 * MARAGING_STEEL.E / RHO))),
+        ("pmb", 1, "stress", (np.sqrt(MARAGING_STEEL.E / RHO), None)),
+        # LPS 2D: rho cL^2 = kappa + mu with the in-plane bulk modulus; 1D: the bar speed.
+        ("lps", 2, "stress", MARAGING_STEEL.classical_speeds(2, "stress")),
+        ("lps", 2, "strain", MARAGING_STEEL.classical_speeds(2, "strain")),
+        ("lps", 1, "stress", (np.sqrt(MARAGING_STEEL.E / RHO), None)),
+    ],
+)
 @pytest.mark.parametrize("influence", ["constant", "inverse", "gaussian"])
 def test_continuous_long_wave_limits_other_models_and_dimensions(model, dim, plane, expected, influence):
     rel = dispersion_relation(model, MARAGING_STEEL, 3e-3, H, influence, dim=dim, plane=plane, points=2)
@@ -84,14 +92,17 @@ def test_continuous_lps_matches_closed_form_bessel_integrals():
         return spherical_jn(n, x)
 
     def longitudinal(k):
-        pair = 4 * np.pi * alpha * quad(lambda r: r**2 * 2 / 3 * (1 - j(0, k * r) + 2 * j(2, k * r)),
-                                        0, delta)[0]
+        pair = (
+            4
+            * np.pi
+            * alpha
+            * quad(lambda r: r**2 * 2 / 3 * (1 - j(0, k * r) + 2 * j(2, k * r)), 0, delta)[0]
+        )
         g = 3 / m * 2 * np.pi * quad(lambda r: r**3 * 2 * j(1, k * r), 0, delta)[0]
         return pair + (K - 5 * MU / 3) * g**2
 
     def shear(k):
-        return 2 * np.pi * alpha * quad(lambda r: r**2 * 4 / 3 * (1 - j(0, k * r) - j(2, k * r)),
-                                        0, delta)[0]
+        return 2 * np.pi * alpha * quad(lambda r: r**2 * 4 / 3 * (1 - j(0, k * r) - j(2, k * r)), 0, delta)[0]
 
     k = np.array([300.0, 1000.0, 2000.0, 3000.0])
     rel = dispersion_relation("lps", MARAGING_STEEL, delta, H, wavenumbers=k)
@@ -110,18 +121,22 @@ def test_discrete_limits_within_1p5_percent_at_3_dx():
     assert shear == pytest.approx(3200.0, rel=0.015)
 
 
-@pytest.mark.parametrize(("factor", "partial", "p_error", "s_error"), [
-    # VALIDATION.md, "Discretisation facts" (P along x and S, percent).
-    (1.4143, False, 0.0, 0.0),
-    (2.015, False, 3.4, -5.3),
-    (2.015, True, 0.7, -1.1),
-    (3.015, False, -3.8, 5.4),
-    (3.015, True, 0.2, -0.3),
-    (5.015, False, -1.0, 1.5),
-])
+@pytest.mark.parametrize(
+    ("factor", "partial", "p_error", "s_error"),
+    [
+        # VALIDATION.md, "Discretisation facts" (P along x and S, percent).
+        (1.4143, False, 0.0, 0.0),
+        (2.015, False, 3.4, -5.3),
+        (2.015, True, 0.7, -1.1),
+        (3.015, False, -3.8, 5.4),
+        (3.015, True, 0.2, -0.3),
+        (5.015, False, -1.0, 1.5),
+    ],
+)
 def test_discrete_lps_limits_reproduce_validation_table(factor, partial, p_error, s_error):
-    rel = dispersion_relation("lps", MARAGING_STEEL, factor * H, H, discrete=True,
-                              partial_volumes=partial, points=2)
+    rel = dispersion_relation(
+        "lps", MARAGING_STEEL, factor * H, H, discrete=True, partial_volumes=partial, points=2
+    )
     longitudinal, shear = _limits(rel)
     assert 100 * (longitudinal / CL - 1) == pytest.approx(p_error, abs=0.2)
     assert 100 * (shear / CS - 1) == pytest.approx(s_error, abs=0.2)
@@ -162,8 +177,9 @@ def test_group_velocity_is_the_derivative_of_omega(model, dim, direction, discre
     k = np.linspace(200.0, 2800.0, 14)
     dk = 1e-4 * np.pi / H
     grid = np.sort(np.concatenate([k - dk, k, k + dk]))
-    rel = dispersion_relation(model, MARAGING_STEEL, 3.015 * H, H, dim=dim, direction=direction,
-                              discrete=discrete, wavenumbers=grid)
+    rel = dispersion_relation(
+        model, MARAGING_STEEL, 3.015 * H, H, dim=dim, direction=direction, discrete=discrete, wavenumbers=grid
+    )
     for branch in rel.branches.values():
         omega = branch.frequency.reshape(-1, 3)
         central = (omega[:, 2] - omega[:, 0]) / (2 * dk)
@@ -187,22 +203,27 @@ def test_negative_group_velocity_onset_scales_with_the_horizon():
     1000 rad/m for all three."""
     for influence in ("constant", "inverse", "gaussian"):
         for delta in (3e-3, 5e-3, 7e-3):
-            onset = dispersion_relation("lps", MARAGING_STEEL, delta, H, influence, discrete=True,
-                                        points=200).branches["longitudinal"]
+            onset = dispersion_relation(
+                "lps", MARAGING_STEEL, delta, H, influence, discrete=True, points=200
+            ).branches["longitudinal"]
             assert 4.6 < onset.negative_group_velocity_from * delta < 5.4
         rel = dispersion_relation("lps", MARAGING_STEEL, 5e-3, H, influence, discrete=True)
-        assert rel.to_dict()["negative_group_velocity_from_rad_m"]["longitudinal"] == \
-            pytest.approx(1000.0, rel=0.05)
+        assert rel.to_dict()["negative_group_velocity_from_rad_m"]["longitudinal"] == pytest.approx(
+            1000.0, rel=0.05
+        )
 
 
-@pytest.mark.parametrize(("influence", "delta", "shear_negative"), [
-    # Shear branch (study table): constant influence from k delta = 7.8-8.0; 1/|xi| never
-    # below the zone edge; Gaussian only from 7 spacings.
-    ("constant", 3e-3, True),
-    ("inverse", 7e-3, False),
-    ("gaussian", 5e-3, False),
-    ("gaussian", 7e-3, True),
-])
+@pytest.mark.parametrize(
+    ("influence", "delta", "shear_negative"),
+    [
+        # Shear branch (study table): constant influence from k delta = 7.8-8.0; 1/|xi| never
+        # below the zone edge; Gaussian only from 7 spacings.
+        ("constant", 3e-3, True),
+        ("inverse", 7e-3, False),
+        ("gaussian", 5e-3, False),
+        ("gaussian", 7e-3, True),
+    ],
+)
 def test_shear_group_velocity_sign_by_influence_function(influence, delta, shear_negative):
     rel = dispersion_relation("lps", MARAGING_STEEL, delta, H, influence, discrete=True)
     onset = rel.to_dict()["negative_group_velocity_from_rad_m"]["shear"]
@@ -212,10 +233,10 @@ def test_shear_group_velocity_sign_by_influence_function(influence, delta, shear
 def test_small_horizon_keeps_group_velocity_positive():
     # 18-neighbour lattice (1.4143 h) and 2 h with 1/|xi| or Gaussian weights: none in the zone.
     for influence, factor in (("constant", 1.4143), ("inverse", 2.0), ("gaussian", 2.0)):
-        rel = dispersion_relation("lps", MARAGING_STEEL, factor * H, H, influence, discrete=True,
-                                  partial_volumes=factor > 1.5)
-        assert rel.to_dict()["negative_group_velocity_from_rad_m"] == \
-            {"longitudinal": None, "shear": None}
+        rel = dispersion_relation(
+            "lps", MARAGING_STEEL, factor * H, H, influence, discrete=True, partial_volumes=factor > 1.5
+        )
+        assert rel.to_dict()["negative_group_velocity_from_rad_m"] == {"longitudinal": None, "shear": None}
 
 
 def test_directions_and_polarisations():
@@ -223,26 +244,30 @@ def test_directions_and_polarisations():
     assert parse_direction([0, 0, 2], 3) == pytest.approx([0.0, 0.0, 1.0])
     basis = polarisations(parse_direction("xyz", 3), 3)
     assert basis @ basis.T == pytest.approx(np.eye(3))
-    assert basis[1] == pytest.approx([-2**-0.5, 2**-0.5, 0.0])
+    assert basis[1] == pytest.approx([-(2**-0.5), 2**-0.5, 0.0])
     assert polarisations(parse_direction("z", 3), 3)[1] == pytest.approx([1.0, 0.0, 0.0])
 
 
-@pytest.mark.parametrize(("direction", "dim"), [("xz", 2), ("y", 1), ("xq", 3), ("xx", 3),
-                                                ([0, 0, 0], 3), ([1, 2], 3)])
+@pytest.mark.parametrize(
+    ("direction", "dim"), [("xz", 2), ("y", 1), ("xq", 3), ("xx", 3), ([0, 0, 0], 3), ([1, 2], 3)]
+)
 def test_bad_directions_are_refused(direction, dim):
     with pytest.raises(InputError, match="direction"):
         parse_direction(direction, dim)
 
 
-@pytest.mark.parametrize(("kwargs", "match"), [
-    ({"horizon": -1e-3}, "horizon"),
-    ({"spacing": 0.0}, "spacing"),
-    ({"dim": 4}, "dimension"),
-    ({"points": 1}, "points"),
-    ({"wavenumbers": [2.0, 1.0]}, "wavenumbers"),
-    ({"model": "bond"}, "model"),
-    ({"influence": "cubic"}, "influence"),
-])
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"horizon": -1e-3}, "horizon"),
+        ({"spacing": 0.0}, "spacing"),
+        ({"dim": 4}, "dimension"),
+        ({"points": 1}, "points"),
+        ({"wavenumbers": [2.0, 1.0]}, "wavenumbers"),
+        ({"model": "bond"}, "model"),
+        ({"influence": "cubic"}, "influence"),
+    ],
+)
 def test_bad_arguments_are_refused(kwargs, match):
     args = {"model": "lps", "medium": MARAGING_STEEL, "horizon": 3e-3, "spacing": H} | kwargs
     with pytest.raises(InputError, match=match):
@@ -257,38 +282,62 @@ def test_bad_media_are_refused():
 
 
 def test_study_table_and_figures(tmp_path):
-    result = study(influences=("constant", "gaussian"), horizons=(2e-3, 3e-3),
-                   spacings=(1e-3, 1.5e-3), points=60)
+    result = study(
+        influences=("constant", "gaussian"), horizons=(2e-3, 3e-3), spacings=(1e-3, 1.5e-3), points=60
+    )
     rows = result.table
     assert len(rows) == 2 * (2 + 2 - 1)  # the base case (3 mm, 1 mm) once per influence
-    assert {"influence", "horizon_m", "spacing_m", "longitudinal_error", "shear_error",
-            "longitudinal_band_rad_m", "negative_longitudinal_rad_m"} <= set(rows[0])
+    assert {
+        "influence",
+        "horizon_m",
+        "spacing_m",
+        "longitudinal_error",
+        "shear_error",
+        "longitudinal_band_rad_m",
+        "negative_longitudinal_rad_m",
+    } <= set(rows[0])
     assert "delta = 3 mm" in "".join(result.sweep("horizon"))
     assert "constant" in result.negative_group_velocity_summary()
     paths = plot_study(result, tmp_path)
-    assert [p.name for p in paths] == ["dispersion_influence.png", "dispersion_horizon.png",
-                                       "dispersion_spacing.png"]
+    assert [p.name for p in paths] == [
+        "dispersion_influence.png",
+        "dispersion_horizon.png",
+        "dispersion_spacing.png",
+    ]
     assert all(p.stat().st_size > 10_000 for p in paths)
 
 
 def test_plot_of_one_relation(tmp_path):
-    rel = dispersion_relation("lps", MARAGING_STEEL, 3.015 * H, H, discrete=True, direction="xy",
-                              points=40)
+    rel = dispersion_relation("lps", MARAGING_STEEL, 3.015 * H, H, discrete=True, direction="xy", points=40)
     fig = plot_dispersion(rel, tmp_path / "one.png")
     assert len(fig.axes) == 9  # three branches (shear_2 differs along xy), three panels
     assert (tmp_path / "one.png").is_file()
 
 
-STEEL_ARGS = ["dispersion", "--model", "lps", "--rho", "8000", "--bulk-modulus", "132.77e9",
-              "--shear-modulus", "81.92e9", "--horizon", "3.015e-3", "--spacing", "1e-3"]
+STEEL_ARGS = [
+    "dispersion",
+    "--model",
+    "lps",
+    "--rho",
+    "8000",
+    "--bulk-modulus",
+    "132.77e9",
+    "--shear-modulus",
+    "81.92e9",
+    "--horizon",
+    "3.015e-3",
+    "--spacing",
+    "1e-3",
+]
 
 
 def test_cli_json(capsys, tmp_path):
     plot = tmp_path / "d.png"
     assert main([*STEEL_ARGS, "--discrete", "--points", "50", "--plot", str(plot), "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
-    assert {"long_wave_limit_m_s", "negative_group_velocity_from_rad_m", "nyquist_rad_m",
-            "branches"} <= set(out)
+    assert {"long_wave_limit_m_s", "negative_group_velocity_from_rad_m", "nyquist_rad_m", "branches"} <= set(
+        out
+    )
     assert set(out["long_wave_limit_m_s"]) >= {"longitudinal", "shear"}
     assert set(out["negative_group_velocity_from_rad_m"]) == {"longitudinal", "shear"}
     assert out["nyquist_rad_m"] == pytest.approx(np.pi / 1e-3)
@@ -300,26 +349,52 @@ def test_cli_json(capsys, tmp_path):
 
 
 def test_cli_report_and_young_modulus_input(capsys):
-    assert main(["dispersion", "--model", "pmb", "--rho", "8000", "--E", "200e9", "--nu", "0.25",
-                 "--horizon", "3e-3", "--spacing", "1e-3", "--dimension", "2",
-                 "--direction", "1,1,0", "--points", "20"]) == 0
+    assert (
+        main(
+            [
+                "dispersion",
+                "--model",
+                "pmb",
+                "--rho",
+                "8000",
+                "--E",
+                "200e9",
+                "--nu",
+                "0.25",
+                "--horizon",
+                "3e-3",
+                "--spacing",
+                "1e-3",
+                "--dimension",
+                "2",
+                "--direction",
+                "1,1,0",
+                "--points",
+                "20",
+            ]
+        )
+        == 0
+    )
     report = capsys.readouterr().out
     assert "long-wave limits" in report and "Nyquist" in report
 
 
-@pytest.mark.parametrize(("extra", "flag"), [
-    (["--rho", "-1"], "--rho"),
-    (["--horizon", "abc"], "--horizon"),
-    (["--spacing", "0"], "--spacing"),
-    (["--influence", "cubic"], "--influence"),
-    (["--model", "bond"], "--model"),
-    (["--dimension", "4"], "--dimension"),
-    (["--direction", "xq"], "--direction"),
-    (["--plane", "shell"], "--plane"),
-    (["--points", "1"], "--points"),
-    (["--k-max", "-5"], "--k-max"),
-    (["--E", "1e9", "--nu", "0.3"], "exactly one"),
-])
+@pytest.mark.parametrize(
+    ("extra", "flag"),
+    [
+        (["--rho", "-1"], "--rho"),
+        (["--horizon", "abc"], "--horizon"),
+        (["--spacing", "0"], "--spacing"),
+        (["--influence", "cubic"], "--influence"),
+        (["--model", "bond"], "--model"),
+        (["--dimension", "4"], "--dimension"),
+        (["--direction", "xq"], "--direction"),
+        (["--plane", "shell"], "--plane"),
+        (["--points", "1"], "--points"),
+        (["--k-max", "-5"], "--k-max"),
+        (["--E", "1e9", "--nu", "0.3"], "exactly one"),
+    ],
+)
 def test_cli_bad_input_names_the_argument(extra, flag, capsys):
     args = build_parser().parse_args([*STEEL_ARGS, *extra])
     with pytest.raises(InputError, match=flag):

@@ -102,8 +102,9 @@ def _circular_waves(modes, n_t=40):
     """sum over modes of sin(k r - w t) / sqrt(r): (n_t, n, n) records DT apart."""
     x = (np.arange(N_XY) - N_XY // 2) * DXY
     r = np.maximum(np.hypot(*np.meshgrid(x, x, indexing="ij")), 0.5 * DXY)
-    return np.stack([sum(np.sin(K[m] * r - OMEGA * t) for m in modes) / np.sqrt(r)
-                     for t in np.arange(n_t) * DT])
+    return np.stack(
+        [sum(np.sin(K[m] * r - OMEGA * t) for m in modes) / np.sqrt(r) for t in np.arange(n_t) * DT]
+    )
 
 
 @pytest.mark.parametrize("modes", [("S0",), ("A0",), ("S0", "A0")], ids="+".join)
@@ -163,7 +164,8 @@ def test_line_fk_reads_a_series(tmp_path):
 
 def test_point_grid_handles_holes_and_refuses_non_grids():
     body = geometry.plate(10e-3, 8e-3, 1e-3, 1e-3, layers=1).remove(
-        lambda p: np.hypot(p[:, 0] - 5e-3, p[:, 1] - 4e-3) < 1.5e-3)
+        lambda p: np.hypot(p[:, 0] - 5e-3, p[:, 1] - 4e-3) < 1.5e-3
+    )
     grid = point_grid(body.points)
     assert grid.shape == (10, 8)
     image = grid.scatter(np.ones(body.n_points), fill=np.nan)

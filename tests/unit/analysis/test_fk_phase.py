@@ -22,9 +22,9 @@ from peridyn.io.hdf5 import HDF5Writer, read_series
 F0 = 150e3
 OMEGA = 2 * np.pi * F0
 K_S0, K_A0, K_SH0 = 176.34, 612.41, OMEGA / 3100.0
-DX = 1.2e-3                                       # line step of the seed plate, m
-X = np.arange(250) * DX + 0.6e-3                  # the seed's line, m
-SOURCE = 0.1506                                   # the seed's PZT centre, m
+DX = 1.2e-3  # line step of the seed plate, m
+X = np.arange(250) * DX + 0.6e-3  # the seed's line, m
+SOURCE = 0.1506  # the seed's PZT centre, m
 
 
 def _burst_record(order: int, k_of_f, dt=1e-7, n_t=800) -> np.ndarray:
@@ -88,8 +88,7 @@ def _harmonic_lines(tmp_path, sh_amplitude: float):
             return hankel1(0, K_S0 * np.hypot(px - SOURCE, py))
 
         def psi(px, py):
-            return hankel1(2, K_SH0 * np.hypot(px - SOURCE, py)) * np.sin(
-                2 * np.arctan2(py, px - SOURCE))
+            return hankel1(2, K_SH0 * np.hypot(px - SOURCE, py)) * np.sin(2 * np.arctan2(py, px - SOURCE))
 
         def d(fun, px, py, axis):
             step = (h, 0.0) if axis == 0 else (0.0, h)
@@ -126,8 +125,7 @@ def test_divergence_reads_s0_without_sh0(tmp_path):
     _, times, top = read_series(path, "line_x_axis")
     _, _, bottom = read_series(path, "line_x_axis_bottom")
     u_x = mirror_parts(top, bottom)["S"][:, :, 0]
-    assert abs(phase_wavenumber(u_x, times[1] - times[0], X, F0, SOURCE, (0.02, 0.09), 1)
-               / K_S0 - 1) > 0.01
+    assert abs(phase_wavenumber(u_x, times[1] - times[0], X, F0, SOURCE, (0.02, 0.09), 1) / K_S0 - 1) > 0.01
 
 
 def test_bad_requests_are_refused():

@@ -14,20 +14,32 @@ H = 1e-3  # grid spacing of seed 001 (VALIDATION.md V3), m
 WAVENUMBERS = np.linspace(0.05, 0.5, 6) * np.pi / H
 
 
-@pytest.mark.parametrize(("model", "dim", "direction", "partial"), [
-    pytest.param("lps", 3, "x", True, id="lps-3d-x-partial"),
-    pytest.param("lps", 3, "xyz", False, id="lps-3d-xyz-centre"),
-    pytest.param("pmb", 3, "xy", True, id="pmb-3d-xy-partial"),
-    pytest.param("lps", 2, "x", True, id="lps-2d-x-partial"),
-])
+@pytest.mark.parametrize(
+    ("model", "dim", "direction", "partial"),
+    [
+        pytest.param("lps", 3, "x", True, id="lps-3d-x-partial"),
+        pytest.param("lps", 3, "xyz", False, id="lps-3d-xyz-centre"),
+        pytest.param("pmb", 3, "xy", True, id="pmb-3d-xy-partial"),
+        pytest.param("lps", 2, "x", True, id="lps-2d-x-partial"),
+    ],
+)
 def test_measured_dispersion_is_the_discrete_relation(model, dim, direction, partial):
     """Issue 4 asks for 1%; the quotients are exact up to round-off (measured about 1e-9)."""
     k = WAVENUMBERS / (np.sqrt(2.0) if direction == "xy" else 1.0)
-    measured = measure_dispersion(model, MARAGING_STEEL, 3.015 * H, H, k, dim=dim,
-                                  direction=direction, partial_volumes=partial)
-    relation = dispersion_relation(model, MARAGING_STEEL, 3.015 * H, H, dim=dim,
-                                   direction=direction, discrete=True, partial_volumes=partial,
-                                   wavenumbers=k)
+    measured = measure_dispersion(
+        model, MARAGING_STEEL, 3.015 * H, H, k, dim=dim, direction=direction, partial_volumes=partial
+    )
+    relation = dispersion_relation(
+        model,
+        MARAGING_STEEL,
+        3.015 * H,
+        H,
+        dim=dim,
+        direction=direction,
+        discrete=True,
+        partial_volumes=partial,
+        wavenumbers=k,
+    )
     for name, error in measured.relative_error(relation).items():
         assert np.max(np.abs(error)) < 1e-6, name
     assert measured.interior_points > 0
@@ -38,8 +50,7 @@ def test_group_velocity_of_the_relation_is_the_slope_of_the_measured_omega():
     dk = 0.1
     grid = np.sort(np.concatenate([k - dk, k + dk]))
     measured = measure_dispersion("lps", MARAGING_STEEL, 3.015 * H, H, grid)
-    relation = dispersion_relation("lps", MARAGING_STEEL, 3.015 * H, H, discrete=True,
-                                   wavenumbers=k)
+    relation = dispersion_relation("lps", MARAGING_STEEL, 3.015 * H, H, discrete=True, wavenumbers=k)
     for name, omega in measured.frequency.items():
         slope = (omega[1::2] - omega[0::2]) / (2 * dk)
         branch = relation.branches[name]

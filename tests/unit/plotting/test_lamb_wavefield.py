@@ -66,11 +66,11 @@ def test_through_thickness_cut(results, tmp_path):
 
 def test_fk_map_with_theory_and_peaks(tmp_path):
     t, x = np.meshgrid(np.arange(64) * 0.5e-6, np.arange(48) * 1e-3, indexing="ij")
-    freq, k, magnitude = fk_transform(np.cos(K_A0 * x - 2 * np.pi * 150e3 * t), 0.5e-6, 1e-3,
-                                      f_max=400e3)
+    freq, k, magnitude = fk_transform(np.cos(K_A0 * x - 2 * np.pi * 150e3 * t), 0.5e-6, 1e-3, f_max=400e3)
     curves = dispersion_curves(*PLATE, f_max=400e3, n=30, max_order=0)
-    png = plot_fk_map(freq, k, magnitude, tmp_path / "fk.png", theory=curves,
-                      peaks={"A0": (150e3, K_A0)}, k_max=1500.0)
+    png = plot_fk_map(
+        freq, k, magnitude, tmp_path / "fk.png", theory=curves, peaks={"A0": (150e3, K_A0)}, k_max=1500.0
+    )
     _assert_png(png)
 
 
@@ -78,12 +78,10 @@ def test_kxky_maps_with_theory_rings(tmp_path):
     frequencies = [110e3, 150e3, 185e3, 225e3]  # the seed's (kx, ky) figures
     x = (np.arange(41) - 20) * 1e-3
     r = np.maximum(np.hypot(*np.meshgrid(x, x, indexing="ij")), 0.5e-3)
-    plane = np.stack([np.sin(K_A0 * r - 2 * np.pi * 150e3 * t) / np.sqrt(r)
-                      for t in np.arange(16) * 0.5e-6])
+    plane = np.stack([np.sin(K_A0 * r - 2 * np.pi * 150e3 * t) / np.sqrt(r) for t in np.arange(16) * 0.5e-6])
     kx, ky, maps = kxky_transform(plane, 0.5e-6, 1e-3, 1e-3, frequencies)
     modes = lamb_modes(*PLATE, frequencies, max_order=0)
-    png = plot_kxky_maps(kx, ky, maps, frequencies, tmp_path / "kxky.png", theory=modes,
-                         k_max=1000.0)
+    png = plot_kxky_maps(kx, ky, maps, frequencies, tmp_path / "kxky.png", theory=modes, k_max=1000.0)
     _assert_png(png)
     with pytest.raises(InputError, match="shape"):
         plot_kxky_maps(kx, ky, maps[:2], frequencies, tmp_path / "bad.png")

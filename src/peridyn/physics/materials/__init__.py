@@ -16,19 +16,28 @@ MODELS = {"pmb": PMBModel, "lps": LPSModel}
 __all__ = ["MODELS", "LPSModel", "Model", "PMBModel", "make_model"]
 
 
-def make_model(name: str, body: Body, bonds: Bonds, *, E: float, density: float,
-               nu: float | None = None, surface_correction: str = "none",
-               dtype=np.float64) -> Model:
+def make_model(
+    name: str,
+    body: Body,
+    bonds: Bonds,
+    *,
+    E: float,
+    density: float,
+    nu: float | None = None,
+    surface_correction: str = "none",
+    dtype=np.float64,
+) -> Model:
     """Bind the material model ``name`` ("pmb" or "lps") to a body and its bonds."""
     if name not in MODELS:
         raise InputError(
-            f"unknown material model {name!r}{did_you_mean(name, MODELS)}; choose one of "
-            f"{sorted(MODELS)}"
+            f"unknown material model {name!r}{did_you_mean(name, MODELS)}; choose one of {sorted(MODELS)}"
         )
     if name == "lps":
         if nu is None:
             raise InputError("an LPS material needs Poisson's ratio nu")
-        return LPSModel(body, bonds, E=E, nu=nu, density=density,
-                        surface_correction=surface_correction, dtype=dtype)
-    return PMBModel(body, bonds, E=E, density=density, nu=nu,
-                    surface_correction=surface_correction, dtype=dtype)
+        return LPSModel(
+            body, bonds, E=E, nu=nu, density=density, surface_correction=surface_correction, dtype=dtype
+        )
+    return PMBModel(
+        body, bonds, E=E, density=density, nu=nu, surface_correction=surface_correction, dtype=dtype
+    )

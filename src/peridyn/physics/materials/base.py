@@ -71,8 +71,9 @@ class Model:
         """Critical bond stretch for a fracture energy ``fracture_energy`` (J/m^2)."""
         raise NotImplementedError
 
-    def critical_time_step(self, extra_bound: np.ndarray | None = None,
-                           points: np.ndarray | None = None) -> float:
+    def critical_time_step(
+        self, extra_bound: np.ndarray | None = None, points: np.ndarray | None = None
+    ) -> float:
         """Largest stable velocity-Verlet step, s: 2 / sqrt(max stiffness_bound / density).
 
         ``extra_bound`` ((n_points,) N/m^4): stiffness added to the material's (e.g. contact);

@@ -40,8 +40,7 @@ def plane_bulk_modulus(E: float, nu: float, plane: str) -> float:
 def radial_moment(influence: str, horizon: float, power: int) -> float:
     """Integral of omega(r) r^power over [0, horizon] (m^(power+1))."""
     omega = influence_function(influence)
-    value, _ = quad(lambda r: float(omega(np.array(r), horizon)) * r**power, 0.0, horizon,
-                    limit=200)
+    value, _ = quad(lambda r: float(omega(np.array(r), horizon)) * r**power, 0.0, horizon, limit=200)
     return value
 
 

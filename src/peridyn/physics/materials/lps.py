@@ -78,13 +78,20 @@ class LPSModel(Model):
 
     name = "lps"
 
-    def __init__(self, body: Body, bonds: Bonds, E: float, nu: float, density: float,
-                 surface_correction: str = "none", dtype=np.float64):
+    def __init__(
+        self,
+        body: Body,
+        bonds: Bonds,
+        E: float,
+        nu: float,
+        density: float,
+        surface_correction: str = "none",
+        dtype=np.float64,
+    ):
         check_elastic(E, nu, density)
         if surface_correction not in SURFACE_CORRECTIONS:
             raise InputError(
-                f"LPS surface_correction must be one of {SURFACE_CORRECTIONS}, "
-                f"got {surface_correction!r}"
+                f"LPS surface_correction must be one of {SURFACE_CORRECTIONS}, got {surface_correction!r}"
             )
         super().__init__(body, bonds, density, dtype)
         dim = body.dim
@@ -108,8 +115,16 @@ class LPSModel(Model):
         if surface_correction == "energy":
             owners = b.owners()
             n_vec = (body.points[b.neighbours] - body.points[owners]) / b.length[:, None]
-            self.dev_factor = energy_factors(owners, n_vec, b.length, np.where(b.intact, w, 0.0),
-                                             self.alpha, self.shear, dim, body.n_points)
+            self.dev_factor = energy_factors(
+                owners,
+                n_vec,
+                b.length,
+                np.where(b.intact, w, 0.0),
+                self.alpha,
+                self.shear,
+                dim,
+                body.n_points,
+            )
             negative = int(np.count_nonzero(self.dev_factor[b.intact] <= 0.0))
             if negative:
                 warnings.warn(
@@ -120,7 +135,8 @@ class LPSModel(Model):
                 )
         # m~_i = sum_j g_ij w |xi|^2 (= m without correction), m^5
         self.dev_weighted_volume = family_sums(
-            b.offsets, np.where(b.intact, self.dev_factor * w * b.length**2, 0.0))
+            b.offsets, np.where(b.intact, self.dev_factor * w * b.length**2, 0.0)
+        )
         # k_ij = w (alpha_i g_ij + alpha_j g_ji), the bond's deviatoric stiffness (both energies)
         point_dev = self.alpha[b.owners()] * self.dev_factor
         self.dev = (w * (point_dev + point_dev[b.reverse()])).astype(self.dtype)
@@ -128,8 +144,9 @@ class LPSModel(Model):
         self.w = w.astype(self.dtype)
         self._theta_coef = self.theta_coef.astype(self.dtype)
         # P_i = theta_i * p_coef_i, see peridyn.kernels.lps
-        self._p_coef = (dim * self.bulk / m - self.alpha * self.dev_weighted_volume / (dim * m)
-                        ).astype(self.dtype)
+        self._p_coef = (dim * self.bulk / m - self.alpha * self.dev_weighted_volume / (dim * m)).astype(
+            self.dtype
+        )
         self._theta = np.empty(body.n_points, dtype=self.dtype)
         self._p = np.empty(body.n_points, dtype=self.dtype)
 
@@ -153,10 +170,21 @@ class LPSModel(Model):
             u = np.zeros_like(x)
             u[:, a] = gamma * x[:, c]
             u[:, c] = gamma * x[:, a]
-            theta = lps_dilatation(x, u, b.offsets, b.neighbours, b.length, w, b.intact,
-                                   self.theta_coef, np.empty(body.n_points))
-            norm = lps_deviatoric_energy(x, u, b.offsets, b.neighbours, b.length, w, b.intact,
-                                         theta, float(self.dim), np.empty(body.n_points))
+            theta = lps_dilatation(
+                x, u, b.offsets, b.neighbours, b.length, w, b.intact, self.theta_coef, np.empty(body.n_points)
+            )
+            norm = lps_deviatoric_energy(
+                x,
+                u,
+                b.offsets,
+                b.neighbours,
+                b.length,
+                w,
+                b.intact,
+                theta,
+                float(self.dim),
+                np.empty(body.n_points),
+            )
             largest = np.maximum(largest, norm)
         bulk = 4.0 * gamma**2 * self.weighted_volume / (15.0 if self.dim == 3 else 8.0)
         return bulk / largest
@@ -165,10 +193,12 @@ class LPSModel(Model):
         """theta into ``self._theta``; ``u`` already in the kernel dtype and layout."""
         b = self.bonds
         if self.dtype == np.float32:
-            return lps_dilatation_cf(self.x, u, b.offsets, b.neighbours, self.w, b.intact,
-                                     self._theta_coef, self._theta)
-        return lps_dilatation(self.x, u, b.offsets, b.neighbours, self.length, self.w, b.intact,
-                              self._theta_coef, self._theta)
+            return lps_dilatation_cf(
+                self.x, u, b.offsets, b.neighbours, self.w, b.intact, self._theta_coef, self._theta
+            )
+        return lps_dilatation(
+            self.x, u, b.offsets, b.neighbours, self.length, self.w, b.intact, self._theta_coef, self._theta
+        )
 
     def dilatation(self, u) -> np.ndarray:
         """Dilatation theta (n_points,), dimensionless."""
@@ -186,22 +216,40 @@ class LPSModel(Model):
         u = self._as_state(u)
         p = np.multiply(self._dilatation(u), self._p_coef, out=self._p)
         if self.dtype == np.float32:
-            return lps_pair_force_cf(self.x, u, b.offsets, b.neighbours, self.w, self.dev,
-                                     b.intact, p, out)
-        return lps_pair_force(self.x, u, b.offsets, b.neighbours, self.length, self.w, self.dev,
-                              b.intact, p, out)
+            return lps_pair_force_cf(self.x, u, b.offsets, b.neighbours, self.w, self.dev, b.intact, p, out)
+        return lps_pair_force(
+            self.x, u, b.offsets, b.neighbours, self.length, self.w, self.dev, b.intact, p, out
+        )
 
     def energy_density(self, u):
         b = self.bonds
         u64 = np.ascontiguousarray(u, dtype=np.float64)
         x64 = self.body.points
         w64 = self.w.astype(np.float64)
-        theta = lps_dilatation(x64, u64, b.offsets, b.neighbours, b.length, w64, b.intact,
-                               self.theta_coef, np.empty(self.body.n_points))
+        theta = lps_dilatation(
+            x64,
+            u64,
+            b.offsets,
+            b.neighbours,
+            b.length,
+            w64,
+            b.intact,
+            self.theta_coef,
+            np.empty(self.body.n_points),
+        )
         # sum_j g w e^2 (the kernel with theta = 0), then the m~ theta^2 / d^2 of the energy
-        squares = lps_deviatoric_energy(x64, u64, b.offsets, b.neighbours, b.length,
-                                        w64 * self.dev_factor, b.intact, np.zeros_like(theta),
-                                        float(self.dim), np.empty(self.body.n_points))
+        squares = lps_deviatoric_energy(
+            x64,
+            u64,
+            b.offsets,
+            b.neighbours,
+            b.length,
+            w64 * self.dev_factor,
+            b.intact,
+            np.zeros_like(theta),
+            float(self.dim),
+            np.empty(self.body.n_points),
+        )
         dev = squares - self.dev_weighted_volume * theta**2 / self.dim**2
         return 0.5 * self.bulk * theta**2 + 0.5 * self.alpha * dev
 

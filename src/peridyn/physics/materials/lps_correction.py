@@ -77,10 +77,11 @@ def energy_factors(owners, n_vec, length, w, alpha, shear, dim, n_points) -> np.
     gram = np.empty((n_points, n_tests, n_tests))
     for k in range(n_tests):
         for q in range(k, n_tests):
-            gram[:, k, q] = gram[:, q, k] = np.bincount(owners, weight * r[:, k] * r[:, q],
-                                                        minlength=n_points)
-    plain = np.stack([np.bincount(owners, weight * r[:, k], minlength=n_points)
-                      for k in range(n_tests)], axis=1)
-    lam = np.einsum("pkq,pq->pk", np.linalg.pinv(gram, rcond=1e-10, hermitian=True),
-                    continuum - plain)
+            gram[:, k, q] = gram[:, q, k] = np.bincount(
+                owners, weight * r[:, k] * r[:, q], minlength=n_points
+            )
+    plain = np.stack(
+        [np.bincount(owners, weight * r[:, k], minlength=n_points) for k in range(n_tests)], axis=1
+    )
+    lam = np.einsum("pkq,pq->pk", np.linalg.pinv(gram, rcond=1e-10, hermitian=True), continuum - plain)
     return 1.0 + np.einsum("bk,bk->b", lam[owners], r)

@@ -46,8 +46,14 @@ def pmb_poisson_ratio(dim: int, plane: str | None) -> float:
     return 1.0 / 3.0 if (dim == 2 and plane == "stress") else 0.25
 
 
-def pmb_micromodulus(E: float, dim: int, horizon: float, influence: str,
-                     plane: str | None = None, thickness: float | None = None) -> float:
+def pmb_micromodulus(
+    E: float,
+    dim: int,
+    horizon: float,
+    influence: str,
+    plane: str | None = None,
+    thickness: float | None = None,
+) -> float:
     """c0 of c(xi) = c0 omega(|xi|), N/m^6 (3D) — see the module docstring."""
     nu = pmb_poisson_ratio(dim, plane)
     if dim == 3:
@@ -72,9 +78,16 @@ class PMBModel(Model):
 
     name = "pmb"
 
-    def __init__(self, body: Body, bonds: Bonds, E: float, density: float,
-                 nu: float | None = None, surface_correction: str = "none",
-                 dtype=np.float64):
+    def __init__(
+        self,
+        body: Body,
+        bonds: Bonds,
+        E: float,
+        density: float,
+        nu: float | None = None,
+        surface_correction: str = "none",
+        dtype=np.float64,
+    ):
         implied = pmb_poisson_ratio(body.dim, body.plane)
         check_elastic(E, implied if nu is None else nu, density)
         if nu is not None and abs(nu - implied) > 1e-3:
@@ -85,13 +98,13 @@ class PMBModel(Model):
             )
         if surface_correction not in SURFACE_CORRECTIONS:
             raise InputError(
-                f"PMB surface_correction must be one of {SURFACE_CORRECTIONS}, "
-                f"got {surface_correction!r}"
+                f"PMB surface_correction must be one of {SURFACE_CORRECTIONS}, got {surface_correction!r}"
             )
         super().__init__(body, bonds, density, dtype)
         self.E = float(E)
-        self.c0 = pmb_micromodulus(E, body.dim, bonds.horizon, bonds.influence_name,
-                                   body.plane, body.thickness)
+        self.c0 = pmb_micromodulus(
+            E, body.dim, bonds.horizon, bonds.influence_name, body.plane, body.thickness
+        )
         self.length = bonds.length.astype(self.dtype)
         self.inv_length = (1.0 / bonds.length).astype(self.dtype)
         base = self.c0 * bonds.influence * self.bond_volume
@@ -111,17 +124,33 @@ class PMBModel(Model):
         out = np.empty_like(self.x) if out is None else out
         b = self.bonds
         if self.dtype == np.float32:
-            return pmb_force_cf(self.x, self._as_state(u), b.offsets, b.neighbours,
-                                self.bond_stiffness, b.intact, out)
-        return pmb_force(self.x, self._as_state(u), b.offsets, b.neighbours, self.inv_length,
-                         self.bond_stiffness, b.intact, out)
+            return pmb_force_cf(
+                self.x, self._as_state(u), b.offsets, b.neighbours, self.bond_stiffness, b.intact, out
+            )
+        return pmb_force(
+            self.x,
+            self._as_state(u),
+            b.offsets,
+            b.neighbours,
+            self.inv_length,
+            self.bond_stiffness,
+            b.intact,
+            out,
+        )
 
     def energy_density(self, u):
         b = self.bonds
         w = np.empty(self.body.n_points)
-        return pmb_energy(self.body.points, np.ascontiguousarray(u, dtype=np.float64), b.offsets,
-                          b.neighbours, b.length, self.bond_stiffness.astype(np.float64),
-                          b.intact, w)
+        return pmb_energy(
+            self.body.points,
+            np.ascontiguousarray(u, dtype=np.float64),
+            b.offsets,
+            b.neighbours,
+            b.length,
+            self.bond_stiffness.astype(np.float64),
+            b.intact,
+            w,
+        )
 
     def stiffness_bound(self):
         b = self.bonds
@@ -158,8 +187,9 @@ class PMBModel(Model):
         for axis in range(dim):
             u = np.zeros_like(body.points)
             u[:, axis] = strain * body.points[:, axis]
-            w = pmb_energy(body.points, u, b.offsets, b.neighbours, b.length, base, b.intact,
-                           np.empty(body.n_points))
+            w = pmb_energy(
+                body.points, u, b.offsets, b.neighbours, b.length, base, b.intact, np.empty(body.n_points)
+            )
             g = w_bulk / np.maximum(w, 1e-300)
             g_bond = 0.5 * (g[owners] + g[b.neighbours])
             inv_g2 += (n[:, axis] / g_bond) ** 2
