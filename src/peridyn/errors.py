@@ -43,6 +43,12 @@ class InstabilityError(PeridynError, RuntimeError):
 
 
 def did_you_mean(word: str, choices) -> str:
-    """A ``" (did you mean 'x'?)"`` suffix for a misspelt ``word``, or ``""``."""
+    """A ``" (did you mean 'x'?)"`` suffix for a misspelt ``word``, or ``""``.
+
+    >>> did_you_mean("lsp", ["pmb", "lps"])
+    " (did you mean 'lps'?)"
+    >>> did_you_mean("elastic", ["pmb", "lps"])
+    ''
+    """
     close = difflib.get_close_matches(word, list(choices), n=1)
     return f" (did you mean {close[0]!r}?)" if close else ""
