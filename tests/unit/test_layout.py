@@ -51,6 +51,9 @@ def test_the_check_sees_a_kernel(tmp_path):
 
 
 def test_every_module_says_what_it_holds():
-    bare = [str(p.relative_to(PACKAGE)) for p in _modules()
-            if p.stat().st_size and ast.get_docstring(ast.parse(p.read_text())) is None]
+    bare = [
+        str(p.relative_to(PACKAGE))
+        for p in _modules()
+        if p.stat().st_size and ast.get_docstring(ast.parse(p.read_text())) is None
+    ]
     assert not bare, f"modules without a docstring: {bare}"

@@ -19,8 +19,29 @@ from peridyn.errors import CaseFileError, did_you_mean
 
 
 class _Loader(yaml.SafeLoader):
-    """SafeLoader that also reads ``1e3`` and ``150.0e3`` as floats (YAML 1.2 style);
-    plain PyYAML would take them for strings."""
+    """SafeLoader that also reads ``1e3`` and ``150.0e3`` as floats (YAML 1.2 style; plain
+    PyYAML would take them for strings) and refuses a key given twice in one mapping (PyYAML
+    keeps the last silently). Keys merged in with ``<<: *anchor`` may be overridden."""
+
+    def construct_mapping(self, node, deep=False):
+        if isinstance(node, yaml.MappingNode):
+            first_line = {}
+            for key_node, _ in node.value:
+                if key_node.tag == "tag:yaml.org,2002:merge":
+                    continue
+                key = self.construct_object(key_node, deep=deep)
+                try:
+                    earlier = first_line.setdefault(key, key_node.start_mark.line + 1)
+                except TypeError:  # an unhashable key: PyYAML's own error follows
+                    continue
+                if earlier != key_node.start_mark.line + 1:
+                    raise yaml.constructor.ConstructorError(
+                        None,
+                        None,
+                        f"key {key!r} is given twice (first on line {earlier})",
+                        key_node.start_mark,
+                    )
+        return super().construct_mapping(node, deep=deep)
 
 
 _Loader.add_implicit_resolver(
@@ -40,6 +61,14 @@ _Loader.add_implicit_resolver(
 def parse_yaml(text: str):
     """Parse YAML text with floats read as in YAML 1.2 (``1e-3``, ``68.9e9``)."""
     return yaml.load(text, Loader=_Loader)
+
+
+def yaml_problem(exc: yaml.YAMLError) -> str:
+    """One line saying what is wrong with some YAML and where (line and column, 1-based)."""
+    problem = getattr(exc, "problem", None) or getattr(exc, "context", None) or str(exc)
+    mark = getattr(exc, "problem_mark", None) or getattr(exc, "context_mark", None)
+    where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark is not None else ""
+    return " ".join(f"{problem}{where}".split())
 
 
 Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
@@ -423,9 +452,13 @@ def load_case(path, overrides=()) -> Case:
     if not path.is_file():
         raise CaseFileError(str(path), "<file>", None, "an existing YAML case file")
     try:
-        raw = parse_yaml(path.read_text())
+        raw = parse_yaml(path.read_text(encoding="utf-8"))
+    except UnicodeDecodeError as exc:
+        raise CaseFileError(
+            str(path), "<file>", None, f"UTF-8 text (byte {exc.start} is {exc.object[exc.start]:#04x})"
+        ) from None
     except yaml.YAMLError as exc:
-        raise CaseFileError(str(path), "<file>", None, f"valid YAML ({exc})") from exc
+        raise CaseFileError(str(path), "<file>", None, f"valid YAML ({yaml_problem(exc)})") from None
     if not isinstance(raw, dict):
         raise CaseFileError(str(path), "<root>", raw, "a mapping of sections")
     for item in overrides:
@@ -446,7 +479,10 @@ def apply_override(raw: dict, item: str, source: str = "<case>") -> None:
     if "=" not in item:
         raise CaseFileError(source, item, None, "an override of the form key.path=value")
     key, text = item.split("=", 1)
-    value = parse_yaml(text)
+    try:
+        value = parse_yaml(text)
+    except yaml.YAMLError as exc:
+        raise CaseFileError(source, key.strip(), text, f"a YAML value ({yaml_problem(exc)})") from None
     parts = key.strip().split(".")
     node = raw
     for depth, part in enumerate(parts[:-1]):
