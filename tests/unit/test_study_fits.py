@@ -81,6 +81,30 @@ def test_skipped_runs_are_left_out_of_the_fits():
     assert np.allclose([f["value_hz"] for f in fits], [a for a, _ in LIMITS.values()], rtol=1e-10)
 
 
+def test_a_diverging_series_has_no_limit_and_says_why_in_the_result_and_the_table():
+    # Issue 19: 1st bending of the 96 x 48 x 8 mm PMMA plate at 3.001 h with the energy
+    # correction, measured at 1.6, 2 and 8/3 mm: 1691.3, 1628.7, 1564.8 Hz. The differences
+    # (62.6, 63.9 Hz) do not shrink although the steps grow (0.4, 0.67 mm), so f = f_inf + C h^p
+    # needs p <= 0 (Roache 1998, ch. 5: no asymptotic range): no value, and the reason.
+    from peridyn.cli.study_cmd import format_table
+
+    runs = [
+        StudyRun(h, 3.001, modes={"1st bending": f})
+        for h, f in ((1.6e-3, 1691.3), (2e-3, 1628.7), (8e-3 / 3, 1564.8))
+    ]
+    (fit,) = fit_series(runs, references={"1st bending": 1847.8})
+    assert "value_hz" not in fit and fit["value_error"] is None
+    assert fit["error"].startswith(
+        "diverging: the differences do not shrink with the spacing "
+        "(1691.3 at 0.0016, 1628.7 at 0.002, 1564.8 at 0.00266667)"
+    )
+    table = format_table(
+        {"runs": [r.to_dict() for r in runs], "fits": [fit], "finest": None, "output_dir": "out"}
+    ).splitlines()
+    row = next(k for k, line in enumerate(table) if line.lstrip().startswith("1st bending"))
+    assert "no fit: diverging" in table[row] and table[row + 1].strip() == fit["error"]
+
+
 @pytest.mark.parametrize(
     "kwargs, message",
     [

@@ -112,7 +112,8 @@ def run(args) -> dict:
 
 
 def format_table(summary: dict) -> str:
-    """The human-readable report: per series and group, frequencies per run, f_inf, p, GCI."""
+    """The human-readable report: per series and group, frequencies per run, f_inf, p, GCI;
+    a mode without a limit gets the fit's reason on the line below."""
     lines = []
     skipped = [r for r in summary["runs"] if r["skipped"]]
     for r in skipped:
@@ -145,6 +146,8 @@ def format_table(summary: dict) -> str:
                 line += f", f_inf {100 * fit['value_error']:+.2f}%"
             line += ")"
         lines.append(line)
+        if "value_hz" not in fit:
+            lines.append(f"    {fit['error']}")  # why there is no limit, with the numbers
     lines.append(f"\nresults written to {summary['output_dir']} (study.csv, runs.csv, study.json, study.png)")
     return "\n".join(lines)
 

@@ -165,7 +165,9 @@ def fit_series(
 
     Returns one dict per (series, group, mode): ``series``, ``group`` (what is held fixed),
     ``variable`` (``spacing_m`` or ``horizon_m``), ``x`` and ``frequencies_hz`` (finest
-    first), and either ``value_hz``, ``order``, ``gci``, ``rms_residual_hz`` or ``error``.
+    first), and either ``value_hz``, ``order``, ``gci``, ``rms_residual_hz`` or, when no
+    value exists, ``error``: why (fewer than three runs with the mode; an oscillating,
+    stagnating or diverging sequence, with its numbers).
     With ``references`` (label -> Hz), ``reference_hz`` and the relative errors of the
     extrapolated and of the finest value are added. With ``finest``, only that many of the
     finest runs of each series enter the fit (the asymptotic range, seed 002 section 6.1);
