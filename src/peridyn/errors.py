@@ -42,6 +42,29 @@ class InstabilityError(PeridynError, RuntimeError):
         super().__init__(msg + (f": {detail}" if detail else ""))
 
 
+class Interrupted(PeridynError):
+    """A run stopped by a signal (SIGINT, SIGTERM) at the end of a step, its files closed.
+
+    Parameters
+    ----------
+    signal_name : str
+        "SIGINT" or "SIGTERM".
+    step : int
+        The last completed step.
+    resume : str
+        How to continue (e.g. the command line with ``--restart``), or "" when it cannot be.
+    """
+
+    #: exit status of the command line: 128 + the signal number
+    EXIT_CODES = {"SIGINT": 130, "SIGTERM": 143}
+
+    def __init__(self, signal_name: str, step: int, resume: str = ""):
+        self.signal_name, self.step, self.resume = signal_name, step, resume
+        self.exit_code = self.EXIT_CODES.get(signal_name, 130)
+        msg = f"interrupted ({signal_name}) at step {step}"
+        super().__init__(msg + (f"; resume with: {resume}" if resume else ""))
+
+
 def did_you_mean(word: str, choices) -> str:
     """A ``" (did you mean 'x'?)"`` suffix for a misspelt ``word``, or ``""``.
 
