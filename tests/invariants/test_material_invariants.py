@@ -4,8 +4,6 @@ import numpy as np
 import pytest
 from conftest import MODEL_CASES, small_model
 
-from peridyn.kernels import reference
-
 
 def _model(case, **kw):
     name, dim, plane = case
@@ -95,33 +93,6 @@ def test_force_is_minus_energy_gradient(case, rng):
             grad = (model.strain_energy(up) - model.strain_energy(um)) / (2 * h)
             expected = -model.body.volumes[point] * f[point, comp]
             assert grad == pytest.approx(expected, rel=2e-5, abs=1e-7 * np.abs(expected).max())
-
-
-@pytest.mark.parametrize("case", MODEL_CASES)
-def test_kernel_matches_numpy_reference(case, rng):
-    model = _model(case, n=8)
-    b = model.bonds
-    b.intact[rng.random(b.n_bonds) < 0.05] = False  # break some bonds (asymmetrically: fine)
-    u = 1e-5 * rng.standard_normal(model.x.shape)
-    if model.name == "pmb":
-        ref = reference.pmb_force(
-            model.x, u, b.offsets, b.neighbours, model.inv_length, model.bond_stiffness, b.intact
-        )
-    else:
-        ref = reference.lps_force(
-            model.x,
-            u,
-            b.offsets,
-            b.neighbours,
-            model.length,
-            model.w,
-            model.dev,
-            b.intact,
-            model.theta_coef,
-            model._p_coef,
-        )
-    got = model.force(u)
-    np.testing.assert_allclose(got, ref, rtol=1e-10, atol=1e-12 * np.abs(ref).max())
 
 
 @pytest.mark.parametrize("name", ["pmb", "lps"])

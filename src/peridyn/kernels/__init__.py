@@ -8,7 +8,12 @@ Layout expected by every kernel (the drivers in ``peridyn.physics.materials`` an
 - per-bond arrays (n_bonds,) and per-point arrays (n_points,) of the float dtype;
 - ``intact``: (n_bonds,) bool.
 
-``reference.py`` holds plain NumPy versions used by the tests.
+``peridyn.kernels.reference`` (one module per kernel module) holds a plain NumPy version of
+every kernel, written from its definition; ``tests/kernels`` compares each kernel with it on
+small random inputs. Those tests carry the pytest marker ``kernels`` and are run a second
+time with the JIT off (the kernels then run as plain Python, which also gives coverage
+and a debugger):
+``NUMBA_DISABLE_JIT=1 PYTHONPATH=src python -m pytest -m kernels -q -p no:cacheprovider``.
 
 How the force kernels are written (what makes them fast, see ``benchmarks/RESULTS.md``):
 

@@ -1,0 +1,23 @@
+"""``peridyn.kernels.bond_differences`` against its NumPy reference."""
+
+import numpy as np
+import pytest
+
+from peridyn.kernels import bond_differences
+from peridyn.kernels.reference import bond_differences as reference
+
+pytestmark = pytest.mark.kernels
+
+
+@pytest.mark.parametrize("dtype", [np.float64, np.float32])
+def test_bond_differences(rng, dtype):
+    """(xj - xi, uj - ui, xi_a + du_a), exactly: compiled without fast-math, its three
+    roundings are its definition; swapping the ends negates all three exactly (round to
+    nearest is symmetric), which is what Newton's third law of the force kernels rests on."""
+    xj, xi = (rng.uniform(0.0, 1e-2, 50).astype(dtype) for _ in range(2))
+    uj, ui = (1e-6 * rng.standard_normal(50).astype(dtype) for _ in range(2))
+    got = np.array([bond_differences(*args) for args in zip(xj, xi, uj, ui, strict=True)]).T
+    for component, expected in zip(got, reference(xj, xi, uj, ui), strict=True):
+        np.testing.assert_array_equal(component, expected)
+    swapped = np.array([bond_differences(*args) for args in zip(xi, xj, ui, uj, strict=True)]).T
+    np.testing.assert_array_equal(swapped, -got)
