@@ -56,6 +56,39 @@ def add_json_flag(parser: argparse.ArgumentParser) -> None:
     )
 
 
+def positive_int(text: str) -> int:
+    """argparse type: an integer >= 1 (a count of steps, modes...)."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number >= 1, got {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expected a whole number >= 1, got {value}")
+    return value
+
+
+def memory_bytes(text: str) -> int:
+    """argparse type: a memory size in bytes, as a number ("4e9") or with a unit ("4GB", "512MiB")."""
+    from peridyn.errors import InputError
+    from peridyn.jobs.estimate import parse_bytes
+
+    try:
+        return parse_bytes(text)
+    except InputError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+
+
+def add_max_memory(parser: argparse.ArgumentParser) -> None:
+    """Give a subcommand the common ``--max-memory BYTES`` option (default: the machine's memory)."""
+    parser.add_argument(
+        "--max-memory",
+        type=memory_bytes,
+        default=None,
+        metavar="BYTES",
+        help="refuse a job whose estimated peak memory exceeds BYTES (e.g. 4GB; default: physical memory)",
+    )
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``peridyn`` console script; returns the exit status."""
     parser = build_parser()

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from peridyn.cli import add_json_flag
+from peridyn.cli import add_json_flag, add_max_memory
 from peridyn.cli.run_cmd import add_case_arguments
 from peridyn.errors import InputError
 
@@ -36,6 +36,7 @@ def register(sub) -> None:
         help="modal analyses before and after (default: when the case has fatigue.modal_after)",
     )
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    add_max_memory(p)
     g = p.add_argument_group("calibrate")
     g.add_argument("--strain-life", help="CSV: cycles, strain")
     g.add_argument("--paris", help="CSV: delta_k_mpa_sqrt_m, da_dn_m_per_cycle")
@@ -61,9 +62,11 @@ def run(args) -> dict:
     from tqdm import tqdm
 
     from peridyn.io.case import load_case
+    from peridyn.jobs.estimate import check_memory
     from peridyn.jobs.fatigue import run_fatigue_case
 
     case = load_case(args.case, args.overrides)
+    check_memory(case, args.max_memory, Path(args.case).parent, job="fatigue")
     progress = (
         None
         if args.no_progress or args.json

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from peridyn.cli import add_json_flag
+from peridyn.cli import add_json_flag, add_max_memory
 from peridyn.cli.run_cmd import add_case_arguments
 from peridyn.io.case import load_case
 
@@ -21,12 +21,14 @@ def register(sub) -> None:
         help="a modal run of the same grid (e.g. the healthy body): frequency-shift "
         "table of this run's modes against it, matched by MAC",
     )
+    add_max_memory(p)
     add_json_flag(p)
     p.set_defaults(func=run)
 
 
 def run(args) -> dict:
     """Solve and print the frequency table unless --json."""
+    from peridyn.jobs.estimate import check_memory
     from peridyn.jobs.modal import mode_label
     from peridyn.jobs.run import run_case
 
@@ -34,6 +36,7 @@ def run(args) -> dict:
     if args.modes is not None:
         overrides.append(f"solver.modes={args.modes}")
     case = load_case(args.case, overrides)
+    check_memory(case, args.max_memory, Path(args.case).parent)
     summary = run_case(case, args.output, case_path=args.case, base_dir=Path(args.case).parent)
     if args.compare:
         from peridyn.jobs.modal import compare_with_run

@@ -7,7 +7,7 @@ from pathlib import Path
 
 from tqdm import tqdm
 
-from peridyn.cli import add_json_flag
+from peridyn.cli import add_json_flag, add_max_memory, positive_int
 from peridyn.io.case import load_case
 from peridyn.io.provenance import provenance
 
@@ -35,19 +35,26 @@ def register(sub) -> None:
         help="output folder (default: the case's output.directory or peridyn-out/<case name>)",
     )
     p.add_argument(
-        "--checkpoint-every", type=int, default=None, metavar="N", help="write a checkpoint every N steps"
+        "--checkpoint-every",
+        type=positive_int,
+        default=None,
+        metavar="N",
+        help="write a checkpoint every N steps",
     )
     p.add_argument("--restart", action="store_true", help="continue from the output folder's checkpoint.h5")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    add_max_memory(p)
     add_json_flag(p)
     p.set_defaults(func=run)
 
 
 def run(args) -> dict:
     """Run the case; print a readable summary unless --json."""
+    from peridyn.jobs.estimate import check_memory
     from peridyn.jobs.run import run_case
 
     case = load_case(args.case, args.overrides)
+    check_memory(case, args.max_memory, Path(args.case).parent)
     info = provenance()
     print(
         f"peridyn {info['peridyn_version']} (commit {info['git_commit'][:12]}): case "

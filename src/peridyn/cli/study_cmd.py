@@ -11,7 +11,7 @@ import math
 import sys
 from pathlib import Path
 
-from peridyn.cli import add_json_flag
+from peridyn.cli import add_json_flag, add_max_memory
 from peridyn.cli.run_cmd import add_case_arguments
 from peridyn.errors import InputError
 
@@ -61,6 +61,7 @@ def register(sub) -> None:
         metavar="FILE",
         help="also save the figure to FILE (PNG); study.png is always written in the output folder",
     )
+    add_max_memory(p)
     add_json_flag(p)
     p.set_defaults(func=run)
 
@@ -68,6 +69,7 @@ def register(sub) -> None:
 def run(args) -> dict:
     """Run the grid, fit, write the tables and the figure; print the table unless --json."""
     from peridyn.io.case import load_case
+    from peridyn.jobs.estimate import check_memory, largest_study_run
     from peridyn.jobs.study import SERIES, fit_series, run_grid, write_study
     from peridyn.plotting.convergence import plot_convergence
 
@@ -83,6 +85,7 @@ def run(args) -> dict:
     if args.finest is not None and args.finest < 3:
         raise InputError(f"--finest = {args.finest}: a Richardson fit needs at least three runs")
     case = load_case(args.case, args.overrides)  # fail early on a bad case or override
+    check_memory(largest_study_run(case, spacings, factors), args.max_memory, Path(args.case).parent)
     out = Path(args.out or Path("peridyn-out") / f"{case.name}-study")
     runs = run_grid(
         args.case,

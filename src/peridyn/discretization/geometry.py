@@ -6,6 +6,8 @@ axis fastest, which keeps neighbours close in memory for the kernels.
 
 from __future__ import annotations
 
+import os
+import resource
 import warnings
 
 import numpy as np
@@ -25,14 +27,18 @@ def _positive_triplet(name: str, value, count: int = 3) -> np.ndarray:
 ROUNDING_WARNING = 1e-4
 
 
-def _cell_counts(lengths: np.ndarray, spacing: np.ndarray) -> np.ndarray:
+def cell_counts(lengths: np.ndarray, spacing: np.ndarray, warn: bool = True) -> np.ndarray:
     """Whole cells along each side (the nearest count); warns when a side changes length."""
-    counts = np.rint(lengths / spacing).astype(np.int64)
+    with np.errstate(over="ignore", invalid="ignore"):
+        ratio = lengths / spacing
+    if not np.all(ratio < 2**62):
+        raise InputError(f"spacing {spacing.tolist()} m is too small for the body {lengths.tolist()} m")
+    counts = np.rint(ratio).astype(np.int64)
     if np.any(counts < 1):
         raise InputError(f"spacing {spacing.tolist()} m is larger than the body {lengths.tolist()} m")
     built = counts * spacing
     changed = np.abs(built - lengths) > ROUNDING_WARNING * lengths
-    if np.any(changed):
+    if warn and np.any(changed):
         sides = ", ".join(
             f"{lengths[a]:g} m -> {built[a]:g} m ({counts[a]} cells)" for a in np.flatnonzero(changed)
         )
@@ -40,6 +46,39 @@ def _cell_counts(lengths: np.ndarray, spacing: np.ndarray) -> np.ndarray:
             f"the spacing does not divide the body: sides rounded to whole cells: {sides}", stacklevel=3
         )
     return counts
+
+
+#: Bytes per point a grid builder holds at its peak: the (n, 3) points, the meshgrid copies
+#: and the stacked result (float64), the volumes, the (n, 3) cells of the Body, layer indices.
+GRID_BYTES_PER_POINT = 128
+
+
+def memory_limit() -> float:
+    """Bytes this process may use: the physical memory, or less under an address-space limit
+    (``ulimit -v``); infinite where the system says neither."""
+    try:
+        physical = float(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
+    except (ValueError, OSError, AttributeError):
+        physical = float("inf")
+    soft = resource.getrlimit(resource.RLIMIT_AS)[0]
+    return min(physical, float(soft)) if soft != resource.RLIM_INFINITY else physical
+
+
+def check_grid_fits(n_points: float, what: str) -> None:
+    """Refuse, before allocating, a grid whose arrays would not fit in memory.
+
+    Raises
+    ------
+    InputError
+        Naming the number of points and the bytes needed against those available.
+    """
+    needed = GRID_BYTES_PER_POINT * float(n_points)
+    available = memory_limit()
+    if needed > available:
+        raise InputError(
+            f"{what} of {float(n_points):.3g} points would need {needed / 2**30:.3g} GiB for its "
+            f"arrays alone; this machine has {available / 2**30:.3g} GiB: use a coarser spacing"
+        )
 
 
 def _grid(counts, spacing, origin) -> np.ndarray:
@@ -62,7 +101,8 @@ def box(lengths, spacing, origin=(0.0, 0.0, 0.0)) -> Body:
     """
     h = _positive_triplet("spacing", spacing)
     lengths = _positive_triplet("lengths", lengths)
-    counts = _cell_counts(lengths, h)
+    counts = cell_counts(lengths, h)
+    check_grid_fits(np.prod(counts.astype(float)), "a box")
     points = _grid(counts, h, np.asarray(origin, dtype=float))
     return Body(points=points, volumes=np.full(len(points), h.prod()), cells=h, dim=3, spacing=float(h.max()))
 
@@ -105,7 +145,8 @@ def plate(
     layers = int(layers)
     h = float(_positive_triplet("spacing", spacing, 1)[0])
     length, width, thickness = _positive_triplet("plate size", (length, width, thickness))
-    counts_xy = _cell_counts(np.array([length, width]), np.array([h, h]))
+    counts_xy = cell_counts(np.array([length, width]), np.array([h, h]))
+    check_grid_fits(np.prod(counts_xy.astype(float)) * layers, "a plate")
     if layer_placement == "cell":
         dz = thickness / layers
         z = (np.arange(layers) + 0.5) * dz
@@ -148,7 +189,8 @@ def rectangle(length, width, spacing, thickness, plane: str = "stress", origin=(
     """
     h = float(_positive_triplet("spacing", spacing, 1)[0])
     t = float(_positive_triplet("thickness", thickness, 1)[0])
-    counts = _cell_counts(_positive_triplet("rectangle size", (length, width), 2), np.array([h, h]))
+    counts = cell_counts(_positive_triplet("rectangle size", (length, width), 2), np.array([h, h]))
+    check_grid_fits(np.prod(counts.astype(float)), "a rectangle")
     xy = _grid(counts, np.array([h, h]), np.asarray(origin, dtype=float))
     points = np.zeros((len(xy), 3))
     points[:, :2] = xy

@@ -37,6 +37,23 @@ class Setup:
 
 def build_body(case: Case, base_dir=".") -> Body:
     """Points of the case geometry, minus removals, with the case's node sets (and ``all``)."""
+    body = build_points(case, base_dir)
+    body = body.with_node_set("all", np.ones(body.n_points, dtype=bool))
+    for name, region in case.node_sets.items():
+        mask = region_mask(body, region, f"node_sets.{name}")
+        if not mask.any():
+            raise CaseFileError(
+                case.name,
+                f"node_sets.{name}",
+                region.model_dump(exclude_none=True),
+                "a region that contains at least one point",
+            )
+        body = body.with_node_set(name, mask)
+    return body
+
+
+def build_points(case: Case, base_dir=".", removals: bool = True) -> Body:
+    """Points of the case geometry, minus its removals (unless ``removals`` is False)."""
     g, d = case.geometry, case.discretization
     if g.type != "mesh" and d.spacing is None:
         raise CaseFileError(case.name, "discretization.spacing", None, "a positive spacing (m)")
@@ -63,19 +80,8 @@ def build_body(case: Case, base_dir=".") -> Body:
         body = mesh_text.from_text_mesh(
             mesh, dim=g.dimension, thickness=g.thickness, plane=g.plane if g.dimension == 2 else None
         )
-    for k, region in enumerate(case.removals):
+    for k, region in enumerate(case.removals if removals else []):
         body = body.remove(region_mask(body, region, f"removals[{k}]"))
-    body = body.with_node_set("all", np.ones(body.n_points, dtype=bool))
-    for name, region in case.node_sets.items():
-        mask = region_mask(body, region, f"node_sets.{name}")
-        if not mask.any():
-            raise CaseFileError(
-                case.name,
-                f"node_sets.{name}",
-                region.model_dump(exclude_none=True),
-                "a region that contains at least one point",
-            )
-        body = body.with_node_set(name, mask)
     return body
 
 
