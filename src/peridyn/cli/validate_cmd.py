@@ -23,9 +23,11 @@ def register(sub) -> None:
 
 
 def run(args) -> dict:
-    """Validate; with --build also construct the discretisation and check the time step."""
+    """Validate all that needs no bonds (memory, regions, placements, loads, signals, the
+    time step against its estimate); with --build also construct the bonds and model and
+    check the time step against the model's own bound."""
     case = load_case(args.case, args.overrides)
-    summary = {"case": case.name, "valid": True}
+    summary = {"case": case.name, "valid": True, **check_without_bonds(case, Path(args.case).parent)}
     if args.build:
         from peridyn.jobs.build import build
         from peridyn.solvers import ExplicitSolver
@@ -38,6 +40,43 @@ def run(args) -> dict:
     if not args.json:
         print(
             f"{args.case}: valid"
-            + "".join(f", {k} {v}" for k, v in summary.items() if k not in ("case", "valid"))
+            + "".join(
+                f", {k} {v:.4g}" if isinstance(v, float) else f", {k} {v}"
+                for k, v in summary.items()
+                if k not in ("case", "valid")
+            )
         )
     return summary
+
+
+def check_without_bonds(case, base_dir) -> dict:
+    """The estimated points, bonds, peak bytes and (explicit) stable step of ``case``, after
+    building its points, node sets, actuators and loads (no bonds); raises on any problem."""
+    import numpy as np
+
+    from peridyn.errors import CaseFileError
+    from peridyn.jobs.build import add_actuators, build_body, build_loading, check_loading, check_placements
+    from peridyn.jobs.estimate import check_memory
+    from peridyn.jobs.run import explicit_damping
+    from peridyn.jobs.stable_step import estimated_stable_step
+    from peridyn.solvers.explicit import damped_stable_step
+
+    est = check_memory(case, None, base_dir)
+    body = build_body(case, base_dir)
+    check_placements(case, body)
+    body, actuation = add_actuators(case, body)
+    check_loading(case, build_loading(case, body, actuation))
+    found = {"points": est.points, "estimated_bonds": est.bonds, "estimated_peak_bytes": est.peak_bytes}
+    if case.solver.type == "explicit":
+        damping = float(np.max(explicit_damping(case, body)))
+        stable = damped_stable_step(estimated_stable_step(case, base_dir), damping)
+        if case.solver.dt is not None and case.solver.dt > stable:
+            raise CaseFileError(
+                case.name,
+                "solver.dt",
+                case.solver.dt,
+                f"at most the estimated stable step {stable:.4g} s (validate --build gives the "
+                "model's own bound), or leave dt unset",
+            )
+        found["estimated_stable_dt_s"] = stable
+    return found

@@ -126,6 +126,17 @@ class Discretization(Strict):
     def _one_horizon(self):
         if (self.horizon is None) == (self.horizon_m is None):
             raise ValueError("give exactly one of horizon (multiple of the spacing) or horizon_m")
+        if self.horizon is not None and self.horizon < 1:
+            raise ValueError(
+                f"horizon = {self.horizon:g} spacings: at least 1 (below the spacing a point "
+                "has no neighbours along the axes)"
+            )
+        spacing = max(self.spacing) if isinstance(self.spacing, list) else self.spacing
+        if self.horizon_m is not None and spacing is not None and self.horizon_m < spacing:
+            raise ValueError(
+                f"horizon_m = {self.horizon_m:g} m is below the spacing {spacing:g} m: "
+                "at least the spacing (else a point has no neighbours along the axes)"
+            )
         return self
 
 

@@ -8,6 +8,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 from peridyn.discretization import geometry
 from peridyn.discretization.body import Body, in_box, in_cylinder, in_sphere
@@ -164,9 +165,63 @@ def build_loading(case: Case, body: Body, extra=()) -> Loading:
     return Loading(body, [*extra, *bcs], ics)
 
 
+def check_placements(case: Case, body: Body) -> None:
+    """Refuse sensors, line-probe ends, PZT sensors and actuators outside the body.
+
+    A position is outside when it lies more than half a spacing outside the cell of every
+    point near it (an in-plane ``center`` is compared with the x-y cells only).
+
+    Raises
+    ------
+    CaseFileError
+        Naming the key (e.g. ``output.sensors.tip``), the position and the distance (m).
+    """
+    out = case.output
+    spots = [(f"output.sensors.{k}", v) for k, v in out.sensors.items()]
+    for k, line in out.lines.items():
+        spots += [(f"output.lines.{k}.start", line.start), (f"output.lines.{k}.end", line.end)]
+    spots += [(f"output.pzt_sensors.{k}.center", v.center) for k, v in out.pzt_sensors.items()]
+    spots += [(f"actuators.{k}.center", v.center) for k, v in case.actuators.items()]
+    if not spots:
+        return
+    in_plane = [len(v) == 2 and body.dim == 3 for _, v in spots]
+    for axes, chosen in ((3, [not p for p in in_plane]), (2, in_plane)):
+        items = [spot for spot, c in zip(spots, chosen, strict=True) if c]
+        if items:
+            far = distance_outside(body, np.array([pad3(v)[:axes] for _, v in items]), axes)
+            for (key, value), d in zip(items, far, strict=True):
+                if d > 0.5 * body.spacing:
+                    raise CaseFileError(
+                        case.name,
+                        key,
+                        value,
+                        f"a position inside the body: it is {d:.3g} m outside "
+                        f"(spacing {body.spacing:g} m; the body spans "
+                        f"{body.points.min(axis=0).tolist()} to {body.points.max(axis=0).tolist()} m)",
+                    )
+
+
+#: Nearest points searched for the cell that a position is closest to.
+NEAREST_CELLS = 8
+
+
+def distance_outside(body: Body, positions: np.ndarray, axes: int = 3) -> np.ndarray:
+    """(m,) distance (m) from each of ``positions`` (m, axes) to the nearest point's cell
+    (0 inside a cell), over the first ``axes`` coordinates."""
+    tree = cKDTree(body.points[:, :axes])
+    k = min(NEAREST_CELLS, body.n_points)
+    _, idx = tree.query(positions, k=k)
+    idx = np.asarray(idx).reshape(len(positions), k)
+    cells = body.cells if body.dim == 3 else np.column_stack([body.cells[:, :2], np.zeros(body.n_points)])
+    gap = np.abs(positions[:, None, :] - body.points[idx, :axes]) - 0.5 * cells[idx, :axes]
+    return np.min(np.linalg.norm(np.clip(gap, 0.0, None), axis=2), axis=1)
+
+
 def build(case: Case, base_dir=".") -> Setup:
     """Body, bonds, model, loading and damage of a case."""
-    body, actuation = add_actuators(case, build_body(case, base_dir))
+    body = build_body(case, base_dir)
+    check_placements(case, body)
+    body, actuation = add_actuators(case, body)
     bonds = build_bonds(case, body)
     mat = case.material
     model = make_model(
@@ -189,6 +244,12 @@ def build(case: Case, base_dir=".") -> Setup:
             critical_bond_stress=mat.damage.critical_bond_stress,
         )
     loading = build_loading(case, body, actuation)
+    check_loading(case, loading)
+    return Setup(body, bonds, model, loading, damage, build_contact(case, model))
+
+
+def check_loading(case: Case, loading: Loading) -> None:
+    """Refuse loads that leave the case's solver nothing to do."""
     if case.solver.type == "static" and not loading.has_loads:
         raise CaseFileError(case.name, "boundary_conditions", [], "at least one load for a static run")
     if case.solver.type == "newmark" and not (loading.has_loads or loading.initial):
@@ -201,7 +262,6 @@ def build(case: Case, base_dir=".") -> Setup:
         raise CaseFileError(
             case.name, "boundary_conditions", [], "a load or an initial condition: nothing would move"
         )
-    return Setup(body, bonds, model, loading, damage, build_contact(case, model))
 
 
 def build_contact(case: Case, model: Model) -> Contact | None:

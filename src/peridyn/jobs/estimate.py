@@ -115,34 +115,50 @@ def parse_bytes(text) -> int:
     return int(value)
 
 
-def lattice_bonds(counts, cell, horizon: float, partial_volumes: bool, dim: int) -> float:
-    """Directed bonds of a grid of ``counts`` points per axis with ``cell`` sides (m).
+def lattice_offsets(counts, cell, reach: float) -> np.ndarray:
+    """(k, 3) int offsets (in cells) of the grid neighbours within ``reach`` (m) of a point,
+    the zero offset excluded; each axis is limited to ``counts - 1``."""
+    cell = np.asarray(cell, dtype=float)
+    half = [min(math.floor(reach / cell[a]), int(counts[a]) - 1) for a in range(3)]
+    axes = [np.arange(-m, m + 1) for m in half]
+    offsets = np.stack([o.ravel() for o in np.meshgrid(*axes, indexing="ij")], axis=1)
+    r = np.linalg.norm(offsets * cell, axis=1)
+    return offsets[(r > 0) & (r <= reach)]
 
-    Follows ``discretization.bonds.find_bonds``: a neighbour is in when its centre lies
-    within the horizon or, with partial volumes, when part of its cell does.
+
+def neighbour_offsets(counts, cell, horizon: float, partial_volumes: bool, dim: int):
+    """Offsets (k, 3) of a grid point's neighbours as ``find_bonds`` keeps them, and each
+    neighbour's volume factor (k,): the share of its cell inside the horizon, or 1.
+
+    A neighbour is in when its centre lies within the horizon or, with partial volumes,
+    when part of its cell does.
     """
     from peridyn.kernels.bond_search import box_fraction_in_ball
 
-    counts = np.asarray(counts, dtype=float)
-    cell = np.asarray(cell, dtype=float)
     radius = horizon * (1 + 1e-12)
-    sides = cell.copy()
+    sides = np.asarray(cell, dtype=float).copy()
     if dim == 2:
         sides[2] = 0.0
-    reach = radius + (0.5 * float(np.linalg.norm(sides)) if partial_volumes else 0.0)
-    half = [min(math.floor(reach / cell[a]), int(counts[a]) - 1) for a in range(3)]
-    if math.prod(2 * m + 1 for m in half) > MAX_OFFSETS:
-        ball = 4.0 / 3.0 * math.pi * radius**3 if dim == 3 else math.pi * radius**2 * cell[2]
+    if not partial_volumes:
+        offsets = lattice_offsets(counts, cell, radius)
+        return offsets, np.ones(len(offsets))
+    offsets = lattice_offsets(counts, cell, radius + 0.5 * float(np.linalg.norm(sides)))
+    xi = offsets * np.asarray(cell, dtype=float)
+    factor = np.array([box_fraction_in_ball(*x, *sides, radius, 8) for x in xi])
+    return offsets[factor > 0], factor[factor > 0]
+
+
+def lattice_bonds(counts, cell, horizon: float, partial_volumes: bool, dim: int) -> float:
+    """Directed bonds of a grid of ``counts`` points per axis with ``cell`` sides (m): each
+    neighbour offset ``o`` joins ``prod_a (n_a - |o_a|)`` ordered pairs."""
+    counts = np.asarray(counts, dtype=float)
+    cell = np.asarray(cell, dtype=float)
+    reach = horizon + (0.5 * float(np.linalg.norm(cell[:dim])) if partial_volumes else 0.0)
+    if math.prod(2 * min(math.floor(reach / cell[a]), counts[a] - 1) + 1 for a in range(3)) > MAX_OFFSETS:
+        ball = 4.0 / 3.0 * math.pi * horizon**3 if dim == 3 else math.pi * horizon**2 * cell[2]
         return float(np.prod(counts)) * min(ball / float(np.prod(cell)), float(np.prod(counts)) - 1)
-    axes = [np.arange(-m, m + 1) for m in half]
-    offsets = np.stack([o.ravel() for o in np.meshgrid(*axes, indexing="ij")], axis=1)
-    xi = offsets * cell
-    r = np.linalg.norm(xi, axis=1)
-    inside = (r > 0) & (r <= reach)
-    if partial_volumes:
-        inside[inside] = [box_fraction_in_ball(*x, *sides, radius, 8) > 0 for x in xi[inside]]
-    pairs = np.prod(counts - np.abs(offsets[inside]), axis=1)
-    return float(pairs.sum())
+    offsets, _ = neighbour_offsets(counts, cell, horizon, partial_volumes, dim)
+    return float(np.prod(counts - np.abs(offsets), axis=1).sum())
 
 
 def grid_shape(case: Case, base_dir=".") -> tuple[np.ndarray, np.ndarray, int]:

@@ -1,0 +1,80 @@
+"""The explicit stable step of a case estimated without its bonds, for ``peridyn validate``.
+
+The models' bound (``Model.critical_time_step``) is dt = 2 / sqrt(max_i B_i / rho), with B_i
+the block-Gershgorin bound of point i's row of the stiffness. For a point of a regular grid
+whose whole family is on the grid, B_i depends only on E, nu, the cell, the horizon and the
+influence function, so it is summed here over the lattice offsets of the family
+(``estimate.neighbour_offsets``) with the model's own constants:
+
+- PMB: B = 2 sum_j c0 omega_j V_j / |xi_j|;
+- LPS (weights w_j = omega_j V_j, m = sum w |xi|^2, alpha = 15 mu / m (8 mu / m in 2D),
+  theta coefficient d / m, S = (d / m) sum w |xi|):
+  B = sum_j (4 alpha w_j + 2 K (d / m) w_j |xi_j| S) + 2 K S^2.
+
+Plates are summed for every layer (the family cut by the faces) and the largest B taken.
+What the lattice cannot see makes the real step shorter: surface corrections (stiffer
+bonds near faces), removals and pre-cracks (cut families, larger alpha), text meshes,
+contact. ``STEP_MARGIN`` is how much longer than the real step the estimate may be on the
+shipped cases (tests/unit/test_stable_step.py measures it); ``validate`` refuses a dt above
+the estimate and ``validate --build`` computes the real bound.
+"""
+
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+
+from peridyn.discretization.bonds import influence_function
+from peridyn.io.case import Case
+from peridyn.jobs.estimate import grid_shape, neighbour_offsets
+from peridyn.physics.materials.elastic import bulk_modulus, plane_bulk_modulus, shear_modulus
+from peridyn.physics.materials.pmb import pmb_micromodulus
+
+#: The estimate is at most this much longer than ``critical_time_step`` on the shipped cases.
+STEP_MARGIN = 0.15
+
+
+def estimated_stable_step(case: Case, base_dir=".") -> float:
+    """Estimated largest stable explicit step of ``case``, s (undamped, without contact)."""
+    counts, cell, dim = grid_shape(case, base_dir)
+    d, mat, g = case.discretization, case.material, case.geometry
+    spacing = float(cell[0]) if g.type == "plate" else float(np.max(cell[:dim]))
+    horizon = d.horizon_m if d.horizon_m is not None else d.horizon * spacing
+    volume = float(np.prod(cell)) if g.type != "mesh" else spacing**3
+    offsets, factor = neighbour_offsets(counts, cell, horizon, d.partial_volumes, dim)
+    bound = 0.0
+    for low in itertools.product(*(_positions(offsets[:, a], int(counts[a])) for a in range(3))):
+        lo, hi = np.array([p[0] for p in low]), np.array([p[1] for p in low])
+        keep = np.all((offsets >= lo) & (offsets <= hi), axis=1)
+        bound = max(bound, _row_bound(case, offsets[keep] * cell, factor[keep], horizon, volume, dim))
+    return float(2.0 / np.sqrt(bound / mat.density))
+
+
+def _positions(offsets: np.ndarray, count: int) -> list[tuple[int, int]]:
+    """(lowest, highest) offset along one axis that a grid point's family may reach, for
+    every distinct position of the point relative to the faces (interior included)."""
+    reach = int(np.max(np.abs(offsets))) if len(offsets) else 0
+    cuts = range(min(reach, count - 1) + 1)
+    limits = {(-min(p, reach), min(count - 1 - p, reach)) for p in cuts}
+    limits |= {(-min(count - 1 - p, reach), min(p, reach)) for p in cuts}
+    return sorted(limits)
+
+
+def _row_bound(case: Case, xi_vec: np.ndarray, factor: np.ndarray, horizon, volume, dim) -> float:
+    """Block-Gershgorin bound B (N/m^5) of a point whose family has bond vectors ``xi_vec``
+    (k, 3) m and volume factors (k,); LPS takes the neighbours' alpha, m and S equal to the
+    point's own."""
+    d, mat, g = case.discretization, case.material, case.geometry
+    plane = g.plane if dim == 2 else None
+    xi = np.linalg.norm(xi_vec, axis=1)
+    w = influence_function(d.influence)(xi, horizon) * volume * factor
+    if mat.model == "pmb":
+        c0 = pmb_micromodulus(mat.E, dim, horizon, d.influence, plane, g.thickness if dim == 2 else None)
+        return float(2.0 * np.sum(c0 * w / xi))
+    mu = shear_modulus(mat.E, mat.nu)
+    bulk = bulk_modulus(mat.E, mat.nu) if dim == 3 else plane_bulk_modulus(mat.E, mat.nu, plane)
+    m = np.sum(w * xi**2)
+    alpha = (15.0 if dim == 3 else 8.0) * mu / m
+    s = dim / m * np.sum(w * xi)
+    return float(np.sum(4.0 * alpha * w + 2.0 * bulk * (dim / m) * w * xi * s) + 2.0 * bulk * s**2)
