@@ -46,7 +46,7 @@ def linear_force(model: Model, u: np.ndarray) -> np.ndarray:
     x = model.body.points
     u = np.ascontiguousarray(u, dtype=np.float64)
     lin = model.linearisation()
-    if lin.has_dilatation:
+    if lin.has_dilatation:  # the state-based kernel takes any material's dilatation coefficients
         return lps_linear_force(
             x,
             u,
@@ -59,6 +59,7 @@ def linear_force(model: Model, u: np.ndarray) -> np.ndarray:
             lin.theta_coef,
             lin.p_coef,
         )
+    # bond-based: t = extension e (for PMB the arithmetic of kernels.linear.pmb_linear_force)
     e = bond_extension(x, u, b.offsets, b.neighbours, b.length, b.intact, np.empty(b.n_bonds))
     return scatter_along_bonds(x, b.offsets, b.neighbours, b.length, lin.extension * e, np.empty_like(x))
 
