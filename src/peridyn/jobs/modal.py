@@ -20,7 +20,6 @@ from peridyn.io.hdf5 import HDF5Writer
 from peridyn.io.provenance import provenance
 from peridyn.io.vtk import write_vtu
 from peridyn.linalg.ordering import estimated_factor_entries
-from peridyn.physics.materials import LPSModel
 from peridyn.solvers.modal import modal_analysis
 
 #: Share of the machine's memory the factorisation may take.
@@ -187,7 +186,7 @@ def choose_eigensolver(model, requested: str = "auto") -> str:
 
 def factor_bytes(model) -> float:
     """Estimated memory of the shift-invert factor, bytes (8-byte values, 4-byte indices)."""
-    unknowns = 4 if isinstance(model, LPSModel) else 3  # LPS: three dofs and a dilatation
+    unknowns = 4 if model.has_dilatation else 3  # with a dilatation (LPS): three dofs and theta
     return 12.0 * estimated_factor_entries(model.body.points, model.bonds.horizon, unknowns)
 
 
