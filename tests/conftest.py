@@ -12,6 +12,10 @@ from peridyn.discretization import geometry
 from peridyn.discretization.bonds import find_bonds
 from peridyn.physics.materials import MODELS, make_model
 
+#: ``materials/`` holds material modules imported above, not tests: doctest collection
+#: (``--doctest-modules``) would import them a second time under another module name.
+collect_ignore = ["materials"]
+
 #: Maraging steel of seed 001 / VALIDATION V3: rho = 8000, mu = 81.92 GPa, K = 132.77 GPa.
 STEEL_K, STEEL_MU, STEEL_RHO = 132.77e9, 81.92e9, 8000.0
 STEEL_E = 9 * STEEL_K * STEEL_MU / (3 * STEEL_K + STEEL_MU)
