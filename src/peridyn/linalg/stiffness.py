@@ -59,7 +59,7 @@ def linear_force(model: Model, u: np.ndarray) -> np.ndarray:
             lin.theta_coef,
             lin.p_coef,
         )
-    # bond-based: t = extension e (for PMB the arithmetic of kernels.linear.pmb_linear_force)
+    # bond-based: t = extension e, scattered along the bonds
     e = bond_extension(x, u, b.offsets, b.neighbours, b.length, b.intact, np.empty(b.n_bonds))
     return scatter_along_bonds(x, b.offsets, b.neighbours, b.length, lin.extension * e, np.empty_like(x))
 
