@@ -110,20 +110,21 @@ def compare_with_run(run_dir: Path, reference_dir: Path) -> list[dict]:
     MAC (so types are compared like with like when damage changes the order); written to
     ``run_dir / "frequency_shift.csv"``. Both runs must have the same points.
     """
-    from peridyn.io.hdf5 import read_array
+    from peridyn.io.results import Results
 
     runs = []
     for d in (reference_dir, run_dir):
         h5 = d / "results.h5"
         if not h5.is_file():
             raise InputError(f"--compare: {h5} not found (give the folder of a modal run)")
+        results = Results(h5)
         runs.append(
             {
-                "points": read_array(h5, "geometry/points"),
-                "volumes": read_array(h5, "geometry/volumes"),
-                "frequencies": read_array(h5, "modes/frequencies"),
-                "shapes": read_array(h5, "modes/shapes"),
-                "rigid": read_array(h5, "modes/rigid").astype(bool),
+                "points": results.array("geometry/points"),
+                "volumes": results.array("geometry/volumes"),
+                "frequencies": results.array("modes/frequencies"),
+                "shapes": results.array("modes/shapes"),
+                "rigid": results.array("modes/rigid").astype(bool),
                 "types": json.loads((d / "modes.json").read_text()),
             }
         )

@@ -4,7 +4,6 @@ runs are ``jobs.modal``), recording, checkpoints, crack history and the stored s
 
 from __future__ import annotations
 
-import json
 import time
 from pathlib import Path
 
@@ -121,13 +120,9 @@ def run_case(
 
 
 def store_summary(results, body: Body, summary: dict) -> None:
-    """(Re)write the run summary as JSON in ``/summary/json`` of a results file."""
+    """(Re)write the run summary in ``/summary/json`` of a results file."""
     with HDF5Writer(results, body.points[:, : body.dim], body.volumes, {}, mode="a") as h5:
-        h5.write_array("summary/json", np.bytes_(json.dumps(summary, default=_json_default)))
-
-
-def _json_default(obj):
-    return obj.tolist() if hasattr(obj, "tolist") else str(obj)
+        h5.write_summary(summary)
 
 
 def _base_summary(setup: Setup, out: Path) -> dict:
