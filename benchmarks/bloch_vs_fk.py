@@ -39,7 +39,7 @@ from peridyn.analysis.bloch_study import predict
 from peridyn.analysis.fk import fk_transform, line_mode_wavenumbers, phase_wavenumber, pick_wavenumbers
 from peridyn.analysis.lamb import lamb_modes
 from peridyn.io.case import load_case
-from peridyn.io.hdf5 import read_array, read_series
+from peridyn.io.results import Results
 from peridyn.jobs.lamb_analysis import centre_frequency
 from peridyn.physics.timefunctions import from_spec
 
@@ -110,7 +110,7 @@ def main() -> None:
     line = case.output.lines[fk.line]
     x = np.linspace(line.start[0], line.end[0], line.points)
     if args.run_dir:
-        _, times, _ = read_series(f"{args.run_dir}/results.h5", f"line_{fk.line}")
+        _, times, _ = Results(f"{args.run_dir}/results.h5").series(f"line_{fk.line}")
     else:
         times = np.linspace(0.0, case.solver.time, args.records + 1)
     actuator = next(iter(case.actuators.values()))
@@ -156,7 +156,7 @@ def main() -> None:
     result = {"case": case.name, "frequency_hz": f0, "r_range_m": r_range, "modes": out}
     if args.run_dir:
         results = f"{args.run_dir}/results.h5"
-        summary = json.loads(read_array(results, "summary/json").tobytes().decode())
+        summary = Results(results).summary()
         run = line_mode_wavenumbers(results, fk.line, x, disc.spacing, f0, actuator.center[0], r_range)
         shares = time_integration_shares(disc, cell, f0, summary["dt_s"])
         result["omega_dt"] = 2 * np.pi * f0 * summary["dt_s"]

@@ -19,6 +19,11 @@ instead: the eigensolver (ARPACK) starts from a random vector, so mode shapes (d
 agree to ``FREQUENCY_ATOL + FREQUENCY_RTOL |f|`` (rigid modes are noise of ~1e-3 Hz around 0)
 and the other numbers of a modal analysis (MAC, frequency changes) to ``MODAL_TOL``, absolute
 and relative (seen run to run: 1e-13).
+
+Summary schema 2 (docs/user-guide.md, "Summaries and results files") renamed keys and made every
+bond count directed. ``compare`` reads a table recorded before it (summaries without a
+``schema_version``) through :data:`SCHEMA_1_TO_2`, so that the old table still checks every
+number; keys that schema 2 added and the old table cannot hold are listed in :data:`SCHEMA_2_NEW`.
 """
 
 from __future__ import annotations
@@ -61,6 +66,18 @@ VOLATILE = {
 }
 FREQUENCY_ATOL, FREQUENCY_RTOL = 1e-2, 1e-9  # Hz, 1
 MODAL_TOL = 1e-9
+#: Schema 1 -> 2, per job kind (the first word of a table entry): old key -> (new key, factor).
+#: The fatigue summary counted each bond once; schema 2 counts directed bonds, as runs always did.
+SCHEMA_1_TO_2 = {
+    "fatigue": {"bonds": ("bonds", 2), "bonds_broken": ("fatigue_broken_bonds", 2)},
+}
+#: Keys new in schema 2, per job kind: ``kind`` and ``schema_version`` everywhere, a mode's
+#: ``label`` ("1st bending", from its type and order), and the fatigue summary's ``broken_bonds``
+#: (every directed bond broken at the end, pre-cracks included, as in a run's summary).
+SCHEMA_2_NEW = {
+    "run": {"kind", "schema_version", "label"},
+    "fatigue": {"kind", "schema_version", "label", "broken_bonds"},
+}
 
 
 def _strip(value):
@@ -133,6 +150,11 @@ def _numbers(value, prefix=""):
         yield prefix, value
 
 
+def _leaf(key: str) -> str:
+    """The last key of a flattened path: ``modes[6].label`` -> ``label``."""
+    return key.rsplit(".", 1)[-1].split("[")[0]
+
+
 def _agree(key: str, a, b) -> bool:
     """Equal, or within the eigensolver's run-to-run scatter for its outputs (module docstring)."""
     if key.endswith("residual"):
@@ -145,6 +167,18 @@ def _agree(key: str, a, b) -> bool:
     return a == b
 
 
+def _schema_2(kind: str, summary: dict) -> tuple[dict, set]:
+    """A schema-1 summary in schema 2's keys and counts, and the leaf keys it cannot hold
+    (unchanged, and nothing to skip, for a summary that has a ``schema_version``)."""
+    if "schema_version" in summary:
+        return summary, set()
+    renamed = dict(summary)
+    for old, (new, factor) in SCHEMA_1_TO_2.get(kind, {}).items():
+        if old in renamed:
+            renamed[new] = renamed.pop(old) * factor
+    return renamed, SCHEMA_2_NEW[kind]
+
+
 def compare(before: dict, after: dict) -> bool:
     same = True
     for name in sorted(set(before) | set(after)):
@@ -153,7 +187,9 @@ def compare(before: dict, after: dict) -> bool:
             same = False
             continue
         a, b = before[name], after[name]
-        flat_a, flat_b = dict(_numbers(a.get("summary", a))), dict(_numbers(b.get("summary", b)))
+        old, new_keys = _schema_2(name.split()[0], a.get("summary", a))
+        flat_a, flat_b = dict(_numbers(old)), dict(_numbers(b.get("summary", b)))
+        flat_b = {k: v for k, v in flat_b.items() if k in flat_a or _leaf(k) not in new_keys}
         keys = sorted(set(flat_a) | set(flat_b))
         missing = [k for k in keys if k not in flat_a or k not in flat_b]
         values = [

@@ -1,11 +1,20 @@
-"""Shared factories: small bodies and models used across the test folders."""
+"""Shared factories: small bodies and models used across the test folders.
+
+Importing ``materials.conical_bond`` registers the test-only "conical" material, so that every
+test parametrized with ``MODEL_CASES`` or ``MATERIALS`` (the registered materials) runs on it.
+"""
 
 import numpy as np
 import pytest
+from materials import conical_bond  # noqa: F401  (registers the "conical" material)
 
 from peridyn.discretization import geometry
 from peridyn.discretization.bonds import find_bonds
-from peridyn.physics.materials import make_model
+from peridyn.physics.materials import MODELS, make_model
+
+#: ``materials/`` holds material modules imported above, not tests: doctest collection
+#: (``--doctest-modules``) would import them a second time under another module name.
+collect_ignore = ["materials"]
 
 #: Maraging steel of seed 001 / VALIDATION V3: rho = 8000, mu = 81.92 GPa, K = 132.77 GPa.
 STEEL_K, STEEL_MU, STEEL_RHO = 132.77e9, 81.92e9, 8000.0
@@ -31,29 +40,32 @@ def small_model(
     nu: float = 0.25,
     surface_correction: str = "none",
 ):
-    """A model on ``small_body`` with steel-like constants."""
+    """A model on ``small_body`` with steel-like constants; ``nu`` goes to the materials that
+    take one (a bond-based material gets the ratio it implies)."""
     body = small_body(dim, plane, n)
     bonds = find_bonds(body, horizon_factor * body.spacing, partial_volumes=partial_volumes)
-    implied = 1 / 3 if (dim == 2 and plane == "stress") else 0.25
+    implied = MODELS[name].implied_poisson_ratio(dim, plane) if name in MODELS else None
     return make_model(
         name,
         body,
         bonds,
         E=200e9,
         density=7850.0,
-        nu=(implied if name == "pmb" else nu),
+        nu=(nu if implied is None else implied),
         surface_correction=surface_correction,
         dtype=dtype,
     )
 
 
+#: Every registered material (the shipped ones and the test-only "conical").
+MATERIALS = sorted(MODELS)
+
+#: (material, dimension, plane) of the material invariant suite: each material in 3D and in
+#: 2D plane stress and plane strain.
 MODEL_CASES = [
-    pytest.param(("pmb", 3, "stress"), id="pmb-3d"),
-    pytest.param(("lps", 3, "stress"), id="lps-3d"),
-    pytest.param(("pmb", 2, "stress"), id="pmb-2d-stress"),
-    pytest.param(("pmb", 2, "strain"), id="pmb-2d-strain"),
-    pytest.param(("lps", 2, "stress"), id="lps-2d-stress"),
-    pytest.param(("lps", 2, "strain"), id="lps-2d-strain"),
+    pytest.param((name, dim, plane), id=f"{name}-{label}")
+    for name in MATERIALS
+    for dim, plane, label in ((3, "stress", "3d"), (2, "stress", "2d-stress"), (2, "strain", "2d-strain"))
 ]
 
 

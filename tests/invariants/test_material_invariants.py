@@ -1,8 +1,9 @@
-"""Invariants every material model must satisfy (run for PMB and LPS, 2D and 3D)."""
+"""Invariants every material model must satisfy: run on every registered material (PMB, LPS
+and the test-only conical bond material of tests/materials), in 3D and 2D."""
 
 import numpy as np
 import pytest
-from conftest import MODEL_CASES, small_model
+from conftest import MATERIALS, MODEL_CASES, small_model
 
 
 def _model(case, **kw):
@@ -45,7 +46,8 @@ def test_rigid_rotation_gives_no_force(case, angle):
 def test_uniform_strain_interior_force_vanishes(case):
     """Patch test: a homogeneous strain gives zero force away from the surface.
 
-    PMB forces depend on one horizon, LPS forces on two (dilatation of the neighbours).
+    Bond-based forces depend on one horizon, forces with a dilatation (LPS) on two (the
+    neighbours' dilatations).
     """
     name, dim, plane = case
     model = _model(case, n=20 if dim == 3 else 24, horizon_factor=2.015)
@@ -55,7 +57,7 @@ def test_uniform_strain_interior_force_vanishes(case):
         strain[2, :] = strain[:, 2] = 0.0
     u = x @ strain.T
     f = model.force(u)
-    reach = (1 if name == "pmb" else 2) * model.bonds.horizon
+    reach = (2 if model.has_dilatation else 1) * model.bonds.horizon
     lo, hi = x.min(axis=0), x.max(axis=0)
     interior = np.all((x[:, :dim] - lo[:dim] > reach) & (hi[:dim] - x[:, :dim] > reach), axis=1)
     assert interior.sum() > 0
@@ -95,7 +97,7 @@ def test_force_is_minus_energy_gradient(case, rng):
             assert grad == pytest.approx(expected, rel=2e-5, abs=1e-7 * np.abs(expected).max())
 
 
-@pytest.mark.parametrize("name", ["pmb", "lps"])
+@pytest.mark.parametrize("name", MATERIALS)
 @pytest.mark.parametrize("amplitude", [1e-6, 1e-9])
 def test_float32_kernel_close_to_float64(name, amplitude, rng):
     """Single precision keeps the small-strain forces: 1e-5 of the largest force even for

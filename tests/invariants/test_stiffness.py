@@ -2,7 +2,7 @@
 
 import numpy as np
 import pytest
-from conftest import MODEL_CASES, small_model
+from conftest import MATERIALS, MODEL_CASES, small_model
 
 from peridyn.linalg.stiffness import assemble_stiffness, linear_force, mass_matrix, stiffness_operator
 
@@ -68,7 +68,7 @@ def test_rigid_motions_are_in_the_null_space(case):
         assert np.abs(K @ mode.ravel()).max() < 1e-10 * scale
 
 
-@pytest.mark.parametrize("name", ["pmb", "lps"])
+@pytest.mark.parametrize("name", MATERIALS)
 def test_operator_equals_matrix_and_mass_is_lumped(name, rng):
     model = small_model(name, 3, n=6, horizon_factor=2.015)
     v = rng.standard_normal(3 * model.body.n_points)

@@ -41,15 +41,6 @@ def test_scatter_along_bonds(rng):
     assert_close(got, ref.scatter_along_bonds(*args), TOL64, family_magnitude(fam.offsets, t))
 
 
-def test_pmb_linear_force(rng):
-    """f_i = sum_j (k / |xi|) (n . eta) n: terms of size k |u_j - u_i| / |xi|."""
-    fam, u, moved = _inputs(rng)
-    k = per_bond(rng, fam, 1e14)
-    args = (fam.x, u, fam.offsets, fam.nbr, fam.length, k, fam.intact)
-    scale = family_magnitude(fam.offsets, fam.intact * k * moved / fam.length)
-    assert_close(linear.pmb_linear_force(*args), ref.pmb_linear_force(*args), TOL64, scale)
-
-
 def test_lps_linear_force(rng):
     """f_i = sum_j [w |xi| (P_i + P_j) + dev e] n: terms of size w |xi| (|P_i| + |P_j|) +
     dev |u_j - u_i|, P bounded by |theta_coef p_coef| sum w |xi| |u_j - u_i|."""

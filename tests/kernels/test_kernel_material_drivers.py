@@ -10,7 +10,7 @@ from peridyn.kernels.reference import lps, pmb
 pytestmark = pytest.mark.kernels
 
 
-@pytest.mark.parametrize("case", MODEL_CASES)
+@pytest.mark.parametrize("case", [c for c in MODEL_CASES if c.values[0][0] in ("pmb", "lps")])
 def test_kernel_matches_numpy_reference(case, rng):
     """``model.force(u)`` is the reference force of the model's own arrays, float64 (1e-10
     relative: the sums of ~100 bonds round to ~1e-14 of their terms)."""

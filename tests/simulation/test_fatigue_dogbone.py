@@ -7,7 +7,7 @@ import pytest
 
 from peridyn.fatigue.mapping import CycleMapping
 from peridyn.fatigue.run import run_fatigue
-from peridyn.io.case import load_case
+from peridyn.io.case import FatigueTip, load_case
 from peridyn.jobs.build import build
 from peridyn.jobs.fatigue import fatigue_parameters, run_fatigue_case
 
@@ -27,11 +27,10 @@ def test_crack_nucleates_at_the_notches_not_at_the_loaded_ends():
         setup.loading,
         fatigue_parameters(case, setup.bonds.horizon),
         CycleMapping(((3, 1e-5),)),
-        f.load_ratio,
-        f.max_load_time,
-        f.no_damage_sets,
-        "y",
-        "z",
+        load_ratio=f.load_ratio,
+        max_load_time=f.max_load_time,
+        no_damage_sets=f.no_damage_sets,
+        tip=FatigueTip(axis="y", depth_axis="z"),
     )
     assert result.broken[-1] > 0
     x = setup.body.points
@@ -52,7 +51,7 @@ def test_first_bending_frequency_falls_with_types_matched(tmp_path):
     modal = summary["modal"]
     before = [m for m in modal["before"] if m["type"] != "rigid"]
     after = [m for m in modal["after"] if m["type"] != "rigid"]
-    assert summary["bonds_broken"] > 0
+    assert summary["fatigue_broken_bonds"] > 0
     for pair in modal["matches"]:
         b, a = before[pair["before"]], after[pair["after"]]
         assert pair["mac"] > 0.9 and (b["type"], b["order"]) == (a["type"], a["order"])

@@ -7,7 +7,7 @@ import pytest
 
 from peridyn.errors import CaseFileError
 from peridyn.io.case import validate_case
-from peridyn.io.hdf5 import read_array, read_series
+from peridyn.io.results import Results
 from peridyn.jobs.run import run_case
 
 BAR = {
@@ -44,8 +44,8 @@ def test_newmark_case_records_like_the_explicit_one(tmp_path):
     explicit = run_case(_case({"type": "explicit", "steps": 60, "dt": 2e-8}), tmp_path / "e")
     implicit = run_case(_case({"type": "newmark", "steps": 60, "dt": 2e-8}), tmp_path / "i")
     assert implicit["steps"] == explicit["steps"] == 60
-    _, t_e, u_e = read_series(tmp_path / "e/results.h5", "sensor_u")
-    _, t_i, u_i = read_series(tmp_path / "i/results.h5", "sensor_u")
+    _, t_e, u_e = Results(tmp_path / "e/results.h5").series("sensor_u")
+    _, t_i, u_i = Results(tmp_path / "i/results.h5").series("sensor_u")
     np.testing.assert_allclose(t_i, t_e)
     scale = np.abs(u_e[..., 0]).max()
     print("largest sensor difference / peak", np.abs(u_i - u_e).max() / scale)
@@ -61,8 +61,8 @@ def test_newton_case_matches_the_static_case(tmp_path):
     ]
     newton = run_case(_case({"type": "newton", "tolerance": 1e-10}, bcs), tmp_path / "n")
     run_case(_case({"type": "static", "tolerance": 1e-8}, bcs), tmp_path / "s")
-    u_n = read_array(tmp_path / "n/results.h5", "final/u")
-    u_s = read_array(tmp_path / "s/results.h5", "final/u")
+    u_n = Results(tmp_path / "n/results.h5").array("final/u")
+    u_s = Results(tmp_path / "s/results.h5").array("final/u")
     assert newton["residual"] < 1e-10
     assert np.abs(u_n - u_s).max() < 1e-5 * np.abs(u_s).max()
 

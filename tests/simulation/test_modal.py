@@ -81,8 +81,9 @@ def test_modal_command_json_and_outputs(tmp_path, capsys):
     )
     summary = json.loads(capsys.readouterr().out)
     assert summary["rigid_modes"] == 6 and len(summary["modes"]) == 8
-    assert {"index", "frequency_hz", "type", "order"} <= set(summary["modes"][6])
+    assert {"index", "frequency_hz", "type", "order", "label"} <= set(summary["modes"][6])
     assert summary["modes"][6]["type"] == "bending" and summary["modes"][7]["type"] == "torsional"
+    assert [m["label"] for m in summary["modes"][6:]] == ["1st bending", "1st torsional"]
     assert summary["points"] == 5000 and summary["peak_memory_bytes"] > 0
     assert (tmp_path / "modes.csv").is_file() and (tmp_path / "modes" / "mode_07.vtu").is_file()
 
@@ -194,7 +195,7 @@ def test_compare_pairs_modes_by_mac_and_refuses_another_grid(tmp_path, capsys):
     assert main(["modal", case, "-o", str(tmp_path / "b"), "--compare", str(tmp_path / "a"), *quiet]) == 0
     rows = json.loads(capsys.readouterr().out)["comparison"]
     assert (
-        [r["type"] for r in rows] == [r["reference_type"] for r in rows] == ["1st bending", "1st torsional"]
+        [r["label"] for r in rows] == [r["reference_label"] for r in rows] == ["1st bending", "1st torsional"]
     )
     assert all(abs(r["frequency_change"]) < 1e-9 and r["mac"] > 1 - 1e-9 for r in rows)
     assert (tmp_path / "b" / "frequency_shift.csv").is_file()

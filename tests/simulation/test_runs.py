@@ -8,7 +8,7 @@ import pytest
 
 from peridyn.cli import main
 from peridyn.io.case import validate_case
-from peridyn.io.hdf5 import read_array, read_series
+from peridyn.io.results import Results
 from peridyn.jobs.build import build
 from peridyn.jobs.run import run_case
 
@@ -51,19 +51,19 @@ def test_restart_reproduces_an_uninterrupted_run(tmp_path):
     run_case(_case(solver__steps=30), tmp_path / "split", checkpoint_every=20)
     resumed = run_case(_case(), tmp_path / "split", restart=True)
     assert resumed["steps"] == whole["steps"] == 40
-    u_whole = read_array(tmp_path / "whole/results.h5", "final/u")
-    u_split = read_array(tmp_path / "split/results.h5", "final/u")
+    u_whole = Results(tmp_path / "whole/results.h5").array("final/u")
+    u_split = Results(tmp_path / "split/results.h5").array("final/u")
     np.testing.assert_array_equal(u_split, u_whole)
     for name in ("sensor_u", "line_axis"):
-        s1, t1, d1 = read_series(tmp_path / "whole/results.h5", name)
-        s2, t2, d2 = read_series(tmp_path / "split/results.h5", name)
+        s1, t1, d1 = Results(tmp_path / "whole/results.h5").series(name)
+        s2, t2, d2 = Results(tmp_path / "split/results.h5").series(name)
         np.testing.assert_array_equal(s1, s2)
         np.testing.assert_array_equal(d1, d2)
 
 
 def test_outputs_are_written(tmp_path):
     summary = run_case(_case(), tmp_path)
-    steps, times, data = read_series(tmp_path / "results.h5", "sensor_u")
+    steps, times, data = Results(tmp_path / "results.h5").series("sensor_u")
     assert steps.tolist() == list(range(0, 41, 2))
     assert data.shape == (21, 1, 3)
     assert (tmp_path / "snapshots.pvd").is_file()
@@ -99,9 +99,8 @@ def test_precracked_plate_separates_with_half_damage(tmp_path):
         "output": {"snapshot_every": 300, "plots": True},
     }
     summary = run_case(validate_case(raw), tmp_path)
-    u = read_array(tmp_path / "results.h5", "final/u")
-    phi = read_array(tmp_path / "results.h5", "final/damage")
-    x = read_array(tmp_path / "results.h5", "geometry/points")
+    results = Results(tmp_path / "results.h5")
+    u, phi, x = (results.array(name) for name in ("final/u", "final/damage", "geometry/points"))
     upper, lower = x[:, 1] > 0.010, x[:, 1] < 0.010
     assert u[upper, 1].min() > 0 > u[lower, 1].max()  # the halves move apart, no bridging
     faces = np.abs(x[:, 1] - 0.010) < 0.3e-3
@@ -145,7 +144,7 @@ def test_static_case_runs(tmp_path):
     case = validate_case(raw)
     summary = run_case(case, tmp_path)
     assert summary["residual"] < 1e-7
-    u = read_array(tmp_path / "results.h5", "final/u")
+    u = Results(tmp_path / "results.h5").array("final/u")
     # equilibrium: the bar pulls its clamped end with the whole 16 N load
     setup = build(case)
     f = setup.model.force(u) * setup.body.volumes[:, None]

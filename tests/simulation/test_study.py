@@ -79,6 +79,22 @@ def test_every_run_solved_on_the_same_body_and_outputs_written(study):
     assert json.loads((out / "study.json").read_text())["fits"] == summary["fits"]
 
 
+def test_study_summary_has_the_common_keys_and_is_stored_whole(study):
+    """docs/user-guide.md, "Summaries and results files": kind, schema, folder, the figure, and
+    per run its points, directed bonds (at most 18 per point: the neighbours within a 1.4143 h
+    horizon on a cubic grid) and time; ``study.json`` holds the summary printed."""
+    from peridyn.io.hdf5 import SCHEMA_VERSION
+
+    out, summary = study
+    assert summary["schema_version"] == SCHEMA_VERSION and summary["kind"] == "study"
+    assert summary["output_dir"] == str(out) and summary["plots"] == [str(out / "study.png")]
+    assert summary["seconds"] >= sum(r["seconds"] for r in summary["runs"]) > 0
+    assert summary["peak_memory_bytes"] > 0
+    for r in summary["runs"]:
+        assert 0 < r["bonds"] <= 18 * r["points"]
+    assert json.loads((out / "study.json").read_text()) == summary
+
+
 def test_richardson_from_three_grids_predicts_the_fourth_for_bending_modes(study):
     # Richardson's premise (Roache 1998, ch. 5): in the asymptotic range f = f_inf + C h^p
     # predicts a finer grid. Fitted on 4, 8/3 and 2 mm, the prediction at 1.6 mm must beat

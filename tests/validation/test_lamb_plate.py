@@ -4,16 +4,14 @@ The shipped cases keep the seed's discretisation (3 layers 1 mm apart, 1.2 mm, 3
 LPS and the shear-correction factor (VALIDATION.md V2). Theory: VALIDATION.md V1.
 """
 
-import json
 from pathlib import Path
 
-import h5py
 import numpy as np
 import pytest
 from scipy.signal import hilbert
 
 from peridyn.io.case import load_case
-from peridyn.io.hdf5 import read_series
+from peridyn.io.results import Results
 from peridyn.jobs.run import run_case
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
@@ -38,15 +36,15 @@ def holed(tmp_path_factory):
 
 def _sensor(out, name, component):
     """Times (s) and one displacement component (m) of a named sensor."""
-    with h5py.File(out / "results.h5", "r") as f:
-        names = json.loads(f["series/sensor_u"].attrs["names"])
-    _, times, data = read_series(out / "results.h5", "sensor_u")
+    results = Results(out / "results.h5")
+    names = results.series_attrs("sensor_u")["names"]
+    _, times, data = results.series("sensor_u")
     return times, data[:, names.index(name), "xyz".index(component)]
 
 
 def _line_point(out, x, component):
     """Times and one component of the top-layer line probe at the point nearest to x (m)."""
-    _, times, data = read_series(out / "results.h5", "line_x_axis")
+    _, times, data = Results(out / "results.h5").series("line_x_axis")
     xs = np.linspace(0.0006, 0.2994, data.shape[1])
     return times, data[:, np.argmin(np.abs(xs - x)), "xyz".index(component)]
 

@@ -39,7 +39,7 @@ from scipy.signal import get_window
 from scipy.special import hankel1
 
 from peridyn.errors import InputError
-from peridyn.io.hdf5 import iter_series_chunks, read_array, read_series
+from peridyn.io.results import Results
 from peridyn.physics.loads import parse_components
 
 __all__ = [
@@ -140,7 +140,7 @@ def line_fk(path: str | os.PathLike, series_name: str, spacing: float, component
     freq, k, magnitude
         As :func:`fk_transform`.
     """
-    _, times, data = read_series(path, series_name)
+    _, times, data = Results(path).series(series_name)
     return fk_transform(data[:, :, _component(component)], _uniform_step(times), spacing, **options)
 
 
@@ -213,10 +213,11 @@ def kxky_from_hdf5(
     """
     omega = _angular(frequencies)
     column = _component(component)
-    wt = _window(window, len(read_array(path, f"series/{series_name}/step")))
+    results = Results(path)
+    wt = _window(window, results.n_records(series_name))
     projected = np.zeros((len(omega), *grid.shape), dtype=complex)
     start = 0
-    for times, data in iter_series_chunks(path, series_name, chunk_records):
+    for times, data in results.iter_series(series_name, chunk_records):
         block = grid.scatter(data[:, :, column])
         projected += _project(times, wt[start : start + len(times)], block, omega)
         start += len(times)
@@ -586,8 +587,9 @@ def line_mode_wavenumbers(
     dict "S0", "A0" to float, rad/m
     """
     records = {}
+    results = Results(path)
     for suffix in LINE_SUFFIXES:
-        _, times, records[suffix] = read_series(path, f"line_{line}{suffix}")
+        _, times, records[suffix] = results.series(f"line_{line}{suffix}")
         if records[suffix].shape != records[""].shape:
             raise InputError(f"series line_{line}{suffix} does not have the shape of line_{line}")
     dt = _uniform_step(times)

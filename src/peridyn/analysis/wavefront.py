@@ -34,7 +34,7 @@ from scipy.signal import hilbert
 
 from peridyn.analysis.dispersion import DispersionRelation
 from peridyn.errors import InputError
-from peridyn.io.hdf5 import read_array, read_series
+from peridyn.io.results import Results
 
 __all__ = [
     "FrontSpeed",
@@ -156,9 +156,10 @@ def axis_signals(results, axis: str, centre=(0.0, 0.0, 0.0), pulse: str = "x"):
     distances : (n_stations,) float64, m
     signals : (n_t, n_stations) float64, 1/1 (strain)
     """
-    index = read_array(results, f"probes/plane_tube_{axis}")
-    points = read_array(results, "geometry/points")[index] - np.asarray(centre, dtype=float)
-    _, times, data = read_series(results, f"plane_tube_{axis}")
+    stored = Results(results)
+    index = stored.array(f"probes/plane_tube_{axis}")
+    points = stored.array("geometry/points")[index] - np.asarray(centre, dtype=float)
+    _, times, data = stored.series(f"plane_tube_{axis}")
     a, p = "xyz".index(axis), "xyz".index(pulse)
     along = np.unique(np.round(points[:, a], 12))
     h = float(np.min(np.diff(along)))

@@ -82,8 +82,8 @@ def run(args) -> dict:
     if not args.json:
         print(
             f"{summary['points']} points, {summary['cycles']:.6g} cycles, crack length "
-            f"{1e3 * summary['crack_length_m']:.3f} mm, {summary['bonds_broken']} bonds broken, "
-            f"{summary['seconds']:.1f} s"
+            f"{1e3 * summary['crack_length_m']:.3f} mm, {summary['fatigue_broken_bonds']} directed bonds "
+            f"broken by the cycles, {summary['seconds']:.1f} s"
         )
         if summary["paris_slope"] is not None:
             print(f"Paris slope {summary['paris_slope']:.3f}")
@@ -100,14 +100,10 @@ def _print_modal(modal: dict) -> None:
     for pair in modal["matches"]:
         b, a = before[pair["before"]], after[pair["after"]]
         print(
-            f"  {pair['before'] + 1:4d}  {b['frequency_hz']:11.2f}  {_label(b):24s}  "
-            f"{a['frequency_hz']:11.2f}  {_label(a):20s}  {pair['mac']:.3f} "
+            f"  {pair['before'] + 1:4d}  {b['frequency_hz']:11.2f}  {b['label']:24s}  "
+            f"{a['frequency_hz']:11.2f}  {a['label']:20s}  {pair['mac']:.3f} "
             f"{100 * pair['frequency_change']:+.2f}%"
         )
-
-
-def _label(mode: dict) -> str:
-    return mode["type"] if mode["order"] == 0 else f"{mode['order']} {mode['type']}"
 
 
 def _read_csv(path: str, n_cols: int) -> np.ndarray:

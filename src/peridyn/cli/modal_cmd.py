@@ -29,7 +29,6 @@ def register(sub) -> None:
 def run(args) -> dict:
     """Solve and print the frequency table unless --json."""
     from peridyn.jobs.estimate import check_memory
-    from peridyn.jobs.modal import mode_label
     from peridyn.jobs.run import run_case
 
     overrides = [*args.overrides, "solver.type=modal"]
@@ -45,12 +44,12 @@ def run(args) -> dict:
     if not args.json:
         print(f"{summary['points']} points, {summary['rigid_modes']} rigid modes, {summary['seconds']:.1f} s")
         for m in summary["modes"]:
-            print(f"  {m['index']:3d}  {m['frequency_hz']:12.2f} Hz  {mode_label(m)}")
+            print(f"  {m['index']:3d}  {m['frequency_hz']:12.2f} Hz  {m['label']}")
         for row in summary.get("comparison", []):
             print(
-                f"  {row['reference_type']:>28s} {row['reference_frequency_hz']:10.2f} Hz -> "
+                f"  {row['reference_label']:>28s} {row['reference_frequency_hz']:10.2f} Hz -> "
                 f"{row['frequency_hz']:10.2f} Hz ({100 * row['frequency_change']:+.2f} %, "
-                f"MAC {row['mac']:.2f}, now {row['type']})"
+                f"MAC {row['mac']:.2f}, now {row['label']})"
             )
         print(f"results written to {summary['output_dir']}")
     return summary

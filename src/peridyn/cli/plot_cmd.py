@@ -23,7 +23,7 @@ def run(args) -> dict:
     """Rebuild the run's case from its provenance and draw its figures again (with the crack
     paths of the final damage for a run with damage)."""
     from peridyn.io.case import validate_case
-    from peridyn.io.hdf5 import read_provenance
+    from peridyn.io.results import Results
     from peridyn.jobs.build import add_actuators, build_body
     from peridyn.jobs.figures import draw_run_figures, redraw_crack_figures
     from peridyn.jobs.lamb_analysis import analyse
@@ -32,7 +32,7 @@ def run(args) -> dict:
     results = out / "results.h5"
     if not results.is_file():
         raise InputError(f"{str(out)!r} holds no results.h5: not the output folder of a run")
-    info = read_provenance(results)
+    info = Results(results).provenance()
     if "case_json" not in info:
         raise InputError(
             f"{str(results)!r} does not record its case (written by an older peridyn): run the case again"

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 import sys
+import time
 from pathlib import Path
 
 from peridyn.cli import add_json_flag, add_max_memory
@@ -73,6 +74,7 @@ def run(args) -> dict:
     from peridyn.jobs.study import SERIES, fit_series, run_grid, write_study
     from peridyn.plotting.convergence import plot_convergence
 
+    start = time.perf_counter()
     spacings = _positive_list("--spacing", args.spacing)
     factors = _positive_list("--horizon", args.horizon)
     series = [s.strip() for s in args.series.split(",") if s.strip()]
@@ -103,12 +105,12 @@ def run(args) -> dict:
         "series": series,
         "finest": args.finest,
     }
-    summary = write_study(out, runs, fits, meta)
+    out.mkdir(parents=True, exist_ok=True)
     plots = [out / "study.png", *([Path(args.plot)] if args.plot else [])]
     figure = plot_convergence(runs, fits, title=f"{case.name}: delta-m convergence")
     for path in plots:
         figure.savefig(path, dpi=110)
-    summary["plots"] = [str(p) for p in plots]
+    summary = write_study(out, runs, fits, meta, start, plots)
     if not args.json:
         print(format_table(summary))
     return summary

@@ -119,14 +119,14 @@ class RemainingLife:
         return float(np.min(self.life[active] / rate[active]))
 
     def advance(self, eps: np.ndarray, cycles: float) -> int:
-        """Spend ``cycles`` cycles at ``eps``; break the bonds whose life ran out. Returns bonds broken
-        (directed bonds / 2)."""
+        """Spend ``cycles`` cycles at ``eps``; break the bonds whose life ran out (both directions
+        of a bond together). Returns the directed bonds broken (twice the bonds)."""
         intact = self.model.bonds.intact
         self.life -= self.rate(eps) * cycles
         dead = intact & (self.life <= 0.0)
         dead |= dead[self._reverse]
         intact &= ~dead
-        return int(dead.sum()) // 2
+        return int(dead.sum())
 
     def update_phase(self, phi: np.ndarray) -> int:
         """Switch points with a family member at phi >= phi_c to phase II (eq. 7.6); returns how many.

@@ -17,7 +17,8 @@ from peridyn.errors import InputError
 from peridyn.fatigue.mapping import CycleMapping
 from peridyn.fatigue.model import FatigueParameters, RemainingLife, cyclic_bond_strain
 from peridyn.fatigue.statics import LinearStatics
-from peridyn.fatigue.tip import TIP_DAMAGE, crack_tip
+from peridyn.fatigue.tip import crack_tip
+from peridyn.io.case import FatigueTip
 from peridyn.physics.damage import damage_field
 from peridyn.physics.loads import Loading
 from peridyn.physics.materials.base import Model
@@ -31,7 +32,8 @@ class FatigueResult:
     ----------
     cycles : (n_steps + 1,) float64, cycles at the end of each step (0 first)
     crack_length : (n_steps + 1,) float64, m
-    broken : (n_steps + 1,) int64, bonds broken so far
+    broken : (n_steps + 1,) int64, directed bonds broken by the cycles so far (each bond
+        counts twice, as in ``Bonds.n_bonds``; pre-cracks not counted)
     u_max : (n_points, 3) float64, m, displacement at the maximum load after the last step
     damage : (n_points,) float64, final damage index
     first_break : (n_points,) float64, cycle at which each point first lost a bond (inf if none)
@@ -59,42 +61,46 @@ def run_fatigue(
     loading: Loading,
     params: FatigueParameters,
     mapping: CycleMapping,
+    *,
     load_ratio: float = 0.0,
     max_load_time: float = 1.0,
     no_damage_sets=(),
-    tip_axis: str = "x",
-    depth_axis: str = "z",
-    tip_damage: float = TIP_DAMAGE,
+    tip: FatigueTip | None = None,
     solver: str = "auto",
-    progress=None,
     stop_length: float = np.inf,
-    tip_start: float | None = None,
-    tip_sense: str = "+",
+    progress=None,
 ) -> FatigueResult:
     """Run the fatigue loop on ``model`` (its ``bonds.intact`` is updated in place).
 
     Parameters
     ----------
-    loading : the case's loads; their value at ``max_load_time`` (s) is the maximum load
+    model, loading : the model and the case's loads; the loads' value at ``max_load_time``
+        (s) is the maximum load
+    params : the remaining-life parameters
+    mapping : cycles per step
     load_ratio : R = min load / max load, in [-1, 1)
-    progress : object with update(n) (e.g. a tqdm bar) or None
+    no_damage_sets : node sets whose bonds never break
+    tip : the crack-tip rule (``fatigue.tip.crack_tip``: growth axis, depth axis, damage
+        threshold, start, sense), the case's ``fatigue.tip``; default ``FatigueTip()`` (along x,
+        depth z, damage 0.385, from the low edge)
+    solver : linear solver of the equilibrium (``fatigue.statics.LinearStatics``)
     stop_length : m, the run ends after the step at which the crack length reaches it
-    tip_axis, depth_axis, tip_damage, tip_start, tip_sense : the crack-tip rule
-        (``fatigue.tip.crack_tip``: growth axis, depth axis, damage threshold, start, sense)
+    progress : object with update(n) (e.g. a tqdm bar) or None
     """
     if not -1.0 <= load_ratio < 1.0:
         raise InputError(f"load ratio R must be in [-1, 1), got {load_ratio!r}")
+    tip = FatigueTip() if tip is None else tip
     statics = LinearStatics(model, loading, max_load_time, solver)
     life = RemainingLife(model, params, breakable_bonds(model, no_damage_sets))
     points, spacing = model.body.points, model.body.spacing
     owners = model.bonds.owners()
-    n_broken0 = int((~model.bonds.intact).sum()) // 2
+    n_broken0 = int((~model.bonds.intact).sum())
     first_break = np.full(model.body.n_points, np.inf)
     life.update_phase(damage_field(model))  # pre-cracks may start families in phase II
     cycles, lengths, broken = [0.0], [], [0]
 
     def crack_length(phi):
-        return crack_tip(points, phi, spacing, tip_axis, depth_axis, tip_damage, tip_start, tip_sense)
+        return crack_tip(points, phi, spacing, tip.axis, tip.depth_axis, tip.damage, tip.start, tip.sense)
 
     lengths.append(crack_length(damage_field(model)))
     n_cycles = 0.0
@@ -118,7 +124,7 @@ def run_fatigue(
         life.update_phase(phi)
         cycles.append(n_cycles)
         lengths.append(crack_length(phi))
-        broken.append(int((~model.bonds.intact).sum()) // 2 - n_broken0)
+        broken.append(int((~model.bonds.intact).sum()) - n_broken0)
         if progress is not None:
             progress.update(1)
         if lengths[-1] >= stop_length:

@@ -1,13 +1,15 @@
-"""Incremental HDF5 results files.
+"""Incremental HDF5 results files: the writer (read them with ``peridyn.io.results``).
 
 Layout of a results file::
 
-    /                       root attributes: the run's provenance
+    /                       root attributes: the run's provenance and ``schema_version``
     /geometry/points        (n_points, dim) float64, m
     /geometry/volumes       (n_points,) float64, m^3
     /series/<name>/data     (n_records, *shape), resizable, chunked along time
     /series/<name>/time     (n_records,) float64, s
     /series/<name>/step     (n_records,) int64, strictly increasing
+    /summary/json           the job's summary, JSON text (docs/user-guide.md, "Summaries and
+                            results files")
     /<any>/<name>           one-off arrays, e.g. /final/damage
 
 The writer flushes after every ``flush_every`` appends, so a process that
@@ -20,8 +22,6 @@ import json
 import math
 import operator
 import os
-from collections.abc import Iterator
-from contextlib import contextmanager
 from dataclasses import dataclass
 
 import h5py
@@ -37,6 +37,18 @@ MIN_INDEX_CHUNK = 1024
 
 JSON_KEYS_ATTR = "_peridyn_json_keys"
 """Root attribute listing the attributes stored as JSON text."""
+
+SCHEMA_VERSION = 2
+"""Version of the results layout and of the job summaries (docs/user-guide.md, "Summaries and
+results files"). 1: files written before the version was recorded (no attribute; a fatigue
+summary counted each bond once, as ``bonds`` and ``bonds_broken``). 2: the common summary keys,
+every bond count directed."""
+
+SCHEMA_ATTR = "schema_version"
+"""Root attribute holding :data:`SCHEMA_VERSION`."""
+
+SUMMARY = "summary/json"
+"""Dataset holding the job's summary as JSON text."""
 
 _CHUNK_CACHE_BYTES = 4 * CHUNK_BYTES
 _RESERVED_GROUPS = ("geometry", "series")
@@ -54,9 +66,10 @@ class HDF5Writer:
     volumes : array_like, shape (n_points,)
         Point volumes in m^3 (m^2 times thickness in 2-D).
     provenance : dict
-        Run metadata stored as root attributes. Values may be strings,
-        numbers, booleans or numeric arrays; dicts, lists, tuples and ``None``
-        are stored as JSON text and decoded by :func:`read_provenance`.
+        Run metadata stored as root attributes, next to ``schema_version``
+        (a reserved name). Values may be strings, numbers, booleans or numeric
+        arrays; dicts, lists, tuples and ``None`` are stored as JSON text and
+        decoded by ``peridyn.io.results.Results.provenance``.
     mode : {"w", "a"}
         ``"w"`` creates the file (overwriting it). ``"a"`` continues an
         existing file, e.g. on restart from a checkpoint; its geometry must
@@ -69,7 +82,7 @@ class HDF5Writer:
     ------
     InputError
         Bad arguments, or in append mode a geometry that differs from the one
-        in the file.
+        in the file or a file written with a newer schema.
 
     Examples
     --------
@@ -89,7 +102,7 @@ class HDF5Writer:
     ):
         if mode not in ("w", "a"):
             raise InputError(f"mode must be 'w' or 'a', got {mode!r}")
-        if not _is_int(flush_every) or flush_every < 1:
+        if not is_integer(flush_every) or flush_every < 1:
             raise InputError(f"flush_every must be a positive integer, got {flush_every!r}")
         points, volumes = _check_geometry(points, volumes)
         self.path = os.fspath(path)
@@ -101,8 +114,12 @@ class HDF5Writer:
         except OSError as exc:
             raise InputError(f"cannot open results file {self.path!r} for writing: {exc}") from None
         try:
+            check_schema(self._file.attrs, self.path)
             self._write_geometry(points, volumes)
+            if SCHEMA_ATTR in provenance:
+                raise InputError(f"{self.path}: provenance: {SCHEMA_ATTR!r} is reserved for the writer")
             _write_attrs(self._file.attrs, provenance, f"{self.path}: provenance")
+            self._file.attrs[SCHEMA_ATTR] = SCHEMA_VERSION
             self._open_existing_series()
             self._file.flush()
         except BaseException:
@@ -220,13 +237,23 @@ class HDF5Writer:
             _write_attrs(dataset.attrs, attrs, f"{self.path}: {key!r} attrs")
         self.flush()
 
+    def write_summary(self, summary: dict) -> None:
+        """(Re)write the job's summary as JSON text in ``/summary/json``.
+
+        Raises
+        ------
+        InputError
+            A value JSON cannot hold (numpy scalars and arrays are stored as numbers and lists).
+        """
+        self.write_array(SUMMARY, np.bytes_(_to_json(summary, f"{self.path}: summary")))
+
     def truncate(self, step: int) -> None:
         """Drop the records with a step greater than ``step`` in every series.
 
         Used on restart from the checkpoint taken at ``step``, so that records
         written after the checkpoint are not duplicated.
         """
-        if not _is_int(step):
+        if not is_integer(step):
             raise InputError(f"truncate: step must be an integer, got {step!r}")
         for series in self._series.values():
             series.resize(int(np.searchsorted(series.step[:], step, side="right")))
@@ -292,7 +319,7 @@ class _Series:
     def open(cls, group: h5py.Group) -> _Series:
         """Open an existing series, dropping a record half-written by a crash."""
         series = cls(group["data"], group["time"], group["step"], None)
-        series.resize(_n_records(group))
+        series.resize(n_records(group))
         return series
 
     def append(self, step: int, time: float, values: np.ndarray) -> None:
@@ -311,7 +338,7 @@ class _Series:
 
 
 def _check_step_time(name: str, last_step: int | None, step, time) -> tuple[int, float]:
-    if not _is_int(step):
+    if not is_integer(step):
         raise InputError(f"series {name!r}: step must be an integer, got {step!r}")
     if last_step is not None and step <= last_step:
         raise InputError(
@@ -327,107 +354,25 @@ def _check_step_time(name: str, last_step: int | None, step, time) -> tuple[int,
     return int(step), time
 
 
-def read_series(path: str | os.PathLike, name: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Read a whole series.
+def check_schema(attrs: h5py.AttributeManager, path: str) -> int:
+    """The schema version of a results file's root ``attrs`` (1 without the attribute).
 
-    Parameters
-    ----------
-    path : str or path-like
-        A results file.
-    name : str
-        Series name.
-
-    Returns
-    -------
-    steps : ndarray, shape (n_records,), int64
-    times : ndarray, shape (n_records,), float64
-        Times in s.
-    data : ndarray, shape (n_records, *record_shape)
-        Records in the stored dtype.
-    """
-    with _open_series(path, name) as group:
-        n = _n_records(group)
-        return group["step"][:n], group["time"][:n], group["data"][:n]
-
-
-def iter_series_chunks(
-    path: str | os.PathLike, name: str, chunk_records: int
-) -> Iterator[tuple[np.ndarray, np.ndarray]]:
-    """Read a series a few records at a time, without loading it whole.
-
-    Parameters
-    ----------
-    path : str or path-like
-        A results file.
-    name : str
-        Series name.
-    chunk_records : int
-        Records per chunk (the last chunk may be shorter).
-
-    Yields
+    Raises
     ------
-    times : ndarray, shape (k,), float64
-        Times in s.
-    data : ndarray, shape (k, *record_shape)
-        The records, ``k <= chunk_records``.
+    InputError
+        The file was written with a newer schema than this peridyn knows.
     """
-    if not _is_int(chunk_records) or chunk_records < 1:
-        raise InputError(f"chunk_records must be a positive integer, got {chunk_records!r}")
-    with _open_series(path, name) as group:
-        times, data = group["time"], group["data"]
-        n = _n_records(group)
-        for start in range(0, n, chunk_records):
-            stop = min(start + chunk_records, n)
-            yield times[start:stop], data[start:stop]
+    version = int(attrs.get(SCHEMA_ATTR, 1))
+    if version > SCHEMA_VERSION:
+        raise InputError(
+            f"{path}: written with results schema {version}, newer than the schema {SCHEMA_VERSION} "
+            "this peridyn reads: upgrade peridyn to read it"
+        )
+    return version
 
 
-def read_array(path: str | os.PathLike, name: str) -> np.ndarray:
-    """Read one dataset, e.g. ``"final/damage"`` or ``"geometry/points"``."""
-    with _open_results(path) as f:
-        key = name.strip("/")
-        if not key or not isinstance(f.get(key), h5py.Dataset):
-            raise InputError(f"{os.fspath(path)}: no dataset {name!r}")
-        return f[key][()]
-
-
-def read_provenance(path: str | os.PathLike) -> dict:
-    """Read the root attributes of a results file, JSON entries decoded.
-
-    Returns
-    -------
-    dict
-        Provenance as given to :class:`HDF5Writer`; numbers come back as
-        Python scalars, tuples as lists.
-    """
-    with _open_results(path) as f:
-        return _read_attrs(f.attrs)
-
-
-@contextmanager
-def _open_results(path: str | os.PathLike) -> Iterator[h5py.File]:
-    path = os.fspath(path)
-    if not os.path.exists(path):
-        raise InputError(f"results file {path!r} does not exist")
-    try:
-        f = h5py.File(path, "r")
-    except OSError as exc:
-        raise InputError(f"{path}: not a readable HDF5 file ({exc})") from None
-    with f:
-        yield f
-
-
-@contextmanager
-def _open_series(path: str | os.PathLike, name: str) -> Iterator[h5py.Group]:
-    with _open_results(path) as f:
-        available = list(f.get("series", {}))
-        if name not in available:
-            raise InputError(
-                f"{os.fspath(path)}: no series {name!r}; it has {available}" + did_you_mean(name, available)
-            )
-        yield f["series"][name]
-
-
-def _is_int(value) -> bool:
+def is_integer(value) -> bool:
+    """An int or numpy integer, not a bool."""
     return isinstance(value, int | np.integer) and not isinstance(value, bool)
 
 
@@ -468,7 +413,7 @@ def _check_dtype(name: str, dtype) -> np.dtype:
     return dtype
 
 
-def _n_records(group: h5py.Group) -> int:
+def n_records(group: h5py.Group) -> int:
     """Number of complete records (a crash may leave data or time one longer)."""
     return min(group[key].shape[0] for key in ("data", "time", "step"))
 
@@ -519,7 +464,8 @@ def _json_default(value):
     raise TypeError(f"{type(value).__name__} is not JSON serializable")
 
 
-def _read_attrs(attrs: h5py.AttributeManager) -> dict:
+def decode_attrs(attrs: h5py.AttributeManager) -> dict:
+    """Attributes as written by the writer: JSON entries decoded, numpy scalars as Python ones."""
     json_keys = set(json.loads(attrs.get(JSON_KEYS_ATTR, "[]")))
     out = {}
     for key, value in attrs.items():

@@ -1,6 +1,7 @@
 """A fatigue case: build, optional modal analysis, fatigue loop, modal analysis of the damaged body.
 
-Outputs in the run folder: ``crack_length.csv`` (cycles, crack length, bonds broken),
+Outputs in the run folder: ``crack_length.csv`` (cycles, crack length, directed bonds broken by
+the cycles),
 ``crack_length.png``, ``damage.vtu`` (final damage and first-break cycle), ``modal.json``
 (frequency tables before/after, MAC matrix, matched types) when ``modal_after`` is set,
 and ``fatigue.json`` (the summary).
@@ -10,7 +11,6 @@ from __future__ import annotations
 
 import csv
 import json
-import resource
 import time
 from pathlib import Path
 
@@ -28,6 +28,7 @@ from peridyn.io.vtk import write_vtu
 from peridyn.jobs.build import build
 from peridyn.jobs.modal import match_modes, modal_table
 from peridyn.jobs.run import output_directory
+from peridyn.jobs.summary import finish_summary
 
 
 def check_fatigue_case(case: Case) -> None:
@@ -121,7 +122,8 @@ def _stop_length(f) -> float:
 def run_fatigue_case(
     case: Case, output_dir=None, base_dir=".", modal: bool | None = None, progress=None
 ) -> dict:
-    """Run a fatigue case; returns the summary (JSON keys of ``peridyn fatigue --json``)."""
+    """Run a fatigue case; returns the summary (JSON keys of ``peridyn fatigue --json``, also in
+    ``fatigue.json``; docs/user-guide.md, "Summaries and results files")."""
     start = time.perf_counter()
     check_fatigue_case(case)
     f = case.fatigue
@@ -142,17 +144,13 @@ def run_fatigue_case(
         setup.loading,
         fatigue_parameters(case, setup.bonds.horizon),
         mapping,
-        f.load_ratio,
-        f.max_load_time,
-        f.no_damage_sets,
-        f.tip.axis,
-        f.tip.depth_axis,
-        f.tip.damage,
-        f.solver,
-        progress,
-        _stop_length(f),
-        f.tip.start,
-        f.tip.sense,
+        load_ratio=f.load_ratio,
+        max_load_time=f.max_load_time,
+        no_damage_sets=f.no_damage_sets,
+        tip=f.tip,
+        solver=f.solver,
+        stop_length=_stop_length(f),
+        progress=progress,
     )
     if progress is not None:
         progress.close()
@@ -161,10 +159,10 @@ def run_fatigue_case(
         "crack_length_m": float(result.crack_length[-1]),
         "paris_slope": paris_slope(case, result, k_curve),
         "paris_rates": int(paris_rates(case, result)[1].size) if f.paris is not None else 0,
-        "bonds_broken": int(result.broken[-1]),
         "points": setup.body.n_points,
-        "bonds": setup.bonds.n_bonds // 2,
-        "output_dir": str(out),
+        "bonds": setup.bonds.n_bonds,
+        "broken_bonds": int((~setup.bonds.intact).sum()),
+        "fatigue_broken_bonds": int(result.broken[-1]),
     }
     if do_modal:
         after, _, after_rows = modal_table(setup.model, n_modes)
@@ -183,14 +181,12 @@ def run_fatigue_case(
             "u_max": result.u_max[:, : body.dim],
         },
     )
+    plots = []
     if case.output.plots:
         from peridyn.plotting.fatigue import plot_crack_length
 
-        summary["plots"] = [
-            str(plot_crack_length(result.cycles, result.crack_length, out / "crack_length.png"))
-        ]
-    summary["seconds"] = time.perf_counter() - start
-    summary["peak_memory_bytes"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+        plots.append(plot_crack_length(result.cycles, result.crack_length, out / "crack_length.png"))
+    finish_summary(summary, "fatigue", out, start, plots)
     (out / "fatigue.json").write_text(json.dumps(summary, indent=1))
     return summary
 
@@ -198,6 +194,6 @@ def run_fatigue_case(
 def _write_history(path: Path, result: FatigueResult) -> None:
     with open(path, "w", newline="") as fh:
         w = csv.writer(fh)
-        w.writerow(["cycles", "crack_length_m", "bonds_broken"])
+        w.writerow(["cycles", "crack_length_m", "fatigue_broken_bonds"])
         for n, a, k in zip(result.cycles, result.crack_length, result.broken, strict=True):
             w.writerow([f"{n:.6g}", f"{a:.6g}", int(k)])

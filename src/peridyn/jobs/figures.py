@@ -3,14 +3,13 @@ wavefields of plates, crack paths and crack length."""
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import numpy as np
 
 from peridyn.discretization.body import Body
 from peridyn.io.case import Case
-from peridyn.io.hdf5 import read_series
+from peridyn.io.results import Results
 from peridyn.physics.timefunctions import from_spec
 
 
@@ -23,7 +22,7 @@ def draw_run_figures(case: Case, body: Body, out: Path) -> list[Path]:
     if case.geometry.type == "plate" and case.output.snapshot_times:
         from peridyn.plotting.lamb_wavefield import plot_wavefield_snapshots
 
-        _, times, _ = read_series(out / "results.h5", "field_u")
+        _, times, _ = Results(out / "results.h5").series("field_u")
         reached = [t for t in case.output.snapshot_times if t <= times[-1] * (1 + 1e-9)]
         if reached:
             figures.append(plot_wavefield_snapshots(out / "results.h5", out / "wavefield.png", reached))
@@ -52,7 +51,7 @@ def _actuator_figures(case: Case, out: Path, snapshot_times) -> list[Path]:
                 )
             )
     if case.output.pzt_sensors and case.actuators:
-        _, times, data = read_series(out / "results.h5", "pzt_signal")
+        _, times, data = Results(out / "results.h5").series("pzt_signal")
         first = next(iter(case.actuators.values()))
         excitation = from_spec(first.signal, "actuators.signal")(times)
         signals = {n: data[:, k] for k, n in enumerate(case.output.pzt_sensors)}
@@ -74,11 +73,10 @@ def draw_crack_figures(body: Body, out: Path, paths, summary: dict) -> list[Path
     """Damage map on the deformed configuration (x50, as seed 004, or less) with the crack
     ``paths``, and the crack length against time when it was sampled; displacements and
     damage are the final ones of ``out``/results.h5."""
-    from peridyn.io.hdf5 import read_array
     from peridyn.plotting.crack import plot_crack_length, plot_damage_map
 
-    results = out / "results.h5"
-    u, phi = read_array(results, "final/u"), read_array(results, "final/damage")
+    results = Results(out / "results.h5")
+    u, phi = results.array("final/u"), results.array("final/damage")
     figures = [plot_damage_map(body.points, u, phi, paths, out / "crack_paths.png")]
     history = summary.get("crack_length_history")
     if history and len(history["time_s"]) > 1:
@@ -90,11 +88,8 @@ def redraw_crack_figures(case: Case, body: Body, out: Path):
     """Crack paths and figures (``draw_crack_figures``) of a finished run with damage, from
     its results.h5: the final damage and the crack length history of the stored summary.
     Returns (paths, figure paths); (None, []) for a case without damage."""
-    from peridyn.io.hdf5 import read_array
-
     if case.material.damage is None:
         return None, []
-    results = out / "results.h5"
-    summary = json.loads(read_array(results, "summary/json"))
-    paths = final_crack_paths(case, body, read_array(results, "final/damage"))
-    return paths, draw_crack_figures(body, out, paths, summary)
+    results = Results(out / "results.h5")
+    paths = final_crack_paths(case, body, results.array("final/damage"))
+    return paths, draw_crack_figures(body, out, paths, results.summary())

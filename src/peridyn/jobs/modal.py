@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import csv
 import json
-import resource
 from pathlib import Path
 
 import numpy as np
@@ -20,7 +19,6 @@ from peridyn.io.hdf5 import HDF5Writer
 from peridyn.io.provenance import provenance
 from peridyn.io.vtk import write_vtu
 from peridyn.linalg.ordering import estimated_factor_entries
-from peridyn.physics.materials import LPSModel
 from peridyn.solvers.modal import modal_analysis
 
 #: Share of the machine's memory the factorisation may take.
@@ -30,8 +28,9 @@ MEMORY_SHARE = 0.7
 FACTOR_BUDGET = 2**30
 
 
-def run_modal(case, setup, out: Path, case_path=None) -> dict:
-    """Modal analysis of a built case; returns the summary (VALIDATION.md JSON keys)."""
+def run_modal(case, setup, out: Path, case_path=None) -> tuple[dict, list[Path]]:
+    """Modal analysis of a built case; returns the summary's own keys (docs/user-guide.md,
+    "Summaries and results files") and the figures drawn."""
     fixed = setup.loading.constrained if setup.loading.has_loads else None
     result, types, modes = modal_table(
         setup.model, case.solver.modes, fixed=fixed, eigensolver=case.solver.eigensolver
@@ -52,30 +51,36 @@ def run_modal(case, setup, out: Path, case_path=None) -> dict:
             {"mode_shape": shape[:, : body.dim]},
         )
     summary = {
-        "output_dir": str(out),
         "rigid_modes": result.n_rigid,
         "modes": modes,
         "points": body.n_points,
         "bonds": setup.bonds.n_bonds,
-        "peak_memory_bytes": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024,
     }
+    plots = []
     if case.output.plots:
         from peridyn.plotting.modes import plot_mode_shapes
 
-        summary["plots"] = [str(plot_mode_shapes(body, result, types, out / "modes.png"))]
-    return summary
+        plots.append(plot_mode_shapes(body, result, types, out / "modes.png"))
+    return summary, plots
 
 
 def modal_table(model, n_modes: int, fixed=None, eigensolver: str = "auto"):
     """Modes of ``model`` (eigensolver chosen by ``choose_eigensolver``), classified:
     (ModalResult, types, rows), the rows being the JSON/CSV dicts index, frequency_hz, type,
-    order, residual."""
+    order, label ("1st bending", ``mode_label``), residual."""
     method = choose_eigensolver(model, eigensolver)
     result = modal_analysis(model, n_modes, fixed=fixed, method=method)
     masses = model.density * model.body.volumes
     types = classify_modes(model.body.points, result.shapes, masses, result.rigid)
     rows = [
-        {"index": i, "frequency_hz": float(f), "type": t.type, "order": t.order, "residual": float(r)}
+        {
+            "index": i,
+            "frequency_hz": float(f),
+            "type": t.type,
+            "order": t.order,
+            "label": str(t),
+            "residual": float(r),
+        }
         for i, (f, t, r) in enumerate(zip(result.frequencies, types, result.residuals, strict=True))
     ]
     return result, types, rows
@@ -110,20 +115,21 @@ def compare_with_run(run_dir: Path, reference_dir: Path) -> list[dict]:
     MAC (so types are compared like with like when damage changes the order); written to
     ``run_dir / "frequency_shift.csv"``. Both runs must have the same points.
     """
-    from peridyn.io.hdf5 import read_array
+    from peridyn.io.results import Results
 
     runs = []
     for d in (reference_dir, run_dir):
         h5 = d / "results.h5"
         if not h5.is_file():
             raise InputError(f"--compare: {h5} not found (give the folder of a modal run)")
+        results = Results(h5)
         runs.append(
             {
-                "points": read_array(h5, "geometry/points"),
-                "volumes": read_array(h5, "geometry/volumes"),
-                "frequencies": read_array(h5, "modes/frequencies"),
-                "shapes": read_array(h5, "modes/shapes"),
-                "rigid": read_array(h5, "modes/rigid").astype(bool),
+                "points": results.array("geometry/points"),
+                "volumes": results.array("geometry/volumes"),
+                "frequencies": results.array("modes/frequencies"),
+                "shapes": results.array("modes/shapes"),
+                "rigid": results.array("modes/rigid").astype(bool),
                 "types": json.loads((d / "modes.json").read_text()),
             }
         )
@@ -145,10 +151,10 @@ def compare_with_run(run_dir: Path, reference_dir: Path) -> list[dict]:
         rows.append(
             {
                 "reference_index": ref_row["index"],
-                "reference_type": mode_label(ref_row),
+                "reference_label": mode_label(ref_row),
                 "reference_frequency_hz": ref_row["frequency_hz"],
                 "index": new_rows[j]["index"],
-                "type": mode_label(new_rows[j]),
+                "label": mode_label(new_rows[j]),
                 "frequency_hz": new_rows[j]["frequency_hz"],
                 "mac": float(mac[i, j]),
                 "frequency_change": new_rows[j]["frequency_hz"] / ref_row["frequency_hz"] - 1,
@@ -162,7 +168,8 @@ def compare_with_run(run_dir: Path, reference_dir: Path) -> list[dict]:
 
 
 def mode_label(row: dict) -> str:
-    """'1st bending' from a mode row (the type alone for order 0)."""
+    """'1st bending' from a mode row's type and order (the type alone for order 0): the one
+    form of a mode's label in every summary, table and report."""
     from peridyn.analysis.modes import ModeType
 
     return str(ModeType(row["type"], row["order"]))
@@ -187,7 +194,7 @@ def choose_eigensolver(model, requested: str = "auto") -> str:
 
 def factor_bytes(model) -> float:
     """Estimated memory of the shift-invert factor, bytes (8-byte values, 4-byte indices)."""
-    unknowns = 4 if isinstance(model, LPSModel) else 3  # LPS: three dofs and a dilatation
+    unknowns = 4 if model.has_dilatation else 3  # with a dilatation (LPS): three dofs and theta
     return 12.0 * estimated_factor_entries(model.body.points, model.bonds.horizon, unknowns)
 
 

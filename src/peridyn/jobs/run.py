@@ -4,7 +4,6 @@ runs are ``jobs.modal``), recording, checkpoints, crack history and the stored s
 
 from __future__ import annotations
 
-import json
 import time
 from pathlib import Path
 
@@ -22,6 +21,7 @@ from peridyn.io.recorder import LineProbe, Recorder, RecorderSpec
 from peridyn.jobs.build import Setup, build, pad3
 from peridyn.jobs.figures import draw_crack_figures, draw_run_figures, final_crack_paths
 from peridyn.jobs.lamb_analysis import analyse
+from peridyn.jobs.summary import finish_summary
 from peridyn.physics.absorbing import layer_damping
 from peridyn.physics.damage import damage_field
 from peridyn.physics.transducers import pzt_sensor_weights
@@ -69,7 +69,8 @@ def run_case(
     progress=None,
     base_dir=".",
 ) -> dict:
-    """Run a case and write its results; returns the summary (also stored in results.h5).
+    """Run a case and write its results; returns the summary (also stored in results.h5; keys
+    in docs/user-guide.md, "Summaries and results files").
 
     Parameters
     ----------
@@ -83,6 +84,7 @@ def run_case(
     setup = build(case, base_dir)
     out = output_directory(case, output_dir)
     out.mkdir(parents=True, exist_ok=True)
+    plots = []
     if case.solver.type == "static":
         summary = _run_static(case, setup, out, case_path)
     elif case.solver.type == "newton":
@@ -101,7 +103,7 @@ def run_case(
     elif case.solver.type == "modal":
         from peridyn.jobs.modal import run_modal
 
-        summary = run_modal(case, setup, out, case_path)
+        summary, plots = run_modal(case, setup, out, case_path)
     else:
         summary = _run_explicit(case, setup, out, case_path, checkpoint_every, restart, progress)
     analysis, figures = analyse(case, setup.body, out, plots=case.output.plots)
@@ -112,28 +114,23 @@ def run_case(
     if paths is not None:
         summary["crack_paths"] = [p.summary() for p in paths]
     if case.output.plots and case.solver.type != "modal":  # a modal run draws its own
-        summary["plots"] = [str(p) for p in [*draw_run_figures(case, setup.body, out), *figures]]
+        plots = [*draw_run_figures(case, setup.body, out), *figures]
         if paths is not None:
-            summary["plots"] += [str(p) for p in draw_crack_figures(setup.body, out, paths, summary)]
-    summary["seconds"] = time.perf_counter() - start
+            plots += draw_crack_figures(setup.body, out, paths, summary)
+    finish_summary(summary, "modal" if case.solver.type == "modal" else "run", out, start, plots)
     store_summary(out / "results.h5", setup.body, summary)
     return summary
 
 
 def store_summary(results, body: Body, summary: dict) -> None:
-    """(Re)write the run summary as JSON in ``/summary/json`` of a results file."""
+    """(Re)write the run summary in ``/summary/json`` of a results file."""
     with HDF5Writer(results, body.points[:, : body.dim], body.volumes, {}, mode="a") as h5:
-        h5.write_array("summary/json", np.bytes_(json.dumps(summary, default=_json_default)))
+        h5.write_summary(summary)
 
 
-def _json_default(obj):
-    return obj.tolist() if hasattr(obj, "tolist") else str(obj)
-
-
-def _base_summary(setup: Setup, out: Path) -> dict:
+def _base_summary(setup: Setup) -> dict:
     phi = damage_field(setup.model)
     return {
-        "output_dir": str(out),
         "points": setup.body.n_points,
         "bonds": setup.bonds.n_bonds,
         "broken_bonds": int((~setup.bonds.intact).sum()),
@@ -184,7 +181,7 @@ def _run_explicit(case, setup, out, case_path, checkpoint_every, restart, progre
         spec.snapshot_every and state.step % spec.snapshot_every == 0
     ):
         recorder.snapshot(state)
-    summary = _base_summary(setup, out)
+    summary = _base_summary(setup)
     summary.update(
         {
             "steps": state.step,
@@ -265,7 +262,7 @@ def _record_equilibrium(case, setup, out, case_path, u, results: dict) -> dict:
     recorder = Recorder(setup.body, out, spec, provenance(case_path, case=case), setup.model)
     recorder.record_series(state)
     recorder.snapshot(state)
-    summary = _base_summary(setup, out)
+    summary = _base_summary(setup)
     summary.update(results)
     summary["strain_energy_j"] = setup.model.strain_energy(u)
     recorder.finish(state)

@@ -26,6 +26,7 @@ import numpy as np
 
 from peridyn.analysis.convergence import ConvergenceError, richardson
 from peridyn.errors import InputError
+from peridyn.jobs.summary import finish_summary
 
 #: The kinds of series a study can fit, see the module docstring.
 SERIES = ("delta-m", "delta", "m")
@@ -40,12 +41,14 @@ class StudyRun:
     """One modal run of the grid.
 
     ``modes`` maps a mode label ("1st bending") to its frequency in Hz (the lowest if the
-    label occurs twice); ``skipped`` holds the reason when the run was not solved.
+    label occurs twice); ``bonds`` counts directed bonds; ``seconds`` is the run's time (build
+    and solve); ``skipped`` holds the reason when the run was not solved.
     """
 
     spacing: float
     horizon_factor: float
     points: int = 0
+    bonds: int = 0
     seconds: float = 0.0
     modes: dict[str, float] = field(default_factory=dict)
     skipped: str | None = None
@@ -62,6 +65,7 @@ class StudyRun:
             "horizon_factor": self.horizon_factor,
             "horizon_m": self.horizon,
             "points": self.points,
+            "bonds": self.bonds,
             "seconds": self.seconds,
             "modes": self.modes,
             "skipped": self.skipped,
@@ -93,7 +97,7 @@ def run_grid(
     """
     from peridyn.io.case import load_case
     from peridyn.jobs.build import build
-    from peridyn.jobs.modal import check_assembly_fits, modal_table, mode_label
+    from peridyn.jobs.modal import check_assembly_fits, modal_table
 
     combos = [(h, m) for m in horizon_factors for h in spacings]
     runs = []
@@ -113,6 +117,7 @@ def run_grid(
         )
         setup = build(case, Path(case_path).parent)
         run.points = setup.body.n_points
+        run.bonds = setup.bonds.n_bonds
         run.notes += _geometry_notes(case, setup.body)
         try:
             check_assembly_fits(setup.model)
@@ -122,7 +127,7 @@ def run_grid(
             fixed = setup.loading.constrained if setup.loading.has_loads else None
             _, _, rows = modal_table(setup.model, case.solver.modes, fixed=fixed)
             for row in rows:
-                label = mode_label(row)
+                label = row["label"]
                 if row["type"] in UNMATCHED_TYPES:
                     continue
                 if label in run.modes:
@@ -250,9 +255,13 @@ def _groups(runs: list[StudyRun], kind: str):
             yield f"horizon {d * 1e3:.4g} mm", members, "spacing_m"
 
 
-def write_study(out: Path, runs: list[StudyRun], fits: list[dict], meta: dict) -> dict:
+def write_study(
+    out: Path, runs: list[StudyRun], fits: list[dict], meta: dict, start: float, plots=()
+) -> dict:
     """Write ``runs.csv`` (one row per run and mode), ``study.csv`` (one row per fit) and
-    ``study.json`` (everything); returns the JSON summary."""
+    ``study.json`` (everything); returns the JSON summary (docs/user-guide.md, "Summaries and
+    results files"). ``start``: ``time.perf_counter()`` when the study started; ``plots``: the
+    figures drawn."""
     out.mkdir(parents=True, exist_ok=True)
     with open(out / "runs.csv", "w", newline="") as fh:
         writer = csv.writer(fh)
@@ -316,10 +325,10 @@ def write_study(out: Path, runs: list[StudyRun], fits: list[dict], meta: dict) -
             )
     summary = {
         **meta,
-        "output_dir": str(out),
         "runs": [r.to_dict() for r in runs],
         "fits": fits,
         "skipped_runs": sum(r.skipped is not None for r in runs),
     }
+    finish_summary(summary, "study", out, start, plots)
     (out / "study.json").write_text(json.dumps(summary, indent=1))
     return summary

@@ -43,12 +43,6 @@ def scatter_along_bonds(x, offsets, nbr, length, t, f):
     return f
 
 
-def pmb_linear_force(x, u, offsets, nbr, length, k, intact):
-    """Linearised PMB force density (n_points, 3), N/m^3."""
-    e = bond_extension(x, u, offsets, nbr, length, intact, np.empty(len(nbr)))
-    return scatter_along_bonds(x, offsets, nbr, length, k / length * e, np.empty_like(x))
-
-
 def lps_linear_force(x, u, offsets, nbr, length, w, dev, intact, theta_coef, p_coef):
     """Linearised LPS force density (n_points, 3), N/m^3."""
     e = bond_extension(x, u, offsets, nbr, length, intact, np.empty(len(nbr)))

@@ -4,8 +4,10 @@
 applies it to a dozen at every iteration. Here each bond is visited once per block: its
 unit vector and coefficients are read once and used for all ``k`` vectors, which sit
 contiguously in memory (``u`` of shape (n_points, 3, k)). Same formulas as
-``kernels.linear`` (``K u = -V f_lin(u)``), nothing is assembled: the memory is the
-bonds' plus a few (n_bonds, k) arrays, whatever the horizon.
+``kernels.linear`` (``K u = -V f_lin(u)``), with the coefficients of ``model.linearisation()``
+(``peridyn.physics.materials.linearisation``): t = axial (P_i + P_j) + extension e, axial =
+weight |xi|, and no axial part for a material without dilatation. Nothing is assembled: the
+memory is the bonds' plus a few (n_bonds, k) arrays, whatever the horizon.
 """
 
 from __future__ import annotations
@@ -14,7 +16,7 @@ import numpy as np
 from scipy.sparse.linalg import LinearOperator
 
 from peridyn.kernels.block import block_bond_force, block_extension, block_family_sum
-from peridyn.physics.materials import LPSModel, Model, PMBModel
+from peridyn.physics.materials.base import Model
 
 
 def block_linear_force(model: Model, u: np.ndarray, extension: np.ndarray | None = None) -> np.ndarray:
@@ -29,28 +31,15 @@ def block_linear_force(model: Model, u: np.ndarray, extension: np.ndarray | None
         extension = np.empty((b.n_bonds, u.shape[2]))
     e = block_extension(x, u, b.offsets, b.neighbours, b.length, b.intact, extension)
     f = np.empty_like(u)
-    if isinstance(model, PMBModel):
-        no_dilatation = np.zeros((len(x), u.shape[2]))
-        return block_bond_force(
-            x,
-            e,
-            b.offsets,
-            b.neighbours,
-            b.length,
-            np.zeros(b.n_bonds),
-            model.bond_stiffness.astype(np.float64) / b.length,
-            b.intact,
-            no_dilatation,
-            f,
-        )
-    if isinstance(model, LPSModel):
-        axial = model.w.astype(np.float64) * b.length
+    lin = model.linearisation()
+    if lin.has_dilatation:
+        axial = lin.weight * b.length
         theta = block_family_sum(b.offsets, axial, e, np.empty((len(x), u.shape[2])))
-        p = theta * (model.theta_coef * model._p_coef.astype(np.float64))[:, None]
-        return block_bond_force(
-            x, e, b.offsets, b.neighbours, b.length, axial, model.dev.astype(np.float64), b.intact, p, f
-        )
-    raise TypeError(f"no linearisation for {type(model).__name__}")
+        p = theta * (lin.theta_coef * lin.p_coef)[:, None]
+    else:
+        axial = np.zeros(b.n_bonds)
+        p = np.zeros((len(x), u.shape[2]))
+    return block_bond_force(x, e, b.offsets, b.neighbours, b.length, axial, lin.extension, b.intact, p, f)
 
 
 def block_stiffness_operator(model: Model, dofs: np.ndarray) -> LinearOperator:

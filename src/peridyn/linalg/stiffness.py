@@ -1,16 +1,20 @@
 """Stiffness and mass matrices of the linearised models, and the matrix-free operator.
 
+Everything here is asked of the material through ``Model.linearisation()``
+(``peridyn.physics.materials.linearisation.BondLinearisation``): the linear bond form
+t_ij = axial_ij (P_i + P_j) + extension_ij e_ij, e = n . (u_j - u_i), and the energy
+density W_p = (1/4) sum_j pair_pj e_pj^2 + c_p theta_p^2, theta_p = theta_coef_p sum_j
+weight_pj |xi| e_pj. No material is named: a bond-based material (PMB) has no dilatation part,
+a state-based one (LPS) has one.
+
 Degrees of freedom are ordered point-major: dof = 3 i + a (a = x, y, z); 2D
 bodies keep their z dofs (they carry no stiffness: constrain or drop them with
 ``free_dofs``). Forces are integrated over the volumes, so ``K u = -V f(u)`` for
 small ``u`` (N), and the lumped mass is ``M = rho V`` (kg).
 
-PMB: each directed bond i->j adds the energy (V_i k_ij / |xi|) (n . eta)^2 / 2.
-LPS: the energy of point p is V_p [c_p theta_p^2 + (alpha_p / 2) sum_j g_pj w e^2] with
-c_p = kappa / 2 - alpha_p m~_p / (2 d^2) (``peridyn.physics.materials.lps``; without surface
-correction g = 1, m~ = m and sum w (e^d)^2 = sum w e^2 - m theta^2 / d^2);
-theta_p = g_p . u couples p with its whole family, so each point adds a dense
-block 2 c_p V_p g_p g_p^T over its family: the matrix reaches two horizons
+Each directed bond p->j adds the energy V_p pair_pj (n . eta)^2 / 4 (eta = u_j - u_p).
+With a dilatation, theta_p = g_p . u couples p with its whole family, so each point adds a
+dense block 2 c_p V_p g_p g_p^T over its family: the matrix reaches two horizons
 (about (n_family + 1)^2 blocks per point). ``stiffness_parts`` keeps it factored
 as K = K_pair + G^T diag(2 c V) G, with G (n, 3 n) as sparse as the bonds: the
 eigensolver factorises the augmented matrix built from it instead of K. For
@@ -25,8 +29,8 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import LinearOperator
 
-from peridyn.kernels.linear import lps_linear_force, pmb_linear_force
-from peridyn.physics.materials import LPSModel, Model, PMBModel
+from peridyn.kernels.linear import bond_extension, lps_linear_force, scatter_along_bonds
+from peridyn.physics.materials.base import Model
 
 
 def mass_matrix(model: Model) -> sp.dia_matrix:
@@ -36,28 +40,28 @@ def mass_matrix(model: Model) -> sp.dia_matrix:
 
 
 def linear_force(model: Model, u: np.ndarray) -> np.ndarray:
-    """Linearised internal force density (n_points, 3), N/m^3 (see ``kernels.linear``)."""
+    """Linearised internal force density (n_points, 3), N/m^3, of ``u`` (n_points, 3), m
+    (``kernels.linear``; the coefficients of ``model.linearisation()``)."""
     b = model.bonds
     x = model.body.points
     u = np.ascontiguousarray(u, dtype=np.float64)
-    if isinstance(model, PMBModel):
-        return pmb_linear_force(
-            x, u, b.offsets, b.neighbours, b.length, model.bond_stiffness.astype(np.float64), b.intact
-        )
-    if isinstance(model, LPSModel):
+    lin = model.linearisation()
+    if lin.has_dilatation:  # the state-based kernel takes any material's dilatation coefficients
         return lps_linear_force(
             x,
             u,
             b.offsets,
             b.neighbours,
             b.length,
-            model.w.astype(np.float64),
-            model.dev.astype(np.float64),
+            lin.weight,
+            lin.extension,
             b.intact,
-            model.theta_coef,
-            model._p_coef.astype(np.float64),
+            lin.theta_coef,
+            lin.p_coef,
         )
-    raise TypeError(f"no linearisation for {type(model).__name__}")
+    # bond-based: t = extension e, scattered along the bonds
+    e = bond_extension(x, u, b.offsets, b.neighbours, b.length, b.intact, np.empty(b.n_bonds))
+    return scatter_along_bonds(x, b.offsets, b.neighbours, b.length, lin.extension * e, np.empty_like(x))
 
 
 def stiffness_operator(model: Model) -> LinearOperator:
@@ -80,7 +84,7 @@ class StiffnessParts:
     pair : (3 n, 3 n) csr_matrix
         Bond-pair part: sum over bonds of coef (n n^T) on the ii, jj, -ij, -ji blocks.
     G : (n, 3 n) csr_matrix or None
-        LPS dilatation gradients, theta_p = (G u)_p; None for PMB.
+        Dilatation gradients, theta_p = (G u)_p; None for a material without dilatation.
     dilatation : (n,) float64 or None, J
         2 c_p V_p: the second derivative of each point's energy V_p c_p theta_p^2.
     """
@@ -133,21 +137,15 @@ def stiffness_parts(model: Model, energy_of: np.ndarray | None = None) -> Stiffn
         vol = np.where(energy_of, vol, 0.0)
     counted = b.intact & (vol[owners] > 0)
     n = model.body.n_points
-    if isinstance(model, PMBModel):
-        pair = vol[owners] * model.bond_stiffness.astype(np.float64) / b.length  # W = k e^2 / 4L
-        return StiffnessParts(
-            pair_matrix(owners[counted], b.neighbours[counted], n_vec[counted], pair[counted], n)
-        )
-    if isinstance(model, LPSModel):
-        w = np.where(counted, model.w.astype(np.float64), 0.0)
-        # (V alpha g w / 2) e^2 per bond
-        pair = 2.0 * vol[owners] * model.alpha[owners] * model.dev_factor * w
-        k_pair = pair_matrix(owners[counted], b.neighbours[counted], n_vec[counted], pair[counted], n)
-        d = model.dim
-        c = 0.5 * model.bulk - model.alpha * model.dev_weighted_volume / (2 * d * d)
-        a = model.theta_coef[owners] * w * b.length  # d theta_p / d e_pj
-        return StiffnessParts(k_pair, _dilatation_gradients(owners, b.neighbours, n_vec, a, n), 2.0 * c * vol)
-    raise TypeError(f"no stiffness for {type(model).__name__}")
+    lin = model.linearisation()
+    pair = vol[owners] * lin.pair  # the energy V_p pair e^2 / 4 per bond
+    k_pair = pair_matrix(owners[counted], b.neighbours[counted], n_vec[counted], pair[counted], n)
+    if not lin.has_dilatation:
+        return StiffnessParts(k_pair)
+    w = np.where(counted, lin.weight, 0.0)
+    a = lin.theta_coef[owners] * w * b.length  # d theta_p / d e_pj
+    gradients = _dilatation_gradients(owners, b.neighbours, n_vec, a, n)
+    return StiffnessParts(k_pair, gradients, 2.0 * lin.dilatation_energy * vol)
 
 
 def assemble_stiffness(model: Model, energy_of: np.ndarray | None = None) -> sp.csr_matrix:

@@ -9,7 +9,9 @@ configuration, and not joined by an intact bond, repel each other with the force
 zero beyond d_c and never attractive. The short-range constant is ``c_sr = factor * c``
 with c the micromodulus of a PMB material of the same Young's modulus and a constant
 influence function (3D: c = 18 K / (pi delta^4), K = E / (3 (1 - 2/4)); 2D: see
-``peridyn.physics.materials.pmb``). Peridigm's documentation and Silling's EMU use
+``peridyn.physics.materials.pmb``) whatever the body's material: the constant is defined by
+that reference micromodulus (Peridigm's convention), so it imports ``pmb_micromodulus`` by
+design and asks the model only for ``Model.E``. Peridigm's documentation and Silling's EMU use
 ``factor = 15``, the default here: a contact pair at overlap d is then about as stiff as
 15 bonds of length delta stretched by d, so that closed crack faces carry compression
 nearly as the intact material did, while the stable time step shrinks by only ~20 %

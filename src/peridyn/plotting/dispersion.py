@@ -140,17 +140,18 @@ def plot_mid_planes(
     near : float, m
     clip : float
     """
-    from peridyn.io.hdf5 import read_array, read_series
+    from peridyn.io.results import Results
 
-    points = read_array(results, "geometry/points")
+    stored = Results(results)
+    points = stored.array("geometry/points")
     fig = Figure(
         figsize=(4.2 * (3 if times is None else len(times)) + 1, 4.0 * len(planes)), layout="constrained"
     )
     FigureCanvasAgg(fig)
     axes = None
     for row, name in enumerate(planes):
-        x = points[read_array(results, f"probes/plane_{name}")]
-        _, t, data = read_series(results, f"plane_{name}")
+        x = points[stored.array(f"probes/plane_{name}")]
+        _, t, data = stored.series(f"plane_{name}")
         chosen = [0.3 * t[-1], 0.5 * t[-1], 0.7 * t[-1]] if times is None else list(times)
         if axes is None:
             axes = fig.subplots(len(planes), len(chosen), squeeze=False)

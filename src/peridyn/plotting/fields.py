@@ -2,10 +2,8 @@
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
-import h5py
 import matplotlib
 
 matplotlib.use("Agg")
@@ -14,6 +12,7 @@ import numpy as np  # noqa: E402
 from matplotlib.tri import Triangulation  # noqa: E402
 
 from peridyn.discretization.body import Body  # noqa: E402
+from peridyn.io.results import Results  # noqa: E402
 
 COMPONENT_NAMES = ("x", "y", "z")
 
@@ -21,17 +20,17 @@ COMPONENT_NAMES = ("x", "y", "z")
 def plot_run(directory, body: Body) -> list[Path]:
     """Draw every figure the results support; returns the PNG paths written."""
     directory = Path(directory)
+    results = Results(directory / "results.h5")
     written = []
-    with h5py.File(directory / "results.h5", "r") as f:
-        series = f.get("series", {})
-        if "sensor_u" in series:
-            written.append(plot_sensors(f, directory / "sensors.png"))
-        for key in series:
-            if key.startswith("line_"):
-                name = key.removeprefix("line_")
-                written.append(plot_bscan(f, name, directory / f"bscan_{name}.png"))
-        u = f["final/u"][...]
-        damage = f["final/damage"][...] if "final/damage" in f else None
+    series = results.series_names()
+    if "sensor_u" in series:
+        written.append(plot_sensors(results, directory / "sensors.png"))
+    for key in series:
+        if key.startswith("line_"):
+            name = key.removeprefix("line_")
+            written.append(plot_bscan(results, name, directory / f"bscan_{name}.png"))
+    u = results.array("final/u")
+    damage = results.array("final/damage") if results.has("final/damage") else None
     if body.dim == 3:
         written.append(
             plot_field(
@@ -51,12 +50,11 @@ def plot_run(directory, body: Body) -> list[Path]:
     return written
 
 
-def plot_sensors(f: h5py.File, path: Path) -> Path:
-    """Displacement components against time at each sensor."""
-    group = f["series/sensor_u"]
-    names = _names(group)
-    t = group["time"][...] * 1e6
-    data = group["data"][...]
+def plot_sensors(results: Results, path: Path) -> Path:
+    """Displacement components against time at each sensor (series ``sensor_u``)."""
+    names = [str(n) for n in results.series_attrs("sensor_u")["names"]]
+    _, t, data = results.series("sensor_u")
+    t = t * 1e6
     fig, axes = plt.subplots(len(names), 1, figsize=(7, 1.8 + 1.6 * len(names)), squeeze=False, sharex=True)
     for k, (ax, name) in enumerate(zip(axes[:, 0], names, strict=True)):
         for c in range(3):
@@ -68,13 +66,13 @@ def plot_sensors(f: h5py.File, path: Path) -> Path:
     return _save(fig, path)
 
 
-def plot_bscan(f: h5py.File, name: str, path: Path) -> Path:
-    """Space-time map (B-scan) of each displacement component along a line probe (a profile
-    plot when the line holds a single record, as after a static solve)."""
-    group = f[f"series/line_{name}"]
-    t = group["time"][...] * 1e6
-    data = group["data"][...]
-    points = f["geometry/points"][...][json.loads(group.attrs["points"])]
+def plot_bscan(results: Results, name: str, path: Path) -> Path:
+    """Space-time map (B-scan) of each displacement component along a line probe (series
+    ``line_<name>``; a profile plot when the line holds a single record, as after a static
+    solve)."""
+    _, t, data = results.series(f"line_{name}")
+    t = t * 1e6
+    points = results.array("geometry/points")[results.series_attrs(f"line_{name}")["points"]]
     distance = np.linalg.norm(points - points[0], axis=1) * 1e3
     if len(t) < 2:  # a static result: the displacement profile along the line
         fig, ax = plt.subplots(figsize=(7, 4))
@@ -142,16 +140,6 @@ def plot_field(
     ax.set_title(label + (" (top layer)" if body.dim == 3 else ""))
     fig.colorbar(sc, ax=ax, label=label)
     return _save(fig, path)
-
-
-def _names(group) -> list[str]:
-    raw = group.attrs.get("names")
-    if isinstance(raw, bytes | str):
-        try:
-            return list(json.loads(raw))
-        except ValueError:
-            return [str(raw)]
-    return [str(n) for n in raw]
 
 
 def _save(fig, path: Path) -> Path:

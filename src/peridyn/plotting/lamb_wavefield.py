@@ -21,7 +21,7 @@ from matplotlib.patches import Circle
 from peridyn.analysis.fk import point_grid
 from peridyn.analysis.lamb import DispersionBranch, LambMode
 from peridyn.errors import InputError
-from peridyn.io.hdf5 import iter_series_chunks, read_array
+from peridyn.io.results import Results
 from peridyn.physics.loads import parse_components
 
 __all__ = [
@@ -71,7 +71,7 @@ def plot_wavefield_snapshots(
     -------
     Path
     """
-    points = read_array(results, "geometry/points")
+    points = Results(results).array("geometry/points")
     layer, n_layers = _layers(points)
     shown = range(n_layers) if layers is None else [_layer_number(i, n_layers) for i in layers]
     columns = parse_components(components)
@@ -254,7 +254,7 @@ def plot_through_thickness(
     -------
     Path
     """
-    points = read_array(results, "geometry/points")
+    points = Results(results).array("geometry/points")
     if points.shape[1] != 3:
         raise InputError("a through-thickness cut needs a 3D body")
     found, records = _records_near(results, series, [time])
@@ -353,7 +353,7 @@ def _records_near(results, series: str, times) -> tuple[np.ndarray, np.ndarray]:
     wanted = np.atleast_1d(np.asarray(times, dtype=float))
     best_gap = np.full(len(wanted), np.inf)
     found, records = np.zeros(len(wanted)), [None] * len(wanted)
-    for chunk_times, data in iter_series_chunks(results, series, 1):
+    for chunk_times, data in Results(results).iter_series(series, 1):
         gap = np.abs(wanted - chunk_times[0])
         for i in np.flatnonzero(gap < best_gap):
             best_gap[i], found[i], records[i] = gap[i], chunk_times[0], data[0]

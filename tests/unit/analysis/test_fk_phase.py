@@ -17,7 +17,8 @@ from scipy.special import hankel1
 from peridyn.analysis.fk import LINE_SUFFIXES, line_mode_wavenumbers, mirror_parts, phase_wavenumber
 from peridyn.discretization import geometry
 from peridyn.errors import InputError
-from peridyn.io.hdf5 import HDF5Writer, read_series
+from peridyn.io.hdf5 import HDF5Writer
+from peridyn.io.results import Results
 
 F0 = 150e3
 OMEGA = 2 * np.pi * F0
@@ -122,8 +123,8 @@ def test_divergence_reads_s0_without_sh0(tmp_path):
     found = line_mode_wavenumbers(path, "x_axis", X, DX, F0, SOURCE, (0.02, 0.09))
     assert found["S0"] == pytest.approx(K_S0, rel=3e-3)
     assert found["A0"] == pytest.approx(K_A0, rel=5e-4)
-    _, times, top = read_series(path, "line_x_axis")
-    _, _, bottom = read_series(path, "line_x_axis_bottom")
+    _, times, top = Results(path).series("line_x_axis")
+    _, _, bottom = Results(path).series("line_x_axis_bottom")
     u_x = mirror_parts(top, bottom)["S"][:, :, 0]
     assert abs(phase_wavenumber(u_x, times[1] - times[0], X, F0, SOURCE, (0.02, 0.09), 1) / K_S0 - 1) > 0.01
 

@@ -1,4 +1,4 @@
-"""Tests of the incremental HDF5 results writer and its readers."""
+"""Tests of the incremental HDF5 results writer (read back with ``peridyn.io.results``)."""
 
 import os
 import subprocess
@@ -12,13 +12,8 @@ import pytest
 
 import peridyn
 from peridyn.errors import InputError
-from peridyn.io.hdf5 import (
-    HDF5Writer,
-    iter_series_chunks,
-    read_array,
-    read_provenance,
-    read_series,
-)
+from peridyn.io.hdf5 import HDF5Writer
+from peridyn.io.results import Results
 
 N = 10
 
@@ -43,13 +38,13 @@ def write_run(path, geometry, steps, mode="w", **kwargs):
 def test_geometry_and_series_round_trip(tmp_path, geometry):
     path = tmp_path / "run.h5"
     write_run(path, geometry, range(5))
-    steps, times, data = read_series(path, "u")
+    steps, times, data = Results(path).series("u")
     np.testing.assert_array_equal(steps, np.arange(5))
     np.testing.assert_array_equal(times, np.arange(5) * 1e-7)
     np.testing.assert_array_equal(data, np.stack([record(s) for s in range(5)]))
     assert (steps.dtype, times.dtype, data.dtype) == (np.int64, np.float64, np.float64)
-    np.testing.assert_array_equal(read_array(path, "/geometry/points"), geometry[0])
-    np.testing.assert_array_equal(read_array(path, "geometry/volumes"), geometry[1])
+    np.testing.assert_array_equal(Results(path).array("/geometry/points"), geometry[0])
+    np.testing.assert_array_equal(Results(path).array("geometry/volumes"), geometry[1])
 
 
 def test_series_layout_is_resizable_and_chunked_along_time(tmp_path, geometry):
@@ -73,7 +68,7 @@ def test_scalar_series(tmp_path, geometry):
     with HDF5Writer(path, *geometry, {}) as out:
         out.create_series("energy", ())
         out.append("energy", 3, 0.5, 2.25)
-    steps, times, data = read_series(path, "energy")
+    steps, times, data = Results(path).series("energy")
     assert steps.tolist() == [3] and times.tolist() == [0.5] and data.tolist() == [2.25]
 
 
@@ -83,7 +78,7 @@ def test_float32_storage(tmp_path, geometry):
     with HDF5Writer(path, *geometry, {}) as out:
         out.create_series("plane", (N, 2), dtype="float32")
         out.append("plane", 0, 0.0, values)
-    _, _, data = read_series(path, "plane")
+    _, _, data = Results(path).series("plane")
     assert data.dtype == np.float32
     np.testing.assert_array_equal(data[0], values.astype(np.float32))
 
@@ -102,7 +97,7 @@ def test_provenance_round_trip(tmp_path, geometry):
     }
     with HDF5Writer(path, *geometry, provenance):
         pass
-    read = read_provenance(path)
+    read = Results(path).provenance()
     np.testing.assert_array_equal(read.pop("horizon_factors"), [3.0, 4.0])
     provenance.pop("horizon_factors")
     assert read == provenance
@@ -117,8 +112,8 @@ def test_provenance_rejects_unstorable_value(tmp_path, geometry):
 def test_chunked_reading_equals_whole_reading(tmp_path, geometry):
     path = tmp_path / "run.h5"
     write_run(path, geometry, range(0, 23, 1))
-    _, times, data = read_series(path, "u")
-    chunks = list(iter_series_chunks(path, "u", 5))
+    _, times, data = Results(path).series("u")
+    chunks = list(Results(path).iter_series("u", 5))
     assert [len(t) for t, _ in chunks] == [5, 5, 5, 5, 3]
     np.testing.assert_array_equal(np.concatenate([t for t, _ in chunks]), times)
     np.testing.assert_array_equal(np.concatenate([d for _, d in chunks]), data)
@@ -132,7 +127,7 @@ def test_data_written_before_an_exception_is_readable(tmp_path, geometry):
             out.append("u", 0, 0.0, record(0))
             out.append("u", 1, 1e-7, record(1))
             raise RuntimeError("solver blew up")
-    steps, _, data = read_series(path, "u")
+    steps, _, data = Results(path).series("u")
     assert steps.tolist() == [0, 1]
     np.testing.assert_array_equal(data[1], record(1))
 
@@ -154,17 +149,17 @@ def test_data_survives_a_process_killed_without_closing(tmp_path):
     env = dict(os.environ, PYTHONPATH=str(Path(peridyn.__file__).parents[1]))
     done = subprocess.run([sys.executable, "-c", script], timeout=60, env=env)
     assert done.returncode == 1
-    steps, _, data = read_series(path, "u")
+    steps, _, data = Results(path).series("u")
     assert steps.tolist() == [0, 1, 2]
     np.testing.assert_array_equal(data[2], np.full((4, 3), 2.0))
-    assert read_provenance(path) == {"case": "crash"}
+    assert Results(path).provenance() == {"case": "crash"}
 
 
 def test_append_mode_continues_series(tmp_path, geometry):
     path = tmp_path / "run.h5"
     write_run(path, geometry, range(3))
     write_run(path, geometry, range(3, 5), mode="a")
-    steps, _, data = read_series(path, "u")
+    steps, _, data = Results(path).series("u")
     assert steps.tolist() == [0, 1, 2, 3, 4]
     np.testing.assert_array_equal(data[4], record(4))
 
@@ -180,12 +175,12 @@ def test_truncate_drops_records_after_checkpoint_step(tmp_path, geometry):
     with HDF5Writer(path, *geometry, {"restarted_at": 25}, mode="a") as out:
         out.truncate(25)
         out.append("u", 30, 30e-7, record(30) + 1)
-    steps, times, data = read_series(path, "u")
+    steps, times, data = Results(path).series("u")
     assert steps.tolist() == [0, 10, 20, 30]
     np.testing.assert_array_equal(times, [0, 10e-7, 20e-7, 30e-7])
     np.testing.assert_array_equal(data[3], record(30) + 1)
-    assert read_series(path, "e")[0].tolist() == [0, 10, 20]
-    assert read_provenance(path) == {"case": "bar", "restarted_at": 25}
+    assert Results(path).series("e")[0].tolist() == [0, 10, 20]
+    assert Results(path).provenance() == {"case": "bar", "restarted_at": 25}
 
 
 def test_append_rejects_repeated_step(tmp_path, geometry):
@@ -203,7 +198,7 @@ def test_append_mode_recreating_a_series_reuses_it(tmp_path, geometry):
         out.create_series("u", (N, 2))
         with pytest.raises(InputError, match="already exists with record shape"):
             out.create_series("u", (N, 3))
-    assert read_series(path, "u")[0].tolist() == [0, 1]
+    assert Results(path).series("u")[0].tolist() == [0, 1]
 
 
 def test_append_mode_rejects_other_geometry(tmp_path, geometry):
@@ -225,7 +220,7 @@ def test_append_rejects_wrong_record_shape_and_unknown_series(tmp_path, geometry
 def test_flush_every_batches_flushes(tmp_path, geometry):
     path = tmp_path / "run.h5"
     write_run(path, geometry, range(7), flush_every=3)
-    assert read_series(path, "u")[0].tolist() == list(range(7))
+    assert Results(path).series("u")[0].tolist() == list(range(7))
 
 
 def test_write_array_replaces_and_keeps_attrs(tmp_path, geometry):
@@ -235,22 +230,22 @@ def test_write_array_replaces_and_keeps_attrs(tmp_path, geometry):
         out.write_array("/final/damage", np.linspace(0, 1, N), attrs={"units": "1"})
         with pytest.raises(InputError, match="outside /geometry, /series"):
             out.write_array("geometry/points", np.zeros((N, 2)))
-    np.testing.assert_array_equal(read_array(path, "final/damage"), np.linspace(0, 1, N))
+    np.testing.assert_array_equal(Results(path).array("final/damage"), np.linspace(0, 1, N))
     with h5py.File(path) as f:
         assert f["final/damage"].attrs["units"] == "1"
 
 
 def test_readers_name_missing_file_and_series(tmp_path, geometry):
     with pytest.raises(InputError, match="nothing.h5.*does not exist"):
-        read_series(tmp_path / "nothing.h5", "u")
+        Results(tmp_path / "nothing.h5").series("u")
     path = tmp_path / "run.h5"
     write_run(path, geometry, range(1))
     with pytest.raises(InputError, match=r"no series 'uu'; it has \['u'\]"):
-        read_series(path, "uu")
+        Results(path).series("uu")
     with pytest.raises(InputError, match="no dataset 'final/damage'"):
-        read_array(path, "final/damage")
+        Results(path).array("final/damage")
     with pytest.raises(InputError, match="chunk_records must be a positive integer"):
-        next(iter_series_chunks(path, "u", 0))
+        next(Results(path).iter_series("u", 0))
 
 
 def test_append_mode_drops_a_half_written_record(tmp_path, geometry):
@@ -259,9 +254,9 @@ def test_append_mode_drops_a_half_written_record(tmp_path, geometry):
     with h5py.File(path, "a") as f:  # a crash after writing data and time, before step
         for key in ("data", "time"):
             f["series/u"][key].resize(4, axis=0)
-    assert read_series(path, "u")[0].tolist() == [0, 1, 2]
+    assert Results(path).series("u")[0].tolist() == [0, 1, 2]
     write_run(path, geometry, [3], mode="a")
-    steps, _, data = read_series(path, "u")
+    steps, _, data = Results(path).series("u")
     assert steps.tolist() == [0, 1, 2, 3]
     np.testing.assert_array_equal(data[3], record(3))
 

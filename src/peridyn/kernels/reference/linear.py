@@ -25,13 +25,6 @@ def scatter_along_bonds(x, offsets, nbr, length, t):
     return family_sum(offsets, t[:, None] * unit_vectors(x, offsets, nbr, length))
 
 
-def pmb_linear_force(x, u, offsets, nbr, length, k, intact):
-    """(n_points, 3) float64, N/m^3: linearised PMB force, t = (k / |xi|) e."""
-    length, k = as64(length, k)
-    e = bond_extension(x, u, offsets, nbr, length, intact)
-    return scatter_along_bonds(x, offsets, nbr, length, k / length * e)
-
-
 def lps_linear_force(x, u, offsets, nbr, length, w, dev, intact, theta_coef, p_coef):
     """(n_points, 3) float64, N/m^3: linearised LPS force (module docstring)."""
     length, w, dev, theta_coef, p_coef = as64(length, w, dev, theta_coef, p_coef)

@@ -1,4 +1,22 @@
-"""What every material model bound to a discretisation provides."""
+"""What every material model bound to a discretisation provides: the one interface through
+which solvers, stiffness assembly, modal analysis, fatigue, damage and contact use a material.
+
+A material is one class deriving from :class:`Model`, registered under its case-file name
+with ``peridyn.physics.materials.registry.register_material``. It implements
+
+- :meth:`Model.force` and :meth:`Model.energy_density` (the nonlinear law, explicit and
+  static solvers, energies),
+- :meth:`Model.stiffness_bound` (stable time step, preconditioner scale),
+- :meth:`Model.critical_stretch` (damage from a fracture energy),
+- :meth:`Model._linearise`, returning the :class:`BondLinearisation` of its small-displacement
+  form (``peridyn.physics.materials.linearisation``): everything ``linalg.stiffness``,
+  ``linalg.block_operator``, ``linalg.tangent``, the modal solvers and fatigue statics need;
+
+and, if its constructor does not take the case parameters as keywords, :meth:`from_parameters`.
+Code outside this package asks the model only through these methods and the attributes
+documented on :class:`Model`; it never tests for a concrete material class
+(``tests/unit/test_architecture.py``).
+"""
 
 from __future__ import annotations
 
@@ -6,32 +24,40 @@ import numpy as np
 
 from peridyn.discretization.body import Body
 from peridyn.discretization.bonds import Bonds
+from peridyn.physics.materials.linearisation import BondLinearisation
 
 
 class Model:
     """A material law over the bonds of one body (abstract).
 
-    Subclasses set the per-bond and per-point coefficient arrays in their
-    constructor and implement :meth:`force`, :meth:`energy_density`,
-    :meth:`stiffness_bound` and :meth:`critical_stretch`.
+    Subclasses set their per-bond and per-point coefficient arrays in their constructor and
+    implement :meth:`force`, :meth:`energy_density`, :meth:`stiffness_bound`,
+    :meth:`critical_stretch` and :meth:`_linearise`.
 
     Attributes
     ----------
+    name : str
+        The case-file name the class is registered under (``material.model``).
     body : Body
     bonds : Bonds
         ``bonds.intact`` is shared and updated in place when bonds break.
+    E : float, Pa
+        Young's modulus (damage's critical bond stress, contact's short-range constant).
     dtype : numpy dtype
         Floating type of the kernels (float64 or float32).
     x : (n_points, 3) dtype, m
         Reference positions in the kernel dtype.
     density : (n_points,) float64, kg/m^3
+    bond_volume : (n_bonds,) float64, m^3
+        Neighbour volume times the bond's partial-volume factor.
     """
 
     name = "model"
 
-    def __init__(self, body: Body, bonds: Bonds, density: float, dtype=np.float64):
+    def __init__(self, body: Body, bonds: Bonds, E: float, density: float, dtype=np.float64):
         self.body = body
         self.bonds = bonds
+        self.E = float(E)
         self.dtype = np.dtype(dtype)
         self.x = np.ascontiguousarray(body.points, dtype=self.dtype)
         self.density = np.full(body.n_points, float(density))
@@ -39,6 +65,37 @@ class Model:
         self.offsets = bonds.offsets
         # neighbour volume times its volume factor, (n_bonds,) m^3
         self.bond_volume = body.volumes[bonds.neighbours] * bonds.volume_factor
+        self._linearisation: BondLinearisation | None = None
+
+    @classmethod
+    def from_parameters(
+        cls,
+        body: Body,
+        bonds: Bonds,
+        *,
+        E: float,
+        density: float,
+        nu: float | None = None,
+        surface_correction: str = "none",
+        dtype=np.float64,
+    ) -> Model:
+        """The material bound to ``body`` and ``bonds`` from the case's material parameters.
+
+        E (Pa), density (kg/m^3), Poisson's ratio ``nu`` (None: not given), the name of a
+        ``surface_correction`` and the kernel ``dtype``; each material checks them and raises
+        ``InputError`` for values it cannot take. By default the constructor takes them as
+        keywords.
+        """
+        return cls(
+            body, bonds, E=E, density=density, nu=nu, surface_correction=surface_correction, dtype=dtype
+        )
+
+    @classmethod
+    def implied_poisson_ratio(cls, dim: int, plane: str | None = None) -> float | None:
+        """The Poisson ratio the material has on a body of dimension ``dim`` (2D: ``plane``
+        "stress" or "strain") whatever ``nu`` it is given (bond-based materials), or None when
+        it takes the ``nu`` given (the default)."""
+        return None
 
     def __repr__(self) -> str:
         return f"{type(self).__name__}(n_points={self.body.n_points}, dtype={self.dtype.name})"
@@ -70,6 +127,26 @@ class Model:
     def critical_stretch(self, fracture_energy: float) -> float:
         """Critical bond stretch for a fracture energy ``fracture_energy`` (J/m^2)."""
         raise NotImplementedError
+
+    def linearisation(self) -> BondLinearisation:
+        """The small-displacement form of the material (``materials.linearisation``), float64.
+
+        Built once from the set-up coefficients and kept: consumers read ``bonds.intact``
+        themselves, so it stays valid while bonds break.
+        """
+        if self._linearisation is None:
+            self._linearisation = self._linearise()
+        return self._linearisation
+
+    def _linearise(self) -> BondLinearisation:
+        """Build the :class:`BondLinearisation` (called once by :meth:`linearisation`)."""
+        raise NotImplementedError
+
+    @property
+    def has_dilatation(self) -> bool:
+        """True when points couple through a dilatation (state-based): the stiffness then
+        reaches two horizons and a factorisation carries one more unknown per point."""
+        return self.linearisation().has_dilatation
 
     def critical_time_step(
         self, extra_bound: np.ndarray | None = None, points: np.ndarray | None = None

@@ -18,9 +18,12 @@ part with factors g_ij (``peridyn.physics.materials.lps_correction``):
 
 m~_i = sum_j g_ij w_ij |xi|^2 (set-up); g = 1 gives the form above. Its force is
 t_ij = w |xi| P_i + alpha_i g_ij w e_ij with P_i = theta_i p_coef_i,
-p_coef = d kappa / m - alpha m~ / (d m), so every consumer (force kernels, linear force,
-stiffness, tangent, Bloch cell) reads the per-bond deviatoric stiffness
-``dev`` = w (alpha_i g_ij + alpha_j g_ji) and ``_p_coef`` from the model.
+p_coef = d kappa / m - alpha m~ / (d m): the force kernels read the per-bond deviatoric
+stiffness ``dev`` = w (alpha_i g_ij + alpha_j g_ji) and p_coef, and stiffness, tangent, block
+operator and Bloch cell get the same coefficients from ``LPSModel.linearisation()``
+(``peridyn.physics.materials.linearisation``): extension = dev, weight = w, theta_coef = d / m,
+p_coef, pair = 2 alpha_i g_ij w (point i's deviatoric energy) and the dilatation energy
+coefficient c = kappa / 2 - alpha m~ / (2 d^2) of W_i = c theta_i^2 + (alpha_i / 2) sum_j g_ij w e^2.
 """
 
 from __future__ import annotations
@@ -46,12 +49,15 @@ from peridyn.physics.materials.elastic import (
     plane_bulk_modulus,
     shear_modulus,
 )
+from peridyn.physics.materials.linearisation import BondLinearisation
 from peridyn.physics.materials.lps_correction import energy_factors
+from peridyn.physics.materials.registry import register_material
 
 #: ``shear-factor``: Peridigm's former "Apply Shear Correction Factor" (see ``LPSModel``).
 SURFACE_CORRECTIONS = ("none", "shear-factor", "energy")
 
 
+@register_material("lps")
 class LPSModel(Model):
     """LPS material bound to a body and its bonds.
 
@@ -60,6 +66,7 @@ class LPSModel(Model):
     body, bonds : Body, Bonds
     E : float, Pa
     nu : float
+        Required (an LPS material has any Poisson ratio in (-1, 1/2)).
     density : float, kg/m^3
     surface_correction : {"none", "shear-factor", "energy"}
         ``shear-factor`` scales each point's deviatoric coefficient alpha by
@@ -76,26 +83,26 @@ class LPSModel(Model):
         stiffness read by every force and stiffness routine
     """
 
-    name = "lps"
-
     def __init__(
         self,
         body: Body,
         bonds: Bonds,
         E: float,
-        nu: float,
+        nu: float | None,
         density: float,
         surface_correction: str = "none",
         dtype=np.float64,
     ):
+        if nu is None:
+            raise InputError("an LPS material needs Poisson's ratio nu")
         check_elastic(E, nu, density)
         if surface_correction not in SURFACE_CORRECTIONS:
             raise InputError(
                 f"LPS surface_correction must be one of {SURFACE_CORRECTIONS}, got {surface_correction!r}"
             )
-        super().__init__(body, bonds, density, dtype)
+        super().__init__(body, bonds, E=E, density=density, dtype=dtype)
         dim = body.dim
-        self.E, self.nu, self.dim = float(E), float(nu), dim
+        self.nu, self.dim = float(nu), dim
         self.shear = shear_modulus(E, nu)
         self.bulk = bulk_modulus(E, nu) if dim == 3 else plane_bulk_modulus(E, nu, body.plane)
         b = bonds
@@ -252,6 +259,21 @@ class LPSModel(Model):
         )
         dev = squares - self.dev_weighted_volume * theta**2 / self.dim**2
         return 0.5 * self.bulk * theta**2 + 0.5 * self.alpha * dev
+
+    def _linearise(self):
+        """State-based: the coefficients of the module docstring, in float64 from the kernel
+        dtype's ``w``, ``dev`` and p_coef (the linear form of the kernels' numbers)."""
+        b = self.bonds
+        w = np.asarray(self.w, dtype=np.float64)  # no copy in float64
+        d = self.dim
+        return BondLinearisation(
+            extension=np.asarray(self.dev, dtype=np.float64),
+            pair=2.0 * self.alpha[b.owners()] * self.dev_factor * w,
+            weight=w,
+            theta_coef=self.theta_coef,
+            p_coef=np.asarray(self._p_coef, dtype=np.float64),
+            dilatation_energy=0.5 * self.bulk - self.alpha * self.dev_weighted_volume / (2 * d * d),
+        )
 
     def stiffness_bound(self):
         """Block-Gershgorin bound of the LPS stiffness (see ``Model.stiffness_bound``).

@@ -37,6 +37,8 @@ from peridyn.physics.materials.elastic import (
     plane_bulk_modulus,
     radial_moment,
 )
+from peridyn.physics.materials.linearisation import BondLinearisation
+from peridyn.physics.materials.registry import register_material
 
 SURFACE_CORRECTIONS = ("none", "energy")
 
@@ -62,6 +64,7 @@ def pmb_micromodulus(
     return 8.0 * kappa / (thickness * 2.0 * np.pi * radial_moment(influence, horizon, 2))
 
 
+@register_material("pmb")
 class PMBModel(Model):
     """PMB material bound to a body and its bonds.
 
@@ -76,8 +79,6 @@ class PMBModel(Model):
     dtype : float64 or float32
     """
 
-    name = "pmb"
-
     def __init__(
         self,
         body: Body,
@@ -88,7 +89,7 @@ class PMBModel(Model):
         surface_correction: str = "none",
         dtype=np.float64,
     ):
-        implied = pmb_poisson_ratio(body.dim, body.plane)
+        implied = self.implied_poisson_ratio(body.dim, body.plane)
         check_elastic(E, implied if nu is None else nu, density)
         if nu is not None and abs(nu - implied) > 1e-3:
             warnings.warn(
@@ -100,8 +101,7 @@ class PMBModel(Model):
             raise InputError(
                 f"PMB surface_correction must be one of {SURFACE_CORRECTIONS}, got {surface_correction!r}"
             )
-        super().__init__(body, bonds, density, dtype)
-        self.E = float(E)
+        super().__init__(body, bonds, E=E, density=density, dtype=dtype)
         self.c0 = pmb_micromodulus(
             E, body.dim, bonds.horizon, bonds.influence_name, body.plane, body.thickness
         )
@@ -113,6 +113,11 @@ class PMBModel(Model):
         if surface_correction == "energy":
             self.surface_factor = self._energy_surface_factor()
             self.bond_stiffness = (base * self.surface_factor).astype(self.dtype)
+
+    @classmethod
+    def implied_poisson_ratio(cls, dim, plane=None):
+        """1/3 in plane stress, else 1/4 (``pmb_poisson_ratio``)."""
+        return pmb_poisson_ratio(dim, plane)
 
     def force(self, u, out=None):
         """Internal force density (see ``Model.force``).
@@ -156,6 +161,11 @@ class PMBModel(Model):
         b = self.bonds
         per_bond = np.where(b.intact, self.bond_stiffness / b.length, 0.0)
         return 2.0 * b.family_sum(per_bond)
+
+    def _linearise(self):
+        """Bond-based: t = (k / |xi|) e, and point i's energy holds k e^2 / (4 |xi|) per bond."""
+        per_length = self.bond_stiffness.astype(np.float64) / self.bonds.length
+        return BondLinearisation(extension=per_length, pair=per_length)
 
     def critical_stretch(self, fracture_energy):
         """s_c from G_c by integrating the bond energies across a crack plane.

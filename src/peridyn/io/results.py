@@ -1,0 +1,137 @@
+"""The reader of results files (layout in ``peridyn.io.hdf5``, written by its ``HDF5Writer``).
+
+Every reader of a ``results.h5`` (figures, the command line, the jobs, the analyses) goes
+through :class:`Results`, so that each read checks the same things: the file exists and is
+HDF5, its schema is one this peridyn knows, and a series is read up to its last complete
+record (a crash may leave ``data`` or ``time`` one record longer than ``step``).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from collections.abc import Iterator
+from contextlib import contextmanager
+
+import h5py
+import numpy as np
+
+from peridyn.errors import InputError, did_you_mean
+from peridyn.io.hdf5 import SCHEMA_ATTR, SUMMARY, check_schema, decode_attrs, is_integer, n_records
+
+
+class Results:
+    """A results file, read on demand (each method opens and closes the file).
+
+    Parameters
+    ----------
+    path : str or path-like
+        A results file.
+
+    Attributes
+    ----------
+    path : str
+    schema_version : int
+        The file's schema (``peridyn.io.hdf5.SCHEMA_VERSION``; 1 for files written before
+        the version was recorded).
+
+    Raises
+    ------
+    InputError
+        The file is missing, not HDF5, or written with a newer schema than this peridyn reads.
+
+    Examples
+    --------
+    >>> results = Results("peridyn-out/bar_pulse/results.h5")  # doctest: +SKIP
+    >>> steps, times, u = results.series("sensor_u")  # doctest: +SKIP
+    >>> results.summary()["points"]  # doctest: +SKIP
+    """
+
+    def __init__(self, path: str | os.PathLike):
+        self.path = os.fspath(path)
+        with self._open() as f:
+            self.schema_version = check_schema(f.attrs, self.path)
+
+    def series(self, name: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """A whole series: steps (n_records,) int64, times (n_records,) float64 in s, and the
+        records (n_records, *record_shape) in their stored dtype."""
+        with self._series(name) as group:
+            n = n_records(group)
+            return group["step"][:n], group["time"][:n], group["data"][:n]
+
+    def iter_series(self, name: str, chunk_records: int) -> Iterator[tuple[np.ndarray, np.ndarray]]:
+        """A series a few records at a time, without loading it whole: yields times (k,) in s
+        and records (k, *record_shape), ``k <= chunk_records`` (the last chunk may be shorter)."""
+        if not is_integer(chunk_records) or chunk_records < 1:
+            raise InputError(f"chunk_records must be a positive integer, got {chunk_records!r}")
+        with self._series(name) as group:
+            times, data = group["time"], group["data"]
+            n = n_records(group)
+            for start in range(0, n, chunk_records):
+                stop = min(start + chunk_records, n)
+                yield times[start:stop], data[start:stop]
+
+    def n_records(self, name: str) -> int:
+        """Number of complete records of a series."""
+        with self._series(name) as group:
+            return n_records(group)
+
+    def series_names(self) -> list[str]:
+        """Names of the series in the file."""
+        with self._open() as f:
+            return list(f.get("series", {}))
+
+    def series_attrs(self, name: str) -> dict:
+        """Attributes of a series (e.g. ``names`` of sensors, ``points`` of a line probe),
+        JSON entries decoded."""
+        with self._series(name) as group:
+            return decode_attrs(group.attrs)
+
+    def array(self, name: str) -> np.ndarray:
+        """One dataset, e.g. ``"final/damage"`` or ``"geometry/points"``."""
+        with self._open() as f:
+            key = name.strip("/")
+            if not key or not isinstance(f.get(key), h5py.Dataset):
+                raise InputError(f"{self.path}: no dataset {name!r}")
+            return f[key][()]
+
+    def has(self, name: str) -> bool:
+        """Whether the file holds the dataset ``name``."""
+        with self._open() as f:
+            key = name.strip("/")
+            return bool(key) and isinstance(f.get(key), h5py.Dataset)
+
+    def provenance(self) -> dict:
+        """The root attributes as given to the writer (without ``schema_version``), JSON entries
+        decoded; numbers come back as Python scalars, tuples as lists."""
+        with self._open() as f:
+            attrs = decode_attrs(f.attrs)
+        attrs.pop(SCHEMA_ATTR, None)
+        return attrs
+
+    def summary(self) -> dict:
+        """The job's summary (docs/user-guide.md, "Summaries and results files")."""
+        if not self.has(SUMMARY):
+            raise InputError(f"{self.path}: no summary (the job did not finish)")
+        return json.loads(self.array(SUMMARY))
+
+    @contextmanager
+    def _open(self) -> Iterator[h5py.File]:
+        if not os.path.exists(self.path):
+            raise InputError(f"results file {self.path!r} does not exist")
+        try:
+            f = h5py.File(self.path, "r")
+        except OSError as exc:
+            raise InputError(f"{self.path}: not a readable HDF5 file ({exc})") from None
+        with f:
+            yield f
+
+    @contextmanager
+    def _series(self, name: str) -> Iterator[h5py.Group]:
+        with self._open() as f:
+            available = list(f.get("series", {}))
+            if name not in available:
+                raise InputError(
+                    f"{self.path}: no series {name!r}; it has {available}" + did_you_mean(name, available)
+                )
+            yield f["series"][name]

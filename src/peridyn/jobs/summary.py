@@ -1,0 +1,49 @@
+"""The keys every job summary shares (run, modal, fatigue and study).
+
+The schema of the summaries, these keys and each kind's own, is the table of docs/user-guide.md,
+"Summaries and results files"; ``peridyn.io.hdf5.SCHEMA_VERSION`` numbers it.
+"""
+
+from __future__ import annotations
+
+import resource
+import time
+from pathlib import Path
+
+from peridyn.io.hdf5 import SCHEMA_VERSION
+
+#: The job kinds: the ``kind`` of their summaries.
+KINDS = ("run", "modal", "fatigue", "study")
+
+
+def finish_summary(summary: dict, kind: str, out: Path, start: float, plots=()) -> dict:
+    """Add the common keys to a job's ``summary`` (in place) and return it.
+
+    Parameters
+    ----------
+    summary : dict
+        The job's own keys.
+    kind : one of :data:`KINDS`
+    out : Path
+        The job's output folder.
+    start : float
+        ``time.perf_counter()`` when the job started, s.
+    plots : sequence of path
+        The figures the job drew (none when ``output.plots`` is off).
+    """
+    if kind not in KINDS:
+        raise ValueError(f"summary kind must be one of {KINDS}, got {kind!r}")
+    summary.update(
+        schema_version=SCHEMA_VERSION,
+        kind=kind,
+        output_dir=str(out),
+        plots=[str(p) for p in plots],
+        seconds=time.perf_counter() - start,
+        peak_memory_bytes=peak_memory_bytes(),
+    )
+    return summary
+
+
+def peak_memory_bytes() -> int:
+    """Peak resident memory of this process so far, bytes (Linux reports KiB)."""
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
