@@ -73,11 +73,14 @@ def test_negative_spacing():
 
 
 def test_horizon_below_spacing_isolates_points():
-    case = validate_case(
-        _case(**{"discretization.horizon": "0.4", "discretization.partial_volumes": "false"})
-    )
-    with pytest.raises(InputError, match="horizon"):
-        build(case)
+    """Issue 17: a horizon below the spacing is refused when the case is read (in spacings
+    or in metres), not when the bonds are searched."""
+    with pytest.raises(CaseFileError, match=r"discretization.*horizon = 0.4 spacings: at least 1"):
+        validate_case(_case(**{"discretization.horizon": "0.4", "discretization.partial_volumes": "false"}))
+    raw = _case()
+    raw["discretization"] = {"spacing": 1e-3, "horizon_m": 0.9e-3}
+    with pytest.raises(CaseFileError, match=r"horizon_m = 0.0009 m is below the spacing 0.001 m"):
+        validate_case(raw)
 
 
 def test_nan_coordinates_in_mesh(tmp_path):
@@ -168,9 +171,18 @@ def test_nothing_moves():
         build(validate_case(raw))
 
 
-def test_pmb_warns_about_poisson_ratio():
-    with pytest.warns(UserWarning, match="Poisson ratio"):
-        build(validate_case(_case(**{"material.model": "pmb"})))
+def test_pmb_refuses_another_poisson_ratio():
+    """Issue 17: a bond-based PMB material has nu = 1/4 in 3D; another nu is an error, not a
+    warning; its own ratio (to 1e-3) or no nu at all is accepted."""
+    raw = _case(**{"material.model": "pmb", "material.nu": "0.29"})
+    with pytest.raises(InputError, match=r"nu = 0.29: .*Poisson ratio 0.25 .*omit nu or use lps"):
+        build(validate_case(raw))
+    assert (
+        build(validate_case(_case(**{"material.model": "pmb", "material.nu": "0.2501"}))).model.name == "pmb"
+    )
+    raw = _case(**{"material.model": "pmb"})
+    del raw["material"]["nu"]
+    assert build(validate_case(raw)).model.name == "pmb"
 
 
 def test_override_index_out_of_range():

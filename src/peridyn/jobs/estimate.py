@@ -266,7 +266,9 @@ def _suggestion(case: Case, est: Estimate, limit: float) -> str:
     """``"; a spacing of about X m fits"`` from the points' and bonds' scaling with spacing."""
     budget = limit - est.parts["base"]
     varying = est.peak_bytes - est.parts["base"]
-    if budget <= 0 or varying <= 0 or case.discretization.spacing is None:
+    if budget <= 0:
+        return f"; the interpreter and libraries alone take ~{est.parts['base'] / 1e9:.2g} GB"
+    if varying <= 0 or case.discretization.spacing is None:
         return ""
     power = 2 if case.geometry.type in ("plate", "rectangle") else 3
     if case.discretization.horizon_m is not None:

@@ -10,7 +10,7 @@ bulk (Silling and Askari 2005):
 
 A bond-based model has a fixed Poisson ratio: 1/4 in 3D and plane strain,
 1/3 in plane stress. K (kappa) is taken from E with that ratio, so that the
-Young's modulus is right; a different ``nu`` given by the user only draws a warning.
+Young's modulus is right; a different ``nu`` given by the user is refused (InputError).
 
 Surface correction ``"energy"`` (Madenci and Oterkus 2014, sec. 4.2): for each
 axis a, a uniform uniaxial strain along a gives each point a strain energy
@@ -20,8 +20,6 @@ G = (sum_a (n_a / g_a)^2)^(-1/2) of the two end points' averaged factors.
 """
 
 from __future__ import annotations
-
-import warnings
 
 import numpy as np
 
@@ -92,10 +90,9 @@ class PMBModel(Model):
         implied = self.implied_poisson_ratio(body.dim, body.plane)
         check_elastic(E, implied if nu is None else nu, density)
         if nu is not None and abs(nu - implied) > 1e-3:
-            warnings.warn(
-                f"a bond-based PMB material has Poisson ratio {implied:.4g} here; nu = {nu} "
-                "is ignored (use LPS for another ratio)",
-                stacklevel=2,
+            raise InputError(
+                f"nu = {nu}: a bond-based PMB material has Poisson ratio {implied:.4g} here "
+                "(1/4 in 3D and plane strain, 1/3 in plane stress): omit nu or use lps"
             )
         if surface_correction not in SURFACE_CORRECTIONS:
             raise InputError(

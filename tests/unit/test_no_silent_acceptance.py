@@ -1,0 +1,166 @@
+"""Issue 17, item 5: what used to be accepted silently is refused with the key and the numbers:
+probes and actuators outside the body, --checkpoint-every < 1, and (validate without --build)
+a dt above the stable step, an empty node set, a horizon below the spacing, too much memory."""
+
+import copy
+import re
+
+import pytest
+import yaml
+
+from peridyn.cli import main
+from peridyn.errors import CaseFileError
+from peridyn.io.case import apply_override, validate_case
+from peridyn.jobs.build import build, build_body, check_placements
+from peridyn.jobs.stable_step import STEP_MARGIN, estimated_stable_step
+
+BAR = {
+    "name": "bar",
+    "geometry": {"type": "box", "size": [0.06, 0.006, 0.006]},
+    "discretization": {"spacing": 1e-3, "horizon": 3.015},
+    "material": {"model": "lps", "E": 70e9, "nu": 0.3, "density": 2700},
+    "node_sets": {"left": {"type": "face", "face": "x-"}},
+    "boundary_conditions": [{"set": "left", "kind": "force", "components": "x", "value": 1.0}],
+    "solver": {"type": "explicit", "steps": 5},
+}
+
+
+def _raw(**changes):
+    raw = copy.deepcopy(BAR)
+    for key, value in changes.items():
+        apply_override(raw, f"{key}={value}")
+    return raw
+
+
+def _file(tmp_path, **changes):
+    path = tmp_path / "bar.yaml"
+    path.write_text(yaml.safe_dump(_raw(**changes)))
+    return str(path)
+
+
+@pytest.mark.parametrize(
+    "key, override",
+    [
+        ("output.sensors.tip", "output.sensors={tip: [3.06, 0.003, 0.003]}"),
+        (
+            "output.lines.axis.end",
+            "output.lines={axis: {start: [0, 0.003, 0.003], end: [0.2, 0.003, 0.003], points: 5}}",
+        ),
+        ("output.pzt_sensors.p.center", "output.pzt_sensors={p: {center: [0.03, 0.02], size: 0.002}}"),
+    ],
+)
+def test_probe_outside_the_body_is_refused(key, override):
+    """The issue's sensor 3 m outside a 60 mm bar (and a line end, a PZT sensor) name the key
+    and how far outside they lie (3 m from the x+ face: 3.0 m)."""
+    raw = _raw()
+    k, v = override.split("=", 1)
+    apply_override(raw, f"{k}={v}")
+    case = validate_case(raw)
+    with pytest.raises(CaseFileError, match=rf"{key} = .*it is [0-9.e+-]+ m outside") as err:
+        check_placements(case, build_body(case))
+    assert err.value.key == key
+    if key == "output.sensors.tip":
+        assert "3 m outside" in str(err.value)
+
+
+def test_actuator_outside_the_body_is_refused():
+    raw = _raw()
+    raw["geometry"] = {"type": "plate", "size": [0.06, 0.04, 0.002], "layers": 2}
+    raw["node_sets"] = {"left": {"type": "face", "face": "x-"}}
+    raw["actuators"] = {
+        "pzt": {
+            "type": "pzt_radial",
+            "center": [0.1, 0.02],
+            "size": 0.004,
+            "signal": {"type": "constant", "value": 1.0},
+        }
+    }
+    with pytest.raises(CaseFileError, match=r"actuators\.pzt\.center = .*0\.04 m outside"):
+        build(validate_case(raw))
+
+
+def test_probes_on_faces_and_corners_are_accepted():
+    """A position on the body's surface (half a cell from the outermost points' centres) is inside."""
+    sensors = "{corner: [0.0, 0.0, 0.0], far_corner: [0.06, 0.006, 0.006], mid: [0.03, 0.003, 0.0035]}"
+    case = validate_case(_raw(**{"output.sensors": sensors}))
+    check_placements(case, build_body(case))
+
+
+def test_checkpoint_every_below_one_is_refused_before_anything(tmp_path, capsys):
+    out = tmp_path / "out"
+    for value in ("0", "-5", "two"):
+        with pytest.raises(SystemExit) as exit_:
+            main(["run", _file(tmp_path), "--checkpoint-every", value, "-o", str(out), "--no-progress"])
+        assert exit_.value.code == 2
+        assert "--checkpoint-every: expected a whole number >= 1" in capsys.readouterr().err
+    assert not out.exists()
+
+
+def test_max_memory_refuses_with_the_numbers(tmp_path, capsys):
+    out = tmp_path / "out"
+    status = main(["run", _file(tmp_path), "--max-memory", "100MB", "-o", str(out), "--no-progress"])
+    assert status == 1
+    err = capsys.readouterr().err
+    assert "2.16e+03 points" in err and "more than the 0.1 GB available" in err
+    assert "libraries alone take" in err
+    assert not out.exists()
+    with pytest.raises(SystemExit):
+        main(["modal", _file(tmp_path), "--max-memory", "lots"])
+    assert "memory size 'lots'" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    "changes, message",
+    [
+        ({"solver.dt": "1e-6"}, r"solver.dt = 1e-06: at most the estimated stable step"),
+        (
+            {"node_sets.left": "{type: box, min: [1, 1, 1], max: [2, 2, 2]}"},
+            r"node_sets.left = .*at least one point",
+        ),
+        ({"discretization.horizon": "0.9"}, r"horizon = 0.9 spacings: at least 1"),
+        ({"geometry.size": "[3.0, 3.0, 3.0]", "discretization.spacing": "1e-4"}, r"points and .* GB"),
+        (
+            {"boundary_conditions.0.value": "{type: tone_burst, frequency: -1, cycles: 3}"},
+            r"tone burst frequency must be positive, got -1",
+        ),
+    ],
+)
+def test_validate_without_build_refuses(tmp_path, capsys, changes, message):
+    """Each of these used to pass ``peridyn validate`` without --build."""
+    assert main(["validate", _file(tmp_path)]) == 0
+    capsys.readouterr()
+    assert main(["validate", _file(tmp_path, **changes)]) == 1
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1  # one line
+    assert re.search(message, err)
+
+
+@pytest.mark.parametrize(
+    "changes",
+    [
+        {},
+        {"material.model": "pmb", "material.nu": "0.25"},
+        {"material.model": "pmb", "material.nu": "0.25", "discretization.partial_volumes": "false"},
+        {
+            "geometry": "{type: plate, size: [0.03, 0.02, 0.002], layers: 3, layer_placement: surface}",
+            "node_sets.left": "{type: face, face: x-}",
+        },
+        {
+            "geometry": "{type: rectangle, size: [0.03, 0.02], thickness: 0.001}",
+            "material.model": "pmb",
+            "material.nu": "0.3333333333",
+        },
+        {"material.surface_correction": "energy"},
+    ],
+)
+def test_stable_step_estimate_against_the_model(changes):
+    """The lattice estimate is the model's own Gershgorin bound for PMB without surface
+    correction (to round-off) and never more than STEP_MARGIN longer otherwise
+    (jobs/stable_step.py)."""
+    case = validate_case(_raw(**changes))
+    est = estimated_stable_step(case)
+    real = build(case).model.critical_time_step()
+    if case.material.model == "pmb" and case.material.surface_correction == "none":
+        assert est == pytest.approx(real, rel=1e-9)
+    else:
+        assert 0.85 * real <= est <= (1 + STEP_MARGIN) * real
