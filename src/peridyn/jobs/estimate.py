@@ -31,7 +31,7 @@ from peridyn.io.case import Case
 
 #: Resident bytes of the interpreter with numpy, scipy, numba (and its loaded kernels), h5py
 #: and peridyn imported, before the first array: measured with ``/usr/bin/time -v`` on a
-#: 1 000-point case (benchmarks/RESULTS.md).
+#: 2 500-point case (bar_pulse at 2 mm: 310 MB; benchmarks/RESULTS.md).
 BASE_BYTES = 300e6
 
 
@@ -50,8 +50,11 @@ class Costs:
 #: factor; LPS: length, weight, deviatoric coefficient, shear factor: 32 B) and the kernels'
 #: temporaries: about 100 B; per point the body (points, volumes, cells, sets: 64 B) and the
 #: state (x, u, v, a, f, forces, damping: 8 x 24 B).
-#: ``static`` / ``fatigue``: + a bond-stiffness assembly (9 entries of 8 B values + 2 x 4 B
+#: ``static``, ``newton``, ``newmark``: + a bond-stiffness assembly (9 entries of 8 B values + 2 x 4 B
 #: indices per bond, COO then CSR): about 400 B.
+#: ``fatigue``: statics by AMG-preconditioned CG (or a factor) and modal analyses before and after:
+#: 2 400 B per bond, fitted to the one measured run (dog-bone at 0.33 mm, 795 k directed bonds,
+#: 2.05 GiB peak; benchmarks/RESULTS.md) and not checked at other sizes.
 #: ``modal``: + the stiffness parts P and G (LPS) in COO and CSR and the augmented matrix:
 #: about 500 B; per point the mode shapes are small (n_modes x 24 B) next to the bonds.
 COSTS = {
@@ -59,7 +62,7 @@ COSTS = {
     "newmark": Costs(per_point=600.0, per_bond=400.0),
     "static": Costs(per_point=600.0, per_bond=400.0),
     "newton": Costs(per_point=600.0, per_bond=400.0),
-    "fatigue": Costs(per_point=600.0, per_bond=400.0),
+    "fatigue": Costs(per_point=600.0, per_bond=2400.0),
     "modal": Costs(per_point=600.0, per_bond=500.0),
 }
 
