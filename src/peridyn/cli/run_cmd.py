@@ -54,7 +54,7 @@ def run(args) -> dict:
     from peridyn.jobs.run import run_case
 
     case = load_case(args.case, args.overrides)
-    check_memory(case, args.max_memory, Path(args.case).parent)
+    check_memory(case, getattr(args, "max_memory", None), Path(args.case).parent)  # demo: no flag
     info = provenance()
     print(
         f"peridyn {info['peridyn_version']} (commit {info['git_commit'][:12]}): case "
