@@ -49,12 +49,26 @@ import numba
 FASTMATH = {"reassoc", "contract", "nsz", "arcp"}
 
 
-@numba.njit(cache=True)
+def exact_helper(signature: str):
+    """Compile a helper of the fast-math kernels now, without fast-math, for float64 and float32.
+
+    ``signature`` is a format string with ``{t}`` for the float type, e.g. ``"{t}({t}, {t})"``. A helper
+    compiled lazily takes the fast-math flags of the first kernel that calls it, and keeps
+    them for every later call and in numba's on-disk cache: its roundings would depend on
+    which function happened to be compiled first (observed: fused multiply-adds in
+    ``squared_length`` after a cold cache). Compiled eagerly for both float types, it has its
+    own flags whatever calls it.
+    """
+    types = [signature.format(t=t) for t in ("float64", "float32")]
+    return numba.njit(types, cache=True)
+
+
+@exact_helper("UniTuple({t}, 3)({t}, {t}, {t}, {t})")
 def bond_differences(xj, xi, uj, ui):
     """One component of a bond: ``(xi_a, du_a, Y_a)`` = ``(xj - xi, uj - ui, xi_a + du_a)``.
 
-    Compiled without fast-math: LLVM inlines it into the fast-math kernels but keeps
-    these three roundings as written, so swapping i and j negates all three exactly
+    Compiled without fast-math (``exact_helper``): LLVM inlines it into the fast-math kernels
+    but keeps these three roundings as written, so swapping i and j negates all three exactly
     (Newton's third law to the last bit) and ``du`` keeps its full precision next to
     the much larger coordinates.
 

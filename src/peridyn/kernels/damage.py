@@ -3,7 +3,7 @@
 import numba
 import numpy as np
 
-from peridyn.kernels import FASTMATH, bond_differences
+from peridyn.kernels import FASTMATH, bond_differences, exact_helper
 
 #: A bond's margin is taken as ``limit * MARGIN_SCALE - |Y|``: the 1e-9 relative slack covers
 #: the roundings of |Y|, of the squared-length test and of the displacement norms (a few
@@ -11,9 +11,9 @@ from peridyn.kernels import FASTMATH, bond_differences
 MARGIN_SCALE = 1.0 - 1e-9
 
 
-@numba.njit(cache=True)
+@exact_helper("{t}({t}, {t}, {t})")
 def squared_length(y0, y1, y2):
-    """``y0^2 + y1^2 + y2^2`` in this order, compiled without fast-math.
+    """``y0^2 + y1^2 + y2^2`` in this order, compiled without fast-math (``exact_helper``).
 
     Inlined into the fast-math kernels with its roundings kept as written (no fused
     multiply-add), so a bond's squared length is the same number in every kernel and in
