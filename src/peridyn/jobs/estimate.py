@@ -90,16 +90,6 @@ class Estimate:
     peak_bytes: float
     parts: dict = field(default_factory=dict)
 
-    def to_dict(self) -> dict:
-        """JSON-ready summary."""
-        return {
-            "job": self.job,
-            "points": self.points,
-            "bonds": self.bonds,
-            "peak_bytes": self.peak_bytes,
-            "parts": dict(self.parts),
-        }
-
 
 def parse_bytes(text) -> int:
     """Bytes from ``"4e9"``, ``"4GB"`` (10^9), ``"4GiB"`` (2^30), ``"512 MB"``, ``"2T"``.
@@ -158,7 +148,11 @@ def lattice_bonds(counts, cell, horizon: float, partial_volumes: bool, dim: int)
     cell = np.asarray(cell, dtype=float)
     reach = horizon + (0.5 * float(np.linalg.norm(cell[:dim])) if partial_volumes else 0.0)
     if math.prod(2 * min(math.floor(reach / cell[a]), counts[a] - 1) + 1 for a in range(3)) > MAX_OFFSETS:
-        ball = 4.0 / 3.0 * math.pi * horizon**3 if dim == 3 else math.pi * horizon**2 * cell[2]
+        # the ball of radius reach, thinned along each axis shorter than it (a thin plate's
+        # family is a disc: (4/3) pi r^3 x 0.75 L / r = pi r^2 L)
+        extent = counts * cell
+        ball = 4.0 / 3.0 * math.pi * reach**3 if dim == 3 else math.pi * reach**2 * cell[2]
+        ball *= math.prod(min(1.0, 0.75 * extent[a] / reach) for a in range(dim))
         return float(np.prod(counts)) * min(ball / float(np.prod(cell)), float(np.prod(counts)) - 1)
     offsets, _ = neighbour_offsets(counts, cell, horizon, partial_volumes, dim)
     return float(np.prod(counts - np.abs(offsets), axis=1).sum())
