@@ -132,6 +132,8 @@ def os_error_message(exc: OSError) -> str:
     """``PATH: reason`` of an I/O failure (``[Errno 28] No space left on device: 'x'`` ->
     ``x: No space left on device``, also from HDF5's long report), or the message as it is when
     it names no path."""
+    if isinstance(exc, BrokenPipeError) and exc.filename is None:  # the only pipe written: stdout
+        return f"<stdout>: {exc.strerror}"
     if exc.filename is None or not exc.strerror:
         if m := _HDF5_IO_FAILURE.search(str(exc)):
             return f"{m['path']}: {m['reason']} ({(exc.strerror or str(exc)).split(' (')[0]})"
