@@ -154,7 +154,7 @@ def test_runs_that_would_not_fit_in_memory_are_skipped_and_reported(tmp_path, mo
     import peridyn.jobs.modal
 
     monkeypatch.setattr(peridyn.jobs.modal, "MEMORY_SHARE", 1e-12)  # nothing fits
-    status = main(["study", CASE, "--spacing", "4e-3", "--horizon", "1.4143,2.001", "--output", str(tmp_path)])
+    status = main(["study", CASE, "--spacing", "4e-3", "--horizon", "1.4143,2.001", "-o", str(tmp_path)])
     captured = capsys.readouterr()
     assert status == 0
     assert "skipped spacing 4 mm, horizon 1.4143 h: the sparse factorisation" in captured.out
