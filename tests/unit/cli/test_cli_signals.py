@@ -19,10 +19,10 @@ LAMB = ["lamb", "--E", "2e11", "--nu", "0.3", "--rho", "7800", "--thickness", "0
 
 
 def _peridyn(args: list[str], **kwargs) -> subprocess.Popen:
-    """``python -m peridyn.cli ARGS`` from the repository root with this checkout's package."""
+    """``python -m peridyn ARGS`` from the repository root with this checkout's package."""
     env = {**os.environ, "PYTHONPATH": str(ROOT / "src")}
     return subprocess.Popen(
-        [sys.executable, "-m", "peridyn.cli", *args], cwd=ROOT, env=env, text=True, **kwargs
+        [sys.executable, "-m", "peridyn", *args], cwd=ROOT, env=env, text=True, **kwargs
     )
 
 
