@@ -36,6 +36,8 @@ class UsageError(InputError):
         The (sub)command, e.g. ``"peridyn run"``.
     message : str
         argparse's message, e.g. ``"argument --checkpoint-every: invalid int value: 'x'"``.
+    choices : sequence of str
+        The options and subcommands the parser knows: the nearest to the value is suggested.
     """
 
     exit_code = 2
@@ -96,14 +98,27 @@ def report(exc: BaseException, prog: str, as_json: bool, debug: bool) -> int:
     print(f"{prog}: {label}{line}", file=sys.stderr)
     if as_json:
         fields = {"error": line}
-        fields.update({k: getattr(exc, k) for k in JSON_FIELDS if getattr(exc, k, None) is not None})
+        fields.update(
+            {k: _jsonable(getattr(exc, k)) for k in JSON_FIELDS if getattr(exc, k, None) is not None}
+        )
         if isinstance(exc, OSError) and exc.filename is not None:
             fields["path"] = str(exc.filename)
         try:
-            print(json.dumps(fields, default=repr))
+            print(json.dumps(fields))
         except OSError:  # stdout itself failed (a full disk, a closed pipe): stderr has the line
             pass
     return status
+
+
+def _jsonable(value):
+    """``value`` where it is strict JSON (numpy values as numbers or lists), else its repr (NaN and
+    infinity too, which strict JSON has no numbers for)."""
+    value = value.tolist() if hasattr(value, "tolist") else value
+    try:
+        json.dumps(value, allow_nan=False)
+    except (TypeError, ValueError):
+        return repr(value)
+    return value
 
 
 def describe(exc: BaseException) -> tuple[str, int]:

@@ -228,3 +228,14 @@ def test_a_multi_line_message_is_joined_on_one_line(monkeypatch, capsys):
     _fail_in_build(monkeypatch, PeridynError("first line\n  second line\n"))
     status, _, err = _call(["run", BAR], capsys)
     assert status == 1 and err.splitlines()[-1] == "peridyn run: error: first line; second line"
+
+
+def test_the_json_error_object_is_strict_json_for_a_nan_value(capsys):
+    """NaN has no strict-JSON number (RFC 8259): the value is given as its repr."""
+
+    def refuse(name):
+        raise ValueError(f"{name} is not strict JSON")
+
+    status, out, _ = _call(["validate", BAR, "--set", "material.density=.nan", "--json"], capsys)
+    obj = json.loads(out, parse_constant=refuse)
+    assert status == 1 and obj["key"] == "material.density" and obj["value"] == "nan"

@@ -21,9 +21,7 @@ LAMB = ["lamb", "--E", "2e11", "--nu", "0.3", "--rho", "7800", "--thickness", "0
 def _peridyn(args: list[str], **kwargs) -> subprocess.Popen:
     """``python -m peridyn ARGS`` from the repository root with this checkout's package."""
     env = {**os.environ, "PYTHONPATH": str(ROOT / "src")}
-    return subprocess.Popen(
-        [sys.executable, "-m", "peridyn", *args], cwd=ROOT, env=env, text=True, **kwargs
-    )
+    return subprocess.Popen([sys.executable, "-m", "peridyn", *args], cwd=ROOT, env=env, text=True, **kwargs)
 
 
 def _no_traceback(err: str) -> None:
