@@ -54,7 +54,7 @@ def study(tmp_path_factory):
                 ",".join(map(repr, SPACINGS)),
                 "--horizon",
                 "1.4143",
-                "--out",
+                "--output",
                 str(out),
                 "--json",
             ]
@@ -154,7 +154,7 @@ def test_runs_that_would_not_fit_in_memory_are_skipped_and_reported(tmp_path, mo
     import peridyn.jobs.modal
 
     monkeypatch.setattr(peridyn.jobs.modal, "MEMORY_SHARE", 1e-12)  # nothing fits
-    status = main(["study", CASE, "--spacing", "4e-3", "--horizon", "1.4143,2.001", "--out", str(tmp_path)])
+    status = main(["study", CASE, "--spacing", "4e-3", "--horizon", "1.4143,2.001", "-o", str(tmp_path)])
     captured = capsys.readouterr()
     assert status == 0
     assert "skipped spacing 4 mm, horizon 1.4143 h: the sparse factorisation" in captured.out
@@ -166,7 +166,7 @@ def test_runs_that_would_not_fit_in_memory_are_skipped_and_reported(tmp_path, mo
 def test_a_spacing_that_does_not_divide_the_box_is_noted(tmp_path, capsys):
     # V4 plate at 3 mm: 33 x 17 x 3 cells span 99 x 51 x 9 mm, another body
     status = main(
-        ["study", CASE, "--spacing", "3e-3", "--horizon", "1.4143", "--modes", "7", "--out", str(tmp_path)]
+        ["study", CASE, "--spacing", "3e-3", "--horizon", "1.4143", "--modes", "7", "--output", str(tmp_path)]
     )
     assert status == 0
     assert "the grid spans 99 x 51 x 9 mm, not the case's 100 x 50 x 8 mm" in capsys.readouterr().err

@@ -5,16 +5,19 @@ Each subcommand lives in its own module in this package and exposes
 function ``func(args) -> dict``. The returned dict is the machine-readable
 summary: printed as one JSON object on stdout with ``--json``; otherwise the
 command prints its own human-readable report (to stdout) and logs go to stderr.
+A failure is one line on stderr (and one JSON object on stdout with ``--json``):
+see :mod:`peridyn.cli.errors`.
 """
 
 from __future__ import annotations
 
-import argparse
 import importlib
 import json
+import os
 import sys
 
-from peridyn.errors import PeridynError
+from peridyn.cli.errors import ArgumentParser, report, writing
+from peridyn.cli.logs import plain_warnings
 
 #: Subcommand modules, in the order ``peridyn --help`` lists them.
 COMMAND_MODULES = (
@@ -31,12 +34,13 @@ COMMAND_MODULES = (
 )
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser() -> ArgumentParser:
     """The top-level parser with every available subcommand registered."""
-    parser = argparse.ArgumentParser(
+    parser = ArgumentParser(
         prog="peridyn", description="Peridynamics for waves, vibration and damage in solids."
     )
     parser.add_argument("--version", action="store_true", help="print the version and exit")
+    parser.add_argument("--debug", action="store_true", help="on an error, also print the Python traceback")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     for name in COMMAND_MODULES:
         try:
@@ -49,50 +53,43 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def add_json_flag(parser: argparse.ArgumentParser) -> None:
-    """Give a subcommand the common ``--json`` flag."""
-    parser.add_argument(
-        "--json", action="store_true", help="print one machine-readable JSON object on stdout"
-    )
-
-
-def positive_int(text: str) -> int:
-    """argparse type: an integer >= 1 (a count of steps, modes...)."""
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a whole number >= 1, got {text!r}") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"expected a whole number >= 1, got {value}")
-    return value
-
-
-def memory_bytes(text: str) -> int:
-    """argparse type: a memory size in bytes, as a number ("4e9") or with a unit ("4GB", "512MiB")."""
-    from peridyn.errors import InputError
-    from peridyn.jobs.estimate import parse_bytes
-
-    try:
-        return parse_bytes(text)
-    except InputError as exc:
-        raise argparse.ArgumentTypeError(str(exc)) from None
-
-
-def add_max_memory(parser: argparse.ArgumentParser) -> None:
-    """Give a subcommand the common ``--max-memory BYTES`` option (default: the machine's memory)."""
-    parser.add_argument(
-        "--max-memory",
-        type=memory_bytes,
-        default=None,
-        metavar="BYTES",
-        help="refuse a job whose estimated peak memory exceeds BYTES (e.g. 4GB; default: physical memory)",
-    )
-
-
 def main(argv: list[str] | None = None) -> int:
-    """Entry point of the ``peridyn`` console script; returns the exit status."""
-    parser = build_parser()
-    args = parser.parse_args(argv)
+    """Entry point of the ``peridyn`` console script; returns the exit status.
+
+    Never raises (but ``--help``'s SystemExit): every failure is reported by
+    :func:`peridyn.cli.errors.report`.
+    """
+    argv = sys.argv[1:] if argv is None else list(argv)
+    args = None
+    with plain_warnings():
+        try:
+            parser = build_parser()
+            args = _parse(parser, argv)
+            status = _dispatch(parser, args)
+            with writing("<stdout>"):  # a full disk or a closed pipe on stdout is reported here
+                sys.stdout.flush()
+        except (Exception, KeyboardInterrupt) as exc:
+            prog = getattr(exc, "prog", None) or " ".join(
+                filter(None, ["peridyn", getattr(args, "command", None)])
+            )
+            as_json = getattr(args, "json", "--json" in argv)
+            status = report(exc, prog, as_json, getattr(args, "debug", "--debug" in argv))
+            _drop_unwritable_stdout()
+    return status
+
+
+def _parse(parser: ArgumentParser, argv: list[str]):
+    """``parser.parse_args(argv)``, but an unknown argument is refused by the subcommand's parser
+    (which names the subcommand and the nearest option)."""
+    args, extra = parser.parse_known_args(argv)
+    if extra:
+        command = parser.subcommand(args.command) if args.command else parser
+        command.error(f"unrecognized arguments: {' '.join(extra)}")
+    return args
+
+
+def _dispatch(parser: ArgumentParser, args) -> int:
+    """Run the parsed command; print its summary with ``--json``; the exit status."""
     if args.version:
         from peridyn import __version__
 
@@ -101,15 +98,24 @@ def main(argv: list[str] | None = None) -> int:
     if not getattr(args, "func", None):
         parser.print_help()
         return 2
-    try:
-        summary = args.func(args)
-    except PeridynError as exc:
-        print(f"peridyn {args.command}: error: {exc}", file=sys.stderr)
-        return 1
-    if getattr(args, "json", False):
-        json.dump(summary, sys.stdout, default=_to_builtin)
-        sys.stdout.write("\n")
+    summary = args.func(args)
+    if args.json:
+        with writing("<stdout>"):
+            json.dump(summary, sys.stdout, default=_to_builtin)
+            sys.stdout.write("\n")
     return 0
+
+
+def _drop_unwritable_stdout() -> None:
+    """Point stdout at /dev/null when what it holds cannot be written (a full disk, a closed pipe),
+    so that the interpreter's flush at exit prints no traceback."""
+    try:
+        sys.stdout.flush()
+    except OSError:
+        try:
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        except (OSError, ValueError):  # not a real file (captured by a test)
+            pass
 
 
 def _to_builtin(obj):

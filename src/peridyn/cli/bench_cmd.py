@@ -1,10 +1,10 @@
-"""``peridyn bench``: force-kernel throughput (directed bond updates per second).
+"""peridyn bench: force-kernel throughput (directed bond updates per second).
 
 Times one explicit-step force evaluation of the baseline PMB loop and of the PMB and
-LPS models (float64 and float32, through ``model.force``) on a cube of about 100k
+LPS models (float64 and float32, through model.force) on a cube of about 100k
 points (1 mm spacing, horizon 3.015 spacings, no partial volumes unless
-``--partial-volumes``), next to the machine's triad memory bandwidth. Best of
-``--repeat`` interleaved rounds after a warm-up. See ``peridyn.jobs.bench`` for what
+--partial-volumes), next to the machine's triad memory bandwidth. Best of
+--repeat interleaved rounds after a warm-up. See peridyn.jobs.bench for what
 is counted.
 """
 
@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import sys
 
-from peridyn.cli import add_json_flag
+from peridyn.cli.options import add_common_flags
 from peridyn.jobs.bench import DEFAULT_POINTS, format_table, run_benchmark
 
 
@@ -38,7 +38,7 @@ def register(sub) -> None:
         action="store_true",
         help="build the bonds with partial volumes (default: full-volume bonds)",
     )
-    add_json_flag(p)
+    add_common_flags(p)
     p.set_defaults(func=run)
 
 

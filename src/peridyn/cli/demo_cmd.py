@@ -1,10 +1,10 @@
-"""``peridyn demo``: run the small packaged demo case (a tone burst in a 3D plate) with plots."""
+"""peridyn demo: run the small packaged demo case (a tone burst in a 3D plate) with plots."""
 
 from __future__ import annotations
 
 from importlib.resources import as_file, files
 
-from peridyn.cli import add_json_flag
+from peridyn.cli.options import add_common_flags, add_output_flag, add_progress_flags
 
 DEMO_CASE = "demo_plate_burst.yaml"
 
@@ -12,11 +12,9 @@ DEMO_CASE = "demo_plate_burst.yaml"
 def register(sub) -> None:
     """Add the ``demo`` subcommand."""
     p = sub.add_parser("demo", help="run the demo case and write its plots", description=__doc__)
-    p.add_argument(
-        "--output", "-o", default="peridyn-out/demo", help="output folder (default: peridyn-out/demo)"
-    )
-    p.add_argument("--no-progress", action="store_true", help="no progress bar")
-    add_json_flag(p)
+    add_output_flag(p, "output folder (default: peridyn-out/demo)", default="peridyn-out/demo")
+    add_progress_flags(p)
+    add_common_flags(p)
     p.set_defaults(func=run)
 
 
@@ -33,7 +31,7 @@ def run(args) -> dict:
             output=args.output,
             checkpoint_every=None,
             restart=False,
-            no_progress=args.no_progress,
+            progress=args.progress,
             json=args.json,
         )
         return run_cmd.run(ns)

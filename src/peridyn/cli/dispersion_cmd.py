@@ -1,4 +1,4 @@
-"""``peridyn dispersion``: plane-wave dispersion of a peridynamic medium (PMB or LPS)."""
+"""peridyn dispersion: plane-wave dispersion of a peridynamic medium (PMB or LPS)."""
 
 from __future__ import annotations
 
@@ -9,7 +9,8 @@ import sys
 import numpy as np
 
 from peridyn.analysis.dispersion import MODELS, Medium, dispersion_relation, parse_direction
-from peridyn.cli import add_json_flag
+from peridyn.cli.errors import writing
+from peridyn.cli.options import add_common_flags
 from peridyn.discretization.bonds import INFLUENCE_FUNCTIONS
 from peridyn.errors import InputError
 
@@ -77,7 +78,7 @@ def register(subparsers) -> None:
     )
     parser.add_argument("--points", default="400", help="number of wavenumbers (default 400)")
     parser.add_argument("--plot", metavar="FILE", help="save omega(k), phase and group velocity as PNG")
-    add_json_flag(parser)
+    add_common_flags(parser)
     parser.set_defaults(func=run)
 
 
@@ -104,7 +105,8 @@ def run(args: argparse.Namespace) -> dict:
     if args.plot:
         from peridyn.plotting.dispersion import plot_dispersion  # matplotlib only when asked
 
-        plot_dispersion(relation, path=args.plot)
+        with writing(args.plot):
+            plot_dispersion(relation, path=args.plot)
         print(f"wrote {args.plot}", file=sys.stderr)
     if not args.json:
         print(format_report(summary))
@@ -139,7 +141,8 @@ def run_case_file(args: argparse.Namespace) -> dict:
     if args.plot:
         from peridyn.plotting.bloch import plot_bloch  # matplotlib only when asked
 
-        plot_bloch(disc, path=args.plot, frequencies=freqs)
+        with writing(args.plot):
+            plot_bloch(disc, path=args.plot, frequencies=freqs)
         print(f"wrote {args.plot}", file=sys.stderr)
     if not args.json:
         print(format_modes(summary))

@@ -1,5 +1,5 @@
-"""``peridyn fatigue CASE.yaml``: remaining-life fatigue run (crack length against cycles, optional
-modal analyses before and after); ``peridyn fatigue calibrate``: fit the parameters from data.
+"""peridyn fatigue CASE.yaml: remaining-life fatigue run (crack length against cycles, optional
+modal analyses before and after); peridyn fatigue calibrate: fit the parameters from data.
 
 Calibration inputs (CSV with a header row):
   --strain-life: cycles, strain (cyclic strain to failure)  -> A_I, m_I, eps_inf (eqs. 7.7-7.9)
@@ -10,13 +10,18 @@ Calibration inputs (CSV with a header row):
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 
 import numpy as np
 
-from peridyn.cli import add_json_flag, add_max_memory
-from peridyn.cli.run_cmd import add_case_arguments
+from peridyn.cli.logs import progress_bar
+from peridyn.cli.options import (
+    add_case_arguments,
+    add_common_flags,
+    add_max_memory,
+    add_output_flag,
+    add_progress_flags,
+)
 from peridyn.errors import InputError
 
 
@@ -29,13 +34,17 @@ def register(sub) -> None:
         formatter_class=_raw(),
     )
     add_case_arguments(p)
-    p.add_argument("--output", "-o", help="output folder")
+    add_output_flag(
+        p,
+        "output folder (default: the case's output.directory or peridyn-out/<case name>; "
+        "calibrate: peridyn-out/fatigue-calibration)",
+    )
     p.add_argument(
         "--modal",
         action="store_true",
         help="modal analyses before and after (default: when the case has fatigue.modal_after)",
     )
-    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    add_progress_flags(p)
     add_max_memory(p)
     g = p.add_argument_group("calibrate")
     g.add_argument("--strain-life", help="CSV: cycles, strain")
@@ -45,7 +54,7 @@ def register(sub) -> None:
     g.add_argument("--stress", type=float, help="maximum remote stress of the trial run, Pa")
     g.add_argument("--width", type=float, help="specimen width b of the trial run, m")
     g.add_argument("--load-ratio", type=float, default=0.0, help="load ratio R of the trial run")
-    add_json_flag(p)
+    add_common_flags(p)
     p.set_defaults(func=run)
 
 
@@ -59,25 +68,18 @@ def run(args) -> dict:
     """Run a fatigue case, or calibrate when the case argument is ``calibrate``."""
     if args.case == "calibrate":
         return calibrate(args)
-    from tqdm import tqdm
-
     from peridyn.io.case import load_case
     from peridyn.jobs.estimate import check_memory
     from peridyn.jobs.fatigue import run_fatigue_case
 
     case = load_case(args.case, args.overrides)
     check_memory(case, args.max_memory, Path(args.case).parent, job="fatigue")
-    progress = (
-        None
-        if args.no_progress or args.json
-        else (lambda total: tqdm(total=total, desc="fatigue steps", file=sys.stderr))
-    )
     summary = run_fatigue_case(
         case,
         args.output,
         base_dir=Path(args.case).parent,
         modal=True if args.modal else None,
-        progress=progress,
+        progress=progress_bar(args.progress, f"{case.name} fatigue steps"),
     )
     if not args.json:
         print(

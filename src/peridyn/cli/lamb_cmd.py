@@ -1,4 +1,4 @@
-"""``peridyn lamb``: Lamb wave modes of a free isotropic plate (Rayleigh-Lamb theory)."""
+"""peridyn lamb: Lamb wave modes of a free isotropic plate (Rayleigh-Lamb theory)."""
 
 from __future__ import annotations
 
@@ -6,7 +6,8 @@ import argparse
 import sys
 
 from peridyn.analysis.lamb import bulk_speeds, dispersion_curves, lamb_modes
-from peridyn.cli import add_json_flag
+from peridyn.cli.errors import writing
+from peridyn.cli.options import add_common_flags
 from peridyn.errors import InputError
 
 #: The ``--plot`` figure spans 0 to this multiple of the highest ``--freq``.
@@ -34,7 +35,7 @@ def register(subparsers) -> None:
         metavar="FILE",
         help=f"save dispersion curves up to {PLOT_SPAN} x the highest frequency as PNG",
     )
-    add_json_flag(parser)
+    add_common_flags(parser)
     parser.set_defaults(func=run)
 
 
@@ -52,7 +53,8 @@ def run(args: argparse.Namespace) -> dict:
         from peridyn.plotting.lamb import plot_lamb_dispersion  # matplotlib only when asked
 
         curves = dispersion_curves(*plate, PLOT_SPAN * max(freqs), max_order=args.max_order)
-        plot_lamb_dispersion(curves, path=args.plot)
+        with writing(args.plot):
+            plot_lamb_dispersion(curves, path=args.plot)
         print(f"wrote {args.plot}", file=sys.stderr)
     if not args.json:
         print(format_table(summary))

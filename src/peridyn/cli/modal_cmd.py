@@ -1,11 +1,10 @@
-"""``peridyn modal CASE.yaml``: free-vibration modes of a case, classified by type."""
+"""peridyn modal CASE.yaml: free-vibration modes of a case, classified by type."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
-from peridyn.cli import add_json_flag, add_max_memory
-from peridyn.cli.run_cmd import add_case_arguments
+from peridyn.cli.options import add_case_arguments, add_common_flags, add_max_memory, add_output_flag
 from peridyn.io.case import load_case
 
 
@@ -14,15 +13,15 @@ def register(sub) -> None:
     p = sub.add_parser("modal", help="modal analysis of a case", description=__doc__)
     add_case_arguments(p)
     p.add_argument("--modes", type=int, default=None, help="number of modes (rigid included)")
-    p.add_argument("--output", "-o", help="output folder")
+    add_output_flag(p, "output folder (default: the case's output.directory or peridyn-out/<case name>)")
     p.add_argument(
         "--compare",
         metavar="RUN_DIR",
         help="a modal run of the same grid (e.g. the healthy body): frequency-shift "
         "table of this run's modes against it, matched by MAC",
     )
+    add_common_flags(p)
     add_max_memory(p)
-    add_json_flag(p)
     p.set_defaults(func=run)
 
 
@@ -42,14 +41,19 @@ def run(args) -> dict:
 
         summary["comparison"] = compare_with_run(Path(summary["output_dir"]), Path(args.compare))
     if not args.json:
-        print(f"{summary['points']} points, {summary['rigid_modes']} rigid modes, {summary['seconds']:.1f} s")
-        for m in summary["modes"]:
-            print(f"  {m['index']:3d}  {m['frequency_hz']:12.2f} Hz  {m['label']}")
-        for row in summary.get("comparison", []):
-            print(
-                f"  {row['reference_label']:>28s} {row['reference_frequency_hz']:10.2f} Hz -> "
-                f"{row['frequency_hz']:10.2f} Hz ({100 * row['frequency_change']:+.2f} %, "
-                f"MAC {row['mac']:.2f}, now {row['label']})"
-            )
-        print(f"results written to {summary['output_dir']}")
+        print_modes(summary)
     return summary
+
+
+def print_modes(summary: dict) -> None:
+    """Readable report of a modal run: its frequency table (and the comparison, if any)."""
+    print(f"{summary['points']} points, {summary['rigid_modes']} rigid modes, {summary['seconds']:.1f} s")
+    for m in summary["modes"]:
+        print(f"  {m['index']:3d}  {m['frequency_hz']:12.2f} Hz  {m['label']}")
+    for row in summary.get("comparison", []):
+        print(
+            f"  {row['reference_label']:>28s} {row['reference_frequency_hz']:10.2f} Hz -> "
+            f"{row['frequency_hz']:10.2f} Hz ({100 * row['frequency_change']:+.2f} %, "
+            f"MAC {row['mac']:.2f}, now {row['label']})"
+        )
+    print(f"results written to {summary['output_dir']}")

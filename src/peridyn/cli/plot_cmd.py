@@ -1,4 +1,4 @@
-"""``peridyn plot RUN_DIR``: redraw the figures (and analyses) of a finished run from its HDF5,
+"""peridyn plot RUN_DIR: redraw the figures (and analyses) of a finished run from its HDF5,
 with the crack figures (damage map and crack paths, crack length against time) of a run with
 damage."""
 
@@ -7,7 +7,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from peridyn.cli import add_json_flag
+from peridyn.cli.options import add_common_flags
 from peridyn.errors import InputError
 
 
@@ -15,7 +15,7 @@ def register(sub) -> None:
     """Add the ``plot`` subcommand."""
     p = sub.add_parser("plot", help="redraw a run's figures from its results.h5", description=__doc__)
     p.add_argument("run_dir", help="output folder of a run (holds results.h5)")
-    add_json_flag(p)
+    add_common_flags(p)
     p.set_defaults(func=run)
 
 

@@ -1,39 +1,29 @@
-"""``peridyn run CASE.yaml``: run a case with a progress bar and print its summary."""
+"""peridyn run CASE.yaml: run a case (a progress bar on a terminal) and print its summary."""
 
 from __future__ import annotations
 
 import sys
 from pathlib import Path
 
-from tqdm import tqdm
-
-from peridyn.cli import add_json_flag, add_max_memory, positive_int
+from peridyn.cli.logs import progress_bar
+from peridyn.cli.modal_cmd import print_modes
+from peridyn.cli.options import (
+    add_case_arguments,
+    add_common_flags,
+    add_max_memory,
+    add_output_flag,
+    add_progress_flags,
+    positive_int,
+)
 from peridyn.io.case import load_case
 from peridyn.io.provenance import provenance
-
-
-def add_case_arguments(parser) -> None:
-    """The case path and the repeatable ``--set key.path=value`` override."""
-    parser.add_argument("case", help="YAML case file")
-    parser.add_argument(
-        "--set",
-        dest="overrides",
-        action="append",
-        default=[],
-        metavar="KEY=VALUE",
-        help="override a case entry, e.g. discretization.spacing=0.001 (repeatable)",
-    )
 
 
 def register(sub) -> None:
     """Add the ``run`` subcommand."""
     p = sub.add_parser("run", help="run a case file", description=__doc__)
     add_case_arguments(p)
-    p.add_argument(
-        "--output",
-        "-o",
-        help="output folder (default: the case's output.directory or peridyn-out/<case name>)",
-    )
+    add_output_flag(p, "output folder (default: the case's output.directory or peridyn-out/<case name>)")
     p.add_argument(
         "--checkpoint-every",
         type=positive_int,
@@ -42,9 +32,9 @@ def register(sub) -> None:
         help="write a checkpoint every N steps",
     )
     p.add_argument("--restart", action="store_true", help="continue from the output folder's checkpoint.h5")
-    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    add_progress_flags(p)
+    add_common_flags(p)
     add_max_memory(p)
-    add_json_flag(p)
     p.set_defaults(func=run)
 
 
@@ -61,19 +51,13 @@ def run(args) -> dict:
         f"{case.name!r} from {args.case}",
         file=sys.stderr,
     )
-    progress = None
-    if not args.no_progress:
-
-        def progress(total):
-            return tqdm(total=total, unit="step", file=sys.stderr, dynamic_ncols=True, desc=case.name)
-
     summary = run_case(
         case,
         args.output,
         case_path=args.case,
         checkpoint_every=args.checkpoint_every,
         restart=args.restart,
-        progress=progress,
+        progress=progress_bar(args.progress, case.name),
         base_dir=Path(args.case).parent,
     )
     if not args.json:
@@ -82,7 +66,10 @@ def run(args) -> dict:
 
 
 def print_summary(summary: dict) -> None:
-    """Readable end-of-run report."""
+    """Readable end-of-run report (a modal run's: its modes)."""
+    if summary["kind"] == "modal":
+        print_modes(summary)
+        return
     print(
         f"points {summary['points']}, bonds {summary['bonds']}, steps {summary['steps']}, "
         f"{summary['seconds']:.2f} s"

@@ -1,4 +1,4 @@
-"""``peridyn study CASE.yaml``: spacing x horizon convergence study of a modal case.
+"""peridyn study CASE.yaml: spacing x horizon convergence study of a modal case.
 
 Every (spacing, horizon) combination is solved as a modal run; modes are matched by type
 across runs and each series is extrapolated to zero spacing by Richardson extrapolation
@@ -12,8 +12,14 @@ import sys
 import time
 from pathlib import Path
 
-from peridyn.cli import add_json_flag, add_max_memory
-from peridyn.cli.run_cmd import add_case_arguments
+from peridyn.cli.errors import writing
+from peridyn.cli.options import (
+    DeprecatedAlias,
+    add_case_arguments,
+    add_common_flags,
+    add_max_memory,
+    add_output_flag,
+)
 from peridyn.errors import InputError
 
 
@@ -56,14 +62,15 @@ def register(sub) -> None:
         help="a reference frequency, e.g. '1st bending=1706.1' (repeatable): "
         "errors of the finest run and of the extrapolation against it",
     )
-    p.add_argument("--out", "-o", help="output folder (default: peridyn-out/<case name>-study)")
+    add_output_flag(p, "output folder (default: peridyn-out/<case name>-study)")
+    p.add_argument("--out", dest="output", action=DeprecatedAlias, new="--output")
     p.add_argument(
         "--plot",
         metavar="FILE",
         help="also save the figure to FILE (PNG); study.png is always written in the output folder",
     )
+    add_common_flags(p)
     add_max_memory(p)
-    add_json_flag(p)
     p.set_defaults(func=run)
 
 
@@ -88,7 +95,7 @@ def run(args) -> dict:
         raise InputError(f"--finest = {args.finest}: a Richardson fit needs at least three runs")
     case = load_case(args.case, args.overrides)  # fail early on a bad case or override
     check_memory(largest_study_run(case, spacings, factors), args.max_memory, Path(args.case).parent)
-    out = Path(args.out or Path("peridyn-out") / f"{case.name}-study")
+    out = Path(args.output or Path("peridyn-out") / f"{case.name}-study")
     runs = run_grid(
         args.case,
         spacings,
@@ -109,7 +116,8 @@ def run(args) -> dict:
     plots = [out / "study.png", *([Path(args.plot)] if args.plot else [])]
     figure = plot_convergence(runs, fits, title=f"{case.name}: delta-m convergence")
     for path in plots:
-        figure.savefig(path, dpi=110)
+        with writing(path):
+            figure.savefig(path, dpi=110)
     summary = write_study(out, runs, fits, meta, start, plots)
     if not args.json:
         print(format_table(summary))

@@ -1,11 +1,10 @@
-"""``peridyn validate CASE.yaml``: check a case file (and build its body) without running."""
+"""peridyn validate CASE.yaml: check a case file (and build its body) without running."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
-from peridyn.cli import add_json_flag
-from peridyn.cli.run_cmd import add_case_arguments
+from peridyn.cli.options import add_case_arguments, add_common_flags
 from peridyn.io.case import load_case
 
 
@@ -18,7 +17,7 @@ def register(sub) -> None:
         action="store_true",
         help="also build the body, bonds and model (finds isolated points, bad sets)",
     )
-    add_json_flag(p)
+    add_common_flags(p)
     p.set_defaults(func=run)
 
 

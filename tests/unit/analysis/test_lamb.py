@@ -300,9 +300,11 @@ def test_cli_prints_a_table_without_json(capsys):
     ],
 )
 def test_cli_bad_input_exits_1_naming_the_argument(option, shown, capsys):
+    """One error line on stderr; with --json stdout holds the error object (docs/user-guide.md)."""
     assert main([*_argv(**option), "--json"]) == 1
     captured = capsys.readouterr()
-    assert shown in captured.err and captured.out == ""
+    (line,) = captured.err.splitlines()
+    assert shown in line and json.loads(captured.out)["error"] in line
 
 
 def test_cli_plot_writes_png(tmp_path):

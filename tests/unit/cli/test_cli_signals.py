@@ -1,0 +1,100 @@
+"""The command line in a real process: a real SIGINT, a real full disk, a closed pipe; one line
+each and no Python traceback (issue 17, item 1)."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from peridyn.cli import main
+
+ROOT = Path(__file__).resolve().parents[3]
+LAMB = ["lamb", "--E", "2e11", "--nu", "0.3", "--rho", "7800", "--thickness", "0.002", "--freq", "1e5"]
+
+
+def _peridyn(args: list[str], **kwargs) -> subprocess.Popen:
+    """``python -m peridyn ARGS`` from the repository root with this checkout's package."""
+    env = {**os.environ, "PYTHONPATH": str(ROOT / "src")}
+    return subprocess.Popen([sys.executable, "-m", "peridyn", *args], cwd=ROOT, env=env, text=True, **kwargs)
+
+
+def _no_traceback(err: str) -> None:
+    assert "Traceback" not in err and "Exception ignored" not in err, err
+
+
+def test_sigint_while_the_bonds_are_searched_is_one_line_and_exit_130(tmp_path):
+    """SIGINT a second after the run's banner: the 160 000-point bar is still being built (its bond
+    search alone takes several seconds here), outside any step loop."""
+    proc = _peridyn(
+        ["run", "cases/bar_pulse.yaml", "-o", str(tmp_path), "--set", "discretization.spacing=5e-4"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+    )
+    banner = proc.stderr.readline()
+    assert "case 'bar_pulse'" in banner, banner
+    time.sleep(1.0)
+    proc.send_signal(signal.SIGINT)
+    out, err = proc.communicate(timeout=60)
+    _no_traceback(err)
+    assert proc.returncode == 130 and err.splitlines() == ["peridyn run: interrupted"]
+    assert out == ""
+
+
+def test_stdout_on_a_full_device_is_one_line(tmp_path):
+    """/dev/full as stdout: the JSON summary cannot be written (ENOSPC)."""
+    with open("/dev/full", "w") as full:
+        proc = _peridyn([*LAMB, "--json"], stdout=full, stderr=subprocess.PIPE)
+        _, err = proc.communicate(timeout=120)
+    _no_traceback(err)
+    assert proc.returncode == 1
+    assert err.splitlines() == [f"peridyn lamb: error: <stdout>: {os.strerror(28)}"]
+
+
+def test_a_closed_pipe_is_one_line():
+    """The reader of stdout went away before the table was written (EPIPE)."""
+    proc = _peridyn(LAMB, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    proc.stdout.close()
+    err = proc.stderr.read()
+    proc.wait(timeout=120)
+    _no_traceback(err)
+    assert proc.returncode == 1 and err.splitlines() == [f"peridyn lamb: error: <stdout>: {os.strerror(32)}"]
+
+
+@pytest.fixture
+def tiny_disk(tmp_path):
+    """A 64 KiB tmpfs (needs the right to mount: skipped elsewhere; the monkeypatched writer of
+    test_cli_errors.py covers the same path everywhere)."""
+    mount = tmp_path / "tiny"
+    mount.mkdir()
+    made = subprocess.run(
+        ["mount", "-t", "tmpfs", "-o", "size=64k", "tmpfs", str(mount)], capture_output=True, check=False
+    )
+    if made.returncode != 0:
+        pytest.skip(f"cannot mount a tmpfs here: {made.stderr.decode().strip()}")
+    try:
+        yield mount
+    finally:
+        subprocess.run(["umount", str(mount)], check=True)
+
+
+def test_a_full_disk_during_a_run_names_the_file(tiny_disk, capsys):
+    """The bar's results.h5 outgrows a 64 KiB disk: HDF5's long report becomes PATH: reason."""
+    out = tiny_disk / "out"
+    argv = ["run", "cases/bar_pulse.yaml", "-o", str(out), "--set", "solver.time=0.3e-6"]
+    cwd = os.getcwd()
+    os.chdir(ROOT)
+    try:
+        status = main([*argv, "--set", "output.plots=false"])
+    finally:
+        os.chdir(cwd)
+    err = capsys.readouterr().err
+    _no_traceback(err)
+    assert status == 1
+    line = err.splitlines()[-1]
+    assert line.startswith(f"peridyn run: error: {out / 'results.h5'}: {os.strerror(28)} (")
