@@ -72,7 +72,7 @@ def main(argv: list[str] | None = None) -> int:
         summary = args.func(args)
     except PeridynError as exc:
         print(f"peridyn {args.command}: error: {exc}", file=sys.stderr)
-        return 1
+        return getattr(exc, "exit_code", 1)
     if getattr(args, "json", False):
         json.dump(summary, sys.stdout, default=_to_builtin)
         sys.stdout.write("\n")

@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from peridyn.cli import add_json_flag
-from peridyn.cli.run_cmd import add_case_arguments
+from peridyn.cli.run_cmd import add_case_arguments, add_overwrite_flag
 from peridyn.errors import InputError
 
 
@@ -36,6 +36,7 @@ def register(sub) -> None:
         help="modal analyses before and after (default: when the case has fatigue.modal_after)",
     )
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    add_overwrite_flag(p)
     g = p.add_argument_group("calibrate")
     g.add_argument("--strain-life", help="CSV: cycles, strain")
     g.add_argument("--paris", help="CSV: delta_k_mpa_sqrt_m, da_dn_m_per_cycle")
@@ -75,6 +76,7 @@ def run(args) -> dict:
         base_dir=Path(args.case).parent,
         modal=True if args.modal else None,
         progress=progress,
+        overwrite=args.overwrite,
     )
     if not args.json:
         print(

@@ -5,7 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from peridyn.cli import add_json_flag
-from peridyn.cli.run_cmd import add_case_arguments
+from peridyn.cli.run_cmd import add_case_arguments, add_overwrite_flag
 from peridyn.io.case import load_case
 
 
@@ -15,6 +15,7 @@ def register(sub) -> None:
     add_case_arguments(p)
     p.add_argument("--modes", type=int, default=None, help="number of modes (rigid included)")
     p.add_argument("--output", "-o", help="output folder")
+    add_overwrite_flag(p)
     p.add_argument(
         "--compare",
         metavar="RUN_DIR",
@@ -33,7 +34,9 @@ def run(args) -> dict:
     if args.modes is not None:
         overrides.append(f"solver.modes={args.modes}")
     case = load_case(args.case, overrides)
-    summary = run_case(case, args.output, case_path=args.case, base_dir=Path(args.case).parent)
+    summary = run_case(
+        case, args.output, case_path=args.case, base_dir=Path(args.case).parent, overwrite=args.overwrite
+    )
     if args.compare:
         from peridyn.jobs.modal import compare_with_run
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import shlex
 import sys
 from pathlib import Path
 
@@ -38,9 +39,24 @@ def register(sub) -> None:
         "--checkpoint-every", type=int, default=None, metavar="N", help="write a checkpoint every N steps"
     )
     p.add_argument("--restart", action="store_true", help="continue from the output folder's checkpoint.h5")
+    add_overwrite_flag(p)
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     add_json_flag(p)
     p.set_defaults(func=run)
+
+
+def add_overwrite_flag(parser) -> None:
+    """The ``--overwrite`` flag: replace an earlier run's results in the output folder."""
+    parser.add_argument(
+        "--overwrite",
+        action="store_true",
+        help="replace the results of an earlier run in the output folder (refused without it)",
+    )
+
+
+def command_line() -> str:
+    """This process's ``peridyn ...`` command line (without --overwrite), for resume hints."""
+    return shlex.join(["peridyn", *(a for a in sys.argv[1:] if a != "--overwrite")])
 
 
 def run(args) -> dict:
@@ -68,6 +84,8 @@ def run(args) -> dict:
         restart=args.restart,
         progress=progress,
         base_dir=Path(args.case).parent,
+        overwrite=args.overwrite,
+        command=command_line(),
     )
     if not args.json:
         print_summary(summary)

@@ -13,7 +13,7 @@ import time
 from pathlib import Path
 
 from peridyn.cli import add_json_flag
-from peridyn.cli.run_cmd import add_case_arguments
+from peridyn.cli.run_cmd import add_case_arguments, add_overwrite_flag
 from peridyn.errors import InputError
 
 
@@ -57,6 +57,7 @@ def register(sub) -> None:
         "errors of the finest run and of the extrapolation against it",
     )
     p.add_argument("--out", "-o", help="output folder (default: peridyn-out/<case name>-study)")
+    add_overwrite_flag(p)
     p.add_argument(
         "--plot",
         metavar="FILE",
@@ -69,8 +70,8 @@ def register(sub) -> None:
 def run(args) -> dict:
     """Run the grid, fit, write the tables and the figure; print the table unless --json."""
     from peridyn.io.case import load_case
-    from peridyn.jobs.study import SERIES, fit_series, run_grid, write_study
-    from peridyn.plotting.convergence import plot_convergence
+    from peridyn.io.outdir import json_job_status, prepare_output
+    from peridyn.jobs.study import SERIES
 
     start = time.perf_counter()
     spacings = _positive_list("--spacing", args.spacing)
@@ -85,7 +86,16 @@ def run(args) -> dict:
     if args.finest is not None and args.finest < 3:
         raise InputError(f"--finest = {args.finest}: a Richardson fit needs at least three runs")
     case = load_case(args.case, args.overrides)  # fail early on a bad case or override
-    out = Path(args.out or Path("peridyn-out") / f"{case.name}-study")
+    out = prepare_output(args.out or Path("peridyn-out") / f"{case.name}-study", "study.json", args.overwrite)
+    with json_job_status(out):
+        return _study(args, case, out, spacings, factors, series, references, start)
+
+
+def _study(args, case, out, spacings, factors, series, references, start) -> dict:
+    """The grid, fits, tables and figure of ``run`` in its checked output folder."""
+    from peridyn.jobs.study import fit_series, run_grid, write_study
+    from peridyn.plotting.convergence import plot_convergence
+
     runs = run_grid(
         args.case,
         spacings,
