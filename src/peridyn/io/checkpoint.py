@@ -11,6 +11,7 @@ killed while writing leaves the previous checkpoint intact.
 
 from __future__ import annotations
 
+import json
 import os
 from pathlib import Path
 
@@ -20,12 +21,13 @@ import numpy as np
 from peridyn.discretization.state import State
 from peridyn.errors import InputError
 
-#: What ``meta`` holds, with its name in the refusal message.
+#: What ``meta`` holds, with its name in the refusal message (``case``, the case as JSON
+#: text, names the case entries that differ when ``case_hash`` does).
 META_KEYS = {"case_hash": "case", "dt": "time step (s)", "version": "peridyn version"}
 
 
 def save_checkpoint(path, state: State, intact: np.ndarray, meta: dict, parts: dict | None = None) -> None:
-    """Write ``state``, the bonds' ``intact`` mask, ``meta`` (``META_KEYS``) and the ``parts``
+    """Write ``state``, the bonds' ``intact`` mask, ``meta`` (``META_KEYS`` and ``case``) and the ``parts``
     (name -> object with ``checkpoint_state()``) to ``path`` atomically."""
     path = Path(path)
     tmp = path.with_suffix(path.suffix + ".tmp")
@@ -35,7 +37,7 @@ def save_checkpoint(path, state: State, intact: np.ndarray, meta: dict, parts: d
         f.create_dataset("intact", data=intact)
         f.attrs["time"] = state.time
         f.attrs["step"] = state.step
-        for key in META_KEYS:
+        for key in (*META_KEYS, "case"):
             f.attrs[key] = meta[key]
         for name, part in (parts or {}).items():
             group = f.create_group(f"parts/{name}")
@@ -61,7 +63,7 @@ def load_checkpoint(path, n_points: int, n_bonds: int, meta: dict) -> tuple[Stat
         with h5py.File(path, "r") as f:
             state = State(f["u"][...], f["v"][...], f["a"][...], float(f.attrs["time"]), int(f.attrs["step"]))
             intact = f["intact"][...]
-            saved = {key: f.attrs.get(key) for key in META_KEYS}
+            saved = {key: f.attrs.get(key) for key in (*META_KEYS, "case")}
             parts = {
                 name: {key: ds[()] for key, ds in group.items()} for name, group in f.get("parts", {}).items()
             }
@@ -75,7 +77,9 @@ def load_checkpoint(path, n_points: int, n_bonds: int, meta: dict) -> tuple[Stat
             f"bonds, but the case has {n_points} points and {n_bonds} bonds: a different case?"
         )
     differ = [
-        f"{label} {_text(saved[key])} -> {_text(meta[key])}"
+        _case_differences(saved["case"], meta["case"])
+        if key == "case_hash"
+        else f"{label} {_text(saved[key])} -> {_text(meta[key])}"
         for key, label in META_KEYS.items()
         if _text(saved[key]) != _text(meta[key])
     ]
@@ -85,6 +89,30 @@ def load_checkpoint(path, n_points: int, n_bonds: int, meta: dict) -> tuple[Stat
             "with the case and settings that made it, or start again with --overwrite"
         )
     return state, intact, parts
+
+
+def _case_differences(saved, current: str) -> str:
+    """``case: key old -> new, ...`` for the entries of two cases (JSON text) that differ."""
+    if saved is None:
+        return "case (not recorded in the checkpoint)"
+    old, new = _flatten(json.loads(_text(saved))), _flatten(json.loads(current))
+    keys = sorted(k for k in old.keys() | new.keys() if old.get(k) != new.get(k))
+    return "case: " + ", ".join(f"{k} {old.get(k)!r} -> {new.get(k)!r}" for k in keys)
+
+
+def _flatten(value, prefix: str = "") -> dict:
+    """Nested dicts and lists as {dotted key: leaf}."""
+    if isinstance(value, dict):
+        items = value.items()
+    elif isinstance(value, list):
+        items = ((f"[{i}]", v) for i, v in enumerate(value))
+    else:
+        return {prefix: value}
+    flat = {}
+    for key, v in items:
+        name = f"{prefix}{key}" if key.startswith("[") or not prefix else f"{prefix}.{key}"
+        flat.update(_flatten(v, name))
+    return flat
 
 
 def _text(value) -> str:
@@ -109,7 +137,7 @@ class Checkpointer:
     intact : (n_bonds,) bool
         The bonds' intact mask (read at every save).
     meta : dict
-        ``META_KEYS`` of the run.
+        ``META_KEYS`` and ``case`` of the run.
     parts : dict of name -> object with ``checkpoint_state()``
     """
 

@@ -117,15 +117,18 @@ def run_case(
     setup = build(case, base_dir)
     solver = _time_stepper(case, setup) if stepping else None
     out = prepare_output(output_directory(case, output_dir), RESULTS, overwrite, restart)
+    written = not restart  # a restart writes once its checkpoint is accepted (the recorder's part)
     try:
         summary, plots = _solve(
             case, setup, solver, out, case_path, checkpoint_every, restart, progress, start
         )
+        written = True
         _finish(case, setup, out, summary, plots, start)
     except Interrupted as exc:
         raise Interrupted(exc.signal_name, exc.step, _resume_hint(command) if exc.resume else "") from None
     except Exception as exc:
-        _set_status(out / RESULTS, setup.body, failure_status(exc))
+        if written:
+            _set_status(out / RESULTS, setup.body, failure_status(exc))
         raise
     return summary
 
@@ -168,14 +171,16 @@ def _finish(case, setup, out, summary, plots, start) -> None:
     store_summary(out / RESULTS, setup.body, summary, status="complete")
 
 
-def case_hash(case: Case) -> str:
-    """SHA-256 of the validated case (after ``--set``) without its run length
-    (``solver.steps``, ``solver.time``: a restart may extend a run) and output folder."""
+def case_identity(case: Case) -> tuple[str, str]:
+    """The validated case (after ``--set``) as JSON text without its run length
+    (``solver.steps``, ``solver.time``: a restart may extend a run) and output folder, and
+    the SHA-256 of that text."""
     data = case.model_dump(mode="json")
     for key in ("steps", "time"):
         data["solver"].pop(key, None)
     data["output"].pop("directory", None)
-    return hashlib.sha256(json.dumps(data, sort_keys=True).encode()).hexdigest()
+    text = json.dumps(data, sort_keys=True)
+    return text, hashlib.sha256(text.encode()).hexdigest()
 
 
 def _set_status(results: Path, body: Body, status: str) -> None:
@@ -228,7 +233,8 @@ def _run_explicit(case, setup, solver, out, case_path, checkpoint_every, restart
     s = case.solver
     n_steps = s.steps if s.steps is not None else int(np.ceil(s.time / solver.dt - 1e-9))
     ckpt_path = out / "checkpoint.h5"
-    meta = {"case_hash": case_hash(case), "dt": float(solver.dt), "version": package_version()}
+    case_json, digest = case_identity(case)
+    meta = {"case_hash": digest, "case": case_json, "dt": float(solver.dt), "version": package_version()}
     cracks = _crack_observer(case, setup, n_steps)
     parts = {
         name: part
@@ -269,8 +275,8 @@ def _run_explicit(case, setup, solver, out, case_path, checkpoint_every, restart
             checkpointer.save(state)
         recorder.close(f"interrupted at step {exc.step}")
         raise Interrupted(exc.signal_name, exc.step, "resume" if saved else "") from None
-    except BaseException:
-        recorder.close()
+    except BaseException as exc:
+        recorder.close(failure_status(exc))
         raise
     if state.step not in spec.snapshot_steps and not (
         spec.snapshot_every and state.step % spec.snapshot_every == 0
