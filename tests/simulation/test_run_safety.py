@@ -8,7 +8,9 @@ import signal
 
 import numpy as np
 import pytest
+import yaml
 
+from peridyn.cli import main
 from peridyn.discretization.state import State, check_state
 from peridyn.errors import InputError, InstabilityError, Interrupted
 from peridyn.io.case import validate_case
@@ -171,3 +173,18 @@ def test_the_step_loop_defers_a_signal_and_restores_the_handlers():
     assert (info.value.signal_name, info.value.step, info.value.exit_code) == ("SIGTERM", 3, 143)
     assert state.step == 3
     assert signal.getsignal(signal.SIGTERM) is before
+
+
+def test_the_command_line_refuses_an_earlier_runs_folder(finished, capsys):
+    """``peridyn run`` (and modal, fatigue, study, demo: the same check) into a finished run's
+    folder: one line naming the folder and both flags, exit status 1, no byte changed."""
+    before = _digests(finished)
+    case = finished / "case.yaml"
+    case.write_text(yaml.safe_dump(BAR))
+    before[case] = hashlib.sha256(case.read_bytes()).hexdigest()
+    assert main(["run", str(case), "-o", str(finished), "--no-progress"]) == 1
+    err = capsys.readouterr().err
+    line = err.strip().splitlines()[-1]  # after the run's banner line
+    assert "Traceback" not in err and line.startswith("peridyn run: error: output folder")
+    assert str(finished) in line and "--overwrite" in line and "--restart" in line
+    assert _digests(finished) == before

@@ -5,6 +5,7 @@ from __future__ import annotations
 from importlib.resources import as_file, files
 
 from peridyn.cli import add_json_flag
+from peridyn.cli.run_cmd import add_overwrite_flag
 
 DEMO_CASE = "demo_plate_burst.yaml"
 
@@ -16,6 +17,7 @@ def register(sub) -> None:
         "--output", "-o", default="peridyn-out/demo", help="output folder (default: peridyn-out/demo)"
     )
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    add_overwrite_flag(p)
     add_json_flag(p)
     p.set_defaults(func=run)
 
@@ -33,6 +35,7 @@ def run(args) -> dict:
             output=args.output,
             checkpoint_every=None,
             restart=False,
+            overwrite=args.overwrite,
             no_progress=args.no_progress,
             json=args.json,
         )
