@@ -5,6 +5,7 @@ from __future__ import annotations
 from importlib.resources import as_file, files
 
 from peridyn.cli.options import add_common_flags, add_output_flag, add_progress_flags
+from peridyn.cli.run_cmd import add_overwrite_flag
 
 DEMO_CASE = "demo_plate_burst.yaml"
 
@@ -15,6 +16,7 @@ def register(sub) -> None:
     add_output_flag(p, "output folder (default: peridyn-out/demo)", default="peridyn-out/demo")
     add_progress_flags(p)
     add_common_flags(p)
+    add_overwrite_flag(p)
     p.set_defaults(func=run)
 
 
@@ -32,6 +34,7 @@ def run(args) -> dict:
             checkpoint_every=None,
             restart=False,
             progress=args.progress,
+            overwrite=args.overwrite,
             json=args.json,
         )
         return run_cmd.run(ns)

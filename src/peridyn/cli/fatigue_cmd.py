@@ -22,6 +22,7 @@ from peridyn.cli.options import (
     add_output_flag,
     add_progress_flags,
 )
+from peridyn.cli.run_cmd import add_overwrite_flag
 from peridyn.errors import InputError
 
 
@@ -46,6 +47,7 @@ def register(sub) -> None:
     )
     add_progress_flags(p)
     add_max_memory(p)
+    add_overwrite_flag(p)
     g = p.add_argument_group("calibrate")
     g.add_argument("--strain-life", help="CSV: cycles, strain")
     g.add_argument("--paris", help="CSV: delta_k_mpa_sqrt_m, da_dn_m_per_cycle")
@@ -80,6 +82,7 @@ def run(args) -> dict:
         base_dir=Path(args.case).parent,
         modal=True if args.modal else None,
         progress=progress_bar(args.progress, f"{case.name} fatigue steps"),
+        overwrite=args.overwrite,
     )
     if not args.json:
         print(

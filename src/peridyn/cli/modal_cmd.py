@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from peridyn.cli.options import add_case_arguments, add_common_flags, add_max_memory, add_output_flag
+from peridyn.cli.run_cmd import add_overwrite_flag
 from peridyn.io.case import load_case
 
 
@@ -14,6 +15,7 @@ def register(sub) -> None:
     add_case_arguments(p)
     p.add_argument("--modes", type=int, default=None, help="number of modes (rigid included)")
     add_output_flag(p, "output folder (default: the case's output.directory or peridyn-out/<case name>)")
+    add_overwrite_flag(p)
     p.add_argument(
         "--compare",
         metavar="RUN_DIR",
@@ -35,7 +37,9 @@ def run(args) -> dict:
         overrides.append(f"solver.modes={args.modes}")
     case = load_case(args.case, overrides)
     check_memory(case, args.max_memory, Path(args.case).parent)
-    summary = run_case(case, args.output, case_path=args.case, base_dir=Path(args.case).parent)
+    summary = run_case(
+        case, args.output, case_path=args.case, base_dir=Path(args.case).parent, overwrite=args.overwrite
+    )
     if args.compare:
         from peridyn.jobs.modal import compare_with_run
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import shlex
 import sys
 from pathlib import Path
 
@@ -35,7 +36,22 @@ def register(sub) -> None:
     add_progress_flags(p)
     add_common_flags(p)
     add_max_memory(p)
+    add_overwrite_flag(p)
     p.set_defaults(func=run)
+
+
+def add_overwrite_flag(parser) -> None:
+    """The ``--overwrite`` flag: replace an earlier run's results in the output folder."""
+    parser.add_argument(
+        "--overwrite",
+        action="store_true",
+        help="replace the results of an earlier run in the output folder (refused without it)",
+    )
+
+
+def command_line() -> str:
+    """This process's ``peridyn ...`` command line (without --overwrite), for resume hints."""
+    return shlex.join(["peridyn", *(a for a in sys.argv[1:] if a != "--overwrite")])
 
 
 def run(args) -> dict:
@@ -59,6 +75,8 @@ def run(args) -> dict:
         restart=args.restart,
         progress=progress_bar(args.progress, case.name),
         base_dir=Path(args.case).parent,
+        overwrite=args.overwrite,
+        command=command_line(),
     )
     if not args.json:
         print_summary(summary)

@@ -20,6 +20,7 @@ from peridyn.cli.options import (
     add_max_memory,
     add_output_flag,
 )
+from peridyn.cli.run_cmd import add_overwrite_flag
 from peridyn.errors import InputError
 
 
@@ -64,6 +65,7 @@ def register(sub) -> None:
     )
     add_output_flag(p, "output folder (default: peridyn-out/<case name>-study)")
     p.add_argument("--out", dest="output", action=DeprecatedAlias, new="--output")
+    add_overwrite_flag(p)
     p.add_argument(
         "--plot",
         metavar="FILE",
@@ -77,9 +79,9 @@ def register(sub) -> None:
 def run(args) -> dict:
     """Run the grid, fit, write the tables and the figure; print the table unless --json."""
     from peridyn.io.case import load_case
+    from peridyn.io.outdir import json_job_status, prepare_output
     from peridyn.jobs.estimate import check_memory, largest_study_run
-    from peridyn.jobs.study import SERIES, fit_series, run_grid, write_study
-    from peridyn.plotting.convergence import plot_convergence
+    from peridyn.jobs.study import SERIES
 
     start = time.perf_counter()
     spacings = _positive_list("--spacing", args.spacing)
@@ -95,7 +97,18 @@ def run(args) -> dict:
         raise InputError(f"--finest = {args.finest}: a Richardson fit needs at least three runs")
     case = load_case(args.case, args.overrides)  # fail early on a bad case or override
     check_memory(largest_study_run(case, spacings, factors), args.max_memory, Path(args.case).parent)
-    out = Path(args.output or Path("peridyn-out") / f"{case.name}-study")
+    out = prepare_output(
+        args.output or Path("peridyn-out") / f"{case.name}-study", "study.json", args.overwrite
+    )
+    with json_job_status(out):
+        return _study(args, case, out, spacings, factors, series, references, start)
+
+
+def _study(args, case, out, spacings, factors, series, references, start) -> dict:
+    """The grid, fits, tables and figure of ``run`` in its checked output folder."""
+    from peridyn.jobs.study import fit_series, run_grid, write_study
+    from peridyn.plotting.convergence import plot_convergence
+
     runs = run_grid(
         args.case,
         spacings,

@@ -6,6 +6,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from peridyn.errors import InstabilityError
+
+#: A displacement larger than this many times the body's size is a runaway solution.
+RUNAWAY_FACTOR = 100.0
+
 
 @dataclass
 class State:
@@ -28,3 +33,31 @@ class State:
     def zeros(cls, n_points: int) -> State:
         """A body at rest in its reference configuration."""
         return cls(np.zeros((n_points, 3)), np.zeros((n_points, 3)), np.zeros((n_points, 3)))
+
+
+def runaway_limit(points: np.ndarray) -> float:
+    """Largest believable displacement component, m: ``RUNAWAY_FACTOR`` times the largest
+    extent of the body's reference points (n_points, dim)."""
+    return RUNAWAY_FACTOR * float(np.max(np.ptp(points, axis=0)))
+
+
+def check_state(state: State, max_displacement: float = np.inf) -> None:
+    """Raise InstabilityError naming the step, time, first bad point and field when u or v is
+    not finite, or when a displacement component exceeds ``max_displacement`` (m).
+
+    One reduction per field when all is well (``max |u| <= limit`` is false for NaN)."""
+    u_ok = np.max(np.abs(state.u), initial=0.0) <= max_displacement
+    if u_ok and np.isfinite(state.v).all():
+        return
+    fields = (("displacement u", state.u, max_displacement), ("velocity v", state.v, np.inf))
+    for name, values, limit in fields:
+        bad = ~(np.abs(values) <= limit).all(axis=1)
+        if bad.any():
+            point = int(np.flatnonzero(bad)[0])
+            what = "not finite" if not np.isfinite(values[point]).all() else f"above {limit:.3g} m (runaway)"
+            raise InstabilityError(
+                state.step,
+                state.time,
+                point,
+                f"{name} {what} (time step too large, or a load too violent for the discretisation?)",
+            )

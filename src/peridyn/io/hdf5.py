@@ -47,6 +47,8 @@ every bond count directed."""
 SCHEMA_ATTR = "schema_version"
 """Root attribute holding :data:`SCHEMA_VERSION`."""
 
+#: Root attribute holding the job's status (``HDF5Writer.set_status``).
+STATUS_ATTR = "status"
 SUMMARY = "summary/json"
 """Dataset holding the job's summary as JSON text."""
 
@@ -246,6 +248,12 @@ class HDF5Writer:
             A value JSON cannot hold (numpy scalars and arrays are stored as numbers and lists).
         """
         self.write_array(SUMMARY, np.bytes_(_to_json(summary, f"{self.path}: summary")))
+
+    def set_status(self, status: str) -> None:
+        """Set the job's status (root attribute ``status``: ``running``, ``complete``,
+        ``failed: <reason>`` or ``interrupted at step N``) and flush it to disk."""
+        self._file.attrs[STATUS_ATTR] = str(status)
+        self.flush()
 
     def truncate(self, step: int) -> None:
         """Drop the records with a step greater than ``step`` in every series.

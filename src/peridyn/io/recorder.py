@@ -20,7 +20,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from peridyn.discretization.body import Body
-from peridyn.discretization.state import State
+from peridyn.discretization.state import State, check_state, runaway_limit
 from peridyn.errors import InputError
 from peridyn.io.hdf5 import HDF5Writer
 from peridyn.io.vtk import PVDCollection, write_vtu
@@ -125,7 +125,9 @@ class Recorder:
             mode=mode,
             flush_every=1,
         )
+        self.h5.set_status("running")
         self._create_series()
+        self.max_displacement = runaway_limit(body.points)
         self.pvd = None
         if spec.vtu:
             (self.directory / "snapshots").mkdir(exist_ok=True)
@@ -162,7 +164,14 @@ class Recorder:
             self.snapshot(state)
 
     def record_series(self, state: State) -> None:
-        """Append one record to every probe series."""
+        """Append one record to every probe series.
+
+        Raises
+        ------
+        InstabilityError
+            The state is not finite or runs away (``check_state``): nothing is written.
+        """
+        check_state(state, self.max_displacement)
         h5, step, t = self.h5, state.step, state.time
         if self.sensor_names:
             h5.append("sensor_u", step, t, state.u[self.sensor_index])
@@ -176,7 +185,9 @@ class Recorder:
             h5.append("pzt_signal", step, t, np.array(signals))
 
     def snapshot(self, state: State) -> None:
-        """Write the whole displacement field (HDF5, and VTU when enabled)."""
+        """Write the whole displacement field (HDF5, and VTU when enabled); raises
+        InstabilityError, writing nothing, for a non-finite or runaway state."""
+        check_state(state, self.max_displacement)
         self.h5.append("field_u", state.step, state.time, state.u)
         if self.pvd is None:
             return
@@ -193,4 +204,10 @@ class Recorder:
         self.h5.write_array("final/v", state.v)
         if self.model is not None:
             self.h5.write_array("final/damage", damage_field(self.model))
+        self.h5.close()
+
+    def close(self, status: str | None = None) -> None:
+        """Close the file early (failure, interruption), setting its ``status`` when given."""
+        if status is not None:
+            self.h5.set_status(status)
         self.h5.close()

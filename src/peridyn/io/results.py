@@ -17,7 +17,15 @@ import h5py
 import numpy as np
 
 from peridyn.errors import InputError, did_you_mean
-from peridyn.io.hdf5 import SCHEMA_ATTR, SUMMARY, check_schema, decode_attrs, is_integer, n_records
+from peridyn.io.hdf5 import (
+    SCHEMA_ATTR,
+    STATUS_ATTR,
+    SUMMARY,
+    check_schema,
+    decode_attrs,
+    is_integer,
+    n_records,
+)
 
 
 class Results:
@@ -102,12 +110,20 @@ class Results:
             return bool(key) and isinstance(f.get(key), h5py.Dataset)
 
     def provenance(self) -> dict:
-        """The root attributes as given to the writer (without ``schema_version``), JSON entries
-        decoded; numbers come back as Python scalars, tuples as lists."""
+        """The root attributes as given to the writer (without ``schema_version`` and
+        ``status``), JSON entries decoded; numbers come back as Python scalars, tuples as lists."""
         with self._open() as f:
             attrs = decode_attrs(f.attrs)
         attrs.pop(SCHEMA_ATTR, None)
+        attrs.pop(STATUS_ATTR, None)
         return attrs
+
+    def status(self) -> str:
+        """The job's status: ``running``, ``complete``, ``failed: <reason>`` or
+        ``interrupted at step N`` ("unknown" for files written before it was recorded)."""
+        with self._open() as f:
+            status = f.attrs.get(STATUS_ATTR, "unknown")
+        return status.decode() if isinstance(status, bytes) else str(status)
 
     def summary(self) -> dict:
         """The job's summary (docs/user-guide.md, "Summaries and results files")."""

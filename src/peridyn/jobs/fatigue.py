@@ -24,6 +24,7 @@ from peridyn.fatigue.run import FatigueResult, run_fatigue
 from peridyn.fatigue.specimen import compliance_energy, compliance_stress_intensity, straight_crack_cut
 from peridyn.fatigue.tip import AXES
 from peridyn.io.case import Case
+from peridyn.io.outdir import json_job_status, prepare_output
 from peridyn.io.vtk import write_vtu
 from peridyn.jobs.build import build
 from peridyn.jobs.modal import match_modes, modal_table
@@ -120,16 +121,28 @@ def _stop_length(f) -> float:
 
 
 def run_fatigue_case(
-    case: Case, output_dir=None, base_dir=".", modal: bool | None = None, progress=None
+    case: Case,
+    output_dir=None,
+    base_dir=".",
+    modal: bool | None = None,
+    progress=None,
+    overwrite: bool = False,
 ) -> dict:
     """Run a fatigue case; returns the summary (JSON keys of ``peridyn fatigue --json``, also in
-    ``fatigue.json``; docs/user-guide.md, "Summaries and results files")."""
+    ``fatigue.json``; docs/user-guide.md, "Summaries and results files"). A folder holding an
+    earlier ``fatigue.json`` is refused unless ``overwrite``; the job's status goes to
+    ``status.json`` (``peridyn.io.outdir``)."""
     start = time.perf_counter()
     check_fatigue_case(case)
-    f = case.fatigue
     setup = build(case, base_dir)
-    out = output_directory(case, output_dir)
-    out.mkdir(parents=True, exist_ok=True)
+    out = prepare_output(output_directory(case, output_dir), "fatigue.json", overwrite)
+    with json_job_status(out):
+        return _run_fatigue(case, setup, out, modal, progress, start)
+
+
+def _run_fatigue(case, setup, out, modal, progress, start) -> dict:
+    """The fatigue run of ``run_fatigue_case`` in its checked output folder."""
+    f = case.fatigue
     n_modes = f.modal_after.modes if f.modal_after is not None else 12
     do_modal = f.modal_after is not None if modal is None else modal
     before = setup_rows = None

@@ -40,6 +40,7 @@ def run_modal(case, setup, out: Path, case_path=None) -> tuple[dict, list[Path]]
     with HDF5Writer(
         out / "results.h5", body.points[:, : body.dim], body.volumes, provenance(case_path, case=case)
     ) as h5:
+        h5.set_status("running")
         h5.write_array("modes/frequencies", result.frequencies)
         h5.write_array("modes/shapes", result.shapes)
         h5.write_array("modes/rigid", result.rigid)

@@ -3,6 +3,8 @@ called after every step."""
 
 from __future__ import annotations
 
+import numpy as np
+
 from peridyn.analysis.crack import DEFAULT_THRESHOLD, total_crack_length
 from peridyn.errors import InputError
 from peridyn.physics.damage import damage_field
@@ -37,6 +39,15 @@ class CrackLengthObserver:
         self.lengths.append(
             total_crack_length(body.points, damage_field(self.model), body.spacing, self.threshold)
         )
+
+    def checkpoint_state(self) -> dict:
+        """The samples so far, for a checkpoint: times (k,) s and lengths (k,) m."""
+        return {"times": np.array(self.times, dtype=float), "lengths": np.array(self.lengths, dtype=float)}
+
+    def restore_state(self, saved: dict) -> None:
+        """Take back the samples of ``checkpoint_state``."""
+        self.times = [float(t) for t in saved["times"]]
+        self.lengths = [float(x) for x in saved["lengths"]]
 
     def history(self) -> dict:
         """``{"time_s": [...], "length_m": [...]}``."""

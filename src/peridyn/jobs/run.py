@@ -4,6 +4,9 @@ runs are ``jobs.modal``), recording, checkpoints, crack history and the stored s
 
 from __future__ import annotations
 
+import hashlib
+import json
+import sys
 import time
 from pathlib import Path
 
@@ -12,11 +15,12 @@ import numpy as np
 from peridyn.discretization import geometry
 from peridyn.discretization.body import Body
 from peridyn.discretization.state import State
-from peridyn.errors import CaseFileError, InputError
+from peridyn.errors import CaseFileError, InputError, Interrupted
 from peridyn.io.case import Case
 from peridyn.io.checkpoint import Checkpointer, load_checkpoint
 from peridyn.io.hdf5 import HDF5Writer
-from peridyn.io.provenance import provenance
+from peridyn.io.outdir import failure_status, prepare_output
+from peridyn.io.provenance import package_version, provenance
 from peridyn.io.recorder import LineProbe, Recorder, RecorderSpec
 from peridyn.jobs.build import Setup, build, pad3
 from peridyn.jobs.figures import draw_crack_figures, draw_run_figures, final_crack_paths
@@ -26,6 +30,9 @@ from peridyn.physics.absorbing import layer_damping
 from peridyn.physics.damage import damage_field
 from peridyn.physics.transducers import pzt_sensor_weights
 from peridyn.solvers import ExplicitSolver, relax
+
+#: The results file in a run's output folder.
+RESULTS = "results.h5"
 
 
 def recorder_spec(case: Case, body: Body, dt: float) -> RecorderSpec:
@@ -68,44 +75,87 @@ def run_case(
     restart: bool = False,
     progress=None,
     base_dir=".",
+    overwrite: bool = False,
+    command: str | None = None,
 ) -> dict:
     """Run a case and write its results; returns the summary (also stored in results.h5; keys
     in docs/user-guide.md, "Summaries and results files").
 
+    The case is built and every argument checked before the output folder is touched; a
+    folder holding an earlier run's results.h5 is refused unless ``overwrite`` or ``restart``.
+    results.h5 carries the run's status (``peridyn.io.outdir``).
+
     Parameters
     ----------
     checkpoint_every : int or None
-        Steps between checkpoints (``<output>/checkpoint.h5``).
+        Steps between checkpoints (``<output>/checkpoint.h5``), >= 1.
     restart : bool
-        Continue from ``<output>/checkpoint.h5`` (results after it are dropped and rewritten).
+        Continue from ``<output>/checkpoint.h5`` (results after it are dropped and rewritten);
+        the checkpoint must have been made by this case (``case_hash``), dt and peridyn version.
     progress : callable(total) -> bar with update(n) and close(), or None
+    overwrite : bool
+        Replace an earlier run's results in the output folder.
+    command : str or None
+        The command line that started the run, for the resume hint of ``Interrupted``.
+
+    Raises
+    ------
+    Interrupted
+        SIGINT or SIGTERM during the time stepping: the run stops after the current step,
+        writes a checkpoint (when checkpointing, or after a minute of running) and closes
+        its files with the status ``interrupted at step N``.
     """
     start = time.perf_counter()
-    setup = build(case, base_dir)
-    out = output_directory(case, output_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    plots = []
-    if case.solver.type == "static":
-        summary = _run_static(case, setup, out, case_path)
-    elif case.solver.type == "newton":
-        summary = _run_newton(case, setup, out, case_path)
-    elif case.solver.type == "newmark":
-        summary = _run_explicit(
-            case,
-            setup,
-            out,
-            case_path,
-            checkpoint_every,
-            restart,
-            progress,
-            solver=_newmark_solver(case, setup),
+    stepping = case.solver.type in ("explicit", "newmark")
+    if checkpoint_every is not None and (not stepping or checkpoint_every < 1):
+        raise InputError(
+            f"--checkpoint-every must be a whole number of steps >= 1 for an explicit or newmark "
+            f"run, got {checkpoint_every} for a {case.solver.type} run"
         )
-    elif case.solver.type == "modal":
+    if restart and not stepping:
+        raise InputError(f"--restart continues an explicit or newmark run, not a {case.solver.type} run")
+    setup = build(case, base_dir)
+    solver = _time_stepper(case, setup) if stepping else None
+    out = prepare_output(output_directory(case, output_dir), RESULTS, overwrite, restart)
+    written = not restart  # a restart writes once its checkpoint is accepted (the recorder's part)
+    try:
+        summary, plots = _solve(
+            case, setup, solver, out, case_path, checkpoint_every, restart, progress, start
+        )
+        written = True
+        _finish(case, setup, out, summary, plots, start)
+    except Interrupted as exc:
+        raise Interrupted(exc.signal_name, exc.step, _resume_hint(command) if exc.resume else "") from None
+    except Exception as exc:
+        if written:
+            _set_status(out / RESULTS, setup.body, failure_status(exc))
+        raise
+    return summary
+
+
+def _resume_hint(command: str | None) -> str:
+    """How to continue an interrupted run."""
+    if command is None:
+        return "run_case(..., restart=True) with the same case and output folder"
+    return command if "--restart" in command.split() else f"{command} --restart"
+
+
+def _solve(case, setup, solver, out, case_path, checkpoint_every, restart, progress, start):
+    """The solver's part of ``run_case``: its summary and the figures it drew."""
+    if case.solver.type == "static":
+        return _run_static(case, setup, out, case_path), []
+    if case.solver.type == "newton":
+        return _run_newton(case, setup, out, case_path), []
+    if case.solver.type == "modal":
         from peridyn.jobs.modal import run_modal
 
-        summary, plots = run_modal(case, setup, out, case_path)
-    else:
-        summary = _run_explicit(case, setup, out, case_path, checkpoint_every, restart, progress)
+        return run_modal(case, setup, out, case_path)
+    summary = _run_explicit(case, setup, solver, out, case_path, checkpoint_every, restart, progress, start)
+    return summary, []
+
+
+def _finish(case, setup, out, summary, plots, start) -> None:
+    """Analyses, figures and the stored summary after the solve; the status becomes complete."""
     analysis, figures = analyse(case, setup.body, out, plots=case.output.plots)
     summary.update(analysis)
     paths = (
@@ -118,14 +168,34 @@ def run_case(
         if paths is not None:
             plots += draw_crack_figures(setup.body, out, paths, summary)
     finish_summary(summary, "modal" if case.solver.type == "modal" else "run", out, start, plots)
-    store_summary(out / "results.h5", setup.body, summary)
-    return summary
+    store_summary(out / RESULTS, setup.body, summary, status="complete")
 
 
-def store_summary(results, body: Body, summary: dict) -> None:
-    """(Re)write the run summary in ``/summary/json`` of a results file."""
+def case_identity(case: Case) -> tuple[str, str]:
+    """The validated case (after ``--set``) as JSON text without its run length
+    (``solver.steps``, ``solver.time``: a restart may extend a run) and output folder, and
+    the SHA-256 of that text."""
+    data = case.model_dump(mode="json")
+    for key in ("steps", "time"):
+        data["solver"].pop(key, None)
+    data["output"].pop("directory", None)
+    text = json.dumps(data, sort_keys=True)
+    return text, hashlib.sha256(text.encode()).hexdigest()
+
+
+def _set_status(results: Path, body: Body, status: str) -> None:
+    """Set the status of a results file (created if the job failed before writing one)."""
+    with HDF5Writer(results, body.points[:, : body.dim], body.volumes, {}, mode="a") as h5:
+        h5.set_status(status)
+
+
+def store_summary(results, body: Body, summary: dict, status: str | None = None) -> None:
+    """(Re)write the run summary in ``/summary/json`` of a results file, and its status when
+    given."""
     with HDF5Writer(results, body.points[:, : body.dim], body.volumes, {}, mode="a") as h5:
         h5.write_summary(summary)
+        if status is not None:
+            h5.set_status(status)
 
 
 def _base_summary(setup: Setup) -> dict:
@@ -138,45 +208,76 @@ def _base_summary(setup: Setup) -> dict:
     }
 
 
-def _run_explicit(case, setup, out, case_path, checkpoint_every, restart, progress, solver=None) -> dict:
-    """Time integration by ``solver`` (default: velocity Verlet from the case) with recording."""
+def _time_stepper(case, setup):
+    """The solver of an explicit or newmark case (velocity Verlet or implicit Newmark)."""
+    if case.solver.type == "newmark":
+        return _newmark_solver(case, setup)
     s = case.solver
-    if solver is None:
-        solver = ExplicitSolver(
-            setup.model,
-            setup.loading,
-            dt=s.dt,
-            safety=s.safety,
-            damping=explicit_damping(case, setup.body),
-            damage=setup.damage,
-            contact=setup.contact,
-        )
+    return ExplicitSolver(
+        setup.model,
+        setup.loading,
+        dt=s.dt,
+        safety=s.safety,
+        damping=explicit_damping(case, setup.body),
+        damage=setup.damage,
+        contact=setup.contact,
+    )
+
+
+#: Seconds of running after which an interrupted run writes a checkpoint even unasked.
+CHECKPOINT_AFTER_S = 60.0
+
+
+def _run_explicit(case, setup, solver, out, case_path, checkpoint_every, restart, progress, start) -> dict:
+    """Time integration by ``solver`` with recording, checkpoints and the status."""
+    s = case.solver
     n_steps = s.steps if s.steps is not None else int(np.ceil(s.time / solver.dt - 1e-9))
     ckpt_path = out / "checkpoint.h5"
+    case_json, digest = case_identity(case)
+    meta = {"case_hash": digest, "case": case_json, "dt": float(solver.dt), "version": package_version()}
+    cracks = _crack_observer(case, setup, n_steps)
+    parts = {
+        name: part
+        for name, part in (("damage", setup.damage), ("contact", setup.contact), ("cracks", cracks))
+        if part is not None
+    }
     if restart:
-        state, intact = load_checkpoint(ckpt_path, setup.body.n_points, setup.bonds.n_bonds)
+        state, intact, saved = load_checkpoint(ckpt_path, setup.body.n_points, setup.bonds.n_bonds, meta)
         setup.bonds.intact[:] = intact
+        for name, part in parts.items():
+            part.restore_state(saved.get(name, {}))
         resume = (state.step, state.time)
+        print(
+            f"restarting from the checkpoint at step {state.step} (t = {state.time:.6g} s)", file=sys.stderr
+        )
     else:
         state, resume = solver.initial_state(), None
     spec = recorder_spec(case, setup.body, solver.dt)
     recorder = Recorder(setup.body, out, spec, provenance(case_path, case=case), setup.model, resume)
-    if resume is None:
-        recorder.record_series(state)
-        recorder.snapshot(state)
-    observers = [recorder]
-    cracks = _crack_observer(case, setup, n_steps)
-    if cracks is not None:
-        observers.append(cracks)
-    if checkpoint_every:
-        observers.append(Checkpointer(ckpt_path, checkpoint_every, setup.bonds.intact))
-    remaining = n_steps - state.step
-    bar = progress(remaining) if progress is not None else None
+    checkpointer = Checkpointer(ckpt_path, checkpoint_every or n_steps + 1, setup.bonds.intact, meta, parts)
     try:
-        solver.run(state, remaining, observers, bar)
-    finally:
-        if bar is not None:
-            bar.close()
+        if resume is None:
+            recorder.record_series(state)
+            recorder.snapshot(state)
+        observers = [recorder, *([cracks] if cracks is not None else [])]
+        if checkpoint_every:
+            observers.append(checkpointer)
+        remaining = n_steps - state.step
+        bar = progress(remaining) if progress is not None else None
+        try:
+            solver.run(state, remaining, observers, bar)
+        finally:
+            if bar is not None:
+                bar.close()
+    except Interrupted as exc:
+        saved = bool(checkpoint_every) or time.perf_counter() - start > CHECKPOINT_AFTER_S
+        if saved:
+            checkpointer.save(state)
+        recorder.close(f"interrupted at step {exc.step}")
+        raise Interrupted(exc.signal_name, exc.step, "resume" if saved else "") from None
+    except BaseException as exc:
+        recorder.close(failure_status(exc))
+        raise
     if state.step not in spec.snapshot_steps and not (
         spec.snapshot_every and state.step % spec.snapshot_every == 0
     ):

@@ -118,6 +118,20 @@ class Contact:
         self._u_built = np.array(u, dtype=np.float64)
         self.rebuilds += 1
 
+    def checkpoint_state(self) -> dict:
+        """The neighbour list's build displacement (n_points, 3) m and the rebuild count, for a
+        checkpoint (empty before the first build)."""
+        if self._u_built is None:
+            return {}
+        return {"u_built": self._u_built, "rebuilds": self.rebuilds}
+
+    def restore_state(self, saved: dict) -> None:
+        """Rebuild the neighbour list where ``checkpoint_state`` saw it built, and take back
+        the rebuild count."""
+        if saved:
+            self.rebuild(saved["u_built"])
+            self.rebuilds = int(saved["rebuilds"])
+
     def add_force(self, u: np.ndarray, out: np.ndarray) -> np.ndarray:
         """Add the contact force density (N/m^3) at displacement ``u`` (m) to ``out`` in place.
 

@@ -165,14 +165,43 @@ class BondDamage:
         self.critical_stretch.flags.writeable = True
         self.breakable.flags.writeable = True
 
+    def checkpoint_state(self) -> dict:
+        """The stretch-test skin, for a checkpoint: u_ref (n, 3) m, margins (n,) m and the test
+        counters (empty before the first ``update``)."""
+        if self._u_ref is None:
+            return {}
+        return {
+            "u_ref": self._u_ref,
+            "margin": self._margin,
+            "full_tests": self.full_tests,
+            "partial_tests": self.partial_tests,
+        }
+
+    def restore_state(self, saved: dict) -> None:
+        """Take back the skin of ``checkpoint_state`` (the intact mask is restored apart)."""
+        self.reset()
+        if not saved:
+            return
+        self._freeze_limit()
+        self._u_ref = np.array(saved["u_ref"], dtype=np.float64)
+        self._margin[:] = saved["margin"]
+        self.full_tests = int(saved["full_tests"])
+        self.partial_tests = int(saved["partial_tests"])
+
+    def _freeze_limit(self) -> None:
+        """Compute the critical lengths and make their inputs read-only."""
+        self._limit = np.where(
+            self.breakable, self.model.bonds.length * (1.0 + self.critical_stretch), np.inf
+        )
+        self.critical_stretch.flags.writeable = False
+        self.breakable.flags.writeable = False
+
     def _full_test(self, u: np.ndarray) -> int:
         """Test every bond at ``u``; margins and u_ref taken there."""
         m = self.model
         b = m.bonds
         if self._limit is None:
-            self._limit = np.where(self.breakable, b.length * (1.0 + self.critical_stretch), np.inf)
-            self.critical_stretch.flags.writeable = False
-            self.breakable.flags.writeable = False
+            self._freeze_limit()
         broken = stretch_test_families(
             m.body.points,
             u,

@@ -18,8 +18,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from peridyn.discretization.state import State
-from peridyn.errors import InputError, InstabilityError
+from peridyn.discretization.state import State, check_state, runaway_limit
+from peridyn.errors import InputError
 from peridyn.physics.contact import Contact
 from peridyn.physics.damage import BondDamage
 from peridyn.physics.loads import Loading
@@ -43,7 +43,8 @@ class ExplicitSolver:
         absorbing layers, ``peridyn.physics.absorbing``); 0: undamped. It lowers the stable step.
     damage : BondDamage or None
     check_every : int
-        Steps between checks for non-finite values.
+        Steps between checks for a non-finite or runaway state (``check_state``; the
+        recorder also checks before every record).
     contact : Contact or None
         Short-range forces added to the model's force; their stiffness lowers the stable step.
     """
@@ -56,7 +57,7 @@ class ExplicitSolver:
         safety: float = 0.8,
         damping: float = 0.0,
         damage: BondDamage | None = None,
-        check_every: int = 50,
+        check_every: int = 10,
         contact: Contact | None = None,
     ):
         if not 0 < safety <= 1:
@@ -80,6 +81,8 @@ class ExplicitSolver:
         self._damping = (damping if damping.size == 1 else damping[:, None]) if damping.any() else None
         self.damage = damage
         self.check_every = int(check_every)
+        #: largest believable displacement, m (``runaway_limit``)
+        self.max_displacement = runaway_limit(model.body.points)
         n = model.body.n_points
         self._force = np.zeros((n, 3), dtype=model.dtype)
         self._body_force = np.zeros((n, 3))
@@ -121,7 +124,7 @@ class ExplicitSolver:
         state.v += 0.5 * dt * state.a
         self.loading.apply_velocities(state.time, state.v)
         if state.step % self.check_every == 0:
-            check_finite(state)
+            check_state(state, self.max_displacement)
         return broken
 
     def run(self, state: State, n_steps: int, observers: Sequence = (), progress=None) -> State:
@@ -135,7 +138,7 @@ class ExplicitSolver:
             E.g. a tqdm bar.
         """
         advance(self, state, n_steps, observers, progress)
-        check_finite(state)
+        check_state(state, self.max_displacement)
         return state
 
     def kinetic_energy(self, state: State) -> float:
@@ -175,17 +178,3 @@ def _damping_coefficients(damping, n_points: int) -> np.ndarray:
             "damping must be non-negative and finite (1/s)" + (f", got {damping!r}" if c.size == 1 else "")
         )
     return c
-
-
-def check_finite(state: State) -> None:
-    """Raise InstabilityError naming the first point whose u or v is not finite."""
-    bad = ~np.isfinite(state.u).all(axis=1) | ~np.isfinite(state.v).all(axis=1)
-    if bad.any():
-        point = int(np.flatnonzero(bad)[0])
-        raise InstabilityError(
-            state.step,
-            state.time,
-            point,
-            "non-finite displacement or velocity (time step too large, or a "
-            "load too violent for the discretisation?)",
-        )

@@ -24,7 +24,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from peridyn.discretization.state import State
+from peridyn.discretization.state import State, check_state
 from peridyn.errors import InputError
 from peridyn.linalg.dofs import free_dofs
 from peridyn.linalg.stiffness import mass_matrix
@@ -32,7 +32,6 @@ from peridyn.linalg.tangent import tangent_stiffness
 from peridyn.physics.damage import BondDamage
 from peridyn.physics.loads import Loading
 from peridyn.physics.materials.base import Model
-from peridyn.solvers.explicit import check_finite
 from peridyn.solvers.newton import check_linear_solver, solve_held
 from peridyn.solvers.stepping import advance
 
@@ -156,7 +155,7 @@ class NewmarkSolver:
         # bonds broken here act from the next step on: the stored acceleration is the
         # converged one of this step (a lag of one step; the explicit solver breaks first)
         broken = self.damage.update(state.u) if self.damage is not None else 0
-        check_finite(state)
+        check_state(state)
         return broken
 
     def run(self, state: State, n_steps: int, observers: Sequence = (), progress=None) -> State:

@@ -1,0 +1,104 @@
+"""A job's output folder: checked before anything is written to it, and the job's status.
+
+An earlier job's results are never replaced unless asked: ``prepare_output`` refuses a folder
+that holds one (its ``results.h5``, or the JSON summary of a fatigue or study job) unless the
+caller passes ``overwrite`` (start again) or ``restart`` (continue from its checkpoint).
+
+A job's status is one of ``running``, ``complete``, ``failed: <reason>`` and
+``interrupted at step N``. A run and a modal job keep it in the ``status`` root attribute
+of ``results.h5`` (``HDF5Writer.set_status``, read with ``Results.status``); a fatigue or
+study job, which writes JSON, keeps it in ``status.json`` (``{"status": ...}``), written and
+read here.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+
+from peridyn.errors import InputError, InstabilityError, PeridynError
+
+#: Name of the status file of the jobs that write JSON rather than results.h5.
+STATUS_FILE = "status.json"
+
+
+def prepare_output(out, marker: str, overwrite: bool = False, restart: bool = False) -> Path:
+    """Check the output folder ``out`` and create it; returns it as a Path.
+
+    Parameters
+    ----------
+    out : path
+    marker : str
+        The file whose presence means an earlier job's results (e.g. ``"results.h5"``).
+    overwrite, restart : bool
+        Replace the earlier results, or continue them (mutually exclusive).
+
+    Raises
+    ------
+    InputError
+        ``out`` is not a folder or cannot be created, or it holds earlier results and
+        neither ``overwrite`` nor ``restart`` is given.
+    """
+    out = Path(out)
+    if overwrite and restart:
+        raise InputError("--overwrite and --restart exclude each other: restart continues the results")
+    if out.exists() and not out.is_dir():
+        raise InputError(f"output folder {str(out)!r} is a file, not a folder: choose another --output")
+    if (out / marker).exists() and not (overwrite or restart):
+        raise InputError(
+            f"output folder {str(out)!r} holds an earlier run's {marker}: pass --overwrite to replace "
+            "it, --restart to continue it, or choose another --output"
+        )
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise InputError(f"cannot create output folder {str(out)!r}: {exc.strerror or exc}") from None
+    return out
+
+
+def write_status(out, status: str) -> None:
+    """Write ``status`` to ``<out>/status.json`` (replacing it atomically)."""
+    path = Path(out) / STATUS_FILE
+    tmp = path.with_suffix(".json.tmp")
+    tmp.write_text(json.dumps({"status": status}) + "\n")
+    tmp.replace(path)
+
+
+def read_status(out) -> str:
+    """The status in ``<out>/status.json``.
+
+    Raises
+    ------
+    InputError
+        The file is missing or not a status file.
+    """
+    path = Path(out) / STATUS_FILE
+    try:
+        return str(json.loads(path.read_text())["status"])
+    except FileNotFoundError:
+        raise InputError(f"{str(path)!r} does not exist: no job status in that folder") from None
+    except (ValueError, KeyError, TypeError) as exc:
+        raise InputError(f"{str(path)!r} is not a status file ({exc})") from None
+
+
+def failure_status(exc: BaseException) -> str:
+    """The ``failed: <reason>`` status of a job ended by ``exc``."""
+    if isinstance(exc, InstabilityError):
+        return f"failed: unstable at step {exc.step} (t = {exc.time:.6g} s, point {exc.point}): {exc}"
+    reason = str(exc) if isinstance(exc, PeridynError) else f"{type(exc).__name__}: {exc}"
+    return f"failed: {reason}"
+
+
+@contextmanager
+def json_job_status(out) -> Iterator[None]:
+    """``status.json`` of a job that writes JSON: ``running`` within the block, then
+    ``complete``, or ``failed: <reason>`` when the block raises (the exception goes on)."""
+    write_status(out, "running")
+    try:
+        yield
+    except Exception as exc:
+        write_status(out, failure_status(exc))
+        raise
+    write_status(out, "complete")

@@ -1,0 +1,190 @@
+"""An earlier run's files are never touched unless asked, restarts refuse a checkpoint of
+another run, every job records its status, and an unstable run stops before writing NaN
+(issue 17, items 2, 3 and 7)."""
+
+import hashlib
+import re
+import signal
+
+import numpy as np
+import pytest
+import yaml
+
+from peridyn.cli import main
+from peridyn.discretization.state import State, check_state
+from peridyn.errors import InputError, InstabilityError, Interrupted
+from peridyn.io.case import validate_case
+from peridyn.io.outdir import json_job_status, read_status
+from peridyn.io.results import Results
+from peridyn.jobs.build import build
+from peridyn.jobs.run import run_case
+from peridyn.solvers import ExplicitSolver
+from peridyn.solvers.stepping import advance
+
+BAR = {
+    "name": "bar",
+    "geometry": {"type": "box", "size": [0.012, 0.004, 0.004]},
+    "discretization": {"spacing": 1e-3, "horizon": 2.015},
+    "material": {"model": "pmb", "E": 70e9, "density": 2700},
+    "node_sets": {"end": {"type": "face", "face": "x+"}},
+    "boundary_conditions": [
+        {
+            "set": "end",
+            "kind": "velocity",
+            "components": "x",
+            "value": {"type": "ramp", "start": 0, "end": 1e-6, "end_value": 1.0},
+        }
+    ],
+    "solver": {"type": "explicit", "steps": 40},
+    "output": {"every": 2, "snapshot_every": 10, "sensors": {"mid": [0.006, 0.002, 0.002]}, "plots": False},
+}
+
+
+def _case(solver=None, material=None, output=None):
+    raw = {**BAR}
+    raw["solver"] = {**BAR["solver"], **(solver or {})}
+    raw["material"] = {**BAR["material"], **(material or {})}
+    raw["output"] = {**BAR["output"], **(output or {})}
+    return validate_case(raw)
+
+
+def _digests(folder) -> dict:
+    """SHA-256 of every file under ``folder``."""
+    return {p: hashlib.sha256(p.read_bytes()).hexdigest() for p in sorted(folder.rglob("*")) if p.is_file()}
+
+
+@pytest.fixture(scope="module")
+def finished(tmp_path_factory):
+    """A finished, checkpointed run's folder."""
+    out = tmp_path_factory.mktemp("finished")
+    run_case(_case(), out, checkpoint_every=20)
+    return out
+
+
+def test_a_finished_run_is_complete(finished):
+    assert Results(finished / "results.h5").status() == "complete"
+
+
+@pytest.mark.parametrize(
+    "kwargs, message",
+    [
+        ({}, "holds an earlier run's results.h5: pass --overwrite to replace it, --restart to continue"),
+        (
+            {"checkpoint_every": -5, "overwrite": True},
+            "--checkpoint-every must be a whole number of steps >= 1",
+        ),
+        (
+            {"checkpoint_every": -5, "restart": True},
+            "--checkpoint-every must be a whole number of steps >= 1",
+        ),
+        ({"overwrite": True, "restart": True}, "--overwrite and --restart exclude each other"),
+        (
+            {"case": _case(material={"E": 100e9}), "restart": True},
+            "made for another run (case: material.E 70000000000.0 -> 100000000000.0; time step",
+        ),
+        (
+            {"case": _case(solver={"dt": 1e-8}), "restart": True},
+            "(case: solver.dt None -> 1e-08; time step (s) ",
+        ),
+    ],
+)
+def test_an_earlier_run_is_left_alone(finished, kwargs, message):
+    """Issue 17 item 2/3: every refusal comes before a byte of the earlier run changes."""
+    before = _digests(finished)
+    case = kwargs.pop("case", _case())
+    with pytest.raises(InputError, match=re.escape(message)) as info:
+        run_case(case, finished, **kwargs)
+    assert "\n" not in str(info.value)
+    assert _digests(finished) == before
+
+
+def test_overwrite_replaces_and_restart_extends(finished, tmp_path):
+    """--overwrite starts again; --restart with a longer run continues the checkpoint (the run
+    length is not part of the case hash) and equals the longer run made in one go."""
+    whole = run_case(_case(solver={"steps": 60}), tmp_path)
+    again = run_case(_case(solver={"steps": 60}), tmp_path, overwrite=True)
+    assert again["steps"] == 60
+    resumed = run_case(_case(solver={"steps": 60}), finished, restart=True)
+    assert resumed["steps"] == whole["steps"] == 60
+    np.testing.assert_array_equal(
+        Results(finished / "results.h5").array("final/u"), Results(tmp_path / "results.h5").array("final/u")
+    )
+
+
+@pytest.mark.parametrize("every, caught_at", [(2, 24), (40, 30)])
+def test_instability_stops_before_a_nan_is_written(monkeypatch, tmp_path, every, caught_at):
+    """A NaN appearing at step 23 is caught at the next record (every 2 steps) or, between
+    rarer records, at the solver's check (every 10 steps): status failed, no NaN stored."""
+    original = ExplicitSolver._acceleration
+
+    def poisoned(self, state):
+        original(self, state)
+        if state.step >= 23:
+            state.a[5, 1] = np.nan
+
+    monkeypatch.setattr(ExplicitSolver, "_acceleration", poisoned)
+    with pytest.raises(
+        InstabilityError, match=rf"step {caught_at} .*point \d+: (displacement u|velocity v) not finite"
+    ):
+        run_case(_case(output={"every": every}), tmp_path)
+    results = Results(tmp_path / "results.h5")
+    assert results.status().startswith(f"failed: unstable at step {caught_at} ")
+    for name in results.series_names():
+        steps, _, data = results.series(name)
+        assert np.isfinite(data).all() and steps.max() < caught_at
+
+
+def test_a_runaway_displacement_is_named():
+    """Finite but 100 times the body's size: a runaway, named with point and field."""
+    state = State.zeros(4)
+    state.u[2, 0] = 5.0
+    check_state(state, 10.0)
+    state.u[3, 2] = 11.0
+    with pytest.raises(InstabilityError, match="point 3: displacement u above 10 m"):
+        check_state(state, 10.0)
+
+
+def test_modal_and_json_jobs_record_their_status(tmp_path):
+    run_case(_case(solver={"type": "modal", "modes": 8, "steps": None}), tmp_path / "modal")
+    assert Results(tmp_path / "modal/results.h5").status() == "complete"
+    with json_job_status(tmp_path):
+        assert read_status(tmp_path) == "running"
+    assert read_status(tmp_path) == "complete"
+    with pytest.raises(InputError), json_job_status(tmp_path):
+        raise InputError("bad spacing")
+    assert read_status(tmp_path) == "failed: bad spacing"
+
+
+def test_the_step_loop_defers_a_signal_and_restores_the_handlers():
+    """A signal raised inside a step ends the loop after that step, as Interrupted; the
+    previous handler is back afterwards."""
+    setup = build(_case())
+    solver = ExplicitSolver(setup.model, setup.loading)
+    state = solver.initial_state()
+
+    class Stopper:
+        def observe(self, state, solver):
+            if state.step == 3:
+                signal.raise_signal(signal.SIGTERM)
+
+    before = signal.getsignal(signal.SIGTERM)
+    with pytest.raises(Interrupted) as info:
+        advance(solver, state, 10, [Stopper()])
+    assert (info.value.signal_name, info.value.step, info.value.exit_code) == ("SIGTERM", 3, 143)
+    assert state.step == 3
+    assert signal.getsignal(signal.SIGTERM) is before
+
+
+def test_the_command_line_refuses_an_earlier_runs_folder(finished, capsys):
+    """``peridyn run`` (and modal, fatigue, study, demo: the same check) into a finished run's
+    folder: one line naming the folder and both flags, exit status 1, no byte changed."""
+    before = _digests(finished)
+    case = finished / "case.yaml"
+    case.write_text(yaml.safe_dump(BAR))
+    before[case] = hashlib.sha256(case.read_bytes()).hexdigest()
+    assert main(["run", str(case), "-o", str(finished), "--no-progress"]) == 1
+    err = capsys.readouterr().err
+    line = err.strip().splitlines()[-1]  # after the run's banner line
+    assert "Traceback" not in err and line.startswith("peridyn run: error: output folder")
+    assert str(finished) in line and "--overwrite" in line and "--restart" in line
+    assert _digests(finished) == before
