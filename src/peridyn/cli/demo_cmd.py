@@ -4,8 +4,7 @@ from __future__ import annotations
 
 from importlib.resources import as_file, files
 
-from peridyn.cli.options import add_common_flags, add_output_flag, add_progress_flags
-from peridyn.cli.run_cmd import add_overwrite_flag
+from peridyn.cli.options import add_common_flags, add_output_flag, add_overwrite_flag, add_progress_flags
 
 DEMO_CASE = "demo_plate_burst.yaml"
 

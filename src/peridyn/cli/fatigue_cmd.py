@@ -20,9 +20,9 @@ from peridyn.cli.options import (
     add_common_flags,
     add_max_memory,
     add_output_flag,
+    add_overwrite_flag,
     add_progress_flags,
 )
-from peridyn.cli.run_cmd import add_overwrite_flag
 from peridyn.errors import InputError
 
 

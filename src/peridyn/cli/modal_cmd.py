@@ -4,8 +4,13 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from peridyn.cli.options import add_case_arguments, add_common_flags, add_max_memory, add_output_flag
-from peridyn.cli.run_cmd import add_overwrite_flag
+from peridyn.cli.options import (
+    add_case_arguments,
+    add_common_flags,
+    add_max_memory,
+    add_output_flag,
+    add_overwrite_flag,
+)
 from peridyn.io.case import load_case
 
 

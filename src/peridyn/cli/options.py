@@ -93,3 +93,12 @@ def add_max_memory(parser: argparse.ArgumentParser) -> None:
         metavar="BYTES",
         help="refuse a job whose estimated peak memory exceeds BYTES (e.g. 4GB; default: physical memory)",
     )
+
+
+def add_overwrite_flag(parser) -> None:
+    """The ``--overwrite`` flag: replace an earlier run's results in the output folder."""
+    parser.add_argument(
+        "--overwrite",
+        action="store_true",
+        help="replace the results of an earlier run in the output folder (refused without it)",
+    )

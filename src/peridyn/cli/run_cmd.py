@@ -13,6 +13,7 @@ from peridyn.cli.options import (
     add_common_flags,
     add_max_memory,
     add_output_flag,
+    add_overwrite_flag,
     add_progress_flags,
     positive_int,
 )
@@ -38,15 +39,6 @@ def register(sub) -> None:
     add_max_memory(p)
     add_overwrite_flag(p)
     p.set_defaults(func=run)
-
-
-def add_overwrite_flag(parser) -> None:
-    """The ``--overwrite`` flag: replace an earlier run's results in the output folder."""
-    parser.add_argument(
-        "--overwrite",
-        action="store_true",
-        help="replace the results of an earlier run in the output folder (refused without it)",
-    )
 
 
 def command_line() -> str:

@@ -19,8 +19,8 @@ from peridyn.cli.options import (
     add_common_flags,
     add_max_memory,
     add_output_flag,
+    add_overwrite_flag,
 )
-from peridyn.cli.run_cmd import add_overwrite_flag
 from peridyn.errors import InputError
 
 
