@@ -67,6 +67,8 @@ class ArgumentParser(argparse.ArgumentParser):
 _ARGUMENT = re.compile(r"argument (?P<key>[^:]+): (?P<detail>.*)")
 _INVALID_VALUE = re.compile(r"invalid (?P<type>\w+) value: '(?P<value>.*)'")
 _INVALID_CHOICE = re.compile(r"invalid choice: '(?P<value>.*?)' \(choose from (?P<choices>.*)\)")
+#: the message of peridyn's own argparse types (``cli.options.positive_int``, ``memory_bytes``)
+_EXPECTED_GOT = re.compile(r"expected (?P<expected>.*), got '?(?P<value>.*?)'?")
 _EXPECTED_TYPE = {"int": "an integer", "float": "a number"}
 
 
@@ -84,6 +86,8 @@ def _parse_argparse_message(message: str) -> tuple:
         return key, m["value"], _EXPECTED_TYPE.get(m["type"], f"a {m['type']} value")
     if m := _INVALID_CHOICE.fullmatch(detail):
         return key, m["value"], f"one of {m['choices']}"
+    if m := _EXPECTED_GOT.fullmatch(detail):
+        return key, m["value"], m["expected"]
     return key, None, detail
 
 

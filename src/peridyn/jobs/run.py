@@ -128,7 +128,10 @@ def run_case(
         raise Interrupted(exc.signal_name, exc.step, _resume_hint(command) if exc.resume else "") from None
     except Exception as exc:
         if written:
-            _set_status(out / RESULTS, setup.body, failure_status(exc))
+            try:
+                _set_status(out / RESULTS, setup.body, failure_status(exc))
+            except Exception:  # noqa: BLE001 - e.g. the full disk that failed the run: its error is the one to report
+                pass
         raise
     return summary
 

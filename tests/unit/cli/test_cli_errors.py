@@ -60,8 +60,8 @@ def test_without_json_stdout_stays_empty(capsys):
         (
             ["run", BAR, "--checkpoint-every", "x"],
             "run",
-            {"key": "--checkpoint-every", "value": "x", "expected": "an integer"},
-            "invalid int value",
+            {"key": "--checkpoint-every", "value": "x", "expected": "a whole number >= 1"},
+            "expected a whole number >= 1",
         ),
         (["run"], "run", {"key": "case", "expected": "required"}, "required: case"),
         (["validate", BAR, "--biuld"], "validate", {"value": "--biuld"}, "did you mean '--build'?"),
