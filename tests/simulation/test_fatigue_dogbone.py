@@ -12,12 +12,12 @@ from peridyn.jobs.build import build
 from peridyn.jobs.fatigue import fatigue_parameters, run_fatigue_case
 
 CASE = Path(__file__).resolve().parents[2] / "cases" / "dogbone_fatigue.yaml"
-NOTCH_ROOTS = ((0.030, 0.0040), (0.030, 0.0080))  # edge-notch roots (x, y) of the case, m
+NOTCH_ROOT = (0.030, 0.0080)  # the edge notch's root (x, y) of the case, m
 
 
 def test_crack_nucleates_at_the_notches_not_at_the_loaded_ends():
     """Issue 8: fatigue damage starts where the stress concentrates. The first bonds to break
-    belong to points within 1.5 spacings of a notch root; no point outside the middle 6 mm loses
+    belong to points within 1.5 spacings of the notch root; no point outside the middle 6 mm loses
     a bond (the grips are 13 mm away). Three steps of 1e5 cycles (the thesis's first tau)."""
     case = load_case(CASE)
     setup = build(case)
@@ -35,19 +35,25 @@ def test_crack_nucleates_at_the_notches_not_at_the_loaded_ends():
     assert result.broken[-1] > 0
     x = setup.body.points
     first = np.isfinite(result.first_break) & (result.first_break == result.first_break.min())
-    dist = np.min([np.hypot(x[first, 0] - cx, x[first, 1] - cy) for cx, cy in NOTCH_ROOTS], axis=0)
+    dist = np.hypot(x[first, 0] - NOTCH_ROOT[0], x[first, 1] - NOTCH_ROOT[1])
     assert dist.max() <= 1.5 * setup.body.spacing
     damaged = np.isfinite(result.first_break)
     assert np.abs(x[damaged, 0] - 0.030).max() <= 0.003
 
 
 @pytest.mark.slow
-def test_first_bending_frequency_falls_with_types_matched(tmp_path):
-    """Thesis table 7.2: the 1st bending frequency falls after fatigue (2.91% there) and the mode
-    types stay matched. Here: each elastic mode before is matched by MAC (> 0.9) to a mode of the
-    same type after, and the 1st bending mode's frequency is lower after 870 000 cycles."""
+def test_default_run_grows_a_crack_and_lowers_the_first_frequencies(tmp_path):
+    """What the case is for (thesis seed 002 ch. 7, section 7.3 and table 7.2; VALIDATION.md V5):
+    fatigue cracks the specimen at its narrowest part and the damaged body vibrates lower (the
+    1st bending mode fell 2.91% after 870 000 cycles, every mode fell, types kept). Here, at the
+    default settings: after the thesis's 870 000 cycles a crack runs through the depth from the
+    notch root (crack_length_m > 0, section 7.2's criterion at this horizon), each elastic mode
+    before is matched by MAC (> 0.9) to a mode of the same type after, and the first two elastic
+    modes (1st bending, 1st in-plane bending) fall by more than 0.5%."""
     case = load_case(CASE, ["output.plots=false"])
     summary = run_fatigue_case(case, tmp_path)
+    assert summary["cycles"] == pytest.approx(870_000)
+    assert summary["crack_length_m"] > 0.0
     modal = summary["modal"]
     before = [m for m in modal["before"] if m["type"] != "rigid"]
     after = [m for m in modal["after"] if m["type"] != "rigid"]
@@ -55,9 +61,10 @@ def test_first_bending_frequency_falls_with_types_matched(tmp_path):
     for pair in modal["matches"]:
         b, a = before[pair["before"]], after[pair["after"]]
         assert pair["mac"] > 0.9 and (b["type"], b["order"]) == (a["type"], a["order"])
-    bending = [
-        p
+    change = {
+        (before[p["before"]]["type"], before[p["before"]]["order"]): p["frequency_change"]
         for p in modal["matches"]
-        if (before[p["before"]]["type"], before[p["before"]]["order"]) == ("bending", 1)
-    ]
-    assert len(bending) == 1 and bending[0]["frequency_change"] < -0.005
+    }
+    assert [(m["type"], m["order"]) for m in before[:2]] == [("bending", 1), ("in-plane bending", 1)]
+    assert change[("bending", 1)] < -0.005
+    assert change[("in-plane bending", 1)] < -0.005
