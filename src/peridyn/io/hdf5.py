@@ -88,9 +88,19 @@ class HDF5Writer:
 
     Examples
     --------
-    >>> with HDF5Writer("run.h5", x, vol, {"solver": "explicit"}) as out:  # doctest: +SKIP
+    A series written, then read back through ``peridyn.io.results.Results``:
+
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> from peridyn.io.results import Results
+    >>> path = Path(tempfile.mkdtemp()) / "run.h5"
+    >>> x, vol = np.zeros((2, 3)), np.ones(2)
+    >>> with HDF5Writer(path, x, vol, {"solver": "explicit"}) as out:
     ...     out.create_series("u", x.shape)
-    ...     out.append("u", step=0, time=0.0, values=u)
+    ...     out.append("u", step=0, time=0.0, values=x + 1e-6)
+    >>> steps, times, u = Results(path).series("u")
+    >>> steps.tolist(), u.shape, float(u.max())
+    ([0], (1, 2, 3), 1e-06)
     """
 
     def __init__(
