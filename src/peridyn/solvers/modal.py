@@ -122,7 +122,9 @@ def modal_analysis(
         # a fraction of the lowest diagonal frequency estimate keeps K + s M well conditioned
         shift = 1e-6 * float(np.median(parts.diagonal()[dofs] / m))
     op = shifted_inverse(parts, dofs, shift * m, model.body.points, model.bonds.horizon)
-    lam, vecs = eigsh(K, k=n_modes, M=M, sigma=-shift, which="LM", OPinv=op, tol=tol)
+    # a fixed start vector: the same modes, residuals and shapes on every run (ARPACK's default is random)
+    v0 = np.random.default_rng(0).standard_normal(len(dofs))
+    lam, vecs = eigsh(K, k=n_modes, M=M, sigma=-shift, which="LM", OPinv=op, tol=tol, v0=v0)
     k_max = float(np.abs(parts.diagonal()[dofs]).max())
     return _result(lam, vecs, K, m, dofs, model.body.n_points, k_max, np.zeros(n_modes, bool))
 
