@@ -43,26 +43,35 @@ class InstabilityError(PeridynError, RuntimeError):
 
 
 class Interrupted(PeridynError):
-    """A run stopped by a signal (SIGINT, SIGTERM) at the end of a step, its files closed.
+    """A job stopped by a signal (SIGINT, SIGTERM) at a safe point, its files closed.
 
     Parameters
     ----------
     signal_name : str
         "SIGINT" or "SIGTERM".
-    step : int
-        The last completed step.
+    step : int or None
+        The last completed time step of a time-stepping job, else None.
     resume : str
         How to continue (e.g. the command line with ``--restart``), or "" when it cannot be.
+    where : str
+        What a job without time steps was doing (e.g. "building the model"), or "".
     """
 
     #: exit status of the command line: 128 + the signal number
     EXIT_CODES = {"SIGINT": 130, "SIGTERM": 143}
 
-    def __init__(self, signal_name: str, step: int, resume: str = ""):
-        self.signal_name, self.step, self.resume = signal_name, step, resume
+    def __init__(self, signal_name: str, step: int | None = None, resume: str = "", where: str = ""):
+        self.signal_name, self.step, self.resume, self.where = signal_name, step, resume, where
         self.exit_code = self.EXIT_CODES.get(signal_name, 130)
-        msg = f"interrupted ({signal_name}) at step {step}"
+        msg = f"interrupted ({signal_name}) {self.progress}".rstrip()
         super().__init__(msg + (f"; resume with: {resume}" if resume else ""))
+
+    @property
+    def progress(self) -> str:
+        """ "at step N", "while <where>" or ""."""
+        if self.step is not None:
+            return f"at step {self.step}"
+        return f"while {self.where}" if self.where else ""
 
 
 def did_you_mean(word: str, choices) -> str:

@@ -20,6 +20,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from peridyn import interrupts
+
 #: Eigenvalues of W^T A W below this fraction of the largest drop their direction (dependent).
 DEPENDENT = 1e-10
 
@@ -101,6 +103,7 @@ def deflated_pcg(
     p = z if deflation is None else z - W @ (AW.T @ z)
     rz = r @ z
     for it in range(1, maxiter + 1):
+        interrupts.check(where="solving for equilibrium")
         ap = matvec(p)
         alpha = rz / (p @ ap)
         x += alpha * p

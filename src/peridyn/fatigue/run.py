@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from peridyn import interrupts
 from peridyn.errors import InputError
 from peridyn.fatigue.mapping import CycleMapping
 from peridyn.fatigue.model import FatigueParameters, RemainingLife, cyclic_bond_strain
@@ -107,6 +108,7 @@ def run_fatigue(
     u = None
     changed = True
     for dn in mapping.cycles_per_step():
+        interrupts.check(where=f"cycling (at {n_cycles:.6g} cycles)")
         if changed:  # equilibrium only moves when bonds broke
             u = statics.solve()
             eps = cyclic_bond_strain(model, u, load_ratio)

@@ -4,11 +4,11 @@ An earlier job's results are never replaced unless asked: ``prepare_output`` ref
 that holds one (its ``results.h5``, or the JSON summary of a fatigue or study job) unless the
 caller passes ``overwrite`` (start again) or ``restart`` (continue from its checkpoint).
 
-A job's status is one of ``running``, ``complete``, ``failed: <reason>`` and
-``interrupted at step N``. A run and a modal job keep it in the ``status`` root attribute
-of ``results.h5`` (``HDF5Writer.set_status``, read with ``Results.status``); a fatigue or
-study job, which writes JSON, keeps it in ``status.json`` (``{"status": ...}``), written and
-read here.
+A job's status is one of ``running``, ``complete``, ``failed: <reason>``, ``interrupted at
+step N`` and (for a job without time steps) ``interrupted while <what it was doing>``. A run
+and a modal job keep it in the ``status`` root attribute of ``results.h5``
+(``HDF5Writer.set_status``, read with ``Results.status``); a fatigue or study job, which writes
+JSON, keeps it in ``status.json`` (``{"status": ...}``), written and read here.
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
-from peridyn.errors import InputError, InstabilityError, PeridynError
+from peridyn.errors import InputError, InstabilityError, Interrupted, PeridynError
 
 #: Name of the status file of the jobs that write JSON rather than results.h5.
 STATUS_FILE = "status.json"
@@ -80,8 +80,11 @@ def read_status(out) -> str:
         raise InputError(f"{str(path)!r} is not a status file ({exc})") from None
 
 
-def failure_status(exc: BaseException) -> str:
-    """The ``failed: <reason>`` status of a job ended by ``exc``."""
+def end_status(exc: BaseException) -> str:
+    """The status of a job ended by ``exc``: ``interrupted ...`` for a signal, else
+    ``failed: <reason>``."""
+    if isinstance(exc, Interrupted):
+        return f"interrupted {exc.progress}".rstrip()
     if isinstance(exc, InstabilityError):
         return f"failed: unstable at step {exc.step} (t = {exc.time:.6g} s, point {exc.point}): {exc}"
     reason = str(exc) if isinstance(exc, PeridynError) else f"{type(exc).__name__}: {exc}"
@@ -91,11 +94,11 @@ def failure_status(exc: BaseException) -> str:
 @contextmanager
 def json_job_status(out) -> Iterator[None]:
     """``status.json`` of a job that writes JSON: ``running`` within the block, then
-    ``complete``, or ``failed: <reason>`` when the block raises (the exception goes on)."""
+    ``complete``, or the :func:`end_status` of what the block raised (which goes on)."""
     write_status(out, "running")
     try:
         yield
     except Exception as exc:
-        write_status(out, failure_status(exc))
+        write_status(out, end_status(exc))
         raise
     write_status(out, "complete")

@@ -119,8 +119,9 @@ class Results:
         return attrs
 
     def status(self) -> str:
-        """The job's status: ``running``, ``complete``, ``failed: <reason>`` or
-        ``interrupted at step N`` ("unknown" for files written before it was recorded)."""
+        """The job's status: ``running``, ``complete``, ``failed: <reason>``, ``interrupted at
+        step N`` or ``interrupted while ...`` ("unknown" for files written before it was
+        recorded)."""
         with self._open() as f:
             status = f.attrs.get(STATUS_ATTR, "unknown")
         return status.decode() if isinstance(status, bytes) else str(status)

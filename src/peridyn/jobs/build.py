@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial import cKDTree
 
+from peridyn import interrupts
 from peridyn.discretization import geometry
 from peridyn.discretization.body import Body, in_box, in_cylinder, in_sphere
 from peridyn.discretization.bonds import Bonds, crossing_rectangle, crossing_segment, cut_bonds, find_bonds
@@ -22,6 +23,9 @@ from peridyn.physics.loads import BoundaryCondition, InitialCondition, Loading
 from peridyn.physics.materials import Model, make_model
 from peridyn.physics.timefunctions import from_spec
 from peridyn.physics.transducers import pin_force_actuator, pzt_radial_actuator
+
+#: What ``Interrupted`` says a job was doing when it stopped during ``build``.
+BUILDING = "building the model"
 
 
 @dataclass
@@ -218,11 +222,16 @@ def distance_outside(body: Body, positions: np.ndarray, axes: int = 3) -> np.nda
 
 
 def build(case: Case, base_dir=".") -> Setup:
-    """Body, bonds, model, loading and damage of a case."""
+    """Body, bonds, model, loading and damage of a case.
+
+    Within ``peridyn.interrupts.deferred``, a SIGINT or SIGTERM stops it after the phase under
+    way (points, bonds, model) with ``Interrupted``."""
     body = build_body(case, base_dir)
+    interrupts.check(where=BUILDING)
     check_placements(case, body)
     body, actuation = add_actuators(case, body)
     bonds = build_bonds(case, body)
+    interrupts.check(where=BUILDING)
     mat = case.material
     model = make_model(
         mat.model,
@@ -243,6 +252,7 @@ def build(case: Case, base_dir=".") -> Setup:
             mat.damage.no_damage_sets,
             critical_bond_stress=mat.damage.critical_bond_stress,
         )
+    interrupts.check(where=BUILDING)
     loading = build_loading(case, body, actuation)
     check_loading(case, loading)
     return Setup(body, bonds, model, loading, damage, build_contact(case, model))

@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
+from peridyn import interrupts
 from peridyn.errors import CaseFileError, did_you_mean
 from peridyn.fatigue.calibration import growth_rates, paris_fit, stress_intensity
 from peridyn.fatigue.mapping import CycleMapping
@@ -120,6 +121,7 @@ def _stop_length(f) -> float:
     return f.paris.stop_length if f.paris is not None and f.paris.stop_length is not None else np.inf
 
 
+@interrupts.deferred()
 def run_fatigue_case(
     case: Case,
     output_dir=None,

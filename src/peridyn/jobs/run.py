@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
+from peridyn import interrupts
 from peridyn.discretization import geometry
 from peridyn.discretization.body import Body
 from peridyn.discretization.state import State
@@ -19,7 +20,7 @@ from peridyn.errors import CaseFileError, InputError, Interrupted
 from peridyn.io.case import Case
 from peridyn.io.checkpoint import Checkpointer, load_checkpoint
 from peridyn.io.hdf5 import HDF5Writer
-from peridyn.io.outdir import failure_status, prepare_output
+from peridyn.io.outdir import end_status, prepare_output
 from peridyn.io.provenance import package_version, provenance
 from peridyn.io.recorder import LineProbe, Recorder, RecorderSpec
 from peridyn.jobs.build import Setup, build, pad3
@@ -67,6 +68,7 @@ def output_directory(case: Case, override=None) -> Path:
     return Path(case.output.directory or Path("peridyn-out") / case.name)
 
 
+@interrupts.deferred()
 def run_case(
     case: Case,
     output_dir=None,
@@ -101,9 +103,12 @@ def run_case(
     Raises
     ------
     Interrupted
-        SIGINT or SIGTERM during the time stepping: the run stops after the current step,
-        writes a checkpoint (when checkpointing, or after a minute of running) and closes
-        its files with the status ``interrupted at step N``.
+        SIGINT or SIGTERM (noted, then acted on at the next safe point: ``peridyn.interrupts``).
+        During the time stepping the run stops after the current step, writes a checkpoint
+        (when checkpointing, or after a minute of running) and closes its files with the
+        status ``interrupted at step N``; a static, Newton or modal run stops within an
+        iteration of its solver (status ``interrupted while ...``); during the build nothing
+        has been written yet.
     """
     start = time.perf_counter()
     stepping = case.solver.type in ("explicit", "newmark")
@@ -124,14 +129,15 @@ def run_case(
         )
         written = True
         _finish(case, setup, out, summary, plots, start)
-    except Interrupted as exc:
-        raise Interrupted(exc.signal_name, exc.step, _resume_hint(command) if exc.resume else "") from None
     except Exception as exc:
         if written:
             try:
-                _set_status(out / RESULTS, setup.body, failure_status(exc))
+                _set_status(out / RESULTS, setup.body, end_status(exc))
             except Exception:  # noqa: BLE001 - e.g. the full disk that failed the run: its error is the one to report
                 pass
+        if isinstance(exc, Interrupted):
+            hint = _resume_hint(command) if exc.resume else ""
+            raise Interrupted(exc.signal_name, exc.step, hint, exc.where) from None
         raise
     return summary
 
@@ -279,7 +285,7 @@ def _run_explicit(case, setup, solver, out, case_path, checkpoint_every, restart
         recorder.close(f"interrupted at step {exc.step}")
         raise Interrupted(exc.signal_name, exc.step, "resume" if saved else "") from None
     except BaseException as exc:
-        recorder.close(failure_status(exc))
+        recorder.close(end_status(exc))
         raise
     if state.step not in spec.snapshot_steps and not (
         spec.snapshot_every and state.step % spec.snapshot_every == 0

@@ -24,6 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
+from peridyn import interrupts
 from peridyn.analysis.convergence import ConvergenceError, richardson
 from peridyn.errors import InputError
 from peridyn.jobs.summary import finish_summary
@@ -73,6 +74,7 @@ class StudyRun:
         }
 
 
+@interrupts.deferred()
 def run_grid(
     case_path, spacings, horizon_factors, n_modes: int | None = None, overrides=(), progress=None
 ) -> list[StudyRun]:
@@ -102,6 +104,7 @@ def run_grid(
     combos = [(h, m) for m in horizon_factors for h in spacings]
     runs = []
     for k, (h, m) in enumerate(combos, 1):
+        interrupts.check(where=f"running the study (run {k} of {len(combos)})")
         run = StudyRun(float(h), float(m))
         start = time.perf_counter()
         case = load_case(

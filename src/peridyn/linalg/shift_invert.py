@@ -12,6 +12,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import LinearOperator, splu
 
+from peridyn import interrupts
 from peridyn.linalg.ordering import order_unknowns
 from peridyn.linalg.stiffness import StiffnessParts
 
@@ -27,6 +28,7 @@ def shifted_inverse(
     inverse[perm] = np.arange(len(perm))
 
     def solve(b):
+        interrupts.check(where="computing the modes")
         rhs[:n] = b
         return lu.solve(rhs[perm])[inverse[:n]]
 

@@ -25,8 +25,9 @@ import warnings
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.sparse.linalg import lobpcg
+from scipy.sparse.linalg import LinearOperator, lobpcg
 
+from peridyn import interrupts
 from peridyn.errors import InputError
 from peridyn.linalg.amg import (
     amg_preconditioner,
@@ -72,7 +73,7 @@ def lobpcg_modes(model: Model, n_modes: int, dofs: np.ndarray, max_iterations: i
     shift = 1e-6 * float(np.median(proxy.diagonal() / m))
     # near-null space: the local rigid motions, whatever the constraints (Vanek et al. 1996)
     near_null = orthonormal(rigid_fields(model.body.points)[dofs])
-    precond = amg_preconditioner(proxy, m, near_null, shift, proxy_aggregates(model, dofs))
+    precond = _interruptible(amg_preconditioner(proxy, m, near_null, shift, proxy_aggregates(model, dofs)))
     block = min(n_elastic + GUARD_VECTORS, len(dofs) // 5)
     if block < n_elastic:
         raise InputError(
@@ -110,6 +111,16 @@ def lobpcg_modes(model: Model, n_modes: int, dofs: np.ndarray, max_iterations: i
         n_rigid,
         K,
     )
+
+
+def _interruptible(op: LinearOperator) -> LinearOperator:
+    """``op`` with a safe point for SIGINT/SIGTERM (``peridyn.interrupts``) before each product."""
+
+    def apply(x):
+        interrupts.check(where="computing the modes")
+        return op @ x
+
+    return LinearOperator(op.shape, matvec=apply, matmat=apply, dtype=op.dtype)
 
 
 def _quiet_lobpcg(K, x, M, precond, y, tol, max_iterations):

@@ -31,6 +31,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import splu
 
+from peridyn import interrupts
 from peridyn.errors import InputError, did_you_mean
 from peridyn.linalg.dofs import free_dofs
 from peridyn.linalg.tangent import tangent_stiffness
@@ -182,6 +183,7 @@ def equilibrate(
     load = np.linalg.norm(vol * b.ravel())
     history = []
     for it in range(max_iterations + 1):
+        interrupts.check(where="solving for equilibrium")
         force = vol * (np.asarray(model.force(u), dtype=float) + b).ravel()
         scale = max(load, np.linalg.norm(force[held]))
         r = force[free]
@@ -242,6 +244,7 @@ def _jacobi_cg(a: sp.csr_matrix, rhs: np.ndarray) -> np.ndarray:
     rz = r @ z
     target = CG_RTOL * np.linalg.norm(rhs)
     for _ in range(10 * len(rhs) + 1):
+        interrupts.check(where="solving for equilibrium")
         if np.linalg.norm(r) <= target:
             return x
         ap = a @ p

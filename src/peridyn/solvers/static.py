@@ -21,6 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from peridyn import interrupts
 from peridyn.errors import InputError
 from peridyn.physics.contact import Contact
 from peridyn.physics.damage import BondDamage
@@ -100,6 +101,7 @@ def relax(
     broken = 0
     residual = np.inf
     for it in range(1, max_iterations + 1):
+        interrupts.check(where="relaxing to equilibrium")
         r = (f + b) * free
         a = r / lam
         if it == 1:
