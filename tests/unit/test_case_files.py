@@ -197,3 +197,53 @@ def test_stable_step_is_the_silling_askari_bound_for_pmb():
     per_point = np.add.reduceat(m.bond_stiffness / b.length, b.offsets[:-1])
     expected = np.min(np.sqrt(2 * m.density / per_point))
     assert m.critical_time_step() == pytest.approx(expected, rel=1e-12)
+
+
+def test_override_takes_the_index_as_the_errors_write_it():
+    """Error messages name list items ``boundary_conditions[1]``; ``--set`` accepts that form."""
+    case = validate_case(_case(**{"boundary_conditions[1].value": "20"}))
+    assert case.boundary_conditions[1].value == 20
+
+
+RECTANGLE = {
+    **GOOD,
+    "geometry": {"type": "rectangle", "size": [0.006, 0.004], "thickness": 1e-3},
+    "material": {"model": "pmb", "E": 70e9, "density": 2700},
+    "boundary_conditions": [{"set": "right", "kind": "force", "components": "x", "value": 10.0}],
+}
+
+
+@pytest.mark.parametrize("components", ["z", "xz", ["y", "z"]])
+def test_a_z_component_on_a_2d_body_is_refused(components):
+    """Issue 17 (no silent acceptance): a 2D body moves in x and y; a written-out z is a mistake
+    that used to be dropped without a word."""
+    raw = copy.deepcopy(RECTANGLE)
+    raw["boundary_conditions"][0]["components"] = components
+    with pytest.raises(CaseFileError) as caught:
+        validate_case(raw)
+    assert caught.value.key == "boundary_conditions[0].components"
+    assert str(caught.value).endswith("a 2D body has components x and y only")
+
+
+def test_the_default_components_of_a_2d_body_are_x_and_y():
+    raw = copy.deepcopy(RECTANGLE)
+    del raw["boundary_conditions"][0]["components"]
+    assert validate_case(raw).boundary_conditions[0].components == "xyz"
+
+
+@pytest.mark.parametrize("components, problem", [("q", "unknown component 'q'"), (["x", "x"], "distinct")])
+def test_bad_components_name_their_key(components, problem):
+    raw = _case()
+    raw["boundary_conditions"][1]["components"] = components
+    with pytest.raises(CaseFileError, match=rf"^<case>: boundary_conditions\[1\]\.components: .*{problem}"):
+        validate_case(raw)
+
+
+def test_a_check_across_keys_does_not_print_the_whole_case():
+    """The node-set check runs on the whole case; its message names the key, not the case dict."""
+    raw = _case(**{"boundary_conditions.0.set": "lefft"})
+    with pytest.raises(CaseFileError) as caught:
+        validate_case(raw)
+    assert caught.value.key == "boundary_conditions[0].set"
+    assert str(caught.value).startswith("<case>: boundary_conditions[0].set: unknown node set 'lefft'")
+    assert "geometry" not in str(caught.value)

@@ -74,3 +74,29 @@ def test_spec_builds_nested_functions():
 def test_bad_specs(spec, message):
     with pytest.raises(InputError, match=message):
         from_spec(spec)
+
+
+@pytest.mark.parametrize(
+    "spec, message",
+    [
+        ({"type": "ramp", "start": 0, "end": -1}, r"^bc\.value: ramp end \(-1\.0\) must be after its start"),
+        ({"type": "ramp", "end_value": [1, 2]}, r"^bc\.value\.end_value = \[1, 2\]: expected a finite number"),
+        ({"type": "sine", "frequency": float("nan")}, r"^bc\.value\.frequency = nan: expected a finite"),
+        ({"type": "tone_burst", "frequency": "1e5"}, r"^bc\.value\.frequency = '1e5': expected a finite"),
+        ({"type": "sine"}, r"^bc\.value: missing 'frequency', which a Sine needs"),
+        ({"type": "table", "times": 3, "values": [1]}, r"^bc\.value\.times = 3: expected a list of numbers"),
+        ({"type": "table", "times": [0, 1], "values": [1, "a"]}, r"^bc\.value\.values\[1\] = 'a': expected"),
+        (True, r"^bc\.value: expected a number or a mapping"),
+        (float("inf"), r"^bc\.value = inf: expected a finite number"),
+    ],
+)
+def test_every_bad_spec_names_its_key(spec, message):
+    """Issue 17: an error in a signal names the case-file key it came from, and a value of the
+    wrong type is refused rather than computed with (a list ``end_value`` used to be accepted)."""
+    with pytest.raises(InputError, match=message):
+        from_spec(spec, "bc.value")
+
+
+def test_a_gaussian_burst_takes_a_null_delay():
+    """``delay: null`` is the default (4 sigma), not a bad number."""
+    assert from_spec({"type": "gaussian_burst", "frequency": 1e5, "delay": None}) == GaussianBurst(1e5)

@@ -13,9 +13,10 @@ from pathlib import Path
 from typing import Annotated, Literal
 
 import yaml
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, ValidationError, model_validator
 
-from peridyn.errors import CaseFileError, did_you_mean
+from peridyn.errors import CaseFileError, InputError, did_you_mean
+from peridyn.physics.loads import parse_components
 
 
 class _Loader(yaml.SafeLoader):
@@ -71,9 +72,18 @@ def yaml_problem(exc: yaml.YAMLError) -> str:
     return " ".join(f"{problem}{where}".split())
 
 
-Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
-NonNegative = Annotated[float, Field(ge=0, allow_inf_nan=False)]
-Finite = Annotated[float, Field(allow_inf_nan=False)]
+def _not_a_bool(value):
+    """Refuse ``true``/``false`` where a number is expected (pydantic would read them as 1 and 0)."""
+    if isinstance(value, bool):
+        raise ValueError(f"a number, not {str(value).lower()}")
+    return value
+
+
+NotBool = BeforeValidator(_not_a_bool)
+Positive = Annotated[float, NotBool, Field(gt=0, allow_inf_nan=False)]
+NonNegative = Annotated[float, NotBool, Field(ge=0, allow_inf_nan=False)]
+Finite = Annotated[float, NotBool, Field(allow_inf_nan=False)]
+Index = Annotated[int, NotBool]
 Vector3 = Annotated[list[Finite], Field(min_length=2, max_length=3)]
 
 
@@ -91,7 +101,7 @@ class Geometry(Strict):
     type: Literal["box", "plate", "rectangle", "mesh"]
     size: list[Positive] | None = None
     origin: Vector3 | None = None
-    layers: Annotated[int, Field(ge=1)] | None = None
+    layers: Annotated[int, NotBool, Field(ge=1)] | None = None
     layer_placement: Literal["cell", "surface"] = "cell"
     thickness: Positive | None = None
     plane: Literal["stress", "strain"] = "stress"
@@ -110,6 +120,11 @@ class Geometry(Strict):
         if self.type == "mesh" and not self.file:
             raise ValueError("a mesh geometry needs the mesh file")
         return self
+
+    @property
+    def dim(self) -> int:
+        """2 for a rectangle or a 2D mesh, else 3."""
+        return 2 if self.type == "rectangle" or (self.type == "mesh" and self.dimension == 2) else 3
 
 
 class Discretization(Strict):
@@ -163,7 +178,7 @@ class Material(Strict):
 
     model: Literal["pmb", "lps"]
     E: Positive
-    nu: Annotated[float, Field(gt=-1, lt=0.5)] | None = None
+    nu: Annotated[float, NotBool, Field(gt=-1, lt=0.5)] | None = None
     density: Positive
     surface_correction: str = "none"
     damage: Damage | None = None
@@ -181,7 +196,7 @@ class Region(Strict):
     axis: Literal["x", "y", "z"] = "z"
     face: Literal["x-", "x+", "y-", "y+", "z-", "z+"] | None = None
     depth: Positive | None = None
-    index: int | None = None
+    index: Index | None = None
 
     @model_validator(mode="after")
     def _complete(self):
@@ -225,7 +240,7 @@ class BoundaryConditionSpec(Strict):
     set: str
     kind: Literal["displacement", "velocity", "force", "body_force"]
     components: str | list[str] = "xyz"
-    value: float | dict = 0.0
+    value: Finite | dict = 0.0
 
 
 class InitialConditionSpec(Strict):
@@ -246,7 +261,7 @@ class Actuator(Strict):
     center: Annotated[list[Finite], Field(min_length=2, max_length=2)]
     size: Positive
     shape: Literal["square", "circular"] = "square"
-    layer: int | None = -1
+    layer: Index | None = -1
     amplitude: Positive = 1e-6
     line_force: Positive = 1.0
     signal: dict
@@ -258,7 +273,7 @@ class PZTSensor(Strict):
     center: Annotated[list[Finite], Field(min_length=2, max_length=2)]
     size: Positive
     shape: Literal["square", "circular"] = "square"
-    layer: int = -1
+    layer: Index = -1
 
 
 class FKAnalysis(Strict):
@@ -270,8 +285,8 @@ class FKAnalysis(Strict):
     frequency: Positive | None = None
     components: dict[str, Literal["x", "y", "z"]] = {"S0": "x", "A0": "z"}
     window: Literal["hann", "none"] = "hann"
-    pad: Annotated[float, Field(ge=1)] = 2.0
-    tolerance: Annotated[float, Field(gt=0, lt=1)] = 0.2
+    pad: Annotated[float, NotBool, Field(ge=1)] = 2.0
+    tolerance: Annotated[float, NotBool, Field(gt=0, lt=1)] = 0.2
 
 
 class KxKyAnalysis(Strict):
@@ -302,18 +317,18 @@ class Solver(Strict):
     ``linear_solver`` (``lu``, or ``cg`` for large 3D bodies)."""
 
     type: Literal["explicit", "static", "modal", "newton", "newmark"] = "explicit"
-    modes: Annotated[int, Field(ge=1)] = 12
-    steps: Annotated[int, Field(ge=1)] | None = None
+    modes: Annotated[int, NotBool, Field(ge=1)] = 12
+    steps: Annotated[int, NotBool, Field(ge=1)] | None = None
     time: Positive | None = None
     dt: Positive | None = None
-    safety: Annotated[float, Field(gt=0, le=1)] = 0.8
+    safety: Annotated[float, NotBool, Field(gt=0, le=1)] = 0.8
     damping: NonNegative = 0.0
     dtype: Literal["float64", "float32"] = "float64"
     tolerance: Positive = 1e-6
-    max_iterations: Annotated[int, Field(ge=1)] = 200_000
-    load_steps: Annotated[int, Field(ge=1)] = 1
-    newton_iterations: Annotated[int, Field(ge=1)] = 30
-    breaking_rounds: Annotated[int, Field(ge=1)] = 100
+    max_iterations: Annotated[int, NotBool, Field(ge=1)] = 200_000
+    load_steps: Annotated[int, NotBool, Field(ge=1)] = 1
+    newton_iterations: Annotated[int, NotBool, Field(ge=1)] = 30
+    breaking_rounds: Annotated[int, NotBool, Field(ge=1)] = 100
     displacement_tolerance: Positive = 1e-10
     linear_solver: Literal["lu", "cg"] = "lu"
     #: modal: ``shift-invert`` (factorised), ``lobpcg`` (matrix-free) or ``auto`` (by the
@@ -346,15 +361,15 @@ class LineSpec(Strict):
 
     start: Vector3
     end: Vector3
-    points: Annotated[int, Field(ge=2)]
+    points: Annotated[int, NotBool, Field(ge=2)]
 
 
 class Output(Strict):
     """Where and what to write (folder default: ``peridyn-out/<case name>``)."""
 
     directory: str | None = None
-    every: Annotated[int, Field(ge=1)] = 1
-    snapshot_every: Annotated[int, Field(ge=1)] | None = None
+    every: Annotated[int, NotBool, Field(ge=1)] = 1
+    snapshot_every: Annotated[int, NotBool, Field(ge=1)] | None = None
     snapshot_times: list[NonNegative] = []
     sensors: dict[str, Vector3] = {}
     lines: dict[str, LineSpec] = {}
@@ -410,6 +425,22 @@ class Case(Strict):
                 f"absorbing: layers damp the explicit solver only, not the "
                 f"{self.solver.type} solver (use solver.type explicit)"
             )
+        return self
+
+    @model_validator(mode="after")
+    def _components(self):
+        for name in ("boundary_conditions", "initial_conditions"):
+            for i, condition in enumerate(getattr(self, name)):
+                try:
+                    components = parse_components(condition.components)
+                except InputError as exc:
+                    raise ValueError(f"{name}[{i}].components: {exc}") from None
+                # the default "xyz" means x and y on a 2D body; a z written out is a mistake
+                if self.geometry.dim == 2 and 2 in components and "components" in condition.model_fields_set:
+                    raise ValueError(
+                        f"{name}[{i}].components = {condition.components!r}: a 2D body has "
+                        "components x and y only"
+                    )
         return self
 
     @model_validator(mode="after")
@@ -486,7 +517,8 @@ def validate_case(raw: dict, source: str = "<case>") -> Case:
 
 
 def apply_override(raw: dict, item: str, source: str = "<case>") -> None:
-    """Set ``key.path=value`` in the nested dict ``raw`` (list items by index: ``a.0.b``)."""
+    """Set ``key.path=value`` in the nested dict ``raw`` (list items by index: ``a.0.b``, or
+    ``a[0].b`` as the error messages write it)."""
     if "=" not in item:
         raise CaseFileError(source, item, None, "an override of the form key.path=value")
     key, text = item.split("=", 1)
@@ -494,7 +526,7 @@ def apply_override(raw: dict, item: str, source: str = "<case>") -> None:
         value = parse_yaml(text)
     except yaml.YAMLError as exc:
         raise CaseFileError(source, key.strip(), text, f"a YAML value ({yaml_problem(exc)})") from None
-    parts = key.strip().split(".")
+    parts = re.sub(r"\[(-?\d+)\]", r".\1", key.strip()).split(".")
     node = raw
     for depth, part in enumerate(parts[:-1]):
         node = _child(node, part, source, ".".join(parts[: depth + 1]))
@@ -521,6 +553,10 @@ def _index(node: list, part: str, source: str, where: str) -> int:
     return int(part)
 
 
+#: The message of a check across keys: "key: what is wrong" or "key = value: what is wrong".
+_NAMED_PROBLEM = re.compile(r"(?P<key>[A-Za-z_][\w.\[\]-]*)(?: = (?P<value>.+?))?: (?P<expected>.+)", re.S)
+
+
 def _case_error(exc: ValidationError, source: str) -> CaseFileError:
     lines = []
     first = None
@@ -534,10 +570,16 @@ def _case_error(exc: ValidationError, source: str) -> CaseFileError:
             expected, value = "a required key that is missing", None
         else:
             expected = err["msg"].removeprefix("Value error, ")
+        if not loc and (named := _NAMED_PROBLEM.match(expected)):  # a check across keys names its key
+            loc, value, expected = named["key"], named["value"], named["expected"]
+            lines.append(named.string)
+        else:
+            lines.append(f"{loc} = {value!r}: {expected}" if loc else expected)
         if first is None:
-            first = (loc, value, expected)
-        lines.append(f"{loc} = {value!r}: {expected}" if loc else expected)
+            first = (loc, value, expected, lines[-1])
     error = CaseFileError(source, first[0] or "<root>", first[1], first[2])
+    if first[0] and first[3] != f"{first[0]} = {first[1]!r}: {first[2]}":
+        error.args = (f"{source}: {first[3]}",)
     if len(lines) > 1:
         error.args = (f"{source}: {len(lines)} problems:\n  " + "\n  ".join(lines),)
     return error
@@ -583,7 +625,7 @@ def _model_in(annotation):
 class FatigueBlock(Strict):
     """``steps`` fatigue steps of 1 / ``tau`` cycles each (the thesis's linear cycle mapping)."""
 
-    steps: Annotated[int, Field(ge=1)]
+    steps: Annotated[int, NotBool, Field(ge=1)]
     tau: Positive
 
 
@@ -595,7 +637,7 @@ class FatigueTip(Strict):
 
     axis: Literal["x", "y", "z"] = "x"
     depth_axis: Literal["x", "y", "z"] = "z"
-    damage: Annotated[float, Field(gt=0, le=1)] = 0.385
+    damage: Annotated[float, NotBool, Field(gt=0, le=1)] = 0.385
     start: float | None = None
     sense: Literal["+", "-"] = "+"
 
@@ -603,7 +645,7 @@ class FatigueTip(Strict):
 class FatigueModal(Strict):
     """Free-free modal analyses before and after the fatigue run: ``modes`` modes, rigid included."""
 
-    modes: Annotated[int, Field(ge=7)] = 12
+    modes: Annotated[int, NotBool, Field(ge=7)] = 12
 
 
 class ParisSpecimen(Strict):
@@ -643,8 +685,8 @@ class Fatigue(Strict):
     A_II: Positive
     m_II: Positive
     A_II_horizon: Positive | None = None
-    phi_c: Annotated[float, Field(gt=0, le=1)] = 0.385
-    load_ratio: Annotated[float, Field(ge=-1, lt=1)] = 0.0
+    phi_c: Annotated[float, NotBool, Field(gt=0, le=1)] = 0.385
+    load_ratio: Annotated[float, NotBool, Field(ge=-1, lt=1)] = 0.0
     max_load_time: NonNegative = 1.0
     mapping: Annotated[list[FatigueBlock], Field(min_length=1)]
     adaptive: bool = False

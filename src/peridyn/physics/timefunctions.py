@@ -8,7 +8,7 @@ Nothing is ever evaluated from a string.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import MISSING, dataclass
 from pathlib import Path
 
 import numpy as np
@@ -231,8 +231,8 @@ def from_spec(spec, where: str = "value") -> TimeFunction:
     parameters; ``table`` takes ``file`` (CSV) or ``times`` and ``values``;
     ``sum`` and ``product`` take ``terms``.
     """
-    if isinstance(spec, int | float):
-        return Constant(float(spec))
+    if isinstance(spec, int | float) and not isinstance(spec, bool):
+        return Constant(_finite(where, spec))
     if isinstance(spec, TimeFunction):
         return spec
     if not isinstance(spec, dict) or "type" not in spec:
@@ -248,7 +248,12 @@ def from_spec(spec, where: str = "value") -> TimeFunction:
     if kind == "table":
         if "file" in params:
             return Tabulated.from_csv(params["file"])
-        return _construct(Tabulated, where, {k: tuple(v) for k, v in params.items()})
+        lists = {}
+        for k, v in params.items():
+            if not isinstance(v, list | tuple):
+                raise InputError(f"{where}.{k} = {v!r}: expected a list of numbers")
+            lists[k] = tuple(_finite(f"{where}.{k}[{i}]", x) for i, x in enumerate(v))
+        return _construct(Tabulated, where, lists)
     if kind not in _SIMPLE:
         choices = [*_SIMPLE, "table", "sum", "product"]
         raise InputError(
@@ -258,7 +263,15 @@ def from_spec(spec, where: str = "value") -> TimeFunction:
     return _construct(_SIMPLE[kind], where, params)
 
 
+def _finite(where: str, value) -> float:
+    """``value`` as a float, or an ``InputError`` naming ``where`` if it is not a finite number."""
+    if isinstance(value, bool) or not isinstance(value, int | float) or not np.isfinite(value):
+        raise InputError(f"{where} = {value!r}: expected a finite number")
+    return float(value)
+
+
 def _construct(cls, where: str, params: dict) -> TimeFunction:
+    """``cls(**params)``; every error names ``where`` (the case-file key)."""
     fields = cls.__dataclass_fields__
     unknown = [k for k in params if k not in fields]
     if unknown:
@@ -267,7 +280,15 @@ def _construct(cls, where: str, params: dict) -> TimeFunction:
             f"{did_you_mean(unknown[0], fields)} for {cls.__name__}; "
             f"allowed: {sorted(fields)}"
         )
+    missing = [k for k, f in fields.items() if f.default is MISSING and k not in params]
+    if missing:
+        raise InputError(f"{where}: missing {missing[0]!r}, which a {cls.__name__} needs")
+    if cls is not Tabulated:  # the others take numbers only (None where that is the default)
+        params = {
+            k: v if v is None and fields[k].default is None else _finite(f"{where}.{k}", v)
+            for k, v in params.items()
+        }
     try:
         return cls(**params)
-    except TypeError as exc:
-        raise InputError(f"{where}: {exc}") from exc
+    except (TypeError, InputError) as exc:
+        raise InputError(f"{where}: {exc}") from None
