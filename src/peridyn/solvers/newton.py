@@ -51,13 +51,13 @@ class NewtonStep:
     residuals : list of list of float
         Relative residual before each Newton iteration and at the end, one list per
         equilibrium solve (the first, then one per round of bond breaking).
-    bonds_broken : int
+    broken_bonds : int
     converged : bool
     """
 
     time: float
     residuals: list = field(default_factory=list)
-    bonds_broken: int = 0
+    broken_bonds: int = 0
     converged: bool = False
 
 
@@ -74,7 +74,7 @@ class NewtonResult:
         Newton iterations (linear solves) over all steps.
     converged : bool
         Every step converged and stopped breaking bonds.
-    bonds_broken : int
+    broken_bonds : int
     steps : list of NewtonStep
     """
 
@@ -82,7 +82,7 @@ class NewtonResult:
     residual: float
     iterations: int
     converged: bool
-    bonds_broken: int
+    broken_bonds: int
     steps: list
 
 
@@ -149,11 +149,11 @@ def newton(
             if not converged:
                 break
             broken = damage.update(u) if damage is not None else 0
-            step.bonds_broken += broken
+            step.broken_bonds += broken
             if broken == 0:
                 step.converged = True
                 break
-        broken_total += step.bonds_broken
+        broken_total += step.broken_bonds
         steps.append(step)
         if not step.converged:
             break

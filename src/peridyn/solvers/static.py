@@ -40,14 +40,14 @@ class RelaxationResult:
         Relative out-of-balance force at the end.
     iterations : int
     converged : bool
-    bonds_broken : int
+    broken_bonds : int
     """
 
     u: np.ndarray
     residual: float
     iterations: int
     converged: bool
-    bonds_broken: int = 0
+    broken_bonds: int = 0
 
 
 def relax(
