@@ -202,7 +202,7 @@ class Family:
         Volume of each neighbour times its partial-volume factor, or the
         quadrature weight of a continuous family.
     influence : (n,) float64
-        omega(|xi|).
+        ``omega(|xi|)``.
     dim : int
     horizon : float, m
     influence_name : str
@@ -220,12 +220,12 @@ class Family:
 
     @property
     def length(self) -> np.ndarray:
-        """(n,) |xi|, m."""
+        """(n,) ``|xi|``, m."""
         return np.linalg.norm(self.xi, axis=1)
 
     @property
     def weighted_volume(self) -> float:
-        """m = sum omega V |xi|^2 (m^5 in 3D)."""
+        """``m = sum omega V |xi|^2`` (m^5 in 3D)."""
         return float(np.sum(self.influence * self.volume * self.length**2))
 
 
@@ -317,7 +317,7 @@ def continuum_family(
 ) -> Family:
     """Quadrature family of the continuous horizon (segment, disc or ball), aligned with ``direction``.
 
-    Gauss-Legendre in |xi| on [0, delta] (mirrored in 1D) and, in 3D, in the
+    Gauss-Legendre in ``|xi|`` on [0, delta] (mirrored in 1D) and, in 3D, in the
     cosine of the polar angle about ``direction``; trapezoidal rule in the
     azimuth (4 nodes in 3D, where the integrand is a trigonometric polynomial
     of degree 2 in it; as many as the radial nodes in 2D). The node count grows

@@ -61,7 +61,13 @@ class ArgumentParser(argparse.ArgumentParser):
 
     def subcommand(self, name: str) -> ArgumentParser:
         """The parser of subcommand ``name``."""
-        return next(a.choices[name] for a in self._subparsers._group_actions if name in (a.choices or ()))
+        return self.subcommands()[name]
+
+    def subcommands(self) -> dict[str, ArgumentParser]:
+        """The parsers of the subcommands by name, in the order ``--help`` lists them."""
+        if self._subparsers is None:
+            return {}
+        return {name: p for a in self._subparsers._group_actions for name, p in (a.choices or {}).items()}
 
 
 _ARGUMENT = re.compile(r"argument (?P<key>[^:]+): (?P<detail>.*)")

@@ -65,9 +65,9 @@ class Bonds:
     offsets : (n_points + 1,) int64
     neighbours : (n_bonds,) int32
     length : (n_bonds,) float64, m
-        Reference bond length |xi|.
+        Reference bond length ``|xi|``.
     influence : (n_bonds,) float64
-        Influence function value omega(|xi|).
+        Influence function value ``omega(|xi|)``.
     volume_factor : (n_bonds,) float64
         Fraction of the neighbour's cell inside the horizon (1 without partial volumes).
     intact : (n_bonds,) bool
@@ -138,7 +138,7 @@ def find_bonds(
     ----------
     body : Body
     horizon : float, m
-        Bonds with |xi| <= horizon (1 + 1e-12) are kept; with partial volumes,
+        Bonds with ``|xi| <= horizon (1 + 1e-12)`` are kept; with partial volumes,
         every neighbour whose cell reaches into the horizon sphere is kept.
     influence : str
         Name of the influence function (see ``INFLUENCE_FUNCTIONS``).

@@ -62,14 +62,14 @@ class Results:
 
     def series(self, name: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """A whole series: steps (n_records,) int64, times (n_records,) float64 in s, and the
-        records (n_records, *record_shape) in their stored dtype."""
+        records ``(n_records, *record_shape)`` in their stored dtype."""
         with self._series(name) as group:
             n = n_records(group)
             return group["step"][:n], group["time"][:n], group["data"][:n]
 
     def iter_series(self, name: str, chunk_records: int) -> Iterator[tuple[np.ndarray, np.ndarray]]:
         """A series a few records at a time, without loading it whole: yields times (k,) in s
-        and records (k, *record_shape), ``k <= chunk_records`` (the last chunk may be shorter)."""
+        and records ``(k, *record_shape)``, ``k <= chunk_records`` (the last chunk may be shorter)."""
         if not is_integer(chunk_records) or chunk_records < 1:
             raise InputError(f"chunk_records must be a positive integer, got {chunk_records!r}")
         with self._series(name) as group:

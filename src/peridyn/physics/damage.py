@@ -17,13 +17,13 @@ The criterion sigma_b > sigma_u is therefore the critical stretch
 s_c = sigma_u / E (seed 004: sigma_u = 40 MPa, E = 70 GPa -> s_c = 5.71e-4), the same
 for PMB and LPS, 2D and 3D. See docs/theory.md, "Critical bond stress".
 
-The stretch-test skin. A bond (i, j) breaks when its deformed length |Y| passes its
-critical length L_c = |xi| (1 + s_c). Between two displacements |Y| changes by at most
-|du_i| + |du_j| (triangle inequality), so a bond with margin L_c - |Y| cannot break before
+The stretch-test skin. A bond (i, j) breaks when its deformed length ``|Y|`` passes its
+critical length ``L_c = |xi| (1 + s_c)``. Between two displacements ``|Y|`` changes by at most
+``|du_i| + |du_j|`` (triangle inequality), so a bond with margin ``L_c - |Y|`` cannot break before
 its end points have moved that much. ``BondDamage.update`` therefore tests every bond only
 now and then (a "full test" at a reference displacement u_ref), keeping per point the
 smallest margin m_i of its intact breakable bonds. At the next calls, with
-d_k = |u_k - u_ref_k|, a bond can only break if m < d_i + d_j <= 2 max(d_i, d_j): only the
+``d_k = |u_k - u_ref_k|``, a bond can only break if m < d_i + d_j <= 2 max(d_i, d_j): only the
 points with m_i <= 2 d_i have their families tested, and a bond broken there is broken in
 both copies (the other end may not be tested). Their margins are refreshed, taken back to
 u_ref (minus d_j per bond and d_i). When ``FULL_TEST_SHARE`` of the points or more would

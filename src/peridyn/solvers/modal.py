@@ -13,7 +13,7 @@ usual materials), so a symmetric fill-reducing order (geometric nested dissectio
 ``linalg.ordering``) with little pivoting factorises it
 at a fraction of the memory and time of K itself (D < 0, as for a 2D plane-stress LPS
 with nu < 1/3, only needs more pivoting). Rigid-body modes
-(six for a free 3D body, three in 2D) come out with |f| near zero and are
+(six for a free 3D body, three in 2D) come out with ``|f|`` near zero and are
 counted and reported separately.
 
 Where the factor would be too large (wide horizons, large bodies; the choice is
