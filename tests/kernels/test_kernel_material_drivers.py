@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 from conftest import MODEL_CASES, small_model
 
-from peridyn.kernels.reference import lps, pmb
+from peridyn.kernels.reference import lps, pmb, stress
 
 pytestmark = pytest.mark.kernels
 
@@ -38,3 +38,29 @@ def test_kernel_matches_numpy_reference(case, rng):
         )
     got = model.force(u)
     np.testing.assert_allclose(got, ref, rtol=1e-10, atol=1e-12 * np.abs(ref).max())
+
+
+@pytest.mark.parametrize("surface_correction", ["none", "energy"])
+@pytest.mark.parametrize("name", ["pmb", "lps"])
+def test_partial_stress_is_the_materials_force_state(name, surface_correction, rng):
+    """``model.partial_stress(u)`` (built from the linearisation) is sum_j T_ij (x) xi_ij V_j with
+    each material's own force state of its module docstring: PMB T V_j = k e / (2 |xi|) (half the
+    pair force), LPS t = w |xi| P_i + alpha_i g_ij w e with P_i = p_coef_i theta_i; 1e-10 of the
+    largest entry (sums of ~100 bonds)."""
+    model = small_model(name, 3, n=8, surface_correction=surface_correction)
+    b = model.bonds
+    b.intact[rng.random(b.n_bonds) < 0.05] = False
+    u = 1e-5 * rng.standard_normal(model.x.shape)
+    n = model.body.n_points
+    if name == "pmb":
+        axial, owner, p = np.zeros(b.n_bonds), model.bond_stiffness / (2 * b.length), np.zeros(n)
+    else:
+        w = np.asarray(model.w, dtype=np.float64)
+        theta = lps.lps_dilatation(
+            model.x, u, b.offsets, b.neighbours, b.length, w, b.intact, model.theta_coef
+        )
+        axial, owner = w * b.length, model.alpha[b.owners()] * model.dev_factor * w
+        p = theta * model._p_coef
+    ref = stress.partial_stress(model.x, u, b.offsets, b.neighbours, b.length, axial, owner, b.intact, p)
+    got = model.partial_stress(u)
+    np.testing.assert_allclose(got, ref, rtol=0, atol=1e-10 * np.abs(ref).max())

@@ -378,6 +378,9 @@ class Output(Strict):
     series_dtype: Literal["float64", "float32"] = "float64"
     vtu: bool = True
     plots: bool = True
+    #: per-point partial stress and Green-Lagrange strain in the final fields and VTU snapshots
+    stress: bool = False
+    strain: bool = False
 
 
 class ContactSpec(Strict):

@@ -9,6 +9,11 @@ Series in ``results.h5`` (see ``peridyn.io.hdf5`` for the layout):
 - ``pzt_signal``: (n_pzt,) mean in-plane strain under each PZT sensor patch;
 - ``field_u``: (n_points, 3) displacement at every snapshot, with ``snapshots/*.vtu``
   files and ``snapshots.pvd`` for ParaView.
+
+When asked (``stress``, ``strain``), the final fields ``final/stress`` (partial stress, Pa) and
+``final/strain`` (Green-Lagrange strain) with ``final/strain_valid``, (n_points, dim, dim)
+and (n_points,) bool (``peridyn.physics.deformation``), and the same point data in every VTU
+snapshot (9 components, row-major, padded with zeros in 2D: a tensor for ParaView).
 """
 
 from __future__ import annotations
@@ -25,6 +30,7 @@ from peridyn.errors import InputError
 from peridyn.io.hdf5 import HDF5Writer
 from peridyn.io.vtk import PVDCollection, write_vtu
 from peridyn.physics.damage import damage_field
+from peridyn.physics.deformation import strain_field
 
 
 @dataclass
@@ -58,6 +64,8 @@ class RecorderSpec:
         Storage type of the line and plane series (float32 halves big records).
     vtu : bool
         Write VTU snapshots and a PVD collection.
+    stress, strain : bool
+        Write the per-point partial stress / Green-Lagrange strain (final fields and VTU).
     """
 
     every: int = 1
@@ -69,6 +77,8 @@ class RecorderSpec:
     pzt_sensors: dict = field(default_factory=dict)
     series_dtype: str = "float64"
     vtu: bool = True
+    stress: bool = False
+    strain: bool = False
 
 
 class Recorder:
@@ -83,7 +93,7 @@ class Recorder:
     provenance : dict
         Stored as attributes of the results file.
     model : Model or None
-        Needed to write the damage index into snapshots.
+        Needed to write the damage index into snapshots, and for stress and strain.
     resume : (step, time) or None
         Reopen an existing results file and drop the records after this step and
         time (s), for a restart from a checkpoint.
@@ -105,6 +115,8 @@ class Recorder:
         self.model = model
         if spec.every < 1:
             raise InputError(f"output.every must be at least 1, got {spec.every}")
+        if (spec.stress or spec.strain) and model is None:
+            raise InputError("output.stress and output.strain need the model: the recorder has none")
         tree = cKDTree(body.points)
         self.sensor_names = list(spec.sensors)
         self.sensor_index = (
@@ -194,6 +206,8 @@ class Recorder:
         data = {"displacement": state.u[:, : self.body.dim], "velocity": state.v[:, : self.body.dim]}
         if self.model is not None:
             data["damage"] = damage_field(self.model)
+        for key, value in self._tensor_fields(state.u).items():
+            data[key] = _padded_tensor(value)
         name = f"snapshots/step_{state.step:08d}.vtu"
         write_vtu(self.directory / name, self.body.points[:, : self.body.dim], data)
         self.pvd.add(state.time, name)
@@ -204,10 +218,32 @@ class Recorder:
         self.h5.write_array("final/v", state.v)
         if self.model is not None:
             self.h5.write_array("final/damage", damage_field(self.model))
+        for key, value in self._tensor_fields(state.u).items():
+            self.h5.write_array(f"final/{key}", value)
         self.h5.close()
+
+    def _tensor_fields(self, u: np.ndarray) -> dict:
+        """The per-point fields asked for: ``stress`` (n, dim, dim) Pa, ``strain`` (n, dim, dim)
+        and ``strain_valid`` (n,) bool."""
+        fields, dim = {}, self.body.dim
+        if self.spec.stress:
+            fields["stress"] = self.model.partial_stress(u)[:, :dim, :dim]
+        if self.spec.strain:
+            fields["strain"], fields["strain_valid"] = strain_field(self.body, self.model.bonds, u)
+        return fields
 
     def close(self, status: str | None = None) -> None:
         """Close the file early (failure, interruption), setting its ``status`` when given."""
         if status is not None:
             self.h5.set_status(status)
         self.h5.close()
+
+
+def _padded_tensor(values: np.ndarray) -> np.ndarray:
+    """A VTU point field: (n, dim, dim) tensors as (n, 9) rows, zero-padded to 3 x 3 in 2D;
+    other shapes pass through."""
+    if values.ndim != 3:
+        return values
+    full = np.zeros((len(values), 3, 3), dtype=values.dtype)
+    full[:, : values.shape[1], : values.shape[2]] = values
+    return full.reshape(len(values), 9)

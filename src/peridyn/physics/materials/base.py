@@ -11,6 +11,9 @@ with ``peridyn.physics.materials.registry.register_material``. It implements
 - :meth:`Model._linearise`, returning the :class:`BondLinearisation` of its small-displacement
   form (``peridyn.physics.materials.linearisation``): everything ``linalg.stiffness``,
   ``linalg.block_operator``, ``linalg.tangent``, the modal solvers and fatigue statics need;
+- :meth:`Model.partial_stress` (the per-point stress of the output), whose default is built
+  from the linearisation and is exact for every ordinary state-based or bond-based law
+  (PMB, LPS); a material of another form overrides it;
 
 and, if its constructor does not take the case parameters as keywords, :meth:`from_parameters`.
 Code outside this package asks the model only through these methods and the attributes
@@ -24,6 +27,8 @@ import numpy as np
 
 from peridyn.discretization.body import Body
 from peridyn.discretization.bonds import Bonds
+from peridyn.kernels.lps import lps_dilatation
+from peridyn.kernels.stress import partial_stress
 from peridyn.physics.materials.linearisation import BondLinearisation
 
 
@@ -141,6 +146,44 @@ class Model:
     def _linearise(self) -> BondLinearisation:
         """Build the :class:`BondLinearisation` (called once by :meth:`linearisation`)."""
         raise NotImplementedError
+
+    def partial_stress(self, u: np.ndarray) -> np.ndarray:
+        """Peridynamic partial stress of every point (n_points, 3, 3), Pa, at ``u`` (n_points, 3), m.
+
+        sigma_i = sum_j T_ij (x) xi_ij V_j over the intact bonds, T_ij the force state of point
+        i on bond ij (force per volume squared) and xi_ij the reference bond: the "partial
+        stress" of Peridigm (its ``Partial_Stress``), i.e. the peridynamic stress tensor of
+        Lehoucq and Silling (2008) in the limit of a small horizon, nu_0 = int T<xi> (x) xi dV_xi
+        (Silling and Lehoucq 2010, "Peridynamic theory of solid mechanics", sec. 8). It is a
+        first Piola-Kirchhoff (nominal) stress: force per reference area, not symmetric under
+        finite rotations. In 2D its out-of-plane components are 0.
+
+        The default takes the force state of point i as the derivative of its own energy in
+        the linearisation (``materials.linearisation``: W_i = sum_j pair_ij e_ij^2 / 4 +
+        c_i theta_i^2), with the deformed extension e = |Y| - |xi| and direction Y / |Y| as the
+        nonlinear tangent does:
+
+            T_ij V_j = [weight_ij |xi_ij| P_i + (pair_ij / 2) e_ij] Y_ij / |Y_ij|,
+            P_i = p_coef_i theta_i,  theta_i = theta_coef_i sum_j weight_ij |xi_ij| e_ij,
+
+        exact for the ordinary state-based and bond-based forces (PMB: k e / (2 |xi|), half
+        the pair force; LPS: t = w |xi| P_i + alpha_i g_ij w e). Computed in float64 whatever
+        the kernel dtype; broken bonds carry no force.
+        """
+        b, lin = self.bonds, self.linearisation()
+        x = self.body.points
+        u = np.ascontiguousarray(u, dtype=np.float64)
+        n = self.body.n_points
+        if lin.has_dilatation:
+            theta = lps_dilatation(
+                x, u, b.offsets, b.neighbours, b.length, lin.weight, b.intact, lin.theta_coef, np.empty(n)
+            )
+            p, axial = lin.p_coef * theta, lin.weight * b.length
+        else:
+            p, axial = np.zeros(n), np.zeros(b.n_bonds)
+        return partial_stress(
+            x, u, b.offsets, b.neighbours, b.length, axial, 0.5 * lin.pair, b.intact, p, np.empty((n, 3, 3))
+        )
 
     @property
     def has_dilatation(self) -> bool:
