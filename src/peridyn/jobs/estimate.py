@@ -53,8 +53,8 @@ class Costs:
 #: ``static``, ``newton``, ``newmark``: + a bond-stiffness assembly (9 entries of 8 B values + 2 x 4 B
 #: indices per bond, COO then CSR): about 400 B.
 #: ``fatigue``: statics by AMG-preconditioned CG (or a factor) and modal analyses before and after:
-#: 2 400 B per bond, fitted to the one measured run (dog-bone at 0.33 mm, 795 k directed bonds,
-#: 2.05 GiB peak; benchmarks/RESULTS.md) and not checked at other sizes.
+#: 2 400 B per bond, fitted to one measured run (dog-bone at 0.33 mm, 795 k directed bonds,
+#: 2.05 GiB peak) and 7-11 % high on the SEN strip at 132 k-1.24 M bonds (benchmarks/RESULTS.md).
 #: ``modal``: + the stiffness parts P and G (LPS) in COO and CSR and the augmented matrix:
 #: about 500 B; per point the mode shapes are small (n_modes x 24 B) next to the bonds.
 COSTS = {
