@@ -60,6 +60,7 @@ def main(argv: list[str] | None = None) -> int:
     :func:`peridyn.cli.errors.report`.
     """
     argv = sys.argv[1:] if argv is None else list(argv)
+    _quiet_unless_first_rank()
     args = None
     with plain_warnings():
         try:
@@ -104,6 +105,16 @@ def _dispatch(parser: ArgumentParser, args) -> int:
             json.dump(summary, sys.stdout, default=_to_builtin)
             sys.stdout.write("\n")
     return 0
+
+
+def _quiet_unless_first_rank() -> None:
+    """Under ``mpiexec -n N`` only rank 0 speaks: the other ranks' stdout and stderr go to
+    /dev/null (every rank raises the same error at the same point, ``peridyn.parallel.domain``,
+    and rank 0 reports it once)."""
+    from peridyn.parallel.comm import launched_by_mpi, world
+
+    if launched_by_mpi() and world().rank > 0:
+        sys.stdout = sys.stderr = open(os.devnull, "w")  # noqa: SIM115 - for the process's lifetime
 
 
 def _drop_unwritable_stdout() -> None:

@@ -24,7 +24,6 @@ from peridyn.discretization.state import State, check_state, runaway_limit
 from peridyn.errors import InputError
 from peridyn.io.hdf5 import HDF5Writer
 from peridyn.io.vtk import PVDCollection, write_vtu
-from peridyn.physics.damage import damage_field
 
 
 @dataclass
@@ -70,6 +69,18 @@ class RecorderSpec:
     series_dtype: str = "float64"
     vtu: bool = True
 
+    def series_due(self, step: int) -> bool:
+        """True when the probe series are recorded at ``step``."""
+        return step % self.every == 0
+
+    def snapshot_due(self, step: int) -> bool:
+        """True when a field snapshot is written at ``step``."""
+        return bool(self.snapshot_every and step % self.snapshot_every == 0) or step in self.snapshot_steps
+
+    def due(self, step: int) -> bool:
+        """True when anything is recorded at ``step``."""
+        return self.series_due(step) or self.snapshot_due(step)
+
 
 class Recorder:
     """Observer of an explicit run that writes ``results.h5`` (and VTU files) incrementally.
@@ -82,8 +93,9 @@ class Recorder:
     spec : RecorderSpec
     provenance : dict
         Stored as attributes of the results file.
-    model : Model or None
-        Needed to write the damage index into snapshots.
+    damage : callable () -> (n_points,) float64, or None
+        The damage index of the current state, for snapshots and the final state (e.g.
+        ``lambda: damage_field(model)``); None: no damage written.
     resume : (step, time) or None
         Reopen an existing results file and drop the records after this step and
         time (s), for a restart from a checkpoint.
@@ -95,14 +107,14 @@ class Recorder:
         directory,
         spec: RecorderSpec,
         provenance: dict,
-        model=None,
+        damage=None,
         resume: tuple[int, float] | None = None,
     ):
         self.body = body
         self.directory = Path(directory)
         self.directory.mkdir(parents=True, exist_ok=True)
         self.spec = spec
-        self.model = model
+        self.damage = damage
         if spec.every < 1:
             raise InputError(f"output.every must be at least 1, got {spec.every}")
         tree = cKDTree(body.points)
@@ -157,10 +169,9 @@ class Recorder:
 
     def observe(self, state: State, solver) -> None:
         """Record what is due at this step (called after every step)."""
-        if state.step % self.spec.every == 0:
+        if self.spec.series_due(state.step):
             self.record_series(state)
-        every = self.spec.snapshot_every
-        if (every and state.step % every == 0) or state.step in self.spec.snapshot_steps:
+        if self.spec.snapshot_due(state.step):
             self.snapshot(state)
 
     def record_series(self, state: State) -> None:
@@ -192,8 +203,8 @@ class Recorder:
         if self.pvd is None:
             return
         data = {"displacement": state.u[:, : self.body.dim], "velocity": state.v[:, : self.body.dim]}
-        if self.model is not None:
-            data["damage"] = damage_field(self.model)
+        if self.damage is not None:
+            data["damage"] = self.damage()
         name = f"snapshots/step_{state.step:08d}.vtu"
         write_vtu(self.directory / name, self.body.points[:, : self.body.dim], data)
         self.pvd.add(state.time, name)
@@ -202,8 +213,8 @@ class Recorder:
         """Write the final state, then close the file."""
         self.h5.write_array("final/u", state.u)
         self.h5.write_array("final/v", state.v)
-        if self.model is not None:
-            self.h5.write_array("final/damage", damage_field(self.model))
+        if self.damage is not None:
+            self.h5.write_array("final/damage", self.damage())
         self.h5.close()
 
     def close(self, status: str | None = None) -> None:

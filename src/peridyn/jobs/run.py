@@ -26,6 +26,7 @@ from peridyn.jobs.build import Setup, build, pad3
 from peridyn.jobs.figures import draw_crack_figures, draw_run_figures, final_crack_paths
 from peridyn.jobs.lamb_analysis import analyse
 from peridyn.jobs.summary import finish_summary
+from peridyn.parallel.observers import RootObservers
 from peridyn.physics.absorbing import layer_damping
 from peridyn.physics.damage import damage_field
 from peridyn.physics.transducers import pzt_sensor_weights
@@ -77,6 +78,7 @@ def run_case(
     base_dir=".",
     overwrite: bool = False,
     command: str | None = None,
+    comm=None,
 ) -> dict:
     """Run a case and write its results; returns the summary (also stored in results.h5; keys
     in docs/user-guide.md, "Summaries and results files").
@@ -97,6 +99,11 @@ def run_case(
         Replace an earlier run's results in the output folder.
     command : str or None
         The command line that started the run, for the resume hint of ``Interrupted``.
+    comm : communicator or None
+        ``peridyn.parallel.comm.world()`` under ``mpiexec -n N`` (N > 1): each rank runs its
+        part of the body (``peridyn.parallel``), rank 0 writes the one results.h5 with every
+        record equal to a serial run's, and every rank returns the summary. An explicit run
+        without contact, checkpoints or restarts, for now. None: one process.
 
     Raises
     ------
@@ -114,9 +121,13 @@ def run_case(
         )
     if restart and not stepping:
         raise InputError(f"--restart continues an explicit or newmark run, not a {case.solver.type} run")
-    setup = build(case, base_dir)
+    if comm is not None and comm.size > 1:
+        _check_parallel(case, checkpoint_every, restart)
+    setup = build(case, base_dir, comm)
+    domain = setup.domain
     solver = _time_stepper(case, setup) if stepping else None
-    out = prepare_output(output_directory(case, output_dir), RESULTS, overwrite, restart)
+    out = output_directory(case, output_dir)
+    domain.on_root(prepare_output, out, RESULTS, overwrite, restart)
     written = not restart  # a restart writes once its checkpoint is accepted (the recorder's part)
     try:
         summary, plots = _solve(
@@ -127,13 +138,23 @@ def run_case(
     except Interrupted as exc:
         raise Interrupted(exc.signal_name, exc.step, _resume_hint(command) if exc.resume else "") from None
     except Exception as exc:
-        if written:
+        if written and domain.is_root:
             try:
-                _set_status(out / RESULTS, setup.body, failure_status(exc))
+                _set_status(out / RESULTS, setup.whole_body, failure_status(exc))
             except Exception:  # noqa: BLE001 - e.g. the full disk that failed the run: its error is the one to report
                 pass
         raise
-    return summary
+    return domain.comm.bcast(summary)
+
+
+def _check_parallel(case: Case, checkpoint_every, restart: bool) -> None:
+    """Refuse what an MPI run cannot do yet."""
+    if case.solver.type != "explicit":
+        raise InputError(
+            f"an MPI run (mpiexec -n N) is an explicit run for now, not a {case.solver.type} run"
+        )
+    if checkpoint_every is not None or restart:
+        raise InputError("checkpoints and restarts of an MPI run are not supported yet: run without them")
 
 
 def _resume_hint(command: str | None) -> str:
@@ -158,20 +179,26 @@ def _solve(case, setup, solver, out, case_path, checkpoint_every, restart, progr
 
 
 def _finish(case, setup, out, summary, plots, start) -> None:
-    """Analyses, figures and the stored summary after the solve; the status becomes complete."""
-    analysis, figures = analyse(case, setup.body, out, plots=case.output.plots)
+    """Analyses, figures and the stored summary after the solve; the status becomes complete
+    (on rank 0, with the damage of the whole body)."""
+    d = setup.domain
+    phi = d.gather(damage_field(setup.model)) if setup.damage is not None else None
+    d.on_root(_finish_on_root, case, setup.whole_body, out, summary, plots, start, phi)
+
+
+def _finish_on_root(case, body, out, summary, plots, start, phi) -> None:
+    """``_finish`` on rank 0: ``body`` the whole body, ``phi`` its damage (None without damage)."""
+    analysis, figures = analyse(case, body, out, plots=case.output.plots)
     summary.update(analysis)
-    paths = (
-        final_crack_paths(case, setup.body, damage_field(setup.model)) if setup.damage is not None else None
-    )
+    paths = final_crack_paths(case, body, phi) if phi is not None else None
     if paths is not None:
         summary["crack_paths"] = [p.summary() for p in paths]
     if case.output.plots and case.solver.type != "modal":  # a modal run draws its own
-        plots = [*draw_run_figures(case, setup.body, out), *figures]
+        plots = [*draw_run_figures(case, body, out), *figures]
         if paths is not None:
-            plots += draw_crack_figures(setup.body, out, paths, summary)
+            plots += draw_crack_figures(body, out, paths, summary)
     finish_summary(summary, "modal" if case.solver.type == "modal" else "run", out, start, plots)
-    store_summary(out / RESULTS, setup.body, summary, status="complete")
+    store_summary(out / RESULTS, body, summary, status="complete")
 
 
 def case_identity(case: Case) -> tuple[str, str]:
@@ -202,12 +229,16 @@ def store_summary(results, body: Body, summary: dict, status: str | None = None)
 
 
 def _base_summary(setup: Setup) -> dict:
+    """Points, directed bonds, broken bonds and largest damage of the whole body (collective)."""
+    d = setup.domain
+    n = d.n_owned
+    owned_bonds = int(setup.bonds.offsets[n])  # the owned points' families come first
     phi = damage_field(setup.model)
     return {
-        "points": setup.body.n_points,
-        "bonds": setup.bonds.n_bonds,
-        "broken_bonds": int((~setup.bonds.intact).sum()),
-        "max_damage": float(phi.max()),
+        "points": setup.whole_body.n_points,
+        "bonds": d.count(owned_bonds),
+        "broken_bonds": d.count((~setup.bonds.intact[:owned_bonds]).sum()),
+        "max_damage": float(d.max(phi[:n].max())),
     }
 
 
@@ -216,14 +247,18 @@ def _time_stepper(case, setup):
     if case.solver.type == "newmark":
         return _newmark_solver(case, setup)
     s = case.solver
+    damping = explicit_damping(case, setup.whole_body)
+    if np.ndim(damping):  # per point: the rank's points
+        damping = damping[setup.domain.global_ids]
     return ExplicitSolver(
         setup.model,
         setup.loading,
         dt=s.dt,
         safety=s.safety,
-        damping=explicit_damping(case, setup.body),
+        damping=damping,
         damage=setup.damage,
         contact=setup.contact,
+        domain=setup.domain,
     )
 
 
@@ -234,11 +269,13 @@ CHECKPOINT_AFTER_S = 60.0
 def _run_explicit(case, setup, solver, out, case_path, checkpoint_every, restart, progress, start) -> dict:
     """Time integration by ``solver`` with recording, checkpoints and the status."""
     s = case.solver
+    d = setup.domain
     n_steps = s.steps if s.steps is not None else int(np.ceil(s.time / solver.dt - 1e-9))
     ckpt_path = out / "checkpoint.h5"
     case_json, digest = case_identity(case)
     meta = {"case_hash": digest, "case": case_json, "dt": float(solver.dt), "version": package_version()}
-    cracks = _crack_observer(case, setup, n_steps)
+    gathered = RootObservers(d, setup.model)
+    cracks = _crack_observer(case, setup, n_steps, gathered.damage)
     parts = {
         name: part
         for name, part in (("damage", setup.damage), ("contact", setup.contact), ("cracks", cracks))
@@ -255,14 +292,18 @@ def _run_explicit(case, setup, solver, out, case_path, checkpoint_every, restart
         )
     else:
         state, resume = solver.initial_state(), None
-    spec = recorder_spec(case, setup.body, solver.dt)
-    recorder = Recorder(setup.body, out, spec, provenance(case_path, case=case), setup.model, resume)
+    spec = recorder_spec(case, setup.whole_body, solver.dt)
+    info = provenance(case_path, case=case)
+    if d.size > 1:
+        info.update(d.provenance())
+    recorder = d.on_root(Recorder, setup.whole_body, out, spec, info, gathered.damage, resume)
+    watched = [recorder, *([cracks] if cracks is not None else [])]
+    gathered.attach(watched, [spec.due, *([cracks.due] if cracks is not None else [])])
     checkpointer = Checkpointer(ckpt_path, checkpoint_every or n_steps + 1, setup.bonds.intact, meta, parts)
     try:
         if resume is None:
-            recorder.record_series(state)
-            recorder.snapshot(state)
-        observers = [recorder, *([cracks] if cracks is not None else [])]
+            gathered.call(state, lambda whole: (recorder.record_series(whole), recorder.snapshot(whole)))
+        observers = [gathered]
         if checkpoint_every:
             observers.append(checkpointer)
         remaining = n_steps - state.step
@@ -276,15 +317,16 @@ def _run_explicit(case, setup, solver, out, case_path, checkpoint_every, restart
         saved = bool(checkpoint_every) or time.perf_counter() - start > CHECKPOINT_AFTER_S
         if saved:
             checkpointer.save(state)
-        recorder.close(f"interrupted at step {exc.step}")
+        if recorder is not None:
+            recorder.close(f"interrupted at step {exc.step}")
         raise Interrupted(exc.signal_name, exc.step, "resume" if saved else "") from None
     except BaseException as exc:
-        recorder.close(failure_status(exc))
+        if recorder is not None:
+            recorder.close(failure_status(exc))
         raise
-    if state.step not in spec.snapshot_steps and not (
-        spec.snapshot_every and state.step % spec.snapshot_every == 0
-    ):
-        recorder.snapshot(state)
+    if not spec.snapshot_due(state.step):
+        gathered.call(state, lambda whole: recorder.snapshot(whole))
+    n = d.n_owned
     summary = _base_summary(setup)
     summary.update(
         {
@@ -293,14 +335,14 @@ def _run_explicit(case, setup, solver, out, case_path, checkpoint_every, restart
             "dt_s": solver.dt,
             "stable_dt_s": solver.stable_dt,
             "kinetic_energy_j": solver.kinetic_energy(state),
-            "strain_energy_j": setup.model.strain_energy(state.u),
+            "strain_energy_j": float(d.dot(setup.model.energy_density(state.u)[:n], setup.body.volumes[:n])),
         }
     )
     if setup.contact is not None:
         summary["contact_rebuilds"] = setup.contact.rebuilds
     if cracks is not None:
-        summary["crack_length_history"] = cracks.history()
-    recorder.finish(state)
+        summary["crack_length_history"] = cracks.history()  # rank 0's is the one returned
+    gathered.call(state, lambda whole: recorder.finish(whole))
     return summary
 
 
@@ -316,15 +358,15 @@ def explicit_damping(case: Case, body: Body):
         raise CaseFileError(case.name, "absorbing", a.model_dump(), str(exc)) from None
 
 
-def _crack_observer(case, setup, n_steps):
+def _crack_observer(case, setup, n_steps, damage):
     """Crack length against time, sampled at the snapshots (or 100 times a run) of a case
-    with damage; None without damage."""
+    with damage (``damage``: the whole body's damage index, a callable); None without damage."""
     if setup.damage is None:
         return None
     from peridyn.jobs.observers import CrackLengthObserver
 
     every = case.output.snapshot_every or max(1, n_steps // 100)
-    return CrackLengthObserver(setup.model, every)
+    return CrackLengthObserver(setup.whole_body, damage, every)
 
 
 def _run_static(case, setup, out, case_path) -> dict:
@@ -363,7 +405,9 @@ def _record_equilibrium(case, setup, out, case_path, u, results: dict) -> dict:
     """Record a quasi-static solution ``u`` as one state at t = 1 s; the run's summary."""
     state = State(u, np.zeros_like(u), np.zeros_like(u), 1.0, results["steps"])
     spec = recorder_spec(case, setup.body, 1.0)
-    recorder = Recorder(setup.body, out, spec, provenance(case_path, case=case), setup.model)
+    recorder = Recorder(
+        setup.body, out, spec, provenance(case_path, case=case), lambda: damage_field(setup.model)
+    )
     recorder.record_series(state)
     recorder.snapshot(state)
     summary = _base_summary(setup)
