@@ -2,7 +2,8 @@
 
 Every bond is stored twice, once in each end point's family (directed bonds),
 so that a kernel looping over points needs no atomics. Point ``i``'s family
-is ``neighbours[offsets[i]:offsets[i + 1]]``, sorted by index.
+is ``neighbours[offsets[i]:offsets[i + 1]]``, sorted by index (on a rank's part of a body under
+MPI, by the neighbours' global index: ``peridyn.parallel``).
 """
 
 from __future__ import annotations
@@ -101,10 +102,13 @@ class Bonds:
     def reverse(self) -> np.ndarray:
         """(n_bonds,) int64: index of the opposite directed bond j->i of each bond i->j."""
         owners = self.owners()
-        # families are sorted by neighbour, so (j, i) pairs sort by j then i
-        order = np.lexsort((owners, self.neighbours))
+        # the k-th bond in (i, j) order is the reverse of the k-th bond in (j, i) order; families
+        # are usually sorted by neighbour (then the first order is the storage order), but a
+        # rank's part (``peridyn.parallel``) keeps the global order of its ghosts' indices
+        by_owner = np.lexsort((self.neighbours, owners))
+        by_neighbour = np.lexsort((owners, self.neighbours))
         rev = np.empty(self.n_bonds, dtype=np.int64)
-        rev[order] = np.arange(self.n_bonds)
+        rev[by_owner] = by_neighbour
         return rev
 
     def __repr__(self) -> str:

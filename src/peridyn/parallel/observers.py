@@ -50,8 +50,9 @@ class RootObservers:
         return self._damage
 
     def observe(self, state: State, solver) -> None:
-        """Gather and call the observers when one is due (every rank calls it)."""
-        if any(due(state.step) for due in self.due):
+        """Gather and call the observers when one is due (every rank calls it); in one process,
+        call them at every step (nothing to gather)."""
+        if self.domain.size == 1 or any(due(state.step) for due in self.due):
             self.call(state, lambda whole: [obs.observe(whole, solver) for obs in self.observers])
 
     def call(self, state: State, fn):
