@@ -103,7 +103,8 @@ def run_case(
         ``peridyn.parallel.comm.world()`` under ``mpiexec -n N`` (N > 1): each rank runs its
         part of the body (``peridyn.parallel``), rank 0 writes the one results.h5 with every
         record equal to a serial run's, and every rank returns the summary. An explicit run
-        without contact, checkpoints or restarts, for now. None: one process.
+        without contact, for now; checkpoints hold the whole body, so a run may restart on
+        another number of ranks. None: one process.
 
     Raises
     ------
@@ -122,7 +123,7 @@ def run_case(
     if restart and not stepping:
         raise InputError(f"--restart continues an explicit or newmark run, not a {case.solver.type} run")
     if comm is not None and comm.size > 1:
-        _check_parallel(case, checkpoint_every, restart)
+        _check_parallel(case)
     setup = build(case, base_dir, comm)
     domain = setup.domain
     solver = _time_stepper(case, setup) if stepping else None
@@ -147,14 +148,12 @@ def run_case(
     return domain.comm.bcast(summary)
 
 
-def _check_parallel(case: Case, checkpoint_every, restart: bool) -> None:
+def _check_parallel(case: Case) -> None:
     """Refuse what an MPI run cannot do yet."""
     if case.solver.type != "explicit":
         raise InputError(
             f"an MPI run (mpiexec -n N) is an explicit run for now, not a {case.solver.type} run"
         )
-    if checkpoint_every is not None or restart:
-        raise InputError("checkpoints and restarts of an MPI run are not supported yet: run without them")
 
 
 def _resume_hint(command: str | None) -> str:
@@ -281,11 +280,9 @@ def _run_explicit(case, setup, solver, out, case_path, checkpoint_every, restart
         for name, part in (("damage", setup.damage), ("contact", setup.contact), ("cracks", cracks))
         if part is not None
     }
+    whole_bonds = d.bond_offsets(setup.bonds.offsets)
     if restart:
-        state, intact, saved = load_checkpoint(ckpt_path, setup.body.n_points, setup.bonds.n_bonds, meta)
-        setup.bonds.intact[:] = intact
-        for name, part in parts.items():
-            part.restore_state(saved.get(name, {}))
+        state = _restart(ckpt_path, setup, meta, parts, whole_bonds)
         resume = (state.step, state.time)
         print(
             f"restarting from the checkpoint at step {state.step} (t = {state.time:.6g} s)", file=sys.stderr
@@ -297,14 +294,19 @@ def _run_explicit(case, setup, solver, out, case_path, checkpoint_every, restart
     if d.size > 1:
         info.update(d.provenance())
     recorder = d.on_root(Recorder, setup.whole_body, out, spec, info, gathered.damage, resume)
+    checkpointer, prepare = _checkpointer(
+        ckpt_path, checkpoint_every or n_steps + 1, setup, meta, parts, whole_bonds
+    )
     watched = [recorder, *([cracks] if cracks is not None else [])]
-    gathered.attach(watched, [spec.due, *([cracks.due] if cracks is not None else [])])
-    checkpointer = Checkpointer(ckpt_path, checkpoint_every or n_steps + 1, setup.bonds.intact, meta, parts)
+    due = [spec.due, *([cracks.due] if cracks is not None else [])]
+    if d.size > 1 and checkpoint_every:  # saved on rank 0 from the gathered state
+        watched, due = [*watched, checkpointer], [*due, checkpointer.due]
+    gathered.attach(watched, due, prepare)
     try:
         if resume is None:
             gathered.call(state, lambda whole: (recorder.record_series(whole), recorder.snapshot(whole)))
         observers = [gathered]
-        if checkpoint_every:
+        if checkpoint_every and d.size == 1:
             observers.append(checkpointer)
         remaining = n_steps - state.step
         bar = progress(remaining) if progress is not None else None
@@ -315,6 +317,7 @@ def _run_explicit(case, setup, solver, out, case_path, checkpoint_every, restart
                 bar.close()
     except Interrupted as exc:
         saved = bool(checkpoint_every) or time.perf_counter() - start > CHECKPOINT_AFTER_S
+        saved = saved and d.size == 1  # the ranks of an MPI run may stop at different steps
         if saved:
             checkpointer.save(state)
         if recorder is not None:
@@ -344,6 +347,45 @@ def _run_explicit(case, setup, solver, out, case_path, checkpoint_every, restart
         summary["crack_length_history"] = cracks.history()  # rank 0's is the one returned
     gathered.call(state, lambda whole: recorder.finish(whole))
     return summary
+
+
+def _restart(path, setup: Setup, meta: dict, parts: dict, whole_bonds: np.ndarray) -> State:
+    """The state of the checkpoint at ``path`` (this rank's points), with the bonds' intact mask
+    and the parts' states restored. Checkpoints hold the whole body in serial numbering, so a run
+    may restart on another number of ranks. A rank's damage skin covers its part only and is not
+    saved under MPI: it starts again with a full stretch test (the same bonds break, see
+    ``peridyn.physics.damage``)."""
+    d = setup.domain
+    state, intact, saved = d.agree(
+        load_checkpoint, path, setup.whole_body.n_points, int(whole_bonds[-1]), meta
+    )
+    if d.size > 1:
+        ids = d.global_ids
+        state = State(state.u[ids], state.v[ids], state.a[ids], state.time, state.step)
+    setup.bonds.intact[:] = d.scatter_bonds(intact, setup.bonds, whole_bonds)
+    for name, part in parts.items():
+        part.restore_state(saved.get(name, {}) if d.size == 1 or name != "damage" else {})
+    return state
+
+
+def _checkpointer(path, every: int, setup: Setup, meta: dict, parts: dict, whole_bonds: np.ndarray):
+    """The run's ``Checkpointer`` and what must be gathered before it saves (``RootObservers``):
+    under MPI it writes, on rank 0, the whole body's state and intact mask in serial numbering
+    and the parts that hold whole-body state (not a rank's damage skin)."""
+    d = setup.domain
+    if d.size == 1:
+        return Checkpointer(path, every, setup.bonds.intact, meta, parts), []
+    whole_intact = np.ones(int(whole_bonds[-1]), dtype=bool) if d.is_root else None
+    checkpointer = Checkpointer(
+        path, every, whole_intact, meta, {k: v for k, v in parts.items() if k != "damage"}
+    )
+
+    def gather_intact():
+        intact = d.gather_bonds(setup.bonds.intact, setup.bonds.offsets, whole_bonds)
+        if d.is_root:
+            whole_intact[:] = intact
+
+    return checkpointer, [(checkpointer.due, gather_intact)]
 
 
 def explicit_damping(case: Case, body: Body):

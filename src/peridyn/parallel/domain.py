@@ -175,6 +175,62 @@ class Domain:
         u, v, a = (self.gather(x) for x in (state.u, state.v, state.a))
         return State(u, v, a, state.time, state.step) if self.is_root else None
 
+    # -- per-bond arrays (checkpoints) ------------------------------------------------------
+
+    def bond_offsets(self, offsets: np.ndarray) -> np.ndarray:
+        """(n_global + 1,) int64: the whole body's family offsets (serial bond numbering), from
+        the local CSR ``offsets`` (collective; the owned families are whole)."""
+        counts = np.diff(offsets[: self.n_owned + 1])
+        if self.size == 1:
+            return np.asarray(offsets, dtype=np.int64)
+        every = np.zeros(self.n_global, dtype=np.int64)
+        for ids, c in self.comm.allgather((self.global_ids[: self.n_owned], counts)):
+            every[ids] = c
+        return np.concatenate([[0], np.cumsum(every)])
+
+    def _serial_rows(self, offsets: np.ndarray, points: np.ndarray, whole: np.ndarray):
+        """Local bond rows of the families of local ``points`` and their serial bond numbers."""
+        counts = offsets[points + 1] - offsets[points]
+        shift = np.repeat(whole[self.global_ids[points]] - offsets[points], counts)
+        rows = np.repeat(offsets[points], counts) + _ranges(counts)
+        return rows, rows + shift
+
+    def gather_bonds(self, values: np.ndarray, offsets: np.ndarray, whole: np.ndarray):
+        """Per-bond ``values`` of the owned families placed in the serial bond numbering on rank 0
+        (None elsewhere); ``whole`` is ``bond_offsets(offsets)``. In one process ``values``."""
+        if self.size == 1:
+            return values
+        rows, serial = self._serial_rows(offsets, np.arange(self.n_owned), whole)
+        parts = self.comm.gather((serial, values[rows]))
+        if not self.is_root:
+            return None
+        out = np.empty(int(whole[-1]), dtype=values.dtype)
+        for idx, part in parts:
+            out[idx] = part
+        return out
+
+    def scatter_bonds(self, values: np.ndarray, bonds, whole: np.ndarray) -> np.ndarray:
+        """The local part ((n_bonds,) of ``bonds``) of per-bond ``values`` given in the serial
+        numbering (``whole`` = ``bond_offsets``), for a bond value shared by both directed copies
+        (e.g. ``intact``). The owned points' and their neighbours' families are whole on the rank
+        and taken directly; an outer ghost's bond takes its reverse copy's value where that lies in
+        such a family (a bond between two outer ghosts keeps its value, it enters no owned force).
+        In one process ``values``."""
+        if self.size == 1:
+            return values
+        offsets = bonds.offsets
+        whole_family = np.zeros(len(self.global_ids), dtype=bool)
+        whole_family[: self.n_owned] = True
+        whole_family[bonds.neighbours[: offsets[self.n_owned]]] = True
+        rows, serial = self._serial_rows(offsets, np.flatnonzero(whole_family), whole)
+        out = bonds.intact.copy() if values.dtype == bool else np.zeros(bonds.n_bonds, dtype=values.dtype)
+        out[rows] = values[serial]
+        rev = bonds.reverse()
+        owners = bonds.owners()
+        outer = ~whole_family[owners] & whole_family[owners[rev]]
+        out[outer] = out[rev[outer]]
+        return out
+
     def provenance(self) -> dict:
         """Ranks and partition for the results file's provenance (collective)."""
         counts = self.comm.allgather(self.n_owned)
@@ -213,3 +269,10 @@ def _portable(error: BaseException) -> bytes:
         return data
     except Exception:  # noqa: BLE001 - exceptions with custom constructors
         return pickle.dumps(RankError(str(error)))
+
+
+def _ranges(counts: np.ndarray) -> np.ndarray:
+    """0, 1, ..., c_0 - 1, 0, 1, ..., c_1 - 1, ... for the ``counts`` c_k."""
+    total = int(counts.sum())
+    starts = np.repeat(np.cumsum(counts) - counts, counts)
+    return np.arange(total) - starts

@@ -34,14 +34,17 @@ class RootObservers:
         self.model = model
         self.observers: list = []
         self.due: list = []
+        self.prepare: list = []
         self._damage: np.ndarray | None = None
 
-    def attach(self, observers: Sequence, due: Sequence[Callable[[int], bool]]) -> None:
+    def attach(self, observers: Sequence, due: Sequence[Callable[[int], bool]], prepare=()) -> None:
         """Watch with ``observers`` (objects with ``observe(state, solver)``, used on rank 0 only:
         None elsewhere) at the steps where one of ``due`` (callables step -> bool, known on every
-        rank) is True."""
+        rank) is True; ``prepare``: (due, collective callable) pairs run on every rank first at
+        their steps (e.g. gathering the bonds' intact mask for a checkpoint)."""
         self.observers = list(observers) if self.domain.is_root else []
         self.due = list(due)
+        self.prepare = list(prepare)
 
     def damage(self) -> np.ndarray:
         """The damage index (n_points,) of the whole body at the last gathered state (rank 0)."""
@@ -53,6 +56,9 @@ class RootObservers:
         """Gather and call the observers when one is due (every rank calls it); in one process,
         call them at every step (nothing to gather)."""
         if self.domain.size == 1 or any(due(state.step) for due in self.due):
+            for due, gather in self.prepare:
+                if due(state.step):
+                    gather()
             self.call(state, lambda whole: [obs.observe(whole, solver) for obs in self.observers])
 
     def call(self, state: State, fn):

@@ -27,8 +27,11 @@ def advance(solver, state: State, n_steps: int, observers=(), progress=None) -> 
     ------
     Interrupted
         SIGINT or SIGTERM arrived: raised after the current step and its observers, with
-        ``step`` the last completed step (``resume`` is left to the caller).
+        ``step`` the last completed step (``resume`` is left to the caller). A solver with an
+        MPI ``domain`` (``peridyn.parallel``) raises it on every rank after the same step.
     """
+    domain = getattr(solver, "domain", None)
+    several = domain is not None and domain.size > 1
     with _deferred_signals() as received:
         for _ in range(int(n_steps)):
             solver.step(state)
@@ -36,8 +39,11 @@ def advance(solver, state: State, n_steps: int, observers=(), progress=None) -> 
                 obs.observe(state, solver)
             if progress is not None:
                 progress.update(1)
-            if received:
-                raise Interrupted(signal.Signals(received[0]).name, state.step)
+            signum = received[0] if received else 0
+            if several:  # the ranks stop together: a signal seen by any rank ends this step on all
+                signum = domain.max(signum)
+            if signum:
+                raise Interrupted(signal.Signals(signum).name, state.step)
     return state
 
 
