@@ -139,3 +139,24 @@ def test_restart_on_three_ranks_from_a_two_rank_checkpoint_equals_the_serial_run
     resumed = json.loads(done.stdout)
     for key in ("steps", "broken_bonds", "max_damage", "crack_length_history", "strain_energy_j"):
         assert resumed[key] == summary[key], key
+
+
+def test_commands_that_do_not_run_over_ranks_are_refused_once():
+    """``mpiexec -n 2 peridyn modal`` would run the same job twice into one folder: refused."""
+    if not _have_mpi():
+        pytest.skip("mpiexec or mpi4py not installed")
+    env = dict(os.environ, PYTHONPATH=SRC)
+    command = [
+        "mpiexec",
+        "-n",
+        "2",
+        sys.executable,
+        "-m",
+        "peridyn",
+        "modal",
+        str(ROOT / "cases" / "pmma_plate.yaml"),
+    ]
+    done = subprocess.run(command, capture_output=True, text=True, timeout=300, env=env)
+    assert done.returncode == 1
+    lines = [line for line in done.stderr.splitlines() if "error:" in line]
+    assert len(lines) == 1 and "does not run over MPI ranks" in lines[0]

@@ -18,6 +18,7 @@ import sys
 
 from peridyn.cli.errors import ArgumentParser, report, writing
 from peridyn.cli.logs import plain_warnings
+from peridyn.errors import InputError
 
 #: Subcommand modules, in the order ``peridyn --help`` lists them.
 COMMAND_MODULES = (
@@ -99,12 +100,28 @@ def _dispatch(parser: ArgumentParser, args) -> int:
     if not getattr(args, "func", None):
         parser.print_help()
         return 2
+    _refuse_under_mpi(args.command)
     summary = args.func(args)
     if args.json:
         with writing("<stdout>"):
             json.dump(summary, sys.stdout, default=_to_builtin)
             sys.stdout.write("\n")
     return 0
+
+
+#: The commands that run over MPI ranks (``mpiexec -n N peridyn ...``, N > 1).
+MPI_COMMANDS = ("run",)
+
+
+def _refuse_under_mpi(command: str) -> None:
+    """Refuse, on every rank, a command that would run N times over under ``mpiexec -n N``."""
+    from peridyn.parallel.comm import launched_by_mpi, world
+
+    if command not in MPI_COMMANDS and launched_by_mpi() and world().size > 1:
+        raise InputError(
+            f"'peridyn {command}' does not run over MPI ranks (only {', '.join(MPI_COMMANDS)} does): "
+            "run it without mpiexec"
+        )
 
 
 def _quiet_unless_first_rank() -> None:
