@@ -37,7 +37,7 @@ class InstabilityError(PeridynError, RuntimeError):
     """The explicit integration blew up (NaN/inf or runaway displacement)."""
 
     def __init__(self, step: int, time: float, point: int, detail: str = ""):
-        self.step, self.time, self.point = step, time, point
+        self.step, self.time, self.point, self.detail = step, time, point, detail
         msg = f"solution became unstable at step {step} (t = {time:.6g} s), point {point}"
         super().__init__(msg + (f": {detail}" if detail else ""))
 

@@ -56,7 +56,7 @@ def deferred() -> Iterator[None]:
             _pending.clear()
 
 
-def check(step: int | None = None, where: str = "") -> None:
+def check(step: int | None = None, where: str = "", agree=None) -> None:
     """Raise :class:`~peridyn.errors.Interrupted` if a stop signal arrived since the block began.
 
     Parameters
@@ -65,9 +65,16 @@ def check(step: int | None = None, where: str = "") -> None:
         The last completed time step, for a time-stepping job.
     where : str
         What the job was doing (e.g. "building the model"), for the other jobs.
+    agree : callable(int) -> int, optional
+        Combines the signal number noted here (0 for none) with those of the other processes
+        of a parallel run (e.g. the maximum over the MPI ranks), so that all stop together.
+        A collective: every process must call ``check`` at the same point.
     """
-    if _pending:
-        raise Interrupted(signal.Signals(_pending[0]).name, step, where=where)
+    signum = _pending[0] if _pending else 0
+    if agree is not None:
+        signum = agree(signum)
+    if signum:
+        raise Interrupted(signal.Signals(signum).name, step, where=where)
 
 
 def _note(signum, frame) -> None:

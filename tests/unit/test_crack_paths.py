@@ -95,4 +95,4 @@ def test_bad_input():
     with pytest.raises(InputError, match="spacing must be positive"):
         crack_paths(pts, np.zeros(25), -H)
     with pytest.raises(InputError, match="crack observer interval must be >= 1 step"):
-        CrackLengthObserver(None, 0)
+        CrackLengthObserver(None, None, 0)

@@ -18,6 +18,7 @@ import sys
 
 from peridyn.cli.errors import ArgumentParser, report, writing
 from peridyn.cli.logs import plain_warnings
+from peridyn.errors import InputError
 
 #: Subcommand modules, in the order ``peridyn --help`` lists them.
 COMMAND_MODULES = (
@@ -60,6 +61,7 @@ def main(argv: list[str] | None = None) -> int:
     :func:`peridyn.cli.errors.report`.
     """
     argv = sys.argv[1:] if argv is None else list(argv)
+    _quiet_unless_first_rank()
     args = None
     with plain_warnings():
         try:
@@ -98,12 +100,38 @@ def _dispatch(parser: ArgumentParser, args) -> int:
     if not getattr(args, "func", None):
         parser.print_help()
         return 2
+    _refuse_under_mpi(args.command)
     summary = args.func(args)
     if args.json:
         with writing("<stdout>"):
             json.dump(summary, sys.stdout, default=_to_builtin)
             sys.stdout.write("\n")
     return 0
+
+
+#: The commands that run over MPI ranks (``mpiexec -n N peridyn ...``, N > 1).
+MPI_COMMANDS = ("run",)
+
+
+def _refuse_under_mpi(command: str) -> None:
+    """Refuse, on every rank, a command that would run N times over under ``mpiexec -n N``."""
+    from peridyn.parallel.comm import launched_by_mpi, world
+
+    if command not in MPI_COMMANDS and launched_by_mpi() and world().size > 1:
+        raise InputError(
+            f"'peridyn {command}' does not run over MPI ranks (only {', '.join(MPI_COMMANDS)} does): "
+            "run it without mpiexec"
+        )
+
+
+def _quiet_unless_first_rank() -> None:
+    """Under ``mpiexec -n N`` only rank 0 speaks: the other ranks' stdout and stderr go to
+    /dev/null (every rank raises the same error at the same point, ``peridyn.parallel.domain``,
+    and rank 0 reports it once)."""
+    from peridyn.parallel.comm import launched_by_mpi, world
+
+    if launched_by_mpi() and world().rank > 0:
+        sys.stdout = sys.stderr = open(os.devnull, "w")  # noqa: SIM115 - for the process's lifetime
 
 
 def _drop_unwritable_stdout() -> None:

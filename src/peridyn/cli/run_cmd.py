@@ -19,6 +19,7 @@ from peridyn.cli.options import (
 )
 from peridyn.io.case import load_case
 from peridyn.io.provenance import provenance
+from peridyn.parallel.comm import world
 
 
 def register(sub) -> None:
@@ -47,7 +48,8 @@ def command_line() -> str:
 
 
 def run(args) -> dict:
-    """Run the case; print a readable summary unless --json."""
+    """Run the case; print a readable summary unless --json. Under ``mpiexec -n N`` every rank
+    runs its part (``peridyn.parallel``); only rank 0 prints (``peridyn.cli.main``)."""
     from peridyn.jobs.estimate import check_memory
     from peridyn.jobs.run import run_case
 
@@ -69,6 +71,7 @@ def run(args) -> dict:
         base_dir=Path(args.case).parent,
         overwrite=args.overwrite,
         command=command_line(),
+        comm=world(),
     )
     if not args.json:
         print_summary(summary)

@@ -126,6 +126,23 @@ class Body:
             raise InputError(f"node set {name!r} is empty: its region contains no point")
         return replace(self, node_sets={**self.node_sets, name: idx})
 
+    def subset(self, indices) -> Body:
+        """A copy made of the points ``indices`` ((k,) int, distinct), in that order; node sets
+        keep their points that are taken (a set may become empty) and are re-indexed."""
+        idx = np.asarray(indices, dtype=np.int64)
+        new_index = np.full(self.n_points, -1, dtype=np.int64)
+        new_index[idx] = np.arange(len(idx))
+        sets = {k: new_index[v][new_index[v] >= 0] for k, v in self.node_sets.items()}
+        layers = None if self.layer_index is None else self.layer_index[idx]
+        return replace(
+            self,
+            points=self.points[idx],
+            volumes=self.volumes[idx],
+            cells=self.cells[idx],
+            node_sets=sets,
+            layer_index=layers,
+        )
+
     def remove(self, mask_or_predicate) -> Body:
         """A copy without the points selected (e.g. a hole); node sets are re-indexed.
 

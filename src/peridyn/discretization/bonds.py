@@ -2,7 +2,8 @@
 
 Every bond is stored twice, once in each end point's family (directed bonds),
 so that a kernel looping over points needs no atomics. Point ``i``'s family
-is ``neighbours[offsets[i]:offsets[i + 1]]``, sorted by index.
+is ``neighbours[offsets[i]:offsets[i + 1]]``, sorted by index (on a rank's part of a body under
+MPI, by the neighbours' global index: ``peridyn.parallel``).
 """
 
 from __future__ import annotations
@@ -101,10 +102,13 @@ class Bonds:
     def reverse(self) -> np.ndarray:
         """(n_bonds,) int64: index of the opposite directed bond j->i of each bond i->j."""
         owners = self.owners()
-        # families are sorted by neighbour, so (j, i) pairs sort by j then i
-        order = np.lexsort((owners, self.neighbours))
+        # the k-th bond in (i, j) order is the reverse of the k-th bond in (j, i) order; families
+        # are usually sorted by neighbour (then the first order is the storage order), but a
+        # rank's part (``peridyn.parallel``) keeps the global order of its ghosts' indices
+        by_owner = np.lexsort((self.neighbours, owners))
+        by_neighbour = np.lexsort((owners, self.neighbours))
         rev = np.empty(self.n_bonds, dtype=np.int64)
-        rev[order] = np.arange(self.n_bonds)
+        rev[by_owner] = by_neighbour
         return rev
 
     def __repr__(self) -> str:
@@ -131,6 +135,7 @@ def find_bonds(
     influence: str = "constant",
     partial_volumes: bool = True,
     quadrature_points: int = 8,
+    required=None,
 ) -> Bonds:
     """Search the families of all points and build the CSR bond arrays.
 
@@ -147,11 +152,15 @@ def find_bonds(
         sphere (computed by midpoint quadrature with ``quadrature_points`` per
         axis). On lattices with horizons of 2-3 spacings this is what makes the
         discrete long-wave speeds match the continuum (VALIDATION.md).
+    required : (k,) int or None
+        The points that must have a neighbour (default: every point). A rank's part of a
+        body (``peridyn.parallel``) requires it of its owned points only: an outer ghost may
+        see none of its neighbours.
 
     Raises
     ------
     InputError
-        When a point has no neighbour (the horizon is smaller than the spacing).
+        When a required point has no neighbour (the horizon is smaller than the spacing).
     """
     omega = influence_function(influence)
     x = body.points
@@ -160,12 +169,8 @@ def find_bonds(
             f"horizon {horizon:g} m is smaller than half the spacing "
             f"{np.min(body.cells[:, : body.dim]):g} m: points would have no neighbours"
         )
-    reach = horizon * (1 + HORIZON_RTOL)
-    cells = body.cells.copy()
-    if body.dim == 2:
-        cells[:, 2] = 0.0  # 2D cells are rectangles in the plane
-    if partial_volumes:
-        reach += 0.5 * float(np.max(np.linalg.norm(cells, axis=1)))
+    cells = search_cells(body)
+    reach = search_reach(body, horizon, partial_volumes)
     pairs = cKDTree(x).query_pairs(reach, output_type="ndarray")
     offsets, j = bond_families(pairs, body.n_points)
     length, factor = bond_geometry(
@@ -177,8 +182,11 @@ def find_bonds(
         offsets = np.concatenate([[0], np.cumsum(counts)])
         j, length, factor = j[keep], length[keep], factor[keep]
     counts = np.diff(offsets)
+    if required is not None:
+        counts = counts[np.asarray(required, dtype=np.int64)]
     if np.any(counts == 0):
         lonely = int(np.flatnonzero(counts == 0)[0])
+        lonely = lonely if required is None else int(np.asarray(required)[lonely])
         raise InputError(
             f"point {lonely} at {x[lonely].tolist()} has no neighbour within the horizon "
             f"{horizon:g} m (spacing {body.spacing:g} m): increase the horizon"
@@ -192,6 +200,50 @@ def find_bonds(
         intact=np.ones(len(j), dtype=bool),
         horizon=float(horizon),
         influence_name=influence,
+    )
+
+
+def search_cells(body: Body) -> np.ndarray:
+    """(n_points, 3) cell sides of the partial-volume test, m (2D cells: rectangles, third side 0)."""
+    cells = body.cells.copy()
+    if body.dim == 2:
+        cells[:, 2] = 0.0
+    return cells
+
+
+def search_reach(body: Body, horizon: float, partial_volumes: bool = True) -> float:
+    """Distance (m) within which ``find_bonds`` looks for neighbours: the horizon (with its
+    tolerance), plus half the largest cell diagonal with partial volumes."""
+    reach = horizon * (1 + HORIZON_RTOL)
+    if partial_volumes:
+        reach += 0.5 * float(np.max(np.linalg.norm(search_cells(body), axis=1)))
+    return reach
+
+
+def reorder_bonds(bonds: Bonds, order: np.ndarray, n_points: int) -> Bonds:
+    """The bonds of the points ``order`` (old indices, in their new order), neighbours renumbered.
+
+    Each family keeps its bonds in their order. Every neighbour of a kept point must be kept;
+    ``n_points`` is the old number of points.
+    """
+    order = np.asarray(order, dtype=np.int64)
+    new_index = np.full(n_points, -1, dtype=np.int64)
+    new_index[order] = np.arange(len(order))
+    counts = np.diff(bonds.offsets)[order]
+    offsets = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
+    rows = np.repeat(bonds.offsets[order] - offsets[:-1], counts) + np.arange(offsets[-1])
+    neighbours = new_index[bonds.neighbours[rows]]
+    if np.any(neighbours < 0):
+        raise InputError("reorder_bonds: a kept point has a neighbour that is not kept")
+    return Bonds(
+        offsets=offsets,
+        neighbours=neighbours.astype(np.int32),
+        length=bonds.length[rows],
+        influence=bonds.influence[rows],
+        volume_factor=bonds.volume_factor[rows],
+        intact=bonds.intact[rows],
+        horizon=bonds.horizon,
+        influence_name=bonds.influence_name,
     )
 
 

@@ -38,7 +38,12 @@ class State:
 def runaway_limit(points: np.ndarray) -> float:
     """Largest believable displacement component, m: ``RUNAWAY_FACTOR`` times the largest
     extent of the body's reference points (n_points, dim)."""
-    return RUNAWAY_FACTOR * float(np.max(np.ptp(points, axis=0)))
+    return runaway_limit_of_extent(np.ptp(points, axis=0))
+
+
+def runaway_limit_of_extent(extent: np.ndarray) -> float:
+    """``runaway_limit`` from the extent (max - min, m) of the points along each axis."""
+    return RUNAWAY_FACTOR * float(np.max(extent))
 
 
 def check_state(state: State, max_displacement: float = np.inf) -> None:

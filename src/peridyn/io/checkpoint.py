@@ -150,9 +150,13 @@ class Checkpointer:
         self.meta = meta
         self.parts = parts or {}
 
+    def due(self, step: int) -> bool:
+        """True when a checkpoint is saved at ``step``."""
+        return step % self.every == 0
+
     def observe(self, state: State, solver) -> None:
         """Save when the step is a multiple of ``every``."""
-        if state.step % self.every == 0:
+        if self.due(state.step):
             self.save(state)
 
     def save(self, state: State) -> None:

@@ -29,8 +29,6 @@ from peridyn.discretization.state import State, check_state, runaway_limit
 from peridyn.errors import InputError
 from peridyn.io.hdf5 import HDF5Writer
 from peridyn.io.vtk import PVDCollection, write_vtu
-from peridyn.physics.damage import damage_field
-from peridyn.physics.deformation import strain_field
 
 
 @dataclass
@@ -80,6 +78,18 @@ class RecorderSpec:
     stress: bool = False
     strain: bool = False
 
+    def series_due(self, step: int) -> bool:
+        """True when the probe series are recorded at ``step``."""
+        return step % self.every == 0
+
+    def snapshot_due(self, step: int) -> bool:
+        """True when a field snapshot is written at ``step``."""
+        return bool(self.snapshot_every and step % self.snapshot_every == 0) or step in self.snapshot_steps
+
+    def due(self, step: int) -> bool:
+        """True when anything is recorded at ``step``."""
+        return self.series_due(step) or self.snapshot_due(step)
+
 
 class Recorder:
     """Observer of an explicit run that writes ``results.h5`` (and VTU files) incrementally.
@@ -92,8 +102,13 @@ class Recorder:
     spec : RecorderSpec
     provenance : dict
         Stored as attributes of the results file.
-    model : Model or None
-        Needed to write the damage index into snapshots, and for stress and strain.
+    damage : callable () -> (n_points,) float64, or None
+        The damage index of the current state, for snapshots and the final state (e.g.
+        ``lambda: damage_field(model)``); None: no damage written.
+    tensors : callable (u) -> dict of str to array, or None
+        The per-point fields ``output.stress`` and ``output.strain`` ask for (``stress`` and
+        ``strain`` (n_points, dim, dim), ``strain_valid`` (n_points,)) at displacement ``u``
+        (n_points, 3), m, for snapshots and the final state; required when they are asked.
     resume : (step, time) or None
         Reopen an existing results file and drop the records after this step and
         time (s), for a restart from a checkpoint.
@@ -105,18 +120,20 @@ class Recorder:
         directory,
         spec: RecorderSpec,
         provenance: dict,
-        model=None,
+        damage=None,
         resume: tuple[int, float] | None = None,
+        tensors=None,
     ):
         self.body = body
         self.directory = Path(directory)
         self.directory.mkdir(parents=True, exist_ok=True)
         self.spec = spec
-        self.model = model
+        self.damage = damage
+        self.tensors = tensors
         if spec.every < 1:
             raise InputError(f"output.every must be at least 1, got {spec.every}")
-        if (spec.stress or spec.strain) and model is None:
-            raise InputError("output.stress and output.strain need the model: the recorder has none")
+        if (spec.stress or spec.strain) and tensors is None:
+            raise InputError("output.stress and output.strain need a tensors function: the recorder has none")
         tree = cKDTree(body.points)
         self.sensor_names = list(spec.sensors)
         self.sensor_index = (
@@ -169,10 +186,9 @@ class Recorder:
 
     def observe(self, state: State, solver) -> None:
         """Record what is due at this step (called after every step)."""
-        if state.step % self.spec.every == 0:
+        if self.spec.series_due(state.step):
             self.record_series(state)
-        every = self.spec.snapshot_every
-        if (every and state.step % every == 0) or state.step in self.spec.snapshot_steps:
+        if self.spec.snapshot_due(state.step):
             self.snapshot(state)
 
     def record_series(self, state: State) -> None:
@@ -204,8 +220,8 @@ class Recorder:
         if self.pvd is None:
             return
         data = {"displacement": state.u[:, : self.body.dim], "velocity": state.v[:, : self.body.dim]}
-        if self.model is not None:
-            data["damage"] = damage_field(self.model)
+        if self.damage is not None:
+            data["damage"] = self.damage()
         for key, value in self._tensor_fields(state.u).items():
             data[key] = _padded_tensor(value)
         name = f"snapshots/step_{state.step:08d}.vtu"
@@ -216,21 +232,15 @@ class Recorder:
         """Write the final state, then close the file."""
         self.h5.write_array("final/u", state.u)
         self.h5.write_array("final/v", state.v)
-        if self.model is not None:
-            self.h5.write_array("final/damage", damage_field(self.model))
+        if self.damage is not None:
+            self.h5.write_array("final/damage", self.damage())
         for key, value in self._tensor_fields(state.u).items():
             self.h5.write_array(f"final/{key}", value)
         self.h5.close()
 
     def _tensor_fields(self, u: np.ndarray) -> dict:
-        """The per-point fields asked for: ``stress`` (n, dim, dim) Pa, ``strain`` (n, dim, dim)
-        and ``strain_valid`` (n,) bool."""
-        fields, dim = {}, self.body.dim
-        if self.spec.stress:
-            fields["stress"] = self.model.partial_stress(u)[:, :dim, :dim]
-        if self.spec.strain:
-            fields["strain"], fields["strain_valid"] = strain_field(self.body, self.model.bonds, u)
-        return fields
+        """The per-point tensor fields asked for (``tensors``), or none."""
+        return self.tensors(u) if self.tensors is not None else {}
 
     def close(self, status: str | None = None) -> None:
         """Close the file early (failure, interruption), setting its ``status`` when given."""

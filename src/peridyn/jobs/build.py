@@ -13,12 +13,23 @@ from scipy.spatial import cKDTree
 from peridyn import interrupts
 from peridyn.discretization import geometry
 from peridyn.discretization.body import Body, in_box, in_cylinder, in_sphere
-from peridyn.discretization.bonds import Bonds, crossing_rectangle, crossing_segment, cut_bonds, find_bonds
+from peridyn.discretization.bonds import (
+    Bonds,
+    crossing_rectangle,
+    crossing_segment,
+    cut_bonds,
+    find_bonds,
+    reorder_bonds,
+    search_reach,
+)
 from peridyn.errors import CaseFileError, InputError
 from peridyn.io import mesh_text
 from peridyn.io.case import Case, Region
+from peridyn.parallel.domain import Domain, agree
+from peridyn.parallel.halo import Halo, ghost_layers, plan_halo
+from peridyn.parallel.partition import rcb
 from peridyn.physics.contact import Contact
-from peridyn.physics.damage import BondDamage
+from peridyn.physics.damage import BondDamage, protected_points
 from peridyn.physics.loads import BoundaryCondition, InitialCondition, Loading
 from peridyn.physics.materials import Model, make_model
 from peridyn.physics.timefunctions import from_spec
@@ -30,7 +41,13 @@ BUILDING = "building the model"
 
 @dataclass
 class Setup:
-    """Everything a case builds before running."""
+    """Everything a case builds before running.
+
+    Under MPI (``build`` with a communicator of several ranks) ``body``, ``bonds``, ``model``,
+    ``loading`` and ``damage`` are the rank's part (owned points, then ghosts: see
+    ``peridyn.parallel``), ``whole_body`` the body of the case and ``domain`` the part's
+    place in it; in one process ``whole_body`` is ``body`` and ``domain`` the serial stand-in.
+    """
 
     body: Body
     bonds: Bonds
@@ -38,6 +55,14 @@ class Setup:
     loading: Loading
     damage: BondDamage | None
     contact: Contact | None = None
+    domain: Domain | None = None
+    whole_body: Body | None = None
+
+    def __post_init__(self):
+        if self.domain is None:
+            self.domain = Domain.serial(self.body.n_points)
+        if self.whole_body is None:
+            self.whole_body = self.body
 
 
 def build_body(case: Case, base_dir=".") -> Body:
@@ -114,11 +139,17 @@ def pad3(v) -> list:
     return list(v) + [0.0] * (3 - len(v))
 
 
-def build_bonds(case: Case, body: Body) -> Bonds:
-    """Families of the case's discretisation, with its pre-cracks cut."""
+def case_horizon(case: Case, body: Body) -> float:
+    """The horizon of the case's discretisation, m."""
     d = case.discretization
-    horizon = d.horizon_m if d.horizon_m is not None else d.horizon * body.spacing
-    bonds = find_bonds(body, horizon, d.influence, d.partial_volumes)
+    return d.horizon_m if d.horizon_m is not None else d.horizon * body.spacing
+
+
+def build_bonds(case: Case, body: Body, required=None) -> Bonds:
+    """Families of the case's discretisation, with its pre-cracks cut (``required``: the
+    points that must have a neighbour, default all; see ``find_bonds``)."""
+    d = case.discretization
+    bonds = find_bonds(body, case_horizon(case, body), d.influence, d.partial_volumes, required=required)
     for crack in case.precracks:
         if crack.type == "rectangle":
 
@@ -221,19 +252,87 @@ def distance_outside(body: Body, positions: np.ndarray, axes: int = 3) -> np.nda
     return np.min(np.linalg.norm(np.clip(gap, 0.0, None), axis=2), axis=1)
 
 
-def build(case: Case, base_dir=".") -> Setup:
-    """Body, bonds, model, loading and damage of a case.
+def build(case: Case, base_dir=".", comm=None) -> Setup:
+    """Body, bonds, model, loading and damage of a case; with a communicator of several ranks
+    (``peridyn.parallel.comm``), the part of this rank (``build_part``).
 
-    Within ``peridyn.interrupts.deferred``, a SIGINT or SIGTERM stops it after the phase under
-    way (points, bonds, model) with ``Interrupted``."""
+    Within ``peridyn.interrupts.deferred``, a SIGINT or SIGTERM stops a serial build after the
+    phase under way (points, bonds, model) with ``Interrupted``."""
+    if comm is not None and comm.size > 1:
+        return build_part(case, comm, base_dir)
     body = build_body(case, base_dir)
     interrupts.check(where=BUILDING)
     check_placements(case, body)
     body, actuation = add_actuators(case, body)
     bonds = build_bonds(case, body)
     interrupts.check(where=BUILDING)
+    model = build_model(case, body, bonds)
+    damage = build_damage(case, model)
+    interrupts.check(where=BUILDING)
+    loading = build_loading(case, body, actuation)
+    check_loading(case, loading)
+    return Setup(body, bonds, model, loading, damage, build_contact(case, model))
+
+
+#: Ghost layers of a rank's part (``peridyn.parallel.halo``): two, so that every per-point
+#: quantity of a neighbour of an owned point (LPS dilatation, surface corrections) is computed
+#: on the rank from that neighbour's whole family.
+GHOST_LAYERS = 2
+
+
+def build_part(case: Case, comm, base_dir=".") -> Setup:
+    """This rank's part of the case: the points that recursive coordinate bisection gives it and
+    two layers of ghosts (``peridyn.parallel``), their bonds only, the model, damage and loading
+    on them. Each owned point's family keeps the serial order (the search runs on the part's
+    points in global order, then the owned points are moved first and the ghosts after), so
+    that the kernels sum every force in the serial order. Collective: every rank calls it, and
+    an error on one rank is raised on all.
+    """
+    setup, owned, ghosts, ghost_owner = agree(comm, _build_part, case, comm, base_dir)
+    halo = Halo(comm, plan_halo(comm, owned, ghosts, ghost_owner))
+    local_ids = np.concatenate([owned, ghosts])
+    n_points = setup.whole_body.n_points
+    setup.domain = Domain(comm, local_ids, len(owned), n_points, halo, "recursive coordinate bisection")
+    return setup
+
+
+def _build_part(case: Case, comm, base_dir):
+    """``build_part`` up to the halo plan: the part's Setup (its domain set after), the owned
+    and ghost global indices (local order) and the ghosts' ranks."""
+    if case.contact is not None:
+        raise CaseFileError(
+            case.name, "contact", case.contact.model_dump(exclude_none=True), "no contact in an MPI run (yet)"
+        )
+    body = build_body(case, base_dir)
+    check_placements(case, body)
+    body, actuation = add_actuators(case, body)
+    loading = build_loading(case, body, actuation)
+    check_loading(case, loading)
+    owner = rcb(body.points, comm.size)
+    owned = np.flatnonzero(owner == comm.rank)
+    reach = search_reach(body, case_horizon(case, body), case.discretization.partial_volumes)
+    ghosts = ghost_layers(body.points, owned, reach, GHOST_LAYERS)
+    near = np.union1d(owned, ghosts)
+    bonds = build_bonds(case, body.subset(near), required=np.searchsorted(near, owned))
+    # ghosts without a neighbour on the rank (an outer ghost whose cells all miss) are dropped
+    ghosts = ghosts[np.diff(bonds.offsets)[np.searchsorted(near, ghosts)] > 0]
+    ghosts = ghosts[np.lexsort((ghosts, owner[ghosts]))]
+    local_ids = np.concatenate([owned, ghosts])
+    bonds = reorder_bonds(bonds, np.searchsorted(near, local_ids), len(near))
+    part = body.subset(local_ids)
+    model = build_model(case, part, bonds)
+    damage = None
+    if case.material.damage is not None:
+        protected = protected_points(body, case.material.damage.no_damage_sets)[local_ids]
+        damage = build_damage(case, model, protected)
+    setup = Setup(part, bonds, model, loading.restricted(part, local_ids), damage, None, None, body)
+    return setup, owned, ghosts, owner[ghosts]
+
+
+def build_model(case: Case, body: Body, bonds: Bonds) -> Model:
+    """The case's material bound to ``body`` and ``bonds``."""
     mat = case.material
-    model = make_model(
+    return make_model(
         mat.model,
         body,
         bonds,
@@ -243,19 +342,23 @@ def build(case: Case, base_dir=".") -> Setup:
         surface_correction=mat.surface_correction,
         dtype=case.solver.dtype,
     )
-    damage = None
-    if mat.damage is not None:
-        damage = BondDamage(
-            model,
-            mat.damage.critical_stretch,
-            mat.damage.fracture_energy,
-            mat.damage.no_damage_sets,
-            critical_bond_stress=mat.damage.critical_bond_stress,
-        )
-    interrupts.check(where=BUILDING)
-    loading = build_loading(case, body, actuation)
-    check_loading(case, loading)
-    return Setup(body, bonds, model, loading, damage, build_contact(case, model))
+
+
+def build_damage(case: Case, model: Model, protected=None) -> BondDamage | None:
+    """The case's bond breaking on ``model`` (None without ``material.damage``); ``protected``
+    ((n_points,) bool or None): the points of the no-damage sets, given by a rank's part
+    instead of the set names."""
+    d = case.material.damage
+    if d is None:
+        return None
+    return BondDamage(
+        model,
+        d.critical_stretch,
+        d.fracture_energy,
+        d.no_damage_sets if protected is None else (),
+        critical_bond_stress=d.critical_bond_stress,
+        protected=protected,
+    )
 
 
 def check_loading(case: Case, loading: Loading) -> None:

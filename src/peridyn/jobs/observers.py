@@ -7,7 +7,6 @@ import numpy as np
 
 from peridyn.analysis.crack import DEFAULT_THRESHOLD, total_crack_length
 from peridyn.errors import InputError
-from peridyn.physics.damage import damage_field
 
 
 class CrackLengthObserver:
@@ -15,30 +14,34 @@ class CrackLengthObserver:
 
     Parameters
     ----------
-    model : Model
-        Its ``bonds.intact`` gives the damage field.
+    body : Body
+        The whole body.
+    damage : callable () -> (n_points,) float64
+        The damage index of the current state (e.g. ``lambda: damage_field(model)``).
     every : int
     threshold : float
     """
 
-    def __init__(self, model, every: int, threshold: float = DEFAULT_THRESHOLD):
+    def __init__(self, body, damage, every: int, threshold: float = DEFAULT_THRESHOLD):
         if every < 1:
             raise InputError(f"crack observer interval must be >= 1 step, got {every!r}")
-        self.model, self.every, self.threshold = model, int(every), threshold
+        self.body, self.damage, self.every, self.threshold = body, damage, int(every), threshold
         self.times: list[float] = []
         self.lengths: list[float] = []
 
+    def due(self, step: int) -> bool:
+        """True when a sample is taken at ``step``."""
+        return step % self.every == 0
+
     def observe(self, state, solver=None) -> None:
-        if state.step % self.every == 0:
+        if self.due(state.step):
             self.sample(state.time)
 
     def sample(self, time: float) -> None:
         """Record the crack length of the current damage at ``time`` (s)."""
-        body = self.model.body
+        body = self.body
         self.times.append(float(time))
-        self.lengths.append(
-            total_crack_length(body.points, damage_field(self.model), body.spacing, self.threshold)
-        )
+        self.lengths.append(total_crack_length(body.points, self.damage(), body.spacing, self.threshold))
 
     def checkpoint_state(self) -> dict:
         """The samples so far, for a checkpoint: times (k,) s and lengths (k,) m."""

@@ -27,8 +27,10 @@ from peridyn.jobs.build import Setup, build, pad3
 from peridyn.jobs.figures import draw_crack_figures, draw_run_figures, final_crack_paths
 from peridyn.jobs.lamb_analysis import analyse
 from peridyn.jobs.summary import finish_summary
+from peridyn.parallel.observers import RootObservers
 from peridyn.physics.absorbing import layer_damping
 from peridyn.physics.damage import damage_field
+from peridyn.physics.deformation import strain_field
 from peridyn.physics.transducers import pzt_sensor_weights
 from peridyn.solvers import ExplicitSolver, relax
 
@@ -81,6 +83,7 @@ def run_case(
     base_dir=".",
     overwrite: bool = False,
     command: str | None = None,
+    comm=None,
 ) -> dict:
     """Run a case and write its results; returns the summary (also stored in results.h5; keys
     in docs/user-guide.md, "Summaries and results files").
@@ -101,6 +104,12 @@ def run_case(
         Replace an earlier run's results in the output folder.
     command : str or None
         The command line that started the run, for the resume hint of ``Interrupted``.
+    comm : communicator or None
+        ``peridyn.parallel.comm.world()`` under ``mpiexec -n N`` (N > 1): each rank runs its
+        part of the body (``peridyn.parallel``), rank 0 writes the one results.h5 with every
+        record equal to a serial run's, and every rank returns the summary. An explicit run
+        without contact, for now; checkpoints hold the whole body, so a run may restart on
+        another number of ranks. None: one process.
 
     Raises
     ------
@@ -121,9 +130,13 @@ def run_case(
         )
     if restart and not stepping:
         raise InputError(f"--restart continues an explicit or newmark run, not a {case.solver.type} run")
-    setup = build(case, base_dir)
+    if comm is not None and comm.size > 1:
+        _check_parallel(case)
+    setup = build(case, base_dir, comm)
+    domain = setup.domain
     solver = _time_stepper(case, setup) if stepping else None
-    out = prepare_output(output_directory(case, output_dir), RESULTS, overwrite, restart)
+    out = output_directory(case, output_dir)
+    domain.on_root(prepare_output, out, RESULTS, overwrite, restart)
     written = not restart  # a restart writes once its checkpoint is accepted (the recorder's part)
     try:
         summary, plots = _solve(
@@ -132,16 +145,46 @@ def run_case(
         written = True
         _finish(case, setup, out, summary, plots, start)
     except Exception as exc:
-        if written:
+        if written and domain.is_root:
             try:
-                _set_status(out / RESULTS, setup.body, end_status(exc))
+                _set_status(out / RESULTS, setup.whole_body, end_status(exc))
             except Exception:  # noqa: BLE001 - e.g. the full disk that failed the run: its error is the one to report
                 pass
         if isinstance(exc, Interrupted):
             hint = _resume_hint(command) if exc.resume else ""
             raise Interrupted(exc.signal_name, exc.step, hint, exc.where) from None
         raise
-    return summary
+    return domain.comm.bcast(summary)
+
+
+def _check_parallel(case: Case) -> None:
+    """Refuse what an MPI run cannot do yet."""
+    if case.solver.type != "explicit":
+        raise InputError(
+            f"an MPI run (mpiexec -n N) is an explicit run for now, not a {case.solver.type} run"
+        )
+    for key in ("stress", "strain"):
+        if getattr(case.output, key):
+            raise CaseFileError(case.name, f"output.{key}", True, "false in an MPI run (not written yet)")
+
+
+def point_tensors(setup: Setup, spec: RecorderSpec):
+    """The recorder's ``tensors``: u (n_points, 3) m -> the per-point ``stress`` (Pa) and
+    ``strain`` (with ``strain_valid``) that ``output.stress`` and ``output.strain`` ask for,
+    (n_points, dim, dim); None when neither is asked. Serial runs (the whole model)."""
+    if not (spec.stress or spec.strain):
+        return None
+    dim = setup.body.dim
+
+    def fields(u: np.ndarray) -> dict:
+        out = {}
+        if spec.stress:
+            out["stress"] = setup.model.partial_stress(u)[:, :dim, :dim]
+        if spec.strain:
+            out["strain"], out["strain_valid"] = strain_field(setup.body, setup.model.bonds, u)
+        return out
+
+    return fields
 
 
 def _resume_hint(command: str | None) -> str:
@@ -166,20 +209,26 @@ def _solve(case, setup, solver, out, case_path, checkpoint_every, restart, progr
 
 
 def _finish(case, setup, out, summary, plots, start) -> None:
-    """Analyses, figures and the stored summary after the solve; the status becomes complete."""
-    analysis, figures = analyse(case, setup.body, out, plots=case.output.plots)
+    """Analyses, figures and the stored summary after the solve; the status becomes complete
+    (on rank 0, with the damage of the whole body)."""
+    d = setup.domain
+    phi = d.gather(damage_field(setup.model)) if setup.damage is not None else None
+    d.on_root(_finish_on_root, case, setup.whole_body, out, summary, plots, start, phi)
+
+
+def _finish_on_root(case, body, out, summary, plots, start, phi) -> None:
+    """``_finish`` on rank 0: ``body`` the whole body, ``phi`` its damage (None without damage)."""
+    analysis, figures = analyse(case, body, out, plots=case.output.plots)
     summary.update(analysis)
-    paths = (
-        final_crack_paths(case, setup.body, damage_field(setup.model)) if setup.damage is not None else None
-    )
+    paths = final_crack_paths(case, body, phi) if phi is not None else None
     if paths is not None:
         summary["crack_paths"] = [p.summary() for p in paths]
     if case.output.plots and case.solver.type != "modal":  # a modal run draws its own
-        plots = [*draw_run_figures(case, setup.body, out), *figures]
+        plots = [*draw_run_figures(case, body, out), *figures]
         if paths is not None:
-            plots += draw_crack_figures(setup.body, out, paths, summary)
+            plots += draw_crack_figures(body, out, paths, summary)
     finish_summary(summary, "modal" if case.solver.type == "modal" else "run", out, start, plots)
-    store_summary(out / RESULTS, setup.body, summary, status="complete")
+    store_summary(out / RESULTS, body, summary, status="complete")
 
 
 def case_identity(case: Case) -> tuple[str, str]:
@@ -210,12 +259,16 @@ def store_summary(results, body: Body, summary: dict, status: str | None = None)
 
 
 def _base_summary(setup: Setup) -> dict:
+    """Points, directed bonds, broken bonds and largest damage of the whole body (collective)."""
+    d = setup.domain
+    n = d.n_owned
+    owned_bonds = int(setup.bonds.offsets[n])  # the owned points' families come first
     phi = damage_field(setup.model)
     return {
-        "points": setup.body.n_points,
-        "bonds": setup.bonds.n_bonds,
-        "broken_bonds": int((~setup.bonds.intact).sum()),
-        "max_damage": float(phi.max()),
+        "points": setup.whole_body.n_points,
+        "bonds": d.count(owned_bonds),
+        "broken_bonds": d.count((~setup.bonds.intact[:owned_bonds]).sum()),
+        "max_damage": float(d.max(phi[:n].max())),
     }
 
 
@@ -224,14 +277,18 @@ def _time_stepper(case, setup):
     if case.solver.type == "newmark":
         return _newmark_solver(case, setup)
     s = case.solver
+    damping = explicit_damping(case, setup.whole_body)
+    if np.ndim(damping):  # per point: the rank's points
+        damping = damping[setup.domain.global_ids]
     return ExplicitSolver(
         setup.model,
         setup.loading,
         dt=s.dt,
         safety=s.safety,
-        damping=explicit_damping(case, setup.body),
+        damping=damping,
         damage=setup.damage,
         contact=setup.contact,
+        domain=setup.domain,
     )
 
 
@@ -242,36 +299,46 @@ CHECKPOINT_AFTER_S = 60.0
 def _run_explicit(case, setup, solver, out, case_path, checkpoint_every, restart, progress, start) -> dict:
     """Time integration by ``solver`` with recording, checkpoints and the status."""
     s = case.solver
+    d = setup.domain
     n_steps = s.steps if s.steps is not None else int(np.ceil(s.time / solver.dt - 1e-9))
     ckpt_path = out / "checkpoint.h5"
     case_json, digest = case_identity(case)
     meta = {"case_hash": digest, "case": case_json, "dt": float(solver.dt), "version": package_version()}
-    cracks = _crack_observer(case, setup, n_steps)
+    gathered = RootObservers(d, setup.model)
+    cracks = _crack_observer(case, setup, n_steps, gathered.damage)
     parts = {
         name: part
         for name, part in (("damage", setup.damage), ("contact", setup.contact), ("cracks", cracks))
         if part is not None
     }
+    whole_bonds = d.bond_offsets(setup.bonds.offsets)
     if restart:
-        state, intact, saved = load_checkpoint(ckpt_path, setup.body.n_points, setup.bonds.n_bonds, meta)
-        setup.bonds.intact[:] = intact
-        for name, part in parts.items():
-            part.restore_state(saved.get(name, {}))
+        state = _restart(ckpt_path, setup, meta, parts, whole_bonds)
         resume = (state.step, state.time)
         print(
             f"restarting from the checkpoint at step {state.step} (t = {state.time:.6g} s)", file=sys.stderr
         )
     else:
         state, resume = solver.initial_state(), None
-    spec = recorder_spec(case, setup.body, solver.dt)
-    recorder = Recorder(setup.body, out, spec, provenance(case_path, case=case), setup.model, resume)
-    checkpointer = Checkpointer(ckpt_path, checkpoint_every or n_steps + 1, setup.bonds.intact, meta, parts)
+    spec = recorder_spec(case, setup.whole_body, solver.dt)
+    info = provenance(case_path, case=case)
+    if d.size > 1:
+        info.update(d.provenance())
+    tensors = point_tensors(setup, spec)
+    recorder = d.on_root(Recorder, setup.whole_body, out, spec, info, gathered.damage, resume, tensors)
+    checkpointer, prepare = _checkpointer(
+        ckpt_path, checkpoint_every or n_steps + 1, setup, meta, parts, whole_bonds
+    )
+    watched = [recorder, *([cracks] if cracks is not None else [])]
+    due = [spec.due, *([cracks.due] if cracks is not None else [])]
+    if d.size > 1 and checkpoint_every:  # saved on rank 0 from the gathered state
+        watched, due = [*watched, checkpointer], [*due, checkpointer.due]
+    gathered.attach(watched, due, prepare)
     try:
         if resume is None:
-            recorder.record_series(state)
-            recorder.snapshot(state)
-        observers = [recorder, *([cracks] if cracks is not None else [])]
-        if checkpoint_every:
+            gathered.call(state, lambda whole: (recorder.record_series(whole), recorder.snapshot(whole)))
+        observers = [gathered]
+        if checkpoint_every and d.size == 1:
             observers.append(checkpointer)
         remaining = n_steps - state.step
         bar = progress(remaining) if progress is not None else None
@@ -282,17 +349,19 @@ def _run_explicit(case, setup, solver, out, case_path, checkpoint_every, restart
                 bar.close()
     except Interrupted as exc:
         saved = bool(checkpoint_every) or time.perf_counter() - start > CHECKPOINT_AFTER_S
+        saved = saved and d.size == 1  # the ranks of an MPI run may stop at different steps
         if saved:
             checkpointer.save(state)
-        recorder.close(f"interrupted at step {exc.step}")
+        if recorder is not None:
+            recorder.close(f"interrupted at step {exc.step}")
         raise Interrupted(exc.signal_name, exc.step, "resume" if saved else "") from None
     except BaseException as exc:
-        recorder.close(end_status(exc))
+        if recorder is not None:
+            recorder.close(end_status(exc))
         raise
-    if state.step not in spec.snapshot_steps and not (
-        spec.snapshot_every and state.step % spec.snapshot_every == 0
-    ):
-        recorder.snapshot(state)
+    if not spec.snapshot_due(state.step):
+        gathered.call(state, lambda whole: recorder.snapshot(whole))
+    n = d.n_owned
     summary = _base_summary(setup)
     summary.update(
         {
@@ -301,15 +370,54 @@ def _run_explicit(case, setup, solver, out, case_path, checkpoint_every, restart
             "dt_s": solver.dt,
             "stable_dt_s": solver.stable_dt,
             "kinetic_energy_j": solver.kinetic_energy(state),
-            "strain_energy_j": setup.model.strain_energy(state.u),
+            "strain_energy_j": float(d.dot(setup.model.energy_density(state.u)[:n], setup.body.volumes[:n])),
         }
     )
     if setup.contact is not None:
         summary["contact_rebuilds"] = setup.contact.rebuilds
     if cracks is not None:
-        summary["crack_length_history"] = cracks.history()
-    recorder.finish(state)
+        summary["crack_length_history"] = cracks.history()  # rank 0's is the one returned
+    gathered.call(state, lambda whole: recorder.finish(whole))
     return summary
+
+
+def _restart(path, setup: Setup, meta: dict, parts: dict, whole_bonds: np.ndarray) -> State:
+    """The state of the checkpoint at ``path`` (this rank's points), with the bonds' intact mask
+    and the parts' states restored. Checkpoints hold the whole body in serial numbering, so a run
+    may restart on another number of ranks. A rank's damage skin covers its part only and is not
+    saved under MPI: it starts again with a full stretch test (the same bonds break, see
+    ``peridyn.physics.damage``)."""
+    d = setup.domain
+    state, intact, saved = d.agree(
+        load_checkpoint, path, setup.whole_body.n_points, int(whole_bonds[-1]), meta
+    )
+    if d.size > 1:
+        ids = d.global_ids
+        state = State(state.u[ids], state.v[ids], state.a[ids], state.time, state.step)
+    setup.bonds.intact[:] = d.scatter_bonds(intact, setup.bonds, whole_bonds)
+    for name, part in parts.items():
+        part.restore_state(saved.get(name, {}) if d.size == 1 or name != "damage" else {})
+    return state
+
+
+def _checkpointer(path, every: int, setup: Setup, meta: dict, parts: dict, whole_bonds: np.ndarray):
+    """The run's ``Checkpointer`` and what must be gathered before it saves (``RootObservers``):
+    under MPI it writes, on rank 0, the whole body's state and intact mask in serial numbering
+    and the parts that hold whole-body state (not a rank's damage skin)."""
+    d = setup.domain
+    if d.size == 1:
+        return Checkpointer(path, every, setup.bonds.intact, meta, parts), []
+    whole_intact = np.ones(int(whole_bonds[-1]), dtype=bool) if d.is_root else None
+    checkpointer = Checkpointer(
+        path, every, whole_intact, meta, {k: v for k, v in parts.items() if k != "damage"}
+    )
+
+    def gather_intact():
+        intact = d.gather_bonds(setup.bonds.intact, setup.bonds.offsets, whole_bonds)
+        if d.is_root:
+            whole_intact[:] = intact
+
+    return checkpointer, [(checkpointer.due, gather_intact)]
 
 
 def explicit_damping(case: Case, body: Body):
@@ -324,15 +432,15 @@ def explicit_damping(case: Case, body: Body):
         raise CaseFileError(case.name, "absorbing", a.model_dump(), str(exc)) from None
 
 
-def _crack_observer(case, setup, n_steps):
+def _crack_observer(case, setup, n_steps, damage):
     """Crack length against time, sampled at the snapshots (or 100 times a run) of a case
-    with damage; None without damage."""
+    with damage (``damage``: the whole body's damage index, a callable); None without damage."""
     if setup.damage is None:
         return None
     from peridyn.jobs.observers import CrackLengthObserver
 
     every = case.output.snapshot_every or max(1, n_steps // 100)
-    return CrackLengthObserver(setup.model, every)
+    return CrackLengthObserver(setup.whole_body, damage, every)
 
 
 def _run_static(case, setup, out, case_path) -> dict:
@@ -371,7 +479,14 @@ def _record_equilibrium(case, setup, out, case_path, u, results: dict) -> dict:
     """Record a quasi-static solution ``u`` as one state at t = 1 s; the run's summary."""
     state = State(u, np.zeros_like(u), np.zeros_like(u), 1.0, results["steps"])
     spec = recorder_spec(case, setup.body, 1.0)
-    recorder = Recorder(setup.body, out, spec, provenance(case_path, case=case), setup.model)
+    recorder = Recorder(
+        setup.body,
+        out,
+        spec,
+        provenance(case_path, case=case),
+        lambda: damage_field(setup.model),
+        tensors=point_tensors(setup, spec),
+    )
     recorder.record_series(state)
     recorder.snapshot(state)
     summary = _base_summary(setup)

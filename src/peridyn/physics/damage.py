@@ -54,6 +54,14 @@ def stretch_from_bond_stress(critical_bond_stress: float, E: float) -> float:
     return float(critical_bond_stress) / float(E)
 
 
+def protected_points(body, names) -> np.ndarray:
+    """(n_points,) bool: the points of the node sets ``names`` (whose bonds never break)."""
+    protected = np.zeros(body.n_points, dtype=bool)
+    for name in names:
+        protected[body.node_set(name)] = True
+    return protected
+
+
 class BondDamage:
     """Critical-stretch bond failure for one model.
 
@@ -67,6 +75,9 @@ class BondDamage:
         Node sets whose bonds never break.
     critical_bond_stress : float or None, Pa
         Bonds break when E s exceeds it (module docstring); needs ``model.E``.
+    protected : (n_points,) bool or None
+        More points whose bonds never break (a rank's part of the ``no_damage_sets`` of the
+        whole body, where its own part of a set may be empty).
 
     ``critical_stretch`` (n_bonds,) and ``breakable`` (n_bonds,) bool may be edited until
     the first ``update``, which reads them into the critical lengths and makes them
@@ -85,6 +96,7 @@ class BondDamage:
         fracture_energy: float | None = None,
         no_damage_sets=(),
         critical_bond_stress: float | None = None,
+        protected: np.ndarray | None = None,
     ):
         given = [v is not None for v in (critical_stretch, fracture_energy, critical_bond_stress)]
         if sum(given) != 1:
@@ -104,9 +116,7 @@ class BondDamage:
         self.value = float(critical_stretch)
         bonds = model.bonds
         self.critical_stretch = np.full(bonds.n_bonds, self.value)
-        protected = np.zeros(model.body.n_points, dtype=bool)
-        for name in no_damage_sets:
-            protected[model.body.node_set(name)] = True
+        protected = protected_points(model.body, no_damage_sets) | (False if protected is None else protected)
         self.breakable = ~(protected[bonds.owners()] | protected[bonds.neighbours])
         n = model.body.n_points
         self.full_tests = 0  # calls of ``update`` that tested every bond

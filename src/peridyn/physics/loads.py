@@ -126,6 +126,7 @@ class Loading:
                     bound.amplitude = bound.amplitude / body.volumes[idx].sum()
                 self.body_force.append(bound)
         self.constrained = owner >= 0
+        self._initial = [(ic.kind, self._bind_initial(ic)) for ic in self.initial]
         clash = self.constrained & forced
         if clash.any():
             point = int(np.flatnonzero(clash.any(axis=1))[0])
@@ -140,6 +141,32 @@ class Loading:
             idx, bc.components, bc.function, _amplitude(bc.profile, len(idx), len(bc.components), bc.node_set)
         )
 
+    def _bind_initial(self, ic: InitialCondition) -> _Bound:
+        idx = self.body.node_set(ic.node_set)
+        amp = _amplitude(ic.value, len(idx), len(ic.components), ic.node_set)
+        return _Bound(idx, ic.components, Constant(1.0), amp)
+
+    def restricted(self, body: Body, points: np.ndarray) -> Loading:
+        """This loading on the part ``body`` of its body made of the points ``points`` ((k,)
+        indices into ``self.body``, in ``body``'s order): every condition keeps its values
+        (a force's spread over the whole set included) on the points taken."""
+        new_index = np.full(self.body.n_points, -1, dtype=np.int64)
+        new_index[np.asarray(points, dtype=np.int64)] = np.arange(len(points))
+
+        def restrict(b: _Bound) -> _Bound:
+            local = new_index[b.index]
+            keep = local >= 0
+            return _Bound(local[keep], b.components, b.function, b.amplitude[keep])
+
+        part = Loading(body)
+        part.displacement = [restrict(b) for b in self.displacement]
+        part.velocity = [restrict(b) for b in self.velocity]
+        part.body_force = [restrict(b) for b in self.body_force]
+        part.initial = list(self.initial)
+        part._initial = [(kind, restrict(b)) for kind, b in self._initial]
+        part.constrained = self.constrained[points]
+        return part
+
     @property
     def has_loads(self) -> bool:
         """True when any boundary condition is defined."""
@@ -147,11 +174,9 @@ class Loading:
 
     def apply_initial(self, u: np.ndarray, v: np.ndarray) -> None:
         """Write the initial conditions into ``u`` and ``v`` (IN/OUT, (n_points, 3))."""
-        for ic in self.initial:
-            idx = self.body.node_set(ic.node_set)
-            amp = _amplitude(ic.value, len(idx), len(ic.components), ic.node_set)
-            target = u if ic.kind == "displacement" else v
-            target[np.ix_(idx, list(ic.components))] = amp
+        for kind, b in self._initial:
+            target = u if kind == "displacement" else v
+            target[np.ix_(b.index, list(b.components))] = b.amplitude
 
     def apply_start(self, dt: float, u: np.ndarray, v: np.ndarray) -> None:
         """The state of a dynamic run at t = 0 (IN/OUT): initial conditions, then the

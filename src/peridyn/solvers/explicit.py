@@ -18,8 +18,9 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from peridyn.discretization.state import State, check_state, runaway_limit
+from peridyn.discretization.state import State
 from peridyn.errors import InputError
+from peridyn.parallel.domain import Domain
 from peridyn.physics.contact import Contact
 from peridyn.physics.damage import BondDamage
 from peridyn.physics.loads import Loading
@@ -47,6 +48,10 @@ class ExplicitSolver:
         recorder also checks before every record).
     contact : Contact or None
         Short-range forces added to the model's force; their stiffness lowers the stable step.
+    domain : Domain or None
+        The rank's part of the body under MPI (``peridyn.parallel``): the model, loading and
+        damping are the rank's, u's ghost rows are exchanged after every update of u, and the
+        stable step, checks and energies are taken over the whole body. None: one process.
     """
 
     def __init__(
@@ -59,6 +64,7 @@ class ExplicitSolver:
         damage: BondDamage | None = None,
         check_every: int = 10,
         contact: Contact | None = None,
+        domain: Domain | None = None,
     ):
         if not 0 < safety <= 1:
             raise InputError(f"time-step safety factor must lie in (0, 1], got {safety!r}")
@@ -66,7 +72,10 @@ class ExplicitSolver:
         self.model = model
         self.loading = loading if loading is not None else Loading(model.body)
         self.contact = contact
-        self.stable_dt = damped_stable_step(stable_time_step(model, contact), np.max(damping))
+        self.domain = domain if domain is not None else Domain.serial(model.body.n_points)
+        self.stable_dt = damped_stable_step(
+            stable_time_step(model, contact, self.domain), self.domain.max(float(np.max(damping)))
+        )
         if dt is None:
             dt = safety * self.stable_dt
         elif not dt > 0:
@@ -82,7 +91,7 @@ class ExplicitSolver:
         self.damage = damage
         self.check_every = int(check_every)
         #: largest believable displacement, m (``runaway_limit``)
-        self.max_displacement = runaway_limit(model.body.points)
+        self.max_displacement = self.domain.runaway_limit(model.body.points)
         n = model.body.n_points
         self._force = np.zeros((n, 3), dtype=model.dtype)
         self._body_force = np.zeros((n, 3))
@@ -96,6 +105,7 @@ class ExplicitSolver:
         """The state at t = 0: initial conditions applied and accelerations computed."""
         state = State.zeros(self.model.body.n_points)
         self.loading.apply_start(self.dt, state.u, state.v)
+        self.domain.exchange(state.u)
         self._acceleration(state)
         return state
 
@@ -119,12 +129,13 @@ class ExplicitSolver:
         state.time += dt
         state.step += 1
         self.loading.apply_kinematics(state.time, dt, state.u, state.v)
+        self.domain.exchange(state.u)
         broken = self.damage.update(state.u) if self.damage is not None else 0
         self._acceleration(state)
         state.v += 0.5 * dt * state.a
         self.loading.apply_velocities(state.time, state.v)
         if state.step % self.check_every == 0:
-            check_state(state, self.max_displacement)
+            self.domain.check_state(state, self.max_displacement)
         return broken
 
     def run(self, state: State, n_steps: int, observers: Sequence = (), progress=None) -> State:
@@ -138,18 +149,23 @@ class ExplicitSolver:
             E.g. a tqdm bar.
         """
         advance(self, state, n_steps, observers, progress)
-        check_state(state, self.max_displacement)
+        self.domain.check_state(state, self.max_displacement)
         return state
 
     def kinetic_energy(self, state: State) -> float:
-        """Total kinetic energy, J."""
-        v2 = np.einsum("ij,ij->i", state.v, state.v)
-        return float(0.5 * np.sum(self.model.density * self.model.body.volumes * v2))
+        """Total kinetic energy of the whole body, J."""
+        n = self.domain.n_owned
+        v2 = np.einsum("ij,ij->i", state.v[:n], state.v[:n])
+        return float(0.5 * self.domain.sum(self.model.density[:n] * self.model.body.volumes[:n] * v2))
 
 
-def stable_time_step(model: Model, contact: Contact | None = None) -> float:
-    """Largest stable velocity-Verlet step, s, of a model with optional contact."""
-    return model.critical_time_step(None if contact is None else contact.stiffness_bound())
+def stable_time_step(model: Model, contact: Contact | None = None, domain: Domain | None = None) -> float:
+    """Largest stable velocity-Verlet step, s, of a model with optional contact (with a
+    ``domain``: over its owned points, then over every rank)."""
+    extra = None if contact is None else contact.stiffness_bound()
+    if domain is None:
+        return model.critical_time_step(extra)
+    return domain.min(model.critical_time_step(extra, points=domain.owned))
 
 
 def damped_stable_step(undamped_dt: float, damping: float) -> float:

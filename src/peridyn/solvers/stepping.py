@@ -19,8 +19,11 @@ def advance(solver, state: State, n_steps: int, observers=(), progress=None) -> 
     ------
     Interrupted
         SIGINT or SIGTERM arrived: raised after the current step and its observers, with
-        ``step`` the last completed step (``resume`` is left to the caller).
+        ``step`` the last completed step (``resume`` is left to the caller). A solver with an
+        MPI ``domain`` (``peridyn.parallel``) raises it on every rank after the same step.
     """
+    domain = getattr(solver, "domain", None)
+    agree = domain.max if domain is not None and domain.size > 1 else None
     with interrupts.deferred():
         for _ in range(int(n_steps)):
             solver.step(state)
@@ -28,5 +31,5 @@ def advance(solver, state: State, n_steps: int, observers=(), progress=None) -> 
                 obs.observe(state, solver)
             if progress is not None:
                 progress.update(1)
-            interrupts.check(state.step)
+            interrupts.check(state.step, agree=agree)  # with several ranks, all stop after this step
     return state

@@ -1,0 +1,134 @@
+"""The communicator of a run: MPI's COMM_WORLD under ``mpiexec -n N`` (N > 1), a serial stand-in
+otherwise.
+
+Both expose the same small set of methods (rank, size, barrier, bcast, gather, allgather,
+alltoall, allreduce of numbers and arrays, and the non-blocking point-to-point messages of the
+halo exchange), so that code written for ranks runs unchanged in one process; a serial run
+never imports mpi4py. ``world()`` picks one: MPI only when mpi4py imports and the environment
+shows an MPI launch (``PMI_SIZE``, ``OMPI_COMM_WORLD_SIZE``, ``MPI_LOCALNRANKS`` ...).
+"""
+
+from __future__ import annotations
+
+import functools
+import os
+
+import numpy as np
+
+#: Environment variables holding the number of ranks that MPI launchers set (MPICH/Hydra and
+#: Intel MPI, Open MPI, MPICH's local count, Slurm).
+LAUNCH_VARIABLES = ("PMI_SIZE", "OMPI_COMM_WORLD_SIZE", "MPI_LOCALNRANKS", "SLURM_NTASKS")
+
+
+class SerialComm:
+    """One process: every collective returns its own contribution."""
+
+    rank = 0
+    size = 1
+
+    def barrier(self) -> None:
+        """Nothing to wait for."""
+
+    def bcast(self, obj, root: int = 0):
+        return obj
+
+    def gather(self, obj, root: int = 0) -> list:
+        return [obj]
+
+    def allgather(self, obj) -> list:
+        return [obj]
+
+    def alltoall(self, objs: list) -> list:
+        return list(objs)
+
+    def allreduce(self, value, op: str = "sum"):
+        """``value`` itself (``op`` "sum", "max" or "min")."""
+        return value
+
+    def isend(self, buf: np.ndarray, dest: int, tag: int):
+        raise RuntimeError("a serial run has no other rank to send to")
+
+    def irecv(self, buf: np.ndarray, source: int, tag: int):
+        raise RuntimeError("a serial run has no other rank to receive from")
+
+    def waitall(self, requests: list) -> None:
+        """No request can be pending."""
+
+    def abort(self, code: int = 1) -> None:
+        raise SystemExit(code)
+
+
+class MPIComm:
+    """A thin wrapper of an mpi4py communicator (``mpi4py.MPI.Comm``)."""
+
+    def __init__(self, comm):
+        from mpi4py import MPI
+
+        self._mpi = MPI
+        self._comm = comm
+        self.rank = comm.Get_rank()
+        self.size = comm.Get_size()
+        self._ops = {"sum": MPI.SUM, "max": MPI.MAX, "min": MPI.MIN}
+
+    def barrier(self) -> None:
+        self._comm.Barrier()
+
+    def bcast(self, obj, root: int = 0):
+        return self._comm.bcast(obj, root=root)
+
+    def gather(self, obj, root: int = 0):
+        """A list of every rank's ``obj`` on ``root``, None elsewhere."""
+        return self._comm.gather(obj, root=root)
+
+    def allgather(self, obj) -> list:
+        return self._comm.allgather(obj)
+
+    def alltoall(self, objs: list) -> list:
+        return self._comm.alltoall(objs)
+
+    def allreduce(self, value, op: str = "sum"):
+        """The reduction of a number or of a numpy array (element by element) over all ranks.
+
+        Max and min are exact; a sum of floats depends on the order of the ranks, so results
+        that must equal a serial run's are gathered and summed in point order instead."""
+        if isinstance(value, np.ndarray):
+            out = np.empty_like(value)
+            self._comm.Allreduce(np.ascontiguousarray(value), out, op=self._ops[op])
+            return out
+        return self._comm.allreduce(value, op=self._ops[op])
+
+    def isend(self, buf: np.ndarray, dest: int, tag: int):
+        return self._comm.Isend(buf, dest=dest, tag=tag)
+
+    def irecv(self, buf: np.ndarray, source: int, tag: int):
+        return self._comm.Irecv(buf, source=source, tag=tag)
+
+    def waitall(self, requests: list) -> None:
+        self._mpi.Request.Waitall(requests)
+
+    def abort(self, code: int = 1) -> None:
+        self._comm.Abort(code)
+
+
+def launched_by_mpi(environ=None) -> bool:
+    """True when the environment shows an MPI launch with more than one rank."""
+    env = os.environ if environ is None else environ
+    for name in LAUNCH_VARIABLES:
+        value = env.get(name, "")
+        if value.isdigit() and int(value) > 1:
+            return True
+    return False
+
+
+@functools.cache
+def world():
+    """COMM_WORLD wrapped (``MPIComm``) under an MPI launch of more than one rank when mpi4py
+    imports, else a ``SerialComm`` (the same object at every call)."""
+    if not launched_by_mpi():
+        return SerialComm()
+    try:
+        from mpi4py import MPI
+    except ImportError:
+        return SerialComm()
+    comm = MPIComm(MPI.COMM_WORLD)
+    return comm if comm.size > 1 else SerialComm()

@@ -1,0 +1,278 @@
+"""A rank's part of a body (``Domain``): which points it owns, its ghosts and their exchange, and
+the collective operations a run needs, written so that results equal a serial run's bit for bit.
+
+Local arrays hold the owned points first (``owned`` rows, in global order), then the ghosts
+(``peridyn.parallel.halo``). Reductions that round (sums, dot products) are never summed per rank:
+the owned values are gathered on rank 0 in global point order and reduced there with the same
+numpy call as in serial, then broadcast. Max and min are exact and reduced across ranks.
+
+Errors: a step that only some ranks may fail (a check, a file on rank 0) runs through
+``agree`` or ``on_root``; every rank then raises the same error at the same point, so no rank
+waits for a message that never comes. ``Domain.serial(n)`` is the one-process stand-in: every
+method reduces to the plain numpy call.
+"""
+
+from __future__ import annotations
+
+import pickle
+
+import numpy as np
+
+from peridyn.discretization.state import State, check_state, runaway_limit_of_extent
+from peridyn.errors import InstabilityError, PeridynError
+from peridyn.parallel.comm import SerialComm
+from peridyn.parallel.halo import Halo
+
+
+class RankError(PeridynError):
+    """An error raised on another rank, whose exception could not be sent as it was."""
+
+
+class Domain:
+    """The points one rank computes (see the module docstring).
+
+    Parameters
+    ----------
+    comm : SerialComm or MPIComm
+    global_ids : (n_local,) int64
+        Global index of each local point: the owned ones (ascending) first, then the ghosts.
+    n_owned : int
+    n_global : int
+    halo : Halo or None
+        The ghost exchange (None: no ghosts, one rank).
+    partition : str
+        How the points were split, for the provenance.
+    """
+
+    def __init__(self, comm, global_ids, n_owned: int, n_global: int, halo: Halo | None, partition: str):
+        self.comm = comm
+        self.global_ids = np.asarray(global_ids, dtype=np.int64)
+        self.n_owned = int(n_owned)
+        self.n_global = int(n_global)
+        self.halo = halo
+        self.partition = partition
+        owned_ids = self.global_ids[: self.n_owned]
+        #: on rank 0: every rank's owned global indices (None elsewhere)
+        self._rank_ids = comm.gather(owned_ids) if comm.size > 1 else [owned_ids]
+
+    @classmethod
+    def serial(cls, n_points: int) -> Domain:
+        """The whole body in one process."""
+        return cls(SerialComm(), np.arange(n_points), n_points, n_points, None, "none")
+
+    @property
+    def size(self) -> int:
+        """Number of ranks."""
+        return self.comm.size
+
+    @property
+    def is_root(self) -> bool:
+        """True on rank 0, which writes the results."""
+        return self.comm.rank == 0
+
+    @property
+    def owned(self) -> slice:
+        """The owned rows of a local array."""
+        return slice(0, self.n_owned)
+
+    def __repr__(self) -> str:
+        return (
+            f"Domain(rank={self.comm.rank}/{self.size}, owned={self.n_owned}, "
+            f"local={len(self.global_ids)}, global={self.n_global})"
+        )
+
+    # -- ghosts --------------------------------------------------------------------------
+
+    def exchange(self, a: np.ndarray) -> None:
+        """Fill the ghost rows of the local array ``a`` (n_local, ...) from their owners."""
+        if self.halo is not None:
+            self.halo.exchange(a)
+
+    # -- reductions ----------------------------------------------------------------------
+
+    def max(self, value):
+        """The largest of every rank's ``value`` (a number or an array, element by element)."""
+        return self.comm.allreduce(value, "max")
+
+    def min(self, value):
+        """The smallest of every rank's ``value``."""
+        return self.comm.allreduce(value, "min")
+
+    def count(self, value: int) -> int:
+        """The sum of every rank's integer ``value``."""
+        return int(self.comm.allreduce(int(value), "sum"))
+
+    def gather(self, a: np.ndarray) -> np.ndarray | None:
+        """The owned rows of every rank's ``a`` assembled in global point order, on rank 0
+        (None elsewhere); in one process ``a`` itself."""
+        if self.size == 1:
+            return a
+        parts = self.comm.gather(np.ascontiguousarray(a[: self.n_owned]))
+        if not self.is_root:
+            return None
+        out = np.empty((self.n_global, *a.shape[1:]), dtype=a.dtype)
+        for ids, part in zip(self._rank_ids, parts, strict=True):
+            out[ids] = part
+        return out
+
+    def sum(self, a: np.ndarray) -> float:
+        """``np.sum`` of the per-point values ``a`` (owned rows) over the whole body, in global
+        order (the serial rounding), on every rank."""
+        return self._on_root_value(np.sum, self.gather(a))
+
+    def dot(self, a: np.ndarray, b: np.ndarray) -> float:
+        """``np.dot`` of two per-point arrays over the whole body, as in serial, on every rank."""
+        return self._on_root_value(np.dot, self.gather(a), self.gather(b))
+
+    def _on_root_value(self, fn, *args):
+        value = fn(*args) if self.is_root else None
+        return self.comm.bcast(value)
+
+    def runaway_limit(self, points: np.ndarray) -> float:
+        """``runaway_limit`` of the whole body from the local ``points`` (n_local, 3), m."""
+        owned = points[: self.n_owned]
+        extent = self.max(owned.max(axis=0)) - self.min(owned.min(axis=0))
+        return runaway_limit_of_extent(extent)
+
+    # -- errors --------------------------------------------------------------------------
+
+    def agree(self, fn, *args):
+        """``agree`` on this domain's communicator."""
+        return agree(self.comm, fn, *args)
+
+    def on_root(self, fn, *args):
+        """``fn(*args)`` on rank 0 only (its result there, None elsewhere); an error there is
+        raised on every rank."""
+        if self.size == 1:
+            return fn(*args)
+        result, error = None, None
+        if self.is_root:
+            try:
+                result = fn(*args)
+            except Exception as exc:  # noqa: BLE001 - shared, then raised
+                error = exc
+        _raise_any([self.comm.bcast(None if error is None else _portable(error))], error)
+        return result
+
+    def check_state(self, state: State, max_displacement: float) -> None:
+        """``check_state`` of the owned points, on every rank together; the point named is the
+        global index."""
+        n = self.n_owned
+        owned = State(state.u[:n], state.v[:n], state.a[:n], state.time, state.step)
+        self.agree(self._check_owned, owned, max_displacement)
+
+    def _check_owned(self, owned: State, max_displacement: float) -> None:
+        try:
+            check_state(owned, max_displacement)
+        except InstabilityError as exc:
+            raise InstabilityError(exc.step, exc.time, int(self.global_ids[exc.point]), exc.detail) from None
+
+    def gather_state(self, state: State) -> State | None:
+        """The state of the whole body in global order on rank 0 (None elsewhere); in one
+        process ``state`` itself."""
+        if self.size == 1:
+            return state
+        u, v, a = (self.gather(x) for x in (state.u, state.v, state.a))
+        return State(u, v, a, state.time, state.step) if self.is_root else None
+
+    # -- per-bond arrays (checkpoints) ------------------------------------------------------
+
+    def bond_offsets(self, offsets: np.ndarray) -> np.ndarray:
+        """(n_global + 1,) int64: the whole body's family offsets (serial bond numbering), from
+        the local CSR ``offsets`` (collective; the owned families are whole)."""
+        counts = np.diff(offsets[: self.n_owned + 1])
+        if self.size == 1:
+            return np.asarray(offsets, dtype=np.int64)
+        every = np.zeros(self.n_global, dtype=np.int64)
+        for ids, c in self.comm.allgather((self.global_ids[: self.n_owned], counts)):
+            every[ids] = c
+        return np.concatenate([[0], np.cumsum(every)])
+
+    def _serial_rows(self, offsets: np.ndarray, points: np.ndarray, whole: np.ndarray):
+        """Local bond rows of the families of local ``points`` and their serial bond numbers."""
+        counts = offsets[points + 1] - offsets[points]
+        shift = np.repeat(whole[self.global_ids[points]] - offsets[points], counts)
+        rows = np.repeat(offsets[points], counts) + _ranges(counts)
+        return rows, rows + shift
+
+    def gather_bonds(self, values: np.ndarray, offsets: np.ndarray, whole: np.ndarray):
+        """Per-bond ``values`` of the owned families placed in the serial bond numbering on rank 0
+        (None elsewhere); ``whole`` is ``bond_offsets(offsets)``. In one process ``values``."""
+        if self.size == 1:
+            return values
+        rows, serial = self._serial_rows(offsets, np.arange(self.n_owned), whole)
+        parts = self.comm.gather((serial, values[rows]))
+        if not self.is_root:
+            return None
+        out = np.empty(int(whole[-1]), dtype=values.dtype)
+        for idx, part in parts:
+            out[idx] = part
+        return out
+
+    def scatter_bonds(self, values: np.ndarray, bonds, whole: np.ndarray) -> np.ndarray:
+        """The local part ((n_bonds,) of ``bonds``) of per-bond ``values`` given in the serial
+        numbering (``whole`` = ``bond_offsets``), for a bond value shared by both directed copies
+        (e.g. ``intact``). The owned points' and their neighbours' families are whole on the rank
+        and taken directly; an outer ghost's bond takes its reverse copy's value where that lies in
+        such a family (a bond between two outer ghosts keeps its value, it enters no owned force).
+        In one process ``values``."""
+        if self.size == 1:
+            return values
+        offsets = bonds.offsets
+        whole_family = np.zeros(len(self.global_ids), dtype=bool)
+        whole_family[: self.n_owned] = True
+        whole_family[bonds.neighbours[: offsets[self.n_owned]]] = True
+        rows, serial = self._serial_rows(offsets, np.flatnonzero(whole_family), whole)
+        out = bonds.intact.copy() if values.dtype == bool else np.zeros(bonds.n_bonds, dtype=values.dtype)
+        out[rows] = values[serial]
+        rev = bonds.reverse()
+        owners = bonds.owners()
+        outer = ~whole_family[owners] & whole_family[owners[rev]]
+        out[outer] = out[rev[outer]]
+        return out
+
+    def provenance(self) -> dict:
+        """Ranks and partition for the results file's provenance (collective)."""
+        counts = self.comm.allgather(self.n_owned)
+        return {"mpi_ranks": self.size, "partition": self.partition, "points_per_rank": counts}
+
+
+def agree(comm, fn, *args):
+    """``fn(*args)`` on every rank of ``comm``; if it raised on any rank, every rank raises (its
+    own error, or the lowest failing rank's)."""
+    try:
+        result, error = fn(*args), None
+    except Exception as exc:  # noqa: BLE001 - every error is shared, then raised
+        result, error = None, exc
+    if comm.size == 1:
+        if error is not None:
+            raise error
+        return result
+    _raise_any(comm.allgather(None if error is None else _portable(error)), error)
+    return result
+
+
+def _raise_any(errors: list, own: BaseException | None) -> None:
+    """Raise ``own``, else the first error of ``errors`` (pickled), if any."""
+    if own is not None:
+        raise own
+    for err in errors:
+        if err is not None:
+            raise pickle.loads(err)
+
+
+def _portable(error: BaseException) -> bytes:
+    """``error`` pickled, or a ``RankError`` with its message when it does not survive pickling."""
+    try:
+        data = pickle.dumps(error)
+        pickle.loads(data)
+        return data
+    except Exception:  # noqa: BLE001 - exceptions with custom constructors
+        return pickle.dumps(RankError(str(error)))
+
+
+def _ranges(counts: np.ndarray) -> np.ndarray:
+    """0, 1, ..., c_0 - 1, 0, 1, ..., c_1 - 1, ... for the ``counts`` c_k."""
+    total = int(counts.sum())
+    starts = np.repeat(np.cumsum(counts) - counts, counts)
+    return np.arange(total) - starts

@@ -1,0 +1,70 @@
+"""Observers of a run that live on rank 0 (recorder, crack history) fed with the whole body.
+
+``RootObservers`` is the one observer every rank attaches. At a step where one of its observers
+is due, the ranks gather the state (and the damage index) in global point order on rank 0,
+which calls the observers with it; their errors reach every rank (``Domain.on_root``). In one
+process the observers get the run's own state, and the damage is computed when asked.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+
+import numpy as np
+
+from peridyn.discretization.state import State
+from peridyn.parallel.domain import Domain
+from peridyn.physics.damage import damage_field
+
+
+class RootObservers:
+    """Observers called on rank 0 with the gathered state.
+
+    Parameters
+    ----------
+    domain : Domain
+    model : Model
+        The rank's part of the model (its ``bonds.intact`` gives the damage index).
+
+    The observers are given by ``attach`` (they may take ``damage`` as their damage index).
+    """
+
+    def __init__(self, domain: Domain, model):
+        self.domain = domain
+        self.model = model
+        self.observers: list = []
+        self.due: list = []
+        self.prepare: list = []
+        self._damage: np.ndarray | None = None
+
+    def attach(self, observers: Sequence, due: Sequence[Callable[[int], bool]], prepare=()) -> None:
+        """Watch with ``observers`` (objects with ``observe(state, solver)``, used on rank 0 only:
+        None elsewhere) at the steps where one of ``due`` (callables step -> bool, known on every
+        rank) is True; ``prepare``: (due, collective callable) pairs run on every rank first at
+        their steps (e.g. gathering the bonds' intact mask for a checkpoint)."""
+        self.observers = list(observers) if self.domain.is_root else []
+        self.due = list(due)
+        self.prepare = list(prepare)
+
+    def damage(self) -> np.ndarray:
+        """The damage index (n_points,) of the whole body at the last gathered state (rank 0)."""
+        if self.domain.size == 1:
+            return damage_field(self.model)
+        return self._damage
+
+    def observe(self, state: State, solver) -> None:
+        """Gather and call the observers when one is due (every rank calls it); in one process,
+        call them at every step (nothing to gather)."""
+        if self.domain.size == 1 or any(due(state.step) for due in self.due):
+            for due, gather in self.prepare:
+                if due(state.step):
+                    gather()
+            self.call(state, lambda whole: [obs.observe(whole, solver) for obs in self.observers])
+
+    def call(self, state: State, fn):
+        """``fn(state of the whole body)`` on rank 0 after gathering (collective); its result on
+        rank 0, None elsewhere."""
+        whole = self.domain.gather_state(state)
+        if self.domain.size > 1:
+            self._damage = self.domain.gather(damage_field(self.model))
+        return self.domain.on_root(fn, whole)

@@ -1,0 +1,162 @@
+"""``mpiexec -n 2`` and ``-n 3 peridyn run`` give the serial run's results.h5 bit for bit (issue 20,
+acceptance): every dataset under ``final/`` and ``series/`` equal with np.array_equal, same dtype
+and shape. Shipped cases, shortened: LPS in 3D (bar_pulse), PMB in 2D with pre-crack and breaking
+bonds (plate2d_stretch, a lower bond strength so that it cracks within the shorter run) and the
+Kalthoff-Winkler plate (notches, pre-cracks, fracture energy, velocity loading) at 1 mm.
+
+Run with ``PYTHONPATH=src python -m pytest -m mpi -q -p no:cacheprovider`` (NUMBA_NUM_THREADS=1
+per rank; the runs start after a serial warm-up run that fills numba's cache).
+"""
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+
+import peridyn
+
+pytestmark = pytest.mark.mpi
+
+ROOT = Path(__file__).resolve().parents[2]
+SRC = str(Path(peridyn.__file__).parents[1])
+
+CASES = {
+    "bar_pulse": ("bar_pulse.yaml", ["solver.time=10e-6"]),
+    "plate2d_stretch": (
+        "plate2d_stretch.yaml",
+        ["solver.time=40e-6", "material.damage.critical_bond_stress=15e6"],
+    ),
+    "kalthoff_winkler": ("kalthoff_winkler.yaml", ["discretization.spacing=1e-3", "solver.time=30e-6"]),
+}
+
+
+def _have_mpi() -> bool:
+    if shutil.which("mpiexec") is None:
+        return False
+    try:
+        import mpi4py  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
+def _run(case: str, out: Path, ranks: int, *extra: str, flags=()) -> subprocess.CompletedProcess:
+    path, sets = CASES[case]
+    argv = ["run", str(ROOT / "cases" / path), "-o", str(out), "--no-progress", "--json", *flags]
+    for s in ["output.plots=false", *sets, *extra]:
+        argv += ["--set", s]
+    command = [sys.executable, "-m", "peridyn", *argv]
+    if ranks > 1:
+        command = ["mpiexec", "-n", str(ranks), *command]
+    env = dict(os.environ, PYTHONPATH=SRC, NUMBA_NUM_THREADS="1")
+    return subprocess.run(command, capture_output=True, text=True, timeout=600, env=env)
+
+
+def _datasets(path: Path) -> dict:
+    """Every dataset under final/ and series/ of a results file."""
+    found = {}
+    with h5py.File(path) as f:
+        for group in ("final", "series"):
+            if group in f:
+                f[group].visititems(
+                    lambda name, obj, g=group: (
+                        found.__setitem__(f"{g}/{name}", obj[()]) if isinstance(obj, h5py.Dataset) else None
+                    )
+                )
+    return found
+
+
+@pytest.fixture(scope="module")
+def serial(tmp_path_factory):
+    """The serial run of every case, after a short warm-up run (numba's cache filled)."""
+    if not _have_mpi():
+        pytest.skip("mpiexec or mpi4py not installed (pip install 'peridyn[mpi]')")
+    base = tmp_path_factory.mktemp("serial")
+    refs = {}
+    for case in CASES:
+        warm = _run(case, base / f"{case}-warm", 1, "solver.time=2e-7")
+        assert warm.returncode == 0, warm.stderr
+        done = _run(case, base / case, 1)
+        assert done.returncode == 0, done.stderr
+        refs[case] = _datasets(base / case / "results.h5"), json.loads(done.stdout)
+    return refs
+
+
+@pytest.mark.parametrize("ranks", [2, 3])
+@pytest.mark.parametrize("case", list(CASES))
+def test_mpi_run_equals_the_serial_run_bit_for_bit(case, ranks, serial, tmp_path):
+    done = _run(case, tmp_path / case, ranks)
+    assert done.returncode == 0, done.stderr
+    assert done.stderr.count("peridyn 0.1") <= 1  # only rank 0 speaks
+    got, want = _datasets(tmp_path / case / "results.h5"), serial[case][0]
+    assert got.keys() == want.keys()
+    for name, value in want.items():
+        assert got[name].dtype == value.dtype and got[name].shape == value.shape, name
+        assert np.array_equal(got[name], value), name
+    if case != "bar_pulse":  # the damage cases broke bonds: the comparison covers breaking
+        assert want["final/damage"].max() > 0
+    with h5py.File(tmp_path / case / "results.h5") as f:
+        assert f.attrs["mpi_ranks"] == ranks
+        assert sum(int(n) for n in f.attrs["points_per_rank"][1:-1].split(",")) == len(want["final/u"])
+
+
+def test_an_error_ends_every_rank_with_one_line(tmp_path):
+    """A failure on rank 0 alone (an earlier run's results in the output folder) is raised on
+    every rank: the run ends (no rank waits) with the one-line error, printed once."""
+    if not _have_mpi():
+        pytest.skip("mpiexec or mpi4py not installed")
+    out = tmp_path / "taken"
+    out.mkdir()
+    (out / "results.h5").write_bytes(b"")
+    done = _run("bar_pulse", out, 2, "solver.time=2e-7")
+    assert done.returncode == 1
+    lines = [line for line in done.stderr.splitlines() if "error:" in line]
+    assert len(lines) == 1 and "holds an earlier run's results.h5" in lines[0]
+
+
+def test_restart_on_three_ranks_from_a_two_rank_checkpoint_equals_the_serial_run(serial, tmp_path):
+    """Checkpoints hold the whole body in serial numbering: a 2-rank run stopped at 38 us (its
+    last checkpoint at step 1500, after the crack has started: plate2d_stretch's crack history
+    shows it by 35 us) and continued on 3 ranks to 40 us gives the serial 40 us run's datasets,
+    bonds broken and crack history bit for bit."""
+    out = tmp_path / "run"
+    first = _run("plate2d_stretch", out, 2, "solver.time=38e-6", flags=["--checkpoint-every", "100"])
+    assert first.returncode == 0, first.stderr
+    assert json.loads(first.stdout)["crack_length_history"]["length_m"][-1] > 0  # cracked before
+    done = _run("plate2d_stretch", out, 3, flags=["--restart"])
+    assert done.returncode == 0, done.stderr
+    want, summary = serial["plate2d_stretch"]
+    got = _datasets(out / "results.h5")
+    assert got.keys() == want.keys()
+    for name, value in want.items():
+        assert got[name].dtype == value.dtype and np.array_equal(got[name], value), name
+    resumed = json.loads(done.stdout)
+    for key in ("steps", "broken_bonds", "max_damage", "crack_length_history", "strain_energy_j"):
+        assert resumed[key] == summary[key], key
+
+
+def test_commands_that_do_not_run_over_ranks_are_refused_once():
+    """``mpiexec -n 2 peridyn modal`` would run the same job twice into one folder: refused."""
+    if not _have_mpi():
+        pytest.skip("mpiexec or mpi4py not installed")
+    env = dict(os.environ, PYTHONPATH=SRC)
+    command = [
+        "mpiexec",
+        "-n",
+        "2",
+        sys.executable,
+        "-m",
+        "peridyn",
+        "modal",
+        str(ROOT / "cases" / "pmma_plate.yaml"),
+    ]
+    done = subprocess.run(command, capture_output=True, text=True, timeout=300, env=env)
+    assert done.returncode == 1
+    lines = [line for line in done.stderr.splitlines() if "error:" in line]
+    assert len(lines) == 1 and "does not run over MPI ranks" in lines[0]

@@ -1,0 +1,199 @@
+"""Domain decomposition without mpiexec (``peridyn.parallel``): the partition, the ghost layers and
+exchange plans of simulated ranks, the serial stand-in, and each simulated rank's part of a case
+against the serial build (the runs under mpiexec are in ``tests/mpi``).
+
+Facts and their sources: RCB splits a part of p ranks at floor(n (p // 2) / p) points
+(``parallel/partition.py``), so part sizes differ by at most one point per level of cuts; the
+ghosts are by definition the points within the search reach of an owned point (layer 1) or of a
+layer-1 point (layer 2) that are not owned; bit-for-bit runs need every owned point's family, in
+serial order, with identical per-bond and per-point coefficients and forces (issue 20).
+"""
+
+from pathlib import Path
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+from scipy.spatial.distance import cdist
+
+from peridyn.discretization import geometry
+from peridyn.discretization.bonds import search_reach
+from peridyn.discretization.state import State, runaway_limit
+from peridyn.errors import InputError, InstabilityError
+from peridyn.io.case import load_case
+from peridyn.jobs.build import _build_part, build
+from peridyn.parallel.comm import SerialComm, launched_by_mpi
+from peridyn.parallel.domain import Domain
+from peridyn.parallel.halo import ghost_layers, plan_halo
+from peridyn.parallel.partition import rcb
+
+CASES = Path(__file__).resolve().parents[2] / "cases"
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+@pytest.mark.parametrize("parts", [1, 2, 3, 4, 7])
+def test_rcb_owns_every_point_once_balanced_and_deterministic(dim, parts):
+    body = (
+        geometry.box((0.013, 0.007, 0.005), 1e-3)
+        if dim == 3
+        else geometry.rectangle(0.021, 0.008, 1e-3, thickness=1e-3)
+    )
+    part = rcb(body.points, parts)
+    assert part.shape == (body.n_points,) and set(np.unique(part)) == set(range(parts))
+    counts = np.bincount(part, minlength=parts)
+    # one point of rounding per level of cuts (ceil(log2 p) levels)
+    assert counts.max() - counts.min() <= max(1, int(np.ceil(np.log2(parts))))
+    assert counts.sum() == body.n_points
+    # deterministic: a copy of the coordinates (another process's) gives the same parts
+    assert np.array_equal(part, rcb(body.points.copy(), parts))
+
+
+def test_rcb_refuses_more_parts_than_points():
+    with pytest.raises(InputError, match="cannot split 4 points into 5 parts"):
+        rcb(np.zeros((4, 3)), 5)
+
+
+def test_rcb_cuts_the_longest_side_first():
+    body = geometry.rectangle(0.040, 0.004, 1e-3, thickness=1e-3)
+    part = rcb(body.points, 2)
+    x = body.points[:, 0]
+    assert x[part == 0].max() < x[part == 1].min()
+
+
+def _brute_ghosts(points, owned, reach, layers):
+    taken = np.zeros(len(points), dtype=bool)
+    taken[owned] = True
+    frontier = owned
+    for _ in range(layers):
+        near = np.flatnonzero((cdist(points[frontier], points) <= reach).any(axis=0))
+        frontier = near[~taken[near]]
+        taken[frontier] = True
+    taken[owned] = False
+    return np.flatnonzero(taken)
+
+
+@pytest.mark.parametrize("layers", [1, 2])
+def test_ghosts_are_the_points_within_reach_not_owned(layers):
+    body = geometry.rectangle(0.012, 0.009, 1e-3, thickness=1e-3)
+    reach = search_reach(body, 2.015e-3)
+    part = rcb(body.points, 3)
+    for rank in range(3):
+        owned = np.flatnonzero(part == rank)
+        ghosts = ghost_layers(body.points, owned, reach, layers)
+        assert np.array_equal(ghosts, _brute_ghosts(body.points, owned, reach, layers))
+        assert not np.isin(ghosts, owned).any()
+
+
+class _Simulated:
+    """A rank's communicator in a one-process simulation of ``size`` ranks: ``alltoall`` answers
+    from the messages the other simulated ranks posted in a first pass."""
+
+    def __init__(self, rank, size, posted):
+        self.rank, self.size, self.posted = rank, size, posted
+
+    def alltoall(self, objs):
+        self.posted[self.rank] = objs
+        return [self.posted[s][self.rank] if s in self.posted else [] for s in range(self.size)]
+
+
+def test_halo_plans_send_each_ghost_from_its_owner_in_the_receiver_order():
+    body = geometry.box((0.010, 0.006, 0.004), 1e-3)
+    size = 3
+    part = rcb(body.points, size)
+    reach = search_reach(body, 1.5e-3, partial_volumes=False)
+    owned = [np.flatnonzero(part == r) for r in range(size)]
+    ghosts = []
+    for r in range(size):
+        g = ghost_layers(body.points, owned[r], reach, 2)
+        ghosts.append(g[np.lexsort((g, part[g]))])
+    posted = {}
+    for r in range(size):  # first pass posts every rank's requests
+        plan_halo(_Simulated(r, size, posted), owned[r], ghosts[r], part[ghosts[r]])
+    plans = [
+        plan_halo(_Simulated(r, size, posted), owned[r], ghosts[r], part[ghosts[r]]) for r in range(size)
+    ]
+    for r, plan in enumerate(plans):
+        local = np.concatenate([owned[r], ghosts[r]])
+        assert plan.n_ghosts == len(ghosts[r])
+        for source, (lo, hi) in zip(plan.recv_ranks, plan.recv_slices, strict=True):
+            sender = plans[source]
+            k = list(sender.send_ranks).index(r)
+            sent = owned[source][sender.send_rows[k]]
+            assert np.array_equal(sent, local[lo:hi])  # what arrives fills exactly these rows
+        assert set(plan.recv_ranks) == set(np.unique(part[ghosts[r]]))
+
+
+def test_serial_domain_reduces_like_numpy():
+    rng = np.random.default_rng(3)
+    a, b = rng.normal(size=1001), rng.normal(size=1001)
+    d = Domain.serial(1001)
+    assert d.gather(a) is a
+    assert d.sum(a) == np.sum(a) and d.dot(a, b) == np.dot(a, b)
+    assert d.max(2.5) == 2.5 and d.count(7) == 7
+    points = rng.normal(size=(1001, 3))
+    assert d.runaway_limit(points) == runaway_limit(points)
+    state = State(np.zeros((1001, 3)), np.zeros((1001, 3)), np.zeros((1001, 3)), 1e-6, 4)
+    state.v[17, 1] = np.nan
+    with pytest.raises(InstabilityError, match="point 17"):
+        d.check_state(state, 1.0)
+    with pytest.raises(ValueError, match="boom"):
+        d.agree(_raise_value_error)
+
+
+def _raise_value_error():
+    raise ValueError("boom")
+
+
+def test_launch_detection_reads_the_rank_count():
+    assert launched_by_mpi({"PMI_SIZE": "3"}) and launched_by_mpi({"OMPI_COMM_WORLD_SIZE": "2"})
+    assert not launched_by_mpi({"PMI_SIZE": "1"}) and not launched_by_mpi({})
+    assert SerialComm().allreduce(3.0, "max") == 3.0
+
+
+PARTS = [
+    ("bar_pulse.yaml", ["geometry.size=[0.03, 0.008, 0.006]", "output.sensors={}", "output.lines={}"]),
+    (
+        "bar_pulse.yaml",
+        [
+            "geometry.size=[0.03, 0.008, 0.006]",
+            "output.sensors={}",
+            "output.lines={}",
+            "material.surface_correction=energy",
+        ],
+    ),
+    ("plate2d_stretch.yaml", []),
+    ("plate2d_stretch.yaml", ["material.surface_correction=energy"]),
+]
+
+
+@pytest.mark.parametrize(("name", "overrides"), PARTS)
+@pytest.mark.parametrize("size", [2, 3])
+def test_each_rank_part_matches_the_serial_build(name, overrides, size):
+    """Owned families in serial order with identical coefficients, and the same force on the owned
+    points from the same displacement (the kernels are unchanged: per-point arithmetic)."""
+    case = load_case(CASES / name, overrides)
+    whole = build(case, CASES)
+    m, b = whole.model, whole.bonds
+    u = np.random.default_rng(5).normal(scale=1e-6, size=(whole.body.n_points, 3))
+    if whole.body.dim == 2:
+        u[:, 2] = 0.0
+    force = m.force(u)
+    owned_by = np.full(whole.body.n_points, -1)
+    for rank in range(size):
+        setup, owned, ghosts, _ = _build_part(case, SimpleNamespace(rank=rank, size=size), CASES)
+        assert not (owned_by[owned] >= 0).any()
+        owned_by[owned] = rank
+        ids = np.concatenate([owned, ghosts])
+        n, pb = len(owned), setup.bonds
+        nb = pb.offsets[n]
+        serial_bonds = np.concatenate([np.arange(b.offsets[i], b.offsets[i + 1]) for i in owned])
+        assert np.array_equal(ids[pb.neighbours[:nb]], b.neighbours[serial_bonds])
+        assert np.array_equal(pb.intact[:nb], b.intact[serial_bonds])
+        for attr in ("bond_volume", "bond_stiffness", "w", "dev"):
+            if hasattr(m, attr):
+                assert np.array_equal(getattr(setup.model, attr)[:nb], getattr(m, attr)[serial_bonds]), attr
+        assert np.array_equal(setup.model.stiffness_bound()[:n], m.stiffness_bound()[owned])
+        local_force = setup.model.force(np.ascontiguousarray(u[ids]))
+        assert np.array_equal(local_force[:n], force[owned])
+        assert np.array_equal(setup.loading.constrained, whole.loading.constrained[ids])
+    assert (owned_by >= 0).all()
