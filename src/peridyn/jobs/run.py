@@ -50,6 +50,7 @@ def recorder_spec(case: Case, body: Body, dt: float) -> RecorderSpec:
         pzt_sensors={k: _pzt_weights(body, v) for k, v in out.pzt_sensors.items()},
         series_dtype=out.series_dtype,
         vtu=out.vtu,
+        exodus=out.exodus,
     )
 
 
