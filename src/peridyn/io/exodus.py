@@ -237,7 +237,8 @@ def _element_variables(v, dims, blocks, n_steps) -> dict:
         for j, block in enumerate(blocks):
             key = f"vals_elem_var{i + 1}eb{j + 1}"
             if key in v:
-                parts.append(np.array(v[key].data, dtype=np.float64).reshape(n_steps, -1))
+                values = np.array(v[key].data, dtype=np.float64)
+                parts.append(values.reshape(n_steps, len(block.connectivity)))
             else:
                 parts.append(np.full((n_steps, len(block.connectivity)), np.nan))
         out[name] = np.concatenate(parts, axis=1) if parts else np.zeros((n_steps, 0))

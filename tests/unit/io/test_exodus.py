@@ -129,6 +129,28 @@ def test_peridigm_results_file():
         out.node_set("min_x")
 
 
+def test_results_file_without_steps(tmp_path):
+    """A results file closed before its first step: variables declared, none recorded."""
+    gold = read_exodus(DATA / "Compression_2x1x1_gold.e")
+    with scipy.io.netcdf_file(DATA / "Compression_2x1x1_gold.e", "r", mmap=False) as src:
+        with scipy.io.netcdf_file(tmp_path / "empty.e", "w", version=2) as dst:
+            dst.createDimension("time_step", None)  # scipy wants the unlimited one first
+            for name, size in src.dimensions.items():
+                if size is not None:
+                    dst.createDimension(name, size)
+            for name, var in src.variables.items():
+                data = var.data[:0] if var.isrec else var.data
+                out = dst.createVariable(name, var.typecode(), var.dimensions)
+                out[: len(data)] = data
+                for key, value in var._attributes.items():
+                    setattr(out, key, value)
+    empty = read_exodus(tmp_path / "empty.e")
+    assert len(empty.times) == 0
+    assert empty.element_variables.keys() == gold.element_variables.keys()
+    assert empty.element_variables["Dilatation"].shape == (0, 2)
+    np.testing.assert_array_equal(empty.coordinates, gold.coordinates)
+
+
 def test_hex_volume_is_the_trilinear_volume():
     """A warped hexahedron (non-planar faces): the 24-tetrahedron volume equals the integral
     of det J of the trilinear map, exact with 2 x 2 x 2 Gauss points (det J is quadratic per
