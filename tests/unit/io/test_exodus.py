@@ -203,6 +203,69 @@ def test_tet_and_sphere_elements():
     np.testing.assert_array_equal(sphere.volumes, [2e-9, 3e-9])
 
 
+def _chars(names, width=33):
+    """Names as a NUL-padded (n, width) netCDF char table."""
+    table = np.zeros((len(names), width), "S1")
+    for k, name in enumerate(names):
+        table[k, : len(name)] = np.frombuffer(name.encode(), "S1")
+    return table
+
+
+def _write_mesh(path):
+    """Two unit cubes along x sharing a face (block 10 "steel", HEX8) and a corner tetrahedron
+    (block 20, unnamed, TETRA4); node set 7 (unnamed): the x = 0 face; side set 3 "right":
+    side 2 (the x+ face) of element 2. Written the way Cubit writes it (ids, names, 1-based)."""
+    cube = np.array(UNIT_HEX)
+    nodes = np.concatenate(
+        [cube, cube[[1, 2, 5, 6]] + [1, 0, 0], [[5, 0, 0], [6, 0, 0], [5, 1, 0], [5, 0, 1]]]
+    )
+    conn_hex = np.array([[0, 1, 2, 3, 4, 5, 6, 7], [1, 8, 9, 2, 5, 10, 11, 6]]) + 1
+    with scipy.io.netcdf_file(path, "w", version=2) as f:
+        f.title = "two cubes and a tet"
+        for name, size in [("len_name", 33), ("num_dim", 3), ("num_nodes", len(nodes)), ("num_elem", 3)]:
+            f.createDimension(name, size)
+        for name, size in [("num_el_blk", 2), ("num_node_sets", 1), ("num_side_sets", 1)]:
+            f.createDimension(name, size)
+        for name, size in [("num_el_in_blk1", 2), ("num_nod_per_el1", 8), ("num_el_in_blk2", 1)]:
+            f.createDimension(name, size)
+        for name, size in [("num_nod_per_el2", 4), ("num_nod_ns1", 4), ("num_side_ss1", 1)]:
+            f.createDimension(name, size)
+        for axis, c in enumerate("xyz"):
+            f.createVariable(f"coord{c}", "d", ("num_nodes",))[:] = nodes[:, axis]
+        f.createVariable("eb_prop1", "i", ("num_el_blk",))[:] = [10, 20]
+        f.createVariable("eb_names", "c", ("num_el_blk", "len_name"))[:] = _chars(["steel", ""])
+        f.createVariable("connect1", "i", ("num_el_in_blk1", "num_nod_per_el1"))[:] = conn_hex
+        f.variables["connect1"].elem_type = "HEX8"
+        f.createVariable("connect2", "i", ("num_el_in_blk2", "num_nod_per_el2"))[:] = [[13, 14, 15, 16]]
+        f.variables["connect2"].elem_type = "TETRA4"
+        f.createVariable("ns_prop1", "i", ("num_node_sets",))[:] = [7]
+        f.createVariable("node_ns1", "i", ("num_nod_ns1",))[:] = [1, 4, 5, 8]
+        f.createVariable("ss_prop1", "i", ("num_side_sets",))[:] = [3]
+        f.createVariable("ss_names", "c", ("num_side_sets", "len_name"))[:] = _chars(["right"])
+        f.createVariable("elem_ss1", "i", ("num_side_ss1",))[:] = [2]
+        f.createVariable("side_ss1", "i", ("num_side_ss1",))[:] = [2]
+
+
+def test_blocks_sets_and_side_sets_from_a_file(tmp_path):
+    _write_mesh(tmp_path / "m.g")
+    mesh = read_exodus(tmp_path / "m.g")
+    assert mesh.title == "two cubes and a tet"
+    assert [(b.id, b.name, b.element_type) for b in mesh.blocks] == [
+        (10, "steel", "HEX8"),
+        (20, "block_20", "TETRA4"),
+    ]
+    side = mesh.side_set("right")
+    assert side is mesh.side_set(3) and side.elements.tolist() == [1] and side.sides.tolist() == [2]
+    pts = mesh_points(mesh)
+    np.testing.assert_allclose(pts.volumes, [1.0, 1.0, 1 / 6], rtol=HEX_RTOL)
+    np.testing.assert_allclose(
+        pts.points, [[0.5, 0.5, 0.5], [1.5, 0.5, 0.5], [5.25, 0.25, 0.25]], rtol=HEX_RTOL
+    )
+    np.testing.assert_array_equal(pts.block_ids, [10, 10, 20])
+    sets = {k: v.tolist() for k, v in pts.point_sets.items()}
+    assert sets == {"steel": [0, 1], "block_20": [2], "nodelist_7": [0], "right": [1]}
+
+
 def test_bad_meshes_are_refused(tmp_path):
     with pytest.raises(InputError, match="QUAD4"):
         mesh_points(_mesh("QUAD4", [[0, 1, 2, 3]], [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]]))
