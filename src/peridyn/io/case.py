@@ -96,9 +96,11 @@ class Strict(BaseModel):
 class Geometry(Strict):
     """The body's shape. ``box``: size [lx, ly, lz]; ``plate``: size [length, width, thickness]
     and ``layers``; ``rectangle`` (2D): size [lx, ly], ``thickness``, ``plane``;
-    ``mesh``: a Peridigm-style text mesh ``file`` (x y z block_id volume)."""
+    ``mesh``: a Peridigm-style text mesh ``file`` (x y z block_id volume); ``exodus``: an
+    Exodus II mesh ``file`` (a point per element; its blocks, node sets and side sets become
+    node sets, see ``peridyn.io.exodus``)."""
 
-    type: Literal["box", "plate", "rectangle", "mesh"]
+    type: Literal["box", "plate", "rectangle", "mesh", "exodus"]
     size: list[Positive] | None = None
     origin: Vector3 | None = None
     layers: Annotated[int, NotBool, Field(ge=1)] | None = None
@@ -117,9 +119,16 @@ class Geometry(Strict):
             raise ValueError("a plate needs the number of layers through its thickness")
         if self.type == "rectangle" and self.thickness is None:
             raise ValueError("a rectangle (2D) needs its thickness (m)")
-        if self.type == "mesh" and not self.file:
-            raise ValueError("a mesh geometry needs the mesh file")
+        if self.is_mesh and not self.file:
+            raise ValueError(f"a {self.type} geometry needs the mesh file")
+        if self.type == "exodus" and self.dimension != 3:
+            raise ValueError("an exodus geometry is 3D (dimension 3)")
         return self
+
+    @property
+    def is_mesh(self) -> bool:
+        """Points read from a mesh file (text or Exodus) rather than made on a grid."""
+        return self.type in ("mesh", "exodus")
 
     @property
     def dim(self) -> int:
@@ -365,7 +374,8 @@ class LineSpec(Strict):
 
 
 class Output(Strict):
-    """Where and what to write (folder default: ``peridyn-out/<case name>``)."""
+    """Where and what to write (folder default: ``peridyn-out/<case name>``); ``exodus``: also
+    write the snapshots as Exodus II, ``results.e`` (``peridyn.io.exodus_write``)."""
 
     directory: str | None = None
     every: Annotated[int, NotBool, Field(ge=1)] = 1
@@ -377,6 +387,7 @@ class Output(Strict):
     pzt_sensors: dict[str, PZTSensor] = {}
     series_dtype: Literal["float64", "float32"] = "float64"
     vtu: bool = True
+    exodus: bool = False
     plots: bool = True
     #: per-point partial stress and Green-Lagrange strain in the final fields and VTU snapshots
     stress: bool = False
@@ -446,19 +457,24 @@ class Case(Strict):
                     )
         return self
 
+    def set_references(self) -> list[tuple[str, str]]:
+        """(key, node set name) of every node set the case refers to."""
+        used = [(f"boundary_conditions[{i}].set", bc.set) for i, bc in enumerate(self.boundary_conditions)]
+        used += [(f"initial_conditions[{i}].set", ic.set) for i, ic in enumerate(self.initial_conditions)]
+        used += [(f"output.planes.{k}", v) for k, v in self.output.planes.items()]
+        if self.material.damage:
+            used += [("material.damage.no_damage_sets", s) for s in self.material.damage.no_damage_sets]
+        return used
+
     @model_validator(mode="after")
     def _sets_exist(self):
         clash = set(self.actuators) & (set(self.node_sets) | {"all"})
         if clash:
             raise ValueError(f"actuators: name {sorted(clash)[0]!r} is already a node set")
         known = set(self.node_sets) | {"all"} | set(self.actuators)
-        used = [(f"boundary_conditions[{i}].set", bc.set) for i, bc in enumerate(self.boundary_conditions)]
-        used += [(f"initial_conditions[{i}].set", ic.set) for i, ic in enumerate(self.initial_conditions)]
-        used += [(f"output.planes.{k}", v) for k, v in self.output.planes.items()]
-        if self.material.damage:
-            used += [("material.damage.no_damage_sets", s) for s in self.material.damage.no_damage_sets]
-        for where, name in used:
-            if name not in known:
+        in_file = self.geometry.type == "exodus"  # its sets are known once the mesh is read
+        for where, name in self.set_references():
+            if name not in known and not in_file:
                 raise ValueError(
                     f"{where}: unknown node set {name!r}{did_you_mean(name, known)}; defined: {sorted(known)}"
                 )

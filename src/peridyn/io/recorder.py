@@ -8,7 +8,7 @@ Series in ``results.h5`` (see ``peridyn.io.hdf5`` for the layout):
 - ``plane_<name>``: (n, 3) displacement of a plane probe (a node set or a plate layer);
 - ``pzt_signal``: (n_pzt,) mean in-plane strain under each PZT sensor patch;
 - ``field_u``: (n_points, 3) displacement at every snapshot, with ``snapshots/*.vtu``
-  files and ``snapshots.pvd`` for ParaView.
+  files and ``snapshots.pvd`` for ParaView, and ``results.e`` (Exodus II) when asked.
 
 When asked (``stress``, ``strain``), the final fields ``final/stress`` (partial stress, Pa) and
 ``final/strain`` (Green-Lagrange strain) with ``final/strain_valid``, (n_points, dim, dim)
@@ -27,6 +27,7 @@ from scipy.spatial import cKDTree
 from peridyn.discretization.body import Body
 from peridyn.discretization.state import State, check_state, runaway_limit
 from peridyn.errors import InputError
+from peridyn.io.exodus_write import ExodusWriter
 from peridyn.io.hdf5 import HDF5Writer
 from peridyn.io.vtk import PVDCollection, write_vtu
 
@@ -64,6 +65,8 @@ class RecorderSpec:
         Write VTU snapshots and a PVD collection.
     stress, strain : bool
         Write the per-point partial stress / Green-Lagrange strain (final fields and VTU).
+    exodus : bool
+        Write the snapshots to ``results.e`` (``snapshot_exodus``).
     """
 
     every: int = 1
@@ -75,6 +78,7 @@ class RecorderSpec:
     pzt_sensors: dict = field(default_factory=dict)
     series_dtype: str = "float64"
     vtu: bool = True
+    exodus: bool = False
     stress: bool = False
     strain: bool = False
 
@@ -161,10 +165,15 @@ class Recorder:
         if spec.vtu:
             (self.directory / "snapshots").mkdir(exist_ok=True)
             self.pvd = PVDCollection(self.directory / "snapshots.pvd", mode=mode)
+        self.exodus = (
+            snapshot_exodus(body, self.directory / "results.e", damage is not None) if spec.exodus else None
+        )
         if resume is not None:
             self.h5.truncate(resume[0])
             if self.pvd is not None:
                 self.pvd.truncate(resume[1])
+            if self.exodus is not None:
+                self.exodus.resume(resume[1])
 
     def _create_series(self) -> None:
         h5, spec = self.h5, self.spec
@@ -217,6 +226,8 @@ class Recorder:
         InstabilityError, writing nothing, for a non-finite or runaway state."""
         check_state(state, self.max_displacement)
         self.h5.append("field_u", state.step, state.time, state.u)
+        if self.exodus is not None:
+            self.exodus.append(state.time, **exodus_fields(self.body, state, self.damage))
         if self.pvd is None:
             return
         data = {"displacement": state.u[:, : self.body.dim], "velocity": state.v[:, : self.body.dim]}
@@ -257,3 +268,29 @@ def _padded_tensor(values: np.ndarray) -> np.ndarray:
     full = np.zeros((len(values), 3, 3), dtype=values.dtype)
     full[:, : values.shape[1], : values.shape[2]] = values
     return full.reshape(len(values), 9)
+
+
+def snapshot_exodus(body: Body, path, damage: bool = False) -> ExodusWriter:
+    """An Exodus writer of snapshots: nodal ``Displacement`` and ``Velocity`` (m, m/s), element
+    ``Volume`` (m^3) and, with ``damage``, ``Damage``; one block, the body's node sets."""
+    element = {"Volume": 1, **({"Damage": 1} if damage else {})}
+    sets = {k: v for k, v in body.node_sets.items() if len(v)}
+    return ExodusWriter(
+        path,
+        body.points[:, : body.dim],
+        node_sets=sets,
+        nodal={"Displacement": body.dim, "Velocity": body.dim},
+        element=element,
+    )
+
+
+def exodus_fields(body: Body, state: State, damage=None) -> dict:
+    """The fields of ``snapshot_exodus`` at ``state``, as keyword arguments of ``append``
+    (``damage``: the recorder's callable, or None)."""
+    element = {"Volume": body.volumes}
+    if damage is not None:
+        element["Damage"] = damage()
+    return {
+        "nodal": {"Displacement": state.u[:, : body.dim], "Velocity": state.v[:, : body.dim]},
+        "element": element,
+    }

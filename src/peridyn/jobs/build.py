@@ -23,8 +23,8 @@ from peridyn.discretization.bonds import (
     search_reach,
 )
 from peridyn.errors import CaseFileError, InputError
-from peridyn.io import mesh_text
-from peridyn.io.case import Case, Region
+from peridyn.io import exodus, mesh_text
+from peridyn.io.case import Case, Geometry, Region
 from peridyn.parallel.domain import Domain, agree
 from peridyn.parallel.halo import Halo, ghost_layers, plan_halo
 from peridyn.parallel.partition import rcb
@@ -79,13 +79,25 @@ def build_body(case: Case, base_dir=".") -> Body:
                 "a region that contains at least one point",
             )
         body = body.with_node_set(name, mask)
+    if case.geometry.type == "exodus":
+        check_mesh_sets(case, body)
     return body
+
+
+def check_mesh_sets(case: Case, body: Body) -> None:
+    """Refuse references to node sets that neither the case nor the mesh defines (the case
+    file alone cannot tell for a mesh's sets)."""
+    for where, name in case.set_references():
+        if name not in body.node_sets and name not in case.actuators:
+            raise CaseFileError(
+                case.name, where, name, f"a node set of the case or of the mesh: {sorted(body.node_sets)}"
+            )
 
 
 def build_points(case: Case, base_dir=".", removals: bool = True) -> Body:
     """Points of the case geometry, minus its removals (unless ``removals`` is False)."""
     g, d = case.geometry, case.discretization
-    if g.type != "mesh" and d.spacing is None:
+    if not g.is_mesh and d.spacing is None:
         raise CaseFileError(case.name, "discretization.spacing", None, "a positive spacing (m)")
     if g.type == "box":
         body = geometry.box(g.size, d.spacing, g.origin or (0.0, 0.0, 0.0))
@@ -106,13 +118,20 @@ def build_points(case: Case, base_dir=".", removals: bool = True) -> Body:
             origin=(g.origin or (0.0, 0.0))[:2],
         )
     else:
-        mesh = Path(g.file) if Path(g.file).is_absolute() else Path(base_dir) / g.file
-        body = mesh_text.from_text_mesh(
-            mesh, dim=g.dimension, thickness=g.thickness, plane=g.plane if g.dimension == 2 else None
-        )
+        body = mesh_body(g, base_dir)
     for k, region in enumerate(case.removals if removals else []):
         body = body.remove(region_mask(body, region, f"removals[{k}]"))
     return body
+
+
+def mesh_body(g: Geometry, base_dir=".") -> Body:
+    """The body of a text-mesh or Exodus geometry, its file relative to ``base_dir``."""
+    mesh = Path(g.file) if Path(g.file).is_absolute() else Path(base_dir) / g.file
+    if g.type == "exodus":
+        return exodus.body_from_exodus(mesh)
+    return mesh_text.from_text_mesh(
+        mesh, dim=g.dimension, thickness=g.thickness, plane=g.plane if g.dimension == 2 else None
+    )
 
 
 def region_mask(body: Body, region: Region, where: str) -> np.ndarray:

@@ -21,7 +21,6 @@ import math
 import re
 import warnings
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 
@@ -161,11 +160,11 @@ def lattice_bonds(counts, cell, horizon: float, partial_volumes: bool, dim: int)
 def grid_shape(case: Case, base_dir=".") -> tuple[np.ndarray, np.ndarray, int]:
     """Points per axis (3,), cell sides (3,) m and dimension of the case's body, unbuilt.
 
-    A text mesh has no grid: its points are read and taken as one row (its bonds are then
+    A text or Exodus mesh has no grid: its points are read and taken as one row (its bonds are then
     counted as if every point had a full family).
     """
     g, d = case.geometry, case.discretization
-    if g.type != "mesh" and d.spacing is None:
+    if not g.is_mesh and d.spacing is None:
         raise CaseFileError(case.name, "discretization.spacing", None, "a positive spacing (m)")
     spacing = np.broadcast_to(np.asarray(d.spacing, dtype=float), (3,)) if g.type == "box" else None
     try:
@@ -180,17 +179,16 @@ def grid_shape(case: Case, base_dir=".") -> tuple[np.ndarray, np.ndarray, int]:
             return np.array([*xy, g.layers]), np.array([h, h, dz]), 3
     except InputError as exc:
         raise CaseFileError(case.name, "discretization.spacing", d.spacing, str(exc)) from None
-    from peridyn.io import mesh_text
+    from peridyn.jobs.build import mesh_body
 
-    mesh = Path(g.file) if Path(g.file).is_absolute() else Path(base_dir) / g.file
-    body = mesh_text.from_text_mesh(mesh, dim=g.dimension, thickness=g.thickness, plane=g.plane)
+    body = mesh_body(g, base_dir)
     return np.array([body.n_points, 1, 1]), np.array([body.spacing] * 3), g.dimension
 
 
 def kept_share(case: Case, counts: np.ndarray, base_dir=".") -> float:
     """Share of the grid's points left after the case's removals (1 without removals),
     measured on a copy of the body at a spacing giving about ``REMOVAL_SAMPLE_POINTS``."""
-    if not case.removals or case.geometry.type == "mesh":
+    if not case.removals or case.geometry.is_mesh:
         return 1.0
     from peridyn.jobs.build import build_points
 

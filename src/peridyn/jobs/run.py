@@ -54,6 +54,7 @@ def recorder_spec(case: Case, body: Body, dt: float) -> RecorderSpec:
         vtu=out.vtu,
         stress=out.stress,
         strain=out.strain,
+        exodus=out.exodus,
     )
 
 

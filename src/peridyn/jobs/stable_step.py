@@ -43,7 +43,7 @@ def estimated_stable_step(case: Case, base_dir=".") -> float:
     d, mat, g = case.discretization, case.material, case.geometry
     spacing = float(cell[0]) if g.type == "plate" else float(np.max(cell[:dim]))
     horizon = d.horizon_m if d.horizon_m is not None else d.horizon * spacing
-    volume = float(np.prod(cell)) if g.type != "mesh" else spacing**3
+    volume = float(np.prod(cell)) if not g.is_mesh else spacing**3
     offsets, factor = neighbour_offsets(counts, cell, horizon, d.partial_volumes, dim)
     bound = 0.0
     for low in itertools.product(*(_positions(offsets[:, a], int(counts[a])) for a in range(3))):
