@@ -22,7 +22,6 @@ from peridyn.io.exodus import (
 )
 
 DATA = Path(__file__).parents[2] / "data" / "peridigm"
-SHARED = Path("/work/shared/peridigm")
 
 #: Rounding of sums of a few hundred float64 volumes (relative).
 SUM_RTOL = 1e-13
@@ -101,13 +100,10 @@ def test_node_set_becomes_the_elements_touching_it():
     assert len(expected) == 75 and np.all(pts.points[expected, 0] < -0.015)
 
 
-@pytest.mark.skipif(
-    not (SHARED / "WaveInBar").is_dir(), reason="Peridigm's WaveInBar gold file (727 kB) not here"
-)
 def test_node_set_rule_is_peridigms():
     """WaveInBar's deck gives the node set an initial velocity of -100 m/s in x: the points
     moving at t = 0 in Peridigm's gold output are the points of our node set."""
-    gold = read_exodus(SHARED / "WaveInBar" / "WaveInBar_gold.e")
+    gold = read_exodus(DATA / "WaveInBar_gold.e")
     pts = mesh_points(read_exodus(DATA / "WaveInBar.g"))
     np.testing.assert_allclose(pts.points, gold.coordinates, rtol=0, atol=ULPS * 0.021)
     moving = np.flatnonzero(gold.nodal_variables["VelocityX"][0] == -100.0)
