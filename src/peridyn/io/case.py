@@ -17,11 +17,49 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_valida
 
 from peridyn.errors import CaseFileError, did_you_mean
 
+#: Deepest nesting of collections a YAML text may have (a case nests 5 levels; PyYAML composes
+#: each level by recursion, so a deeper text would exhaust Python's recursion limit).
+MAX_YAML_DEPTH = 64
+#: Most values a YAML text may hold with its aliases expanded (a shipped case holds about 300; an
+#: alias bomb, "billion laughs", holds 9**9 from a few lines and would hang whatever walks it).
+MAX_YAML_VALUES = 100_000
+
 
 class _Loader(yaml.SafeLoader):
     """SafeLoader that also reads ``1e3`` and ``150.0e3`` as floats (YAML 1.2 style; plain
     PyYAML would take them for strings) and refuses a key given twice in one mapping (PyYAML
-    keeps the last silently). Keys merged in with ``<<: *anchor`` may be overridden."""
+    keeps the last silently). Keys merged in with ``<<: *anchor`` may be overridden. A text
+    nested deeper than ``MAX_YAML_DEPTH``, whose aliases expand to more than ``MAX_YAML_VALUES``
+    values, or with an alias inside its own anchor is refused before it is constructed."""
+
+    def __init__(self, stream):
+        super().__init__(stream)
+        self._depth = 0
+
+    def compose_node(self, parent, index):
+        if self._depth >= MAX_YAML_DEPTH:
+            raise yaml.composer.ComposerError(
+                None,
+                None,
+                f"collections nested deeper than {MAX_YAML_DEPTH} levels",
+                self.peek_event().start_mark,
+            )
+        self._depth += 1
+        try:
+            return super().compose_node(parent, index)
+        finally:
+            self._depth -= 1
+
+    def construct_document(self, node):
+        if _expanded_size(node, {}) > MAX_YAML_VALUES:
+            raise yaml.constructor.ConstructorError(
+                None,
+                None,
+                f"more than {MAX_YAML_VALUES} values once its aliases are expanded, or an alias "
+                "inside its own anchor",
+                node.start_mark,
+            )
+        return super().construct_document(node)
 
     def construct_mapping(self, node, deep=False):
         if isinstance(node, yaml.MappingNode):
@@ -42,6 +80,27 @@ class _Loader(yaml.SafeLoader):
                         key_node.start_mark,
                     )
         return super().construct_mapping(node, deep=deep)
+
+
+def _expanded_size(node: yaml.Node, sizes: dict) -> int:
+    """Values in ``node`` with every alias expanded, counted once per node (an alias is the same
+    node object as its anchor); above ``MAX_YAML_VALUES`` for a node within itself."""
+    if id(node) in sizes:
+        return sizes[id(node)]
+    sizes[id(node)] = MAX_YAML_VALUES + 1  # while counting: an alias to it is a cycle
+    if isinstance(node, yaml.SequenceNode):
+        children = node.value
+    elif isinstance(node, yaml.MappingNode):
+        children = [child for pair in node.value for child in pair]
+    else:
+        children = []
+    total = 1
+    for child in children:
+        total += _expanded_size(child, sizes)
+        if total > MAX_YAML_VALUES:
+            break
+    sizes[id(node)] = total
+    return total
 
 
 _Loader.add_implicit_resolver(
