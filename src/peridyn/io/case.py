@@ -82,6 +82,29 @@ class _Loader(yaml.SafeLoader):
         return super().construct_mapping(node, deep=deep)
 
 
+def _checked_scalar(construct):
+    """PyYAML's constructor ``construct`` of a scalar type, whose failure on a value it cannot read
+    (``!!int abc``: ValueError; ``!!bool maybe``: KeyError; ``!!timestamp x``: AttributeError; an
+    integer of more than 4300 digits: ValueError) is a YAML error at that value."""
+
+    def checked(loader, node):
+        try:
+            return construct(loader, node)
+        except (ValueError, KeyError, AttributeError):
+            kind, text = node.tag.rsplit(":", 1)[-1], str(node.value)
+            shown = repr(text) if len(text) <= 40 else f"{text[:37]!r}... ({len(text)} characters)"
+            raise yaml.constructor.ConstructorError(
+                None, None, f"{shown} is not a valid {kind}", node.start_mark
+            ) from None
+
+    return checked
+
+
+for _kind in ("int", "float", "bool", "timestamp"):
+    _tag = f"tag:yaml.org,2002:{_kind}"
+    _Loader.add_constructor(_tag, _checked_scalar(_Loader.yaml_constructors[_tag]))
+
+
 def _expanded_size(node: yaml.Node, sizes: dict) -> int:
     """Values in ``node`` with every alias expanded, counted once per node (an alias is the same
     node object as its anchor); above ``MAX_YAML_VALUES`` for a node within itself."""

@@ -103,3 +103,30 @@ def test_deep_nesting_is_refused_with_its_position(tmp_path):
     with pytest.raises(CaseFileError, match=rf"nested deeper than {MAX_YAML_DEPTH} levels at line 1, column"):
         load_case(path)
     assert parse_yaml("[" * MAX_YAML_DEPTH + "]" * MAX_YAML_DEPTH) is not None
+
+
+@pytest.mark.parametrize(
+    ("text", "shown"),
+    [
+        ("!!int abc", "'abc' is not a valid int"),  # int(): ValueError
+        ("!!float x", "'x' is not a valid float"),  # float(): ValueError
+        ("!!bool maybe", "'maybe' is not a valid bool"),  # PyYAML's table: KeyError
+        ("!!timestamp 2001-99", "'2001-99' is not a valid timestamp"),  # no regex match: AttributeError
+        ("9" * 5000, "(5000 characters) is not a valid int"),  # Python's 4300-digit limit: ValueError
+    ],
+)
+def test_a_tagged_value_of_the_wrong_type_names_it_and_its_line(tmp_path, text, shown):
+    """PyYAML's scalar constructors raised ValueError, KeyError or AttributeError (an internal
+    error of the CLI, found by tests/fuzz) for these."""
+    path = tmp_path / "tagged.yaml"
+    path.write_text(BAR.read_text().replace("name: bar_pulse", f"name: {text}"))
+    with pytest.raises(CaseFileError, match=r"at line \d+, column \d+") as info:
+        load_case(path)
+    assert shown in str(info.value) and "\n" not in str(info.value)
+    with pytest.raises(CaseFileError, match="a YAML value") as info:
+        load_case(BAR, [f"name={text}"])
+    assert shown in str(info.value)
+
+
+def test_valid_tagged_scalars_are_still_read():
+    assert parse_yaml("[!!int 1_000, !!float 2, !!bool yes, 1.5e3]") == [1000, 2.0, True, 1500.0]
