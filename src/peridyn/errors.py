@@ -72,6 +72,14 @@ def did_you_mean(word: str, choices) -> str:
     " (did you mean 'lps'?)"
     >>> did_you_mean("elastic", ["pmb", "lps"])
     ''
+
+    Only names are compared: a ``word`` that is not text (a number where a name belongs) has
+    no suggestion, and choices that are not text are skipped.
+
+    >>> did_you_mean(float("nan"), ["pmb", "lps"]), did_you_mean("lsp", [1, "lps"])
+    ('', " (did you mean 'lps'?)")
     """
-    close = difflib.get_close_matches(word, list(choices), n=1)
+    if not isinstance(word, str):
+        return ""
+    close = difflib.get_close_matches(word, [c for c in choices if isinstance(c, str)], n=1)
     return f" (did you mean {close[0]!r}?)" if close else ""

@@ -197,3 +197,29 @@ def test_stable_step_is_the_silling_askari_bound_for_pmb():
     per_point = np.add.reduceat(m.bond_stiffness / b.length, b.offsets[:-1])
     expected = np.min(np.sqrt(2 * m.density / per_point))
     assert m.critical_time_step() == pytest.approx(expected, rel=1e-12)
+
+
+@pytest.mark.parametrize("value", [".nan", ".inf", "-.inf"])
+def test_a_non_finite_boundary_value_is_refused(value):
+    """A NaN load reached the solver before (found by tests/fuzz); InitialConditionSpec already
+    asked for a finite value."""
+    with pytest.raises(CaseFileError, match=r"boundary_conditions\[1\]\.value") as info:
+        validate_case(_case(**{"boundary_conditions.1.value": value}))
+    assert info.value.key == "boundary_conditions[1].value" and "finite" in info.value.expected
+
+
+@pytest.mark.parametrize(
+    ("key", "value"),
+    [
+        ("boundary_conditions.1.value", "abc"),
+        ("discretization.spacing", "abc"),
+        ("discretization.spacing", "[1, x]"),
+    ],
+)
+def test_a_key_of_union_type_is_named_without_pydantic_s_member_names(key, value):
+    """pydantic locates a union's failure at ("spacing", "constrained-float"): the key named was
+    discretization.spacing.constrained-float before."""
+    with pytest.raises(CaseFileError) as info:
+        validate_case(_case(**{key: value}))
+    assert info.value.key == key.replace(".1.", "[1].")
+    assert all(f"{info.value.key}." not in line for line in str(info.value).splitlines())

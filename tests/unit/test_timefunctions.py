@@ -69,8 +69,26 @@ def test_spec_builds_nested_functions():
         ({"type": "ramp", "start": 1.0, "end": 0.5}, "after"),
         ("1 + 1", "expected a number or a mapping"),
         ({"type": "table", "file": "/nonexistent/table.csv"}, "does not exist"),
+        # found by tests/fuzz: each was a TypeError or ValueError (an internal error of the CLI)
+        ({"type": float("nan")}, r"value.type: expected the name of a time function.* got nan"),
+        ({"type": []}, r"value.type: expected the name of a time function.* got \[\]"),
+        ({"type": "sine", "frequency": [1.0]}, r"value.frequency: expected a finite number, got \[1.0\]"),
+        ({"type": "sine", "frequency": 1.0, "amplitude": "x"}, "value.amplitude: expected a finite number"),
+        ({"type": "tone_burst", "frequency": 1.0, "amplitude": float("inf")}, "got inf"),
+        ({"type": "sine", "frequency": True}, "value.frequency: expected a finite number, got True"),
+        ({"type": "sine", "frequency": 1.0, 5: 1.0}, "unknown parameter 5 for Sine"),
+        ({"type": "sum", "terms": 5}, "a sum takes only a non-empty list 'terms'"),
+        ({"type": "table", "times": 5, "values": [1, 2]}, "value.times: expected a list of finite numbers"),
+        ({"type": "table", "times": ["a", 1], "values": [1, 2]}, "value.times: expected a list of finite"),
+        ({"type": "table", "file": 3}, "a table takes a CSV 'file'"),
     ],
 )
 def test_bad_specs(spec, message):
     with pytest.raises(InputError, match=message):
         from_spec(spec)
+
+
+def test_a_null_delay_keeps_the_default_and_numpy_numbers_are_numbers():
+    burst = from_spec({"type": "gaussian_burst", "frequency": 1e5, "delay": None})
+    assert burst(0.0) == pytest.approx(from_spec({"type": "gaussian_burst", "frequency": 1e5})(0.0), abs=0)
+    assert from_spec({"type": "tone_burst", "frequency": np.float64(1e5), "cycles": np.int64(3)}).cycles == 3

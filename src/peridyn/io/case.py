@@ -307,7 +307,7 @@ class BoundaryConditionSpec(Strict):
     set: str
     kind: Literal["displacement", "velocity", "force", "body_force"]
     components: str | list[str] = "xyz"
-    value: float | dict = 0.0
+    value: Finite | dict = 0.0
 
 
 class InitialConditionSpec(Strict):
@@ -625,12 +625,26 @@ def _case_error(exc: ValidationError, source: str) -> CaseFileError:
     return error
 
 
+#: The names pydantic gives the members of a union in an error's location (``value: float | dict``
+#: fails at ``("value", "float")`` and ``("value", "dict[any,any]")``): not keys of the case.
+_UNION_MEMBERS = {
+    "float",
+    "int",
+    "str",
+    "bool",
+    "constrained-float",
+    "constrained-int",
+    "function-after",
+    "literal",
+}
+
+
 def _key_path(loc) -> str:
     out = ""
     for part in loc:
         if isinstance(part, int):
             out += f"[{part}]"
-        elif "[" in str(part) or part in ("function-after", "literal"):
+        elif "[" in str(part) or part in _UNION_MEMBERS:
             continue
         else:
             out += f".{part}" if out else str(part)

@@ -8,6 +8,7 @@ Nothing is ever evaluated from a string.
 
 from __future__ import annotations
 
+import numbers
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -239,18 +240,27 @@ def from_spec(spec, where: str = "value") -> TimeFunction:
         raise InputError(f"{where}: expected a number or a mapping with a 'type', got {spec!r}")
     params = {k: v for k, v in spec.items() if k != "type"}
     kind = spec["type"]
+    choices = [*_SIMPLE, "table", "sum", "product"]
+    if not isinstance(kind, str):
+        raise InputError(
+            f"{where}.type: expected the name of a time function, one of {choices}, got {kind!r}"
+        )
     if kind in ("sum", "product"):
         terms = params.pop("terms", None)
-        if not terms or params:
+        if not isinstance(terms, list) or not terms or params:
             raise InputError(f"{where}: a {kind} takes only a non-empty list 'terms'")
         built = tuple(from_spec(t, f"{where}.terms[{i}]") for i, t in enumerate(terms))
         return Sum(built) if kind == "sum" else Product(built)
     if kind == "table":
         if "file" in params:
+            if not isinstance(params["file"], str) or len(params) > 1:
+                raise InputError(f"{where}: a table takes a CSV 'file' (a path) or 'times' and 'values'")
             return Tabulated.from_csv(params["file"])
+        for key, column in params.items():
+            if not isinstance(column, list) or not all(_is_finite_number(v) for v in column):
+                raise InputError(f"{where}.{key}: expected a list of finite numbers, got {column!r}")
         return _construct(Tabulated, where, {k: tuple(v) for k, v in params.items()})
     if kind not in _SIMPLE:
-        choices = [*_SIMPLE, "table", "sum", "product"]
         raise InputError(
             f"{where}.type: unknown time function {kind!r}{did_you_mean(kind, choices)}"
             f"; choose one of {choices}"
@@ -267,7 +277,16 @@ def _construct(cls, where: str, params: dict) -> TimeFunction:
             f"{did_you_mean(unknown[0], fields)} for {cls.__name__}; "
             f"allowed: {sorted(fields)}"
         )
+    if cls is not Tabulated:  # every parameter of the others is a number (a delay may be null)
+        for key, value in params.items():
+            if not (_is_finite_number(value) or (value is None and fields[key].default is None)):
+                raise InputError(f"{where}.{key}: expected a finite number, got {value!r}")
     try:
         return cls(**params)
     except TypeError as exc:
         raise InputError(f"{where}: {exc}") from exc
+
+
+def _is_finite_number(value) -> bool:
+    """Whether ``value`` is a finite real number (not a bool, a string, NaN or an infinity)."""
+    return isinstance(value, numbers.Real) and not isinstance(value, bool) and bool(np.isfinite(value))
