@@ -223,3 +223,16 @@ def test_a_key_of_union_type_is_named_without_pydantic_s_member_names(key, value
         validate_case(_case(**{key: value}))
     assert info.value.key == key.replace(".1.", "[1].")
     assert all(f"{info.value.key}." not in line for line in str(info.value).splitlines())
+
+
+def test_a_check_of_the_whole_case_names_its_key_not_the_whole_case():
+    """The Case-level checks (node sets, contact, analysis, absorbing) report at the root: the
+    error gave key "<root>" and the whole case as value (found by tests/fuzz)."""
+    raw = _case()
+    raw["boundary_conditions"][1]["set"] = "rihgt"
+    with pytest.raises(CaseFileError) as info:
+        validate_case(raw)
+    exc = info.value
+    assert (exc.key, exc.value) == ("boundary_conditions[1].set", None)
+    assert exc.expected.startswith("unknown node set 'rihgt' (did you mean 'right'?)")
+    assert "'geometry'" not in str(exc)

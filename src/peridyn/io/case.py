@@ -616,6 +616,8 @@ def _case_error(exc: ValidationError, source: str) -> CaseFileError:
             expected, value = "a required key that is missing", None
         else:
             expected = err["msg"].removeprefix("Value error, ")
+        if not loc and (named := _LEADING_KEY.fullmatch(expected)):  # a check of the whole case
+            loc, value, expected = named["key"], None, named["rest"]  # not the whole case as value
         if first is None:
             first = (loc, value, expected)
         lines.append(f"{loc} = {value!r}: {expected}" if loc else expected)
@@ -625,6 +627,8 @@ def _case_error(exc: ValidationError, source: str) -> CaseFileError:
     return error
 
 
+#: A message of a check of the whole case that names its key first ("absorbing: layers damp ...").
+_LEADING_KEY = re.compile(r"(?P<key>[A-Za-z_][\w.\[\]]*): (?P<rest>.*)", re.S)
 #: The names pydantic gives the members of a union in an error's location (``value: float | dict``
 #: fails at ``("value", "float")`` and ``("value", "dict[any,any]")``): not keys of the case.
 _UNION_MEMBERS = {
