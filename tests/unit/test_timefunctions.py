@@ -81,6 +81,11 @@ def test_spec_builds_nested_functions():
         ({"type": "table", "times": 5, "values": [1, 2]}, "value.times: expected a list of finite numbers"),
         ({"type": "table", "times": ["a", 1], "values": [1, 2]}, "value.times: expected a list of finite"),
         ({"type": "table", "file": 3}, "a table takes a CSV 'file'"),
+        ({"type": "sine", "frequency": 10**400}, "value.frequency: expected a finite number"),
+        (
+            {"type": "tone_burst", "frequency": 10**30, "cycles": -(2**63)},
+            "tone burst cycles must be positive",
+        ),
     ],
 )
 def test_bad_specs(spec, message):

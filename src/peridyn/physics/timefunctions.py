@@ -8,6 +8,7 @@ Nothing is ever evaluated from a string.
 
 from __future__ import annotations
 
+import math
 import numbers
 from dataclasses import dataclass
 from pathlib import Path
@@ -211,7 +212,7 @@ class Product(TimeFunction):
 
 
 def _positive(name: str, value: float) -> None:
-    if not (np.isfinite(value) and value > 0):
+    if not (_is_finite_number(value) and value > 0):
         raise InputError(f"{name} must be positive, got {value!r}")
 
 
@@ -289,4 +290,9 @@ def _construct(cls, where: str, params: dict) -> TimeFunction:
 
 def _is_finite_number(value) -> bool:
     """Whether ``value`` is a finite real number (not a bool, a string, NaN or an infinity)."""
-    return isinstance(value, numbers.Real) and not isinstance(value, bool) and bool(np.isfinite(value))
+    if not isinstance(value, numbers.Real) or isinstance(value, bool):
+        return False
+    try:
+        return math.isfinite(value)
+    except OverflowError:  # an integer beyond the floats (10**400)
+        return False
