@@ -246,6 +246,11 @@ def _run_explicit(case, setup, solver, out, case_path, checkpoint_every, restart
     }
     if restart:
         state, intact, saved = load_checkpoint(ckpt_path, setup.body.n_points, setup.bonds.n_bonds, meta)
+        if state.step >= n_steps:  # refused before the recorder opens (and rewrites) results.h5
+            raise InputError(
+                f"--restart: the checkpoint is at step {state.step} and the run ends at step {n_steps}: "
+                "nothing is left to run (a longer solver.time or solver.steps continues it)"
+            )
         setup.bonds.intact[:] = intact
         for name, part in parts.items():
             part.restore_state(saved.get(name, {}))
