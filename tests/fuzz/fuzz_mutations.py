@@ -17,6 +17,8 @@ from pathlib import Path
 import yaml
 from hypothesis import strategies as st
 
+from peridyn.io.case import parse_yaml
+
 ROOT = Path(__file__).resolve().parents[2]
 #: Every shipped case: the examples in cases/ and the demo's case.
 SHIPPED = [
@@ -316,7 +318,7 @@ def text_mutation(draw, text: bytes) -> tuple[bytes, str]:
 
 def base_case(path: Path, tiny: bool = False) -> dict:
     """The shipped case at ``path`` as a mapping; with ``tiny``, with :data:`TINY_OVERRIDES`."""
-    raw = yaml.safe_load(path.read_text())
+    raw = parse_yaml(path.read_text())  # peridyn's reading: 1.0e-3 is a number
     if tiny:
         for (section, key), value in TINY_OVERRIDES.items():
             raw.setdefault(section, {})[key] = value
@@ -473,6 +475,9 @@ def set_items(raw: dict):
     )
 
 
+#: Added to a ``--restart`` aimed at the earlier run: a case it was not made by (the case hash
+#: leaves out the run length, so a case of the same material could continue the run).
+RESTART_CHANGE = ["--set", "material.E=150.0e9"]
 #: Where run/modal examples write: the earlier finished run's folder, a file, a folder below a
 #: file, a folder that cannot be created (/proc refuses new entries, also to root).
 OUTPUTS = ["finished", "file", "below_file", "uncreatable"]
@@ -506,6 +511,7 @@ class Example:
 #: The options each command takes a number for.
 NUMERIC_OPTIONS = {
     "validate": [],
+    "build": [],
     "run": ["--checkpoint-every", "--max-memory"],
     "modal": ["--modes", "--max-memory"],
 }
@@ -535,11 +541,12 @@ def command_options(draw, command: str, raw: dict) -> list[str]:
 
 @st.composite
 def examples(draw, bases: dict[str, dict], tiny: dict[str, dict]) -> Example:
-    """A mutated case and/or command line: ``validate`` of any shipped case (most), ``run`` and
-    ``modal`` of the tiny case aimed at an output folder they must refuse. Half the examples
+    """A mutated case and/or command line: ``validate`` of any shipped case (most), ``validate
+    --build`` of the tiny case, ``run`` and ``modal`` of the tiny case aimed at an output folder
+    they must refuse (``run --restart`` of another case among them). Half the examples
     mutate the case only, a quarter the command line only, a quarter both; one in twenty names
     an odd case path."""
-    command = draw(st.sampled_from(["validate", "validate", "validate", "run", "run", "modal"]))
+    command = draw(st.sampled_from(["validate", "validate", "validate", "run", "run", "modal", "build"]))
     pool = bases if command == "validate" else tiny
     name = draw(st.sampled_from(sorted(pool)))
     raw = pool[name]
@@ -552,8 +559,12 @@ def examples(draw, bases: dict[str, dict], tiny: dict[str, dict]) -> Example:
         case_bytes, mutations = draw(mutated_case(raw))
         case_path, done = "written", [name, *mutations]
     options = draw(command_options(command, raw)) if what != "case" else []
-    output = draw(st.sampled_from(OUTPUTS)) if command != "validate" else None
+    output = draw(st.sampled_from(OUTPUTS)) if command in ("run", "modal") else None
     if output not in (None, "finished") and draw(st.sampled_from([False, False, False, True])):
         options.append(draw(st.sampled_from(["--overwrite", "--restart"])))
+    if output == "finished" and command == "run" and draw(st.sampled_from([False, False, True])):
+        options += ["--restart", *RESTART_CHANGE]  # the checkpoint of another case: refused
+    if command == "build":
+        command, options = "validate", ["--build", *options]
     done.append(" ".join(options))
     return Example(command, case_bytes, case_path, options, output, draw(st.booleans()), done)
