@@ -26,11 +26,15 @@ class CaseFileError(InputError):
         The offending value (``None`` when missing).
     expected : str
         What was expected instead.
+    has_value : bool
+        False where no one value is at fault (a check across keys): the message leaves out
+        ``= value``.
     """
 
-    def __init__(self, path: str, key: str, value, expected: str):
+    def __init__(self, path: str, key: str, value, expected: str, *, has_value: bool = True):
         self.path, self.key, self.value, self.expected = path, key, value, expected
-        super().__init__(f"{path}: {key} = {value!r}: {expected}")
+        shown = f" = {value!r}" if has_value else ""
+        super().__init__(f"{path}: {key}{shown}: {expected}")
 
 
 class InstabilityError(PeridynError, RuntimeError):

@@ -235,4 +235,4 @@ def test_a_check_of_the_whole_case_names_its_key_not_the_whole_case():
     exc = info.value
     assert (exc.key, exc.value) == ("boundary_conditions[1].set", None)
     assert exc.expected.startswith("unknown node set 'rihgt' (did you mean 'right'?)")
-    assert "'geometry'" not in str(exc)
+    assert "'geometry'" not in str(exc) and "boundary_conditions[1].set: unknown node set" in str(exc)

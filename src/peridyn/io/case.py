@@ -616,12 +616,13 @@ def _case_error(exc: ValidationError, source: str) -> CaseFileError:
             expected, value = "a required key that is missing", None
         else:
             expected = err["msg"].removeprefix("Value error, ")
-        if not loc and (named := _LEADING_KEY.fullmatch(expected)):  # a check of the whole case
-            loc, value, expected = named["key"], None, named["rest"]  # not the whole case as value
+        has_value = True
+        if not loc and (named := _LEADING_KEY.fullmatch(expected)):  # a check of the whole case:
+            loc, value, expected, has_value = named["key"], None, named["rest"], False  # no value
         if first is None:
-            first = (loc, value, expected)
-        lines.append(f"{loc} = {value!r}: {expected}" if loc else expected)
-    error = CaseFileError(source, first[0] or "<root>", first[1], first[2])
+            first = (loc, value, expected, has_value)
+        lines.append((f"{loc} = {value!r}: " if has_value else f"{loc}: ") + expected if loc else expected)
+    error = CaseFileError(source, first[0] or "<root>", first[1], first[2], has_value=first[3])
     if len(lines) > 1:
         error.args = (f"{source}: {len(lines)} problems:\n  " + "\n  ".join(lines),)
     return error
