@@ -26,11 +26,15 @@ class CaseFileError(InputError):
         The offending value (``None`` when missing).
     expected : str
         What was expected instead.
+    has_value : bool
+        False where no one value is at fault (a check across keys): the message leaves out
+        ``= value``.
     """
 
-    def __init__(self, path: str, key: str, value, expected: str):
+    def __init__(self, path: str, key: str, value, expected: str, *, has_value: bool = True):
         self.path, self.key, self.value, self.expected = path, key, value, expected
-        super().__init__(f"{path}: {key} = {value!r}: {expected}")
+        shown = f" = {value!r}" if has_value else ""
+        super().__init__(f"{path}: {key}{shown}: {expected}")
 
 
 class InstabilityError(PeridynError, RuntimeError):
@@ -81,6 +85,14 @@ def did_you_mean(word: str, choices) -> str:
     " (did you mean 'lps'?)"
     >>> did_you_mean("elastic", ["pmb", "lps"])
     ''
+
+    Only names are compared: a ``word`` that is not text (a number where a name belongs) has
+    no suggestion, and choices that are not text are skipped.
+
+    >>> did_you_mean(float("nan"), ["pmb", "lps"]), did_you_mean("lsp", [1, "lps"])
+    ('', " (did you mean 'lps'?)")
     """
-    close = difflib.get_close_matches(word, list(choices), n=1)
+    if not isinstance(word, str):
+        return ""
+    close = difflib.get_close_matches(word, [c for c in choices if isinstance(c, str)], n=1)
     return f" (did you mean {close[0]!r}?)" if close else ""

@@ -86,6 +86,13 @@ def test_a_finished_run_is_complete(finished):
             {"case": _case(solver={"dt": 1e-8}), "restart": True},
             "(case: solver.dt None -> 1e-08; time step (s) ",
         ),
+        # found by tests/fuzz: the recorder reopened results.h5 ("running") and failed on the
+        # last snapshot ("step 40 does not exceed the last recorded step 40")
+        ({"restart": True}, "--restart: the checkpoint is at step 40 and the run ends at step 40: nothing"),
+        (
+            {"case": _case(solver={"steps": 30}), "restart": True},
+            "the checkpoint is at step 40 and the run ends at step 30: nothing is left to run",
+        ),
     ],
 )
 def test_an_earlier_run_is_left_alone(finished, kwargs, message):

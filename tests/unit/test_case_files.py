@@ -222,7 +222,7 @@ def test_a_z_component_on_a_2d_body_is_refused(components):
     with pytest.raises(CaseFileError) as caught:
         validate_case(raw)
     assert caught.value.key == "boundary_conditions[0].components"
-    assert str(caught.value).endswith("a 2D body has components x and y only")
+    assert str(caught.value).endswith("names z, but a 2D body has components x and y only")
 
 
 def test_the_default_components_of_a_2d_body_are_x_and_y():
@@ -247,3 +247,42 @@ def test_a_check_across_keys_does_not_print_the_whole_case():
     assert caught.value.key == "boundary_conditions[0].set"
     assert str(caught.value).startswith("<case>: boundary_conditions[0].set: unknown node set 'lefft'")
     assert "geometry" not in str(caught.value)
+
+
+@pytest.mark.parametrize("value", [".nan", ".inf", "-.inf"])
+def test_a_non_finite_boundary_value_is_refused(value):
+    """A NaN load reached the solver before (found by tests/fuzz); InitialConditionSpec already
+    asked for a finite value."""
+    with pytest.raises(CaseFileError, match=r"boundary_conditions\[1\]\.value") as info:
+        validate_case(_case(**{"boundary_conditions.1.value": value}))
+    assert info.value.key == "boundary_conditions[1].value" and "finite" in info.value.expected
+
+
+@pytest.mark.parametrize(
+    ("key", "value"),
+    [
+        ("boundary_conditions.1.value", "abc"),
+        ("discretization.spacing", "abc"),
+        ("discretization.spacing", "[1, x]"),
+    ],
+)
+def test_a_key_of_union_type_is_named_without_pydantic_s_member_names(key, value):
+    """pydantic locates a union's failure at ("spacing", "constrained-float"): the key named was
+    discretization.spacing.constrained-float before."""
+    with pytest.raises(CaseFileError) as info:
+        validate_case(_case(**{key: value}))
+    assert info.value.key == key.replace(".1.", "[1].")
+    assert all(f"{info.value.key}." not in line for line in str(info.value).splitlines())
+
+
+def test_a_check_of_the_whole_case_names_its_key_not_the_whole_case():
+    """The Case-level checks (node sets, contact, analysis, absorbing) report at the root: the
+    error gave key "<root>" and the whole case as value (found by tests/fuzz)."""
+    raw = _case()
+    raw["boundary_conditions"][1]["set"] = "rihgt"
+    with pytest.raises(CaseFileError) as info:
+        validate_case(raw)
+    exc = info.value
+    assert (exc.key, exc.value) == ("boundary_conditions[1].set", None)
+    assert exc.expected.startswith("unknown node set 'rihgt' (did you mean 'right'?)")
+    assert "'geometry'" not in str(exc) and "boundary_conditions[1].set: unknown node set" in str(exc)

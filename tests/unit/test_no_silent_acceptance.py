@@ -63,6 +63,15 @@ def test_probe_outside_the_body_is_refused(key, override):
         assert "3 m outside" in str(err.value)
 
 
+@pytest.mark.parametrize("far", ["1e300", "-1e300", "1e200"])
+def test_a_probe_at_an_overflowing_distance_is_refused(far):
+    """cKDTree finds no neighbour where the squared distance overflows to inf and returns the index
+    n_points: an IndexError (an internal error of the CLI) before (found by tests/fuzz)."""
+    case = validate_case(_raw(**{"output.sensors": f"{{tip: [{far}, 0.003, 0.003]}}"}))
+    with pytest.raises(CaseFileError, match=r"output\.sensors\.tip = .*it is inf m outside"):
+        check_placements(case, build_body(case))
+
+
 def test_actuator_outside_the_body_is_refused():
     raw = _raw()
     raw["geometry"] = {"type": "plate", "size": [0.06, 0.04, 0.002], "layers": 2}

@@ -18,11 +18,49 @@ from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, ValidationEr
 from peridyn.errors import CaseFileError, InputError, did_you_mean
 from peridyn.physics.loads import parse_components
 
+#: Deepest nesting of collections a YAML text may have (a case nests 5 levels; PyYAML composes
+#: each level by recursion, so a deeper text would exhaust Python's recursion limit).
+MAX_YAML_DEPTH = 64
+#: Most values a YAML text may hold with its aliases expanded (a shipped case holds about 300; an
+#: alias bomb, "billion laughs", holds 9**9 from a few lines and would hang whatever walks it).
+MAX_YAML_VALUES = 100_000
+
 
 class _Loader(yaml.SafeLoader):
     """SafeLoader that also reads ``1e3`` and ``150.0e3`` as floats (YAML 1.2 style; plain
     PyYAML would take them for strings) and refuses a key given twice in one mapping (PyYAML
-    keeps the last silently). Keys merged in with ``<<: *anchor`` may be overridden."""
+    keeps the last silently). Keys merged in with ``<<: *anchor`` may be overridden. A text
+    nested deeper than ``MAX_YAML_DEPTH``, whose aliases expand to more than ``MAX_YAML_VALUES``
+    values, or with an alias inside its own anchor is refused before it is constructed."""
+
+    def __init__(self, stream):
+        super().__init__(stream)
+        self._depth = 0
+
+    def compose_node(self, parent, index):
+        if self._depth >= MAX_YAML_DEPTH:
+            raise yaml.composer.ComposerError(
+                None,
+                None,
+                f"collections nested deeper than {MAX_YAML_DEPTH} levels",
+                self.peek_event().start_mark,
+            )
+        self._depth += 1
+        try:
+            return super().compose_node(parent, index)
+        finally:
+            self._depth -= 1
+
+    def construct_document(self, node):
+        if _expanded_size(node, {}) > MAX_YAML_VALUES:
+            raise yaml.constructor.ConstructorError(
+                None,
+                None,
+                f"more than {MAX_YAML_VALUES} values once its aliases are expanded, or an alias "
+                "inside its own anchor",
+                node.start_mark,
+            )
+        return super().construct_document(node)
 
     def construct_mapping(self, node, deep=False):
         if isinstance(node, yaml.MappingNode):
@@ -43,6 +81,50 @@ class _Loader(yaml.SafeLoader):
                         key_node.start_mark,
                     )
         return super().construct_mapping(node, deep=deep)
+
+
+def _checked_scalar(construct):
+    """PyYAML's constructor ``construct`` of a scalar type, whose failure on a value it cannot read
+    (``!!int abc``: ValueError; ``!!bool maybe``: KeyError; ``!!timestamp x``: AttributeError; an
+    integer of more than 4300 digits: ValueError) is a YAML error at that value."""
+
+    def checked(loader, node):
+        try:
+            return construct(loader, node)
+        except (ValueError, KeyError, AttributeError):
+            kind, text = node.tag.rsplit(":", 1)[-1], str(node.value)
+            shown = repr(text) if len(text) <= 40 else f"{text[:37]!r}... ({len(text)} characters)"
+            raise yaml.constructor.ConstructorError(
+                None, None, f"{shown} is not a valid {kind}", node.start_mark
+            ) from None
+
+    return checked
+
+
+for _kind in ("int", "float", "bool", "timestamp"):
+    _tag = f"tag:yaml.org,2002:{_kind}"
+    _Loader.add_constructor(_tag, _checked_scalar(_Loader.yaml_constructors[_tag]))
+
+
+def _expanded_size(node: yaml.Node, sizes: dict) -> int:
+    """Values in ``node`` with every alias expanded, counted once per node (an alias is the same
+    node object as its anchor); above ``MAX_YAML_VALUES`` for a node within itself."""
+    if id(node) in sizes:
+        return sizes[id(node)]
+    sizes[id(node)] = MAX_YAML_VALUES + 1  # while counting: an alias to it is a cycle
+    if isinstance(node, yaml.SequenceNode):
+        children = node.value
+    elif isinstance(node, yaml.MappingNode):
+        children = [child for pair in node.value for child in pair]
+    else:
+        children = []
+    total = 1
+    for child in children:
+        total += _expanded_size(child, sizes)
+        if total > MAX_YAML_VALUES:
+            break
+    sizes[id(node)] = total
+    return total
 
 
 _Loader.add_implicit_resolver(
@@ -452,7 +534,7 @@ class Case(Strict):
                 # the default "xyz" means x and y on a 2D body; a z written out is a mistake
                 if self.geometry.dim == 2 and 2 in components and "components" in condition.model_fields_set:
                     raise ValueError(
-                        f"{name}[{i}].components = {condition.components!r}: a 2D body has "
+                        f"{name}[{i}].components: {condition.components!r} names z, but a 2D body has "
                         "components x and y only"
                     )
         return self
@@ -572,10 +654,6 @@ def _index(node: list, part: str, source: str, where: str) -> int:
     return int(part)
 
 
-#: The message of a check across keys: "key: what is wrong" or "key = value: what is wrong".
-_NAMED_PROBLEM = re.compile(r"(?P<key>[A-Za-z_][\w.\[\]-]*)(?: = (?P<value>.+?))?: (?P<expected>.+)", re.S)
-
-
 def _case_error(exc: ValidationError, source: str) -> CaseFileError:
     lines = []
     first = None
@@ -589,19 +667,32 @@ def _case_error(exc: ValidationError, source: str) -> CaseFileError:
             expected, value = "a required key that is missing", None
         else:
             expected = err["msg"].removeprefix("Value error, ")
-        if not loc and (named := _NAMED_PROBLEM.match(expected)):  # a check across keys names its key
-            loc, value, expected = named["key"], named["value"], named["expected"]
-            lines.append(named.string)
-        else:
-            lines.append(f"{loc} = {value!r}: {expected}" if loc else expected)
+        has_value = True
+        if not loc and (named := _LEADING_KEY.fullmatch(expected)):  # a check of the whole case:
+            loc, value, expected, has_value = named["key"], None, named["rest"], False  # no value
         if first is None:
-            first = (loc, value, expected, lines[-1])
-    error = CaseFileError(source, first[0] or "<root>", first[1], first[2])
-    if first[0] and first[3] != f"{first[0]} = {first[1]!r}: {first[2]}":
-        error.args = (f"{source}: {first[3]}",)
+            first = (loc, value, expected, has_value)
+        lines.append((f"{loc} = {value!r}: " if has_value else f"{loc}: ") + expected if loc else expected)
+    error = CaseFileError(source, first[0] or "<root>", first[1], first[2], has_value=first[3])
     if len(lines) > 1:
         error.args = (f"{source}: {len(lines)} problems:\n  " + "\n  ".join(lines),)
     return error
+
+
+#: A message of a check of the whole case that names its key first ("absorbing: layers damp ...").
+_LEADING_KEY = re.compile(r"(?P<key>[A-Za-z_][\w.\[\]]*): (?P<rest>.*)", re.S)
+#: The names pydantic gives the members of a union in an error's location (``value: float | dict``
+#: fails at ``("value", "float")`` and ``("value", "dict[any,any]")``): not keys of the case.
+_UNION_MEMBERS = {
+    "float",
+    "int",
+    "str",
+    "bool",
+    "constrained-float",
+    "constrained-int",
+    "function-after",
+    "literal",
+}
 
 
 def _key_path(loc) -> str:
@@ -609,7 +700,7 @@ def _key_path(loc) -> str:
     for part in loc:
         if isinstance(part, int):
             out += f"[{part}]"
-        elif "[" in str(part) or part in ("function-after", "literal"):
+        elif "[" in str(part) or part in _UNION_MEMBERS:
             continue
         else:
             out += f".{part}" if out else str(part)

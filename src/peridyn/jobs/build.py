@@ -266,9 +266,13 @@ def distance_outside(body: Body, positions: np.ndarray, axes: int = 3) -> np.nda
     k = min(NEAREST_CELLS, body.n_points)
     _, idx = tree.query(positions, k=k)
     idx = np.asarray(idx).reshape(len(positions), k)
+    found = idx < body.n_points  # the tree finds none where the distance overflows (a 1e300 m position)
+    idx = np.where(found, idx, 0)
     cells = body.cells if body.dim == 3 else np.column_stack([body.cells[:, :2], np.zeros(body.n_points)])
     gap = np.abs(positions[:, None, :] - body.points[idx, :axes]) - 0.5 * cells[idx, :axes]
-    return np.min(np.linalg.norm(np.clip(gap, 0.0, None), axis=2), axis=1)
+    with np.errstate(over="ignore"):  # a distance beyond the floats is inf: outside, as it should
+        far = np.linalg.norm(np.clip(gap, 0.0, None), axis=2)
+    return np.min(np.where(found, far, np.inf), axis=1)
 
 
 def build(case: Case, base_dir=".", comm=None) -> Setup:

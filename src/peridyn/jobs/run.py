@@ -314,7 +314,7 @@ def _run_explicit(case, setup, solver, out, case_path, checkpoint_every, restart
     }
     whole_bonds = d.bond_offsets(setup.bonds.offsets)
     if restart:
-        state = _restart(ckpt_path, setup, meta, parts, whole_bonds)
+        state = _restart(ckpt_path, setup, meta, parts, whole_bonds, n_steps)
         resume = (state.step, state.time)
         print(
             f"restarting from the checkpoint at step {state.step} (t = {state.time:.6g} s)", file=sys.stderr
@@ -382,9 +382,11 @@ def _run_explicit(case, setup, solver, out, case_path, checkpoint_every, restart
     return summary
 
 
-def _restart(path, setup: Setup, meta: dict, parts: dict, whole_bonds: np.ndarray) -> State:
+def _restart(path, setup: Setup, meta: dict, parts: dict, whole_bonds: np.ndarray, n_steps: int) -> State:
     """The state of the checkpoint at ``path`` (this rank's points), with the bonds' intact mask
-    and the parts' states restored. Checkpoints hold the whole body in serial numbering, so a run
+    and the parts' states restored; a checkpoint at or past the run's last step ``n_steps`` is
+    refused (before the recorder reopens, and would rewrite, results.h5). Checkpoints hold the
+    whole body in serial numbering, so a run
     may restart on another number of ranks. A rank's damage skin covers its part only and is not
     saved under MPI: it starts again with a full stretch test (the same bonds break, see
     ``peridyn.physics.damage``)."""
@@ -392,6 +394,11 @@ def _restart(path, setup: Setup, meta: dict, parts: dict, whole_bonds: np.ndarra
     state, intact, saved = d.agree(
         load_checkpoint, path, setup.whole_body.n_points, int(whole_bonds[-1]), meta
     )
+    if state.step >= n_steps:
+        raise InputError(
+            f"--restart: the checkpoint is at step {state.step} and the run ends at step {n_steps}: "
+            "nothing is left to run (a longer solver.time or solver.steps continues it)"
+        )
     if d.size > 1:
         ids = d.global_ids
         state = State(state.u[ids], state.v[ids], state.a[ids], state.time, state.step)

@@ -8,6 +8,8 @@ Nothing is ever evaluated from a string.
 
 from __future__ import annotations
 
+import math
+import numbers
 from dataclasses import MISSING, dataclass
 from pathlib import Path
 
@@ -210,7 +212,7 @@ class Product(TimeFunction):
 
 
 def _positive(name: str, value: float) -> None:
-    if not (np.isfinite(value) and value > 0):
+    if not (_is_finite_number(value) and value > 0):
         raise InputError(f"{name} must be positive, got {value!r}")
 
 
@@ -231,43 +233,42 @@ def from_spec(spec, where: str = "value") -> TimeFunction:
     parameters; ``table`` takes ``file`` (CSV) or ``times`` and ``values``;
     ``sum`` and ``product`` take ``terms``.
     """
-    if isinstance(spec, int | float) and not isinstance(spec, bool):
-        return Constant(_finite(where, spec))
+    if isinstance(spec, numbers.Real) and not isinstance(spec, bool):
+        if not _is_finite_number(spec):
+            raise InputError(f"{where}: expected a finite number, got {spec!r}")
+        return Constant(float(spec))
     if isinstance(spec, TimeFunction):
         return spec
     if not isinstance(spec, dict) or "type" not in spec:
         raise InputError(f"{where}: expected a number or a mapping with a 'type', got {spec!r}")
     params = {k: v for k, v in spec.items() if k != "type"}
     kind = spec["type"]
+    choices = [*_SIMPLE, "table", "sum", "product"]
+    if not isinstance(kind, str):
+        raise InputError(
+            f"{where}.type: expected the name of a time function, one of {choices}, got {kind!r}"
+        )
     if kind in ("sum", "product"):
         terms = params.pop("terms", None)
-        if not terms or params:
+        if not isinstance(terms, list) or not terms or params:
             raise InputError(f"{where}: a {kind} takes only a non-empty list 'terms'")
         built = tuple(from_spec(t, f"{where}.terms[{i}]") for i, t in enumerate(terms))
         return Sum(built) if kind == "sum" else Product(built)
     if kind == "table":
         if "file" in params:
+            if not isinstance(params["file"], str) or len(params) > 1:
+                raise InputError(f"{where}: a table takes a CSV 'file' (a path) or 'times' and 'values'")
             return Tabulated.from_csv(params["file"])
-        lists = {}
-        for k, v in params.items():
-            if not isinstance(v, list | tuple):
-                raise InputError(f"{where}.{k} = {v!r}: expected a list of numbers")
-            lists[k] = tuple(_finite(f"{where}.{k}[{i}]", x) for i, x in enumerate(v))
-        return _construct(Tabulated, where, lists)
+        for key, column in params.items():
+            if not isinstance(column, list) or not all(_is_finite_number(v) for v in column):
+                raise InputError(f"{where}.{key}: expected a list of finite numbers, got {column!r}")
+        return _construct(Tabulated, where, {k: tuple(v) for k, v in params.items()})
     if kind not in _SIMPLE:
-        choices = [*_SIMPLE, "table", "sum", "product"]
         raise InputError(
             f"{where}.type: unknown time function {kind!r}{did_you_mean(kind, choices)}"
             f"; choose one of {choices}"
         )
     return _construct(_SIMPLE[kind], where, params)
-
-
-def _finite(where: str, value) -> float:
-    """``value`` as a float, or an ``InputError`` naming ``where`` if it is not a finite number."""
-    if isinstance(value, bool) or not isinstance(value, int | float) or not np.isfinite(value):
-        raise InputError(f"{where} = {value!r}: expected a finite number")
-    return float(value)
 
 
 def _construct(cls, where: str, params: dict) -> TimeFunction:
@@ -283,12 +284,21 @@ def _construct(cls, where: str, params: dict) -> TimeFunction:
     missing = [k for k, f in fields.items() if f.default is MISSING and k not in params]
     if missing:
         raise InputError(f"{where}: missing {missing[0]!r}, which a {cls.__name__} needs")
-    if cls is not Tabulated:  # the others take numbers only (None where that is the default)
-        params = {
-            k: v if v is None and fields[k].default is None else _finite(f"{where}.{k}", v)
-            for k, v in params.items()
-        }
+    if cls is not Tabulated:  # every parameter of the others is a number (a delay may be null)
+        for key, value in params.items():
+            if not (_is_finite_number(value) or (value is None and fields[key].default is None)):
+                raise InputError(f"{where}.{key}: expected a finite number, got {value!r}")
     try:
         return cls(**params)
-    except (TypeError, InputError) as exc:
+    except (TypeError, InputError) as exc:  # e.g. a ramp that ends before it starts
         raise InputError(f"{where}: {exc}") from None
+
+
+def _is_finite_number(value) -> bool:
+    """Whether ``value`` is a finite real number (not a bool, a string, NaN or an infinity)."""
+    if not isinstance(value, numbers.Real) or isinstance(value, bool):
+        return False
+    try:
+        return math.isfinite(value)
+    except OverflowError:  # an integer beyond the floats (10**400)
+        return False
