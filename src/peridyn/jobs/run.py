@@ -386,10 +386,9 @@ def _restart(path, setup: Setup, meta: dict, parts: dict, whole_bonds: np.ndarra
     """The state of the checkpoint at ``path`` (this rank's points), with the bonds' intact mask
     and the parts' states restored; a checkpoint at or past the run's last step ``n_steps`` is
     refused (before the recorder reopens, and would rewrite, results.h5). Checkpoints hold the
-    whole body in serial numbering, so a run
-    may restart on another number of ranks. A rank's damage skin covers its part only and is not
-    saved under MPI: it starts again with a full stretch test (the same bonds break, see
-    ``peridyn.physics.damage``)."""
+    whole body in serial numbering, so a run may restart on another number of ranks. A rank's
+    damage skin covers its part only and is not saved under MPI: it starts again with a full
+    stretch test (the same bonds break, see ``peridyn.physics.damage``)."""
     d = setup.domain
     state, intact, saved = d.agree(
         load_checkpoint, path, setup.whole_body.n_points, int(whole_bonds[-1]), meta
