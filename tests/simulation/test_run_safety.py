@@ -195,3 +195,24 @@ def test_the_command_line_refuses_an_earlier_runs_folder(finished, capsys):
     assert "Traceback" not in err and line.startswith("peridyn run: error: output folder")
     assert str(finished) in line and "--overwrite" in line and "--restart" in line
     assert _digests(finished) == before
+
+
+def test_a_run_whose_results_cannot_fit_on_the_disk_is_refused_before_writing(tmp_path):
+    """``solver.time = 1e300`` ran until killed (found by tests/fuzz): its records would need more
+    than any disk. The run is refused before its folder is made, naming the steps and the space."""
+    out = tmp_path / "never"
+    with pytest.raises(InputError, match=r"\d\.\d+e\+30\d steps .* more results than any disk holds"):
+        run_case(_case(solver={"steps": None, "time": 1e300}), out)
+    assert not out.exists()
+
+
+def test_the_output_estimate_counts_every_record():
+    """``RecorderSpec.output_bytes``: 40 steps recorded every 2 (21 records of step, time and the
+    sensor's u and v: 8 x (2 + 6) bytes) and 4 + 1 snapshots of 21 values of 8 bytes a point."""
+    from peridyn.jobs.run import recorder_spec
+
+    case = _case()
+    setup = build(case)
+    spec = recorder_spec(case, setup.body, 1e-7)
+    n = setup.body.n_points
+    assert spec.output_bytes(n, 40) == 21 * 8 * 8 + 5 * n * 8 * 21

@@ -41,6 +41,11 @@ class LineProbe:
     points: int
 
 
+#: Values per point of one snapshot in all files: field_u (3) in results.h5, points, u, v and
+#: damage in VTU (10) and u, v, volume and damage in Exodus (8), as 8-byte numbers.
+SNAPSHOT_VALUES = 21
+
+
 @dataclass
 class RecorderSpec:
     """What to record and how often.
@@ -93,6 +98,20 @@ class RecorderSpec:
     def due(self, step: int) -> bool:
         """True when anything is recorded at ``step``."""
         return self.series_due(step) or self.snapshot_due(step)
+
+    def output_bytes(self, n_points: int, n_steps: int) -> float:
+        """Bytes a run of ``n_steps`` steps on ``n_points`` points writes, about: the probe
+        series at every ``every``-th step (step and time, sensors' u and v, PZT signals in
+        float64; lines and planes in ``series_dtype``) and the snapshots (``field_u`` and about
+        as much again in VTU and Exodus files: ``SNAPSHOT_VALUES`` values of 8 bytes a point)."""
+        item = np.dtype(self.series_dtype).itemsize
+        probe_points = sum(line.points for line in self.lines.values()) + sum(map(len, self.planes.values()))
+        per_record = 8 * (2 + 6 * len(self.sensors) + len(self.pzt_sensors)) + 3 * item * probe_points
+        snapshots = len(self.snapshot_steps) + (n_steps // self.snapshot_every if self.snapshot_every else 0)
+        return (
+            float(n_steps // self.every + 1) * per_record
+            + float(snapshots + 1) * n_points * 8 * SNAPSHOT_VALUES
+        )
 
 
 class Recorder:

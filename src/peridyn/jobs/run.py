@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import shutil
 import sys
 import time
 from pathlib import Path
@@ -137,6 +138,8 @@ def run_case(
     domain = setup.domain
     solver = _time_stepper(case, setup) if stepping else None
     out = output_directory(case, output_dir)
+    if stepping:
+        domain.on_root(check_output_fits, case, setup.whole_body, step_count(case, solver), solver.dt, out)
     domain.on_root(prepare_output, out, RESULTS, overwrite, restart)
     written = not restart  # a restart writes once its checkpoint is accepted (the recorder's part)
     try:
@@ -186,6 +189,39 @@ def point_tensors(setup: Setup, spec: RecorderSpec):
         return out
 
     return fields
+
+
+def step_count(case: Case, solver) -> int:
+    """Time steps of a time-stepping run: ``solver.steps``, or ``solver.time`` in steps of dt."""
+    s = case.solver
+    return s.steps if s.steps is not None else int(np.ceil(s.time / solver.dt - 1e-9))
+
+
+def check_output_fits(case: Case, body: Body, n_steps: int, dt: float, out: Path) -> None:
+    """Refuse a run whose records (``RecorderSpec.output_bytes``) would not fit in the free space
+    of the disk of its output folder, before anything is written.
+
+    Raises
+    ------
+    InputError
+        Naming the steps, the bytes and the free space.
+    """
+    need = recorder_spec(case, body, dt).output_bytes(body.n_points, n_steps)
+    folder = out.resolve()
+    while not folder.exists():
+        folder = folder.parent
+    free = shutil.disk_usage(folder).free
+    if need > free:
+        raise InputError(
+            f"the run's {n_steps:.3g} steps (dt = {dt:.3g} s) would write "
+            + (
+                f"about {need / 1e9:.3g} GB of results"
+                if np.isfinite(need)
+                else "more results than any disk holds"
+            )
+            + f", more than the {free / 1e9:.3g} GB free on {folder}: "
+            "shorten solver.time or record less (output.every, output.snapshot_every)"
+        )
 
 
 def _resume_hint(command: str | None) -> str:
@@ -299,9 +335,8 @@ CHECKPOINT_AFTER_S = 60.0
 
 def _run_explicit(case, setup, solver, out, case_path, checkpoint_every, restart, progress, start) -> dict:
     """Time integration by ``solver`` with recording, checkpoints and the status."""
-    s = case.solver
     d = setup.domain
-    n_steps = s.steps if s.steps is not None else int(np.ceil(s.time / solver.dt - 1e-9))
+    n_steps = step_count(case, solver)
     ckpt_path = out / "checkpoint.h5"
     case_json, digest = case_identity(case)
     meta = {"case_hash": digest, "case": case_json, "dt": float(solver.dt), "version": package_version()}
