@@ -2,8 +2,8 @@
 
 An expression is numbers, names, ``+ - * / **``, unary minus, brackets, list indexing by a whole
 number (``geometry.size[0]``) and the functions ``min``, ``max``, ``abs``, ``sqrt``, ``round``.
-A name is a dotted path (``discretization.spacing``, ``crack_cells``): ``lookup(path)`` gives its
-value (a varied parameter, or an entry of the case). Nothing else is accepted: the text is parsed
+A name is a dotted path (``discretization.spacing``, ``crack_cells``, ``precracks[0].end[1]`` for
+``precracks.0.end.1``): ``lookup(path)`` gives its value (a varied parameter, or a case entry). Nothing else is accepted: the text is parsed
 with :mod:`ast` and only these nodes are evaluated, so no Python code ever runs.
 
 >>> evaluate("3 * discretization.spacing + 1", {"discretization.spacing": 0.5}.__getitem__)
@@ -56,13 +56,21 @@ def evaluate(text: str, lookup):
         raise InputError(f"expression {text!r}: {type(exc).__name__}: {exc}") from None
 
 
-def _dotted(node) -> str | None:
-    """``a.b.c`` of a Name/Attribute chain, else None."""
+def _path(node) -> str | None:
+    """The dotted path of a chain of names, attributes and whole-number indices
+    (``precracks[0].end[1]`` -> ``precracks.0.end.1``), else None."""
     if isinstance(node, ast.Name):
         return node.id
     if isinstance(node, ast.Attribute):
-        head = _dotted(node.value)
+        head = _path(node.value)
         return None if head is None else f"{head}.{node.attr}"
+    if (
+        isinstance(node, ast.Subscript)
+        and isinstance(node.slice, ast.Constant)
+        and type(node.slice.value) is int
+    ):
+        head = _path(node.value)
+        return None if head is None else f"{head}.{node.slice.value}"
     return None
 
 
@@ -73,16 +81,15 @@ def _eval(node, lookup, text):
         and not isinstance(node.value, bool)
     ):
         return node.value
-    if isinstance(node, ast.Name | ast.Attribute):
-        path = _dotted(node)
-        if path is None:
-            raise InputError(f"expression {text!r}: only dotted names are allowed")
+    path = _path(node)
+    if path is not None:
         try:
             return lookup(path)
         except KeyError:
-            raise InputError(
-                f"expression {text!r}: unknown name {path!r} (a varied parameter or a case entry)"
-            ) from None
+            if not isinstance(node, ast.Subscript):  # else: the list, then its item
+                raise InputError(
+                    f"expression {text!r}: unknown name {path!r} (a varied parameter or a case entry)"
+                ) from None
     if isinstance(node, ast.BinOp) and type(node.op) in _BINARY:
         return _BINARY[type(node.op)](_eval(node.left, lookup, text), _eval(node.right, lookup, text))
     if isinstance(node, ast.UnaryOp) and isinstance(node.op, ast.USub | ast.UAdd):

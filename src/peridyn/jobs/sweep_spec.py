@@ -28,7 +28,7 @@ import yaml
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
 from peridyn.errors import CaseFileError, InputError
-from peridyn.io.case import Case, load_case, parse_yaml, yaml_problem
+from peridyn.io.case import Case, apply_override, load_case, parse_yaml, yaml_problem
 from peridyn.jobs.run import case_identity
 from peridyn.jobs.sweep_expr import evaluate
 
@@ -297,6 +297,7 @@ def _run_case(spec: SweepSpec, base: Path, values: dict) -> tuple[dict, Case]:
             dumped = case.model_dump(mode="json")
             for key, expression in spec.derived.items():
                 parameters[key] = evaluate(expression, lambda p: _lookup(p, parameters, dumped))
+                apply_override(dumped, _override(key, parameters[key]), str(base))  # for later ones
             case = load_case(base, overrides + [_override(k, parameters[k]) for k in spec.derived])
     except (CaseFileError, InputError) as exc:
         exc.args = (f"run with {_describe(parameters)}: {exc}",)
