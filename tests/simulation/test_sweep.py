@@ -21,7 +21,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-import xarray as xr
 import yaml
 
 import peridyn
@@ -30,6 +29,7 @@ from peridyn.io.dataset import load_sweep
 from peridyn.jobs.sweep import run_sweep
 from peridyn.jobs.sweep_run import CRASH_ONCE_ENV, RECORD, run_tasks
 
+xr = pytest.importorskip("xarray", reason="sweeps need the sweep extra (pip install 'peridyn[sweep]')")
 ROOT = Path(__file__).resolve().parents[2]
 SRC = str(Path(peridyn.__file__).parents[1])
 DEMO = ROOT / "sweeps" / "demo.yaml"
@@ -85,6 +85,8 @@ def test_demo_runs_and_reports(serial):
 
 @pytest.mark.parametrize("executor", ["processes", "dask"])
 def test_executors_give_the_serial_dataset(serial, tmp_path, executor):
+    if executor == "dask":
+        pytest.importorskip("dask.distributed", reason="the dask executor needs the sweep extra")
     summary, _ = serial
     other = run_sweep(DEMO, tmp_path / executor, executor=executor, workers=2)
     assert other["completed"] == 4

@@ -30,6 +30,15 @@ def register(sub) -> None:
         metavar="N",
         help="worker processes (processes, local dask cluster); each gets cores // N threads",
     )
+    p.add_argument(
+        "--set",
+        dest="overrides",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="override a case entry of every run, e.g. discretization.spacing=0.002 (repeatable)",
+    )
+    p.add_argument("--first", type=positive_int, default=None, metavar="N", help="run only the first N runs")
     p.add_argument("--scheduler", default=None, metavar="ADDRESS", help="address of a running dask scheduler")
     add_output_flag(p, "output folder (default: peridyn-out/<sweep name>); a second run resumes it")
     add_overwrite_flag(p)
@@ -52,6 +61,8 @@ def run(args) -> dict:
         overwrite=args.overwrite,
         progress=None if bar is None else _runs(bar),
         command=command_line(),
+        overrides=args.overrides,
+        first=args.first,
     )
     if not args.json:
         print(

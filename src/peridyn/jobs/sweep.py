@@ -26,6 +26,7 @@ from peridyn.io.results import Results
 from peridyn.jobs.sweep_run import (
     EXECUTORS,
     RunTask,
+    execute,
     read_record,
     run_tasks,
     threads_per_worker,
@@ -64,6 +65,8 @@ def run_sweep(
     overwrite: bool = False,
     progress=None,
     command: str | None = None,
+    overrides=(),
+    first: int | None = None,
 ) -> dict:
     """Run the sweep file ``path``; returns its summary.
 
@@ -84,6 +87,10 @@ def run_sweep(
     progress : callable(total) -> bar with update(n) and close(), or None
     command : str or None
         The command line, for the resume hint of an interrupted sweep.
+    overrides : sequence of "key.path=value"
+        ``--set`` items for every run (after the sweep file's ``set``).
+    first : int or None
+        Run only the first ``first`` runs of the sweep (a trial).
 
     Returns
     -------
@@ -106,7 +113,7 @@ def run_sweep(
     if not isinstance(workers, int) or workers < 1:
         raise InputError(f"workers must be a whole number >= 1, got {workers!r}")
     require_xarray()
-    sweep = expand(path)
+    sweep = expand(path, overrides, first)
     out = Path(output_dir or Path("peridyn-out") / sweep.name)
     if out.exists() and not out.is_dir():
         raise InputError(f"output folder {str(out)!r} is a file, not a folder: choose another --output")
@@ -114,6 +121,7 @@ def run_sweep(
     _write_manifest(sweep, out)
     collector = Collector(sweep, out)
     threads = None if executor == "serial" or scheduler is not None else threads_per_worker(workers)
+    reference_dir = _reference(sweep, out, overwrite)
     tasks = []
     for run in sweep.runs:
         if not overwrite and collector.is_complete(run):
@@ -130,6 +138,7 @@ def run_sweep(
                 str(out / "runs" / run.run_id),
                 str(sweep.base.parent),
                 threads,
+                reference_dir,
             )
         )
     bar = progress(len(tasks)) if progress is not None and tasks else None
@@ -173,6 +182,31 @@ def run_sweep(
         "executor": executor,
         "workers": 1 if executor == "serial" else workers,
     }
+
+
+def _reference(sweep: Sweep, out: Path, overwrite: bool) -> str | None:
+    """The folder of the sweep's reference run (``OUT/reference``), run here first unless
+    complete for its case; None without a reference.
+
+    Raises
+    ------
+    InputError
+        The reference run failed (every comparison needs it).
+    """
+    if sweep.reference is None:
+        return None
+    ref = sweep.reference
+    base = (sweep.path.parent / sweep.spec.reference).resolve().parent
+    folder = out / "reference"
+    record = read_record(folder)
+    if overwrite or record is None or record["case_hash"] != ref.case_hash or record["status"] != "complete":
+        task = RunTask(ref.run_id, -1, {}, ref.case, ref.case_hash, "modal", str(folder), str(base), None)
+        record = execute(task)
+    if record["status"] != "complete":
+        raise InputError(
+            f"the sweep's reference run ({sweep.spec.reference}) did not complete: {record['status']}"
+        )
+    return str(folder)
 
 
 def _write_manifest(sweep: Sweep, out: Path) -> None:
@@ -275,7 +309,8 @@ class Collector:
 def flatten_summary(summary: dict) -> dict:
     """A job summary's scalar results by dotted name: nested mappings joined with ``.``, the
     modes of a modal job as ``frequency_hz.<type>.<order>`` (rigid modes left out; a second
-    mode of one type and order gets ``.<index>`` appended); lists and the keys of
+    mode of one type and order gets ``.<index>`` appended), its comparison with the reference
+    as ``frequency_change.<reference mode label>`` and ``mac.<label>``; lists and the keys of
     :data:`NOT_RESULTS` are left out."""
     out: dict = {}
     for key, value in summary.items():
@@ -287,6 +322,11 @@ def flatten_summary(summary: dict) -> dict:
                     continue
                 name = f"frequency_hz.{row['type']}.{row['order']}"
                 out[name if name not in out else f"{name}.{row['index']}"] = row["frequency_hz"]
+        elif key == "comparison" and isinstance(value, list):
+            for row in value:
+                label = row["reference_label"].replace(" ", "_")
+                out[f"frequency_change.{label}"] = row["frequency_change"]
+                out[f"mac.{label}"] = row["mac"]
         elif isinstance(value, dict):
             out.update({f"{key}.{k}": v for k, v in flatten_summary(value).items()})
         elif value is None or isinstance(value, bool | int | float | str):
@@ -317,13 +357,29 @@ def _draw_figures(sweep: Sweep, ds, out: Path) -> list[Path]:
         ][:MAX_FIGURES]
     from peridyn.plotting.sweep import plot_against
 
-    others = [n for n in sweep.spec.parameter_names() if n != numeric[0]]
+    x = numeric[0]
+    others = _independent_of(sweep, x, numeric)
     (out / "figures").mkdir(exist_ok=True)
     return [
-        plot_against(ds, numeric[0], name, others, out / "figures" / f"{name}.png")
+        plot_against(ds, x, name, others, out / "figures" / f"{name.replace(' ', '_')}.png")
         for name in chosen
         if name in ds and np.issubdtype(ds[name].dtype, np.number) and np.isfinite(ds[name].values).any()
     ]
+
+
+def _independent_of(sweep: Sweep, x: str, numeric: list[str]) -> list[str]:
+    """The varied parameters that tell the lines of a figure against ``x`` apart: those of the
+    other blocks; in a product block, the block's others; in a zip or list block, its text
+    values (a damage type; the numbers there move with ``x``). Derived ones follow the rest."""
+    names = []
+    for block in sweep.spec.vary:
+        if x not in block.names():
+            names += block.names()
+        elif block.product is not None:
+            names += [n for n in block.names() if n != x]
+        else:
+            names += [n for n in block.names() if n not in numeric]
+    return names
 
 
 def _varies(values: np.ndarray) -> bool:

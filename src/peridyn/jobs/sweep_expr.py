@@ -2,9 +2,10 @@
 
 An expression is numbers, names, ``+ - * / **``, unary minus, brackets, list indexing by a whole
 number (``geometry.size[0]``) and the functions ``min``, ``max``, ``abs``, ``sqrt``, ``round``.
-A name is a dotted path (``discretization.spacing``, ``crack_cells``, ``precracks[0].end[1]`` for
-``precracks.0.end.1``): ``lookup(path)`` gives its value (a varied parameter, or a case entry). Nothing else is accepted: the text is parsed
-with :mod:`ast` and only these nodes are evaluated, so no Python code ever runs.
+A name is a dotted path (``discretization.spacing``, ``crack_cells``; ``precracks[0].end[1]``
+for ``precracks.0.end.1``): ``lookup(path)`` gives its value (a varied parameter, or a case
+entry). Nothing else is accepted: the text is parsed with :mod:`ast` and only these nodes are
+evaluated, so no Python code ever runs.
 
 >>> evaluate("3 * discretization.spacing + 1", {"discretization.spacing": 0.5}.__getitem__)
 2.5

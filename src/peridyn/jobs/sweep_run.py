@@ -49,6 +49,9 @@ class RunTask:
         Folder of the base case (relative paths of the case are read from it).
     threads : int or None
         numba threads for the run (None: leave the worker's setting).
+    reference_dir : str or None
+        A modal run's folder to compare this modal run's modes with (``comparison`` in the
+        summary: frequency change and MAC of each reference mode).
     """
 
     run_id: str
@@ -60,6 +63,7 @@ class RunTask:
     run_dir: str
     base_dir: str
     threads: int | None
+    reference_dir: str | None = None
 
 
 def execute(task: RunTask) -> dict:
@@ -97,7 +101,12 @@ def _job(task: RunTask) -> dict:
         return run_fatigue_case(task.case, task.run_dir, base_dir=task.base_dir, overwrite=True)
     from peridyn.jobs.run import run_case
 
-    return run_case(task.case, task.run_dir, base_dir=task.base_dir, overwrite=True)
+    summary = run_case(task.case, task.run_dir, base_dir=task.base_dir, overwrite=True)
+    if task.reference_dir is not None:
+        from peridyn.jobs.modal import compare_with_run
+
+        summary["comparison"] = compare_with_run(Path(task.run_dir), Path(task.reference_dir))
+    return summary
 
 
 def _crash_hook() -> None:

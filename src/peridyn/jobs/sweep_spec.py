@@ -1,13 +1,14 @@
 """Sweep files (``SWEEP.yaml``): a base case, the parameters varied over it, and their runs.
 
 A sweep file holds ``base`` (a case file, relative to the sweep file), ``command`` (``run``,
-``modal`` or ``fatigue``: the job each run is), ``set`` (overrides for every run), ``vary`` (one
-block or a list of blocks, combined as a product; a block is ``product``, ``zip``, ``list`` or
-``random``), ``labels`` (varied names that are not case entries, e.g. a damage type, usable in
-expressions), ``derived`` (case entries computed from the others with the expressions of
-:mod:`peridyn.jobs.sweep_expr`, in order) and ``outputs`` (which summary scalars and which
-results series to collect). A parameter is named by its ``--set`` path (``material.E``,
-``precracks.0.end.1``). docs/sweeps.md describes the format with examples.
+``modal`` or ``fatigue``: the job each run is), ``reference`` (modal only: a case file, e.g. the
+healthy body, whose modes every run is compared with by MAC), ``set`` (overrides for every
+run), ``vary`` (one block or a list of blocks, combined as a product; a block is ``product``,
+``zip``, ``list`` or ``random``), ``labels`` (varied names that are not case entries, e.g. a
+damage type, usable in expressions), ``derived`` (case entries computed from the others with
+the expressions of :mod:`peridyn.jobs.sweep_expr`, in order) and ``outputs`` (which summary
+scalars and which results series to collect). A parameter is named by its ``--set`` path
+(``material.E``, ``precracks.0.end.1``). docs/sweeps.md describes the format with examples.
 
 :func:`expand` turns a sweep file into its runs, each with its parameters, its validated case
 and its id (the case's hash, :func:`peridyn.jobs.run.case_identity`); every case is validated
@@ -149,6 +150,7 @@ class SweepSpec(_Strict):
     description: str = ""
     base: str
     command: Literal["run", "modal", "fatigue"] = "run"
+    reference: str | None = None
     set: dict[str, Any] = {}
     vary: Annotated[list[Block], Field(min_length=1)]
     labels: list[str] = []
@@ -173,6 +175,10 @@ class SweepSpec(_Strict):
         for name in self.derived:
             if name in seen:
                 raise ValueError(f"derived {name!r} is also varied (block {seen[name]})")
+        if self.reference is not None and self.command != "modal":
+            raise ValueError(
+                f"reference (a healthy body to compare modes with) needs command: modal, not {self.command}"
+            )
         unused = sorted(set(self.labels) - set(seen))
         if unused:
             raise ValueError(f"labels {unused} are not varied by any block")
@@ -216,6 +222,7 @@ class Sweep:
     path: Path
     base: Path
     runs: list[SweepRun]
+    reference: SweepRun | None = None
 
     @property
     def name(self) -> str:
@@ -251,8 +258,16 @@ def read_spec(path) -> SweepSpec:
         ) from None
 
 
-def expand(path) -> Sweep:
+def expand(path, overrides=(), first: int | None = None) -> Sweep:
     """Read a sweep file and build every run's case (validated, not built).
+
+    Parameters
+    ----------
+    path : path
+    overrides : sequence of "key.path=value"
+        ``--set`` items for every run, after the file's ``set`` (e.g. a smaller grid for a trial).
+    first : int or None
+        Keep only the first ``first`` runs (a trial of the sweep).
 
     Raises
     ------
@@ -267,11 +282,11 @@ def expand(path) -> Sweep:
     points = [
         {k: v for part in combo for k, v in part.items()}
         for combo in itertools.product(*(block.points() for block in spec.vary))
-    ]
+    ][:first]
     runs = []
     by_id: dict[str, int] = {}
     for index, values in enumerate(points):
-        parameters, case = _run_case(spec, base, values)
+        parameters, case = _run_case(spec, base, values, list(overrides))
         text, digest = case_identity(case, run_length=True)
         run_id = digest[:ID_LENGTH]
         if run_id in by_id:
@@ -281,19 +296,28 @@ def expand(path) -> Sweep:
             )
         by_id[run_id] = index
         runs.append(SweepRun(index, parameters, case, run_id, digest))
-    return Sweep(spec, path, base, runs)
+    reference = None
+    if spec.reference is not None:
+        _, case = _run_case(
+            spec, (path.parent / spec.reference).resolve(), {}, list(overrides), derived=False
+        )
+        digest = case_identity(case, run_length=True)[1]
+        reference = SweepRun(-1, {}, case, digest[:ID_LENGTH], digest)
+    return Sweep(spec, path, base, runs, reference)
 
 
-def _run_case(spec: SweepSpec, base: Path, values: dict) -> tuple[dict, Case]:
-    """One run's parameters (varied, then derived) and validated case."""
-    overrides = [_override(k, v) for k, v in spec.set.items()]
+def _run_case(
+    spec: SweepSpec, base: Path, values: dict, extra: list, derived: bool = True
+) -> tuple[dict, Case]:
+    """One run's parameters (varied, then ``derived`` ones) and validated case."""
+    overrides = [_override(k, v) for k, v in spec.set.items()] + extra
     if spec.command == "modal":
         overrides.append("solver.type=modal")
     overrides += [_override(k, v) for k, v in values.items() if k not in spec.labels]
     parameters = dict(values)
     try:
         case = load_case(base, overrides)
-        if spec.derived:
+        if derived and spec.derived:
             dumped = case.model_dump(mode="json")
             for key, expression in spec.derived.items():
                 parameters[key] = evaluate(expression, lambda p: _lookup(p, parameters, dumped))

@@ -4,6 +4,8 @@ frequencies by mode type and order (peridyn.jobs.sweep.flatten_summary)."""
 
 from __future__ import annotations
 
+import importlib.util
+
 import numpy as np
 import pytest
 
@@ -11,7 +13,13 @@ from peridyn.errors import InputError
 from peridyn.io.dataset import SeriesColumn, build_dataset, load_sweep, write_dataset
 from peridyn.jobs.sweep import flatten_summary
 
+#: The dataset tests need the sweep extra (pip install 'peridyn[sweep]').
+needs_sweep_extra = pytest.mark.skipif(
+    not all(importlib.util.find_spec(m) for m in ("xarray", "h5netcdf")), reason="needs the sweep extra"
+)
 
+
+@needs_sweep_extra
 def test_dataset_round_trip_with_types_and_padding(tmp_path):
     rng = np.random.default_rng(0)
     a, b = rng.normal(size=(5, 2, 3)), rng.normal(size=(3, 2, 3))
@@ -52,12 +60,14 @@ def test_dataset_round_trip_with_types_and_padding(tmp_path):
     assert back.attrs["sweep"] == "t"
 
 
+@needs_sweep_extra
 def test_series_of_different_shapes_are_refused():
     column = SeriesColumn(times=[np.zeros(2), np.zeros(2)], values=[np.zeros((2, 3)), np.zeros((2, 4))])
     with pytest.raises(InputError, match="different shapes"):
         build_dataset({"run_id": ["a", "b"]}, {}, {"s": column}, {})
 
 
+@needs_sweep_extra
 def test_a_missing_dataset_is_named(tmp_path):
     with pytest.raises(InputError, match="does not exist"):
         load_sweep(tmp_path / "none.nc")
