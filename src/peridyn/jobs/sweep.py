@@ -139,6 +139,7 @@ def run_sweep(
                 str(sweep.base.parent),
                 threads,
                 reference_dir,
+                tuple(sweep.spec.outputs.bloch),
             )
         )
     bar = progress(len(tasks)) if progress is not None and tasks else None
@@ -275,7 +276,7 @@ class Collector:
         records = [self.records.get(r.run_id) for r in runs]
         coords = {"run_id": [r.run_id for r in runs]}
         for name in self.sweep.spec.parameter_names():
-            coords[name] = [r.parameters[name] for r in runs]
+            coords[name] = [r.parameters.get(name) for r in runs]  # derived_by: not in every run
         flat = [flatten_summary(rec["summary"]) if rec and rec.get("summary") else {} for rec in records]
         names = self.sweep.spec.outputs.scalars
         if names is None:

@@ -52,6 +52,8 @@ class RunTask:
     reference_dir : str or None
         A modal run's folder to compare this modal run's modes with (``comparison`` in the
         summary: frequency change and MAC of each reference mode).
+    bloch : tuple of float
+        Frequencies (Hz) of the Bloch prediction added to the summary (``bloch``).
     """
 
     run_id: str
@@ -64,6 +66,7 @@ class RunTask:
     base_dir: str
     threads: int | None
     reference_dir: str | None = None
+    bloch: tuple = ()
 
 
 def execute(task: RunTask) -> dict:
@@ -93,20 +96,42 @@ def execute(task: RunTask) -> dict:
 
 
 def _job(task: RunTask) -> dict:
-    """The job's summary (run and modal: ``run_case``; fatigue: ``run_fatigue_case``)."""
+    """The job's summary (run and modal: ``run_case``; fatigue: ``run_fatigue_case``; bloch:
+    none), with the comparison with the reference and the Bloch prediction when asked."""
     Path(task.run_dir).mkdir(parents=True, exist_ok=True)
     if task.command == "fatigue":
         from peridyn.jobs.fatigue import run_fatigue_case
 
-        return run_fatigue_case(task.case, task.run_dir, base_dir=task.base_dir, overwrite=True)
-    from peridyn.jobs.run import run_case
+        summary = run_fatigue_case(task.case, task.run_dir, base_dir=task.base_dir, overwrite=True)
+    elif task.command == "bloch":
+        summary = {}
+    else:
+        from peridyn.jobs.run import run_case
 
-    summary = run_case(task.case, task.run_dir, base_dir=task.base_dir, overwrite=True)
+        summary = run_case(task.case, task.run_dir, base_dir=task.base_dir, overwrite=True)
     if task.reference_dir is not None:
         from peridyn.jobs.modal import compare_with_run
 
         summary["comparison"] = compare_with_run(Path(task.run_dir), Path(task.reference_dir))
+    if task.bloch:
+        summary["bloch"] = bloch_prediction(task.case, task.bloch)
     return summary
+
+
+def bloch_prediction(case, frequencies) -> dict:
+    """``{mode: {"<f>": {"wavenumber_rad_m", "theory_rad_m", "error"}}}`` of the Bloch analysis
+    of the case's discretisation at ``frequencies`` (Hz) (None where a branch stays below f)."""
+    from peridyn.analysis.bloch import Discretisation
+    from peridyn.analysis.bloch_study import predict
+
+    out: dict = {}
+    for row in predict(Discretisation.from_case(case), list(frequencies)):
+        out.setdefault(row["mode"], {})[f"{row['frequency_hz']:g}"] = {
+            "wavenumber_rad_m": row["wavenumber_rad_m"],
+            "theory_rad_m": row["theory_wavenumber_rad_m"],
+            "error": row["error"],
+        }
+    return out
 
 
 def _crash_hook() -> None:

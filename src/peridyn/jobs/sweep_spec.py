@@ -1,14 +1,17 @@
 """Sweep files (``SWEEP.yaml``): a base case, the parameters varied over it, and their runs.
 
 A sweep file holds ``base`` (a case file, relative to the sweep file), ``command`` (``run``,
-``modal`` or ``fatigue``: the job each run is), ``reference`` (modal only: a case file, e.g. the
-healthy body, whose modes every run is compared with by MAC), ``set`` (overrides for every
-run), ``vary`` (one block or a list of blocks, combined as a product; a block is ``product``,
+``modal``, ``fatigue``, or ``bloch``: the Bloch prediction alone; the job each run is),
+``reference`` (modal only: a case file, e.g. the healthy body, whose modes every run is
+compared with by MAC), ``set`` (overrides for every run), ``vary`` (one block or a list of
+blocks, combined as a product; a block is ``product``,
 ``zip``, ``list`` or ``random``), ``labels`` (varied names that are not case entries, e.g. a
 damage type, usable in expressions), ``derived`` (case entries computed from the others with
-the expressions of :mod:`peridyn.jobs.sweep_expr`, in order) and ``outputs`` (which summary
-scalars and which results series to collect). A parameter is named by its ``--set`` path
-(``material.E``, ``precracks.0.end.1``). docs/sweeps.md describes the format with examples.
+the expressions of :mod:`peridyn.jobs.sweep_expr`, in order), ``derived_by`` (more derived
+entries chosen by the value of a label: ``{label: {value: {key: expression}}}``) and
+``outputs`` (which summary scalars and which results series to collect). A parameter is named
+by its ``--set`` path (``material.E``, ``precracks.0.end.1``). docs/sweeps.md describes the
+format with examples.
 
 :func:`expand` turns a sweep file into its runs, each with its parameters, its validated case
 and its id (the case's hash, :func:`peridyn.jobs.run.case_identity`); every case is validated
@@ -33,8 +36,9 @@ from peridyn.io.case import Case, apply_override, load_case, parse_yaml, yaml_pr
 from peridyn.jobs.run import case_identity
 from peridyn.jobs.sweep_expr import evaluate
 
-#: The jobs a sweep's runs can be.
-COMMANDS = ("run", "modal", "fatigue")
+#: The jobs a sweep's runs can be (``bloch``: only the Bloch prediction of the case's
+#: discretisation, no simulation).
+COMMANDS = ("run", "modal", "fatigue", "bloch")
 #: Characters of the case hash that name a run's folder.
 ID_LENGTH = 16
 
@@ -134,13 +138,22 @@ class Block(_Strict):
 
 
 class Outputs(_Strict):
-    """What the dataset collects: ``scalars`` (flattened summary names, default: all) and
-    ``series`` (names of results.h5 series, e.g. ``sensor_u``, ``pzt_signal``); ``figures``:
+    """What the dataset collects: ``scalars`` (flattened summary names, default: all),
+    ``series`` (names of results.h5 series, e.g. ``sensor_u``, ``pzt_signal``) and ``bloch``
+    (frequencies, Hz, at which each run's discretisation gets its Bloch wavenumbers of S0, A0
+    and SH0 against Rayleigh-Lamb, ``peridyn.analysis.bloch_study.predict``); ``figures``:
     draw the scalars against the first varied parameter (``OUT/figures/``)."""
 
     scalars: list[str] | None = None
     series: list[str] = []
+    bloch: list[Annotated[float, Field(gt=0)]] = []
     figures: bool = True
+
+    @model_validator(mode="after")
+    def _bloch(self):
+        if len(set(self.bloch)) != len(self.bloch):
+            raise ValueError(f"bloch: frequencies given twice in {self.bloch}")
+        return self
 
 
 class SweepSpec(_Strict):
@@ -149,12 +162,13 @@ class SweepSpec(_Strict):
     name: str | None = None
     description: str = ""
     base: str
-    command: Literal["run", "modal", "fatigue"] = "run"
+    command: Literal["run", "modal", "fatigue", "bloch"] = "run"
     reference: str | None = None
     set: dict[str, Any] = {}
     vary: Annotated[list[Block], Field(min_length=1)]
     labels: list[str] = []
-    derived: dict[str, str] = {}
+    derived: dict[str, str | float] = {}
+    derived_by: dict[str, dict[str, dict[str, str | float]]] = {}
     outputs: Outputs = Outputs()
 
     @model_validator(mode="before")
@@ -175,6 +189,15 @@ class SweepSpec(_Strict):
         for name in self.derived:
             if name in seen:
                 raise ValueError(f"derived {name!r} is also varied (block {seen[name]})")
+        for label, tables in self.derived_by.items():
+            if label not in self.labels:
+                raise ValueError(f"derived_by.{label}: {label!r} is not one of labels {self.labels}")
+            keys = set().union(*tables.values())
+            clash = sorted(keys & (set(self.derived) | set(seen)))
+            if clash:
+                raise ValueError(f"derived_by.{label}: {clash} are also varied or derived")
+        if self.command == "bloch" and not self.outputs.bloch:
+            raise ValueError("command bloch needs the frequencies of outputs.bloch")
         if self.reference is not None and self.command != "modal":
             raise ValueError(
                 f"reference (a healthy body to compare modes with) needs command: modal, not {self.command}"
@@ -186,7 +209,16 @@ class SweepSpec(_Strict):
 
     def parameter_names(self) -> list[str]:
         """Varied then derived names, in order: the dataset's coordinates."""
-        return [*(n for block in self.vary for n in block.names()), *self.derived]
+        by_label = [n for tables in self.derived_by.values() for table in tables.values() for n in table]
+        return [*(n for block in self.vary for n in block.names()), *self.derived, *dict.fromkeys(by_label)]
+
+    def derived_for(self, parameters: dict) -> dict:
+        """The derived entries of a run: ``derived``, then those of ``derived_by`` for the run's
+        label values (a label value without a table derives nothing more)."""
+        out = dict(self.derived)
+        for label, tables in self.derived_by.items():
+            out.update(tables.get(str(parameters[label]), {}))
+        return out
 
 
 @dataclass(frozen=True)
@@ -317,12 +349,13 @@ def _run_case(
     parameters = dict(values)
     try:
         case = load_case(base, overrides)
-        if derived and spec.derived:
+        expressions = spec.derived_for(parameters) if derived else {}
+        if expressions:
             dumped = case.model_dump(mode="json")
-            for key, expression in spec.derived.items():
-                parameters[key] = evaluate(expression, lambda p: _lookup(p, parameters, dumped))
+            for key, expression in expressions.items():
+                parameters[key] = evaluate(str(expression), lambda p: _lookup(p, parameters, dumped))
                 apply_override(dumped, _override(key, parameters[key]), str(base))  # for later ones
-            case = load_case(base, overrides + [_override(k, parameters[k]) for k in spec.derived])
+            case = load_case(base, overrides + [_override(k, parameters[k]) for k in expressions])
     except (CaseFileError, InputError) as exc:
         exc.args = (f"run with {_describe(parameters)}: {exc}",)
         raise
