@@ -151,3 +151,45 @@ def test_ctrl_c_keeps_finished_runs_and_a_second_run_does_the_rest(tmp_path):
     assert int((ds["status"].values == "complete").sum()) == complete
     again = json.loads(subprocess.run(command, env=env, capture_output=True, text=True, check=True).stdout)
     assert (again["skipped"], again["completed"], again["runs"]) == (complete, 5, 5)
+
+
+def test_modal_sweep_against_a_reference_gives_shifts_and_mac(tmp_path):
+    """sweeps/pmma_cracks.yaml on a 4 mm grid, its first two runs (edge cracks 2.5 and 5 mm):
+    each elastic mode of the healthy plate is paired by MAC and its frequency change is the
+    ratio of the two frequencies; a crack removes stiffness and no mass, so no paired mode
+    rises (Rayleigh quotient; tolerance 1e-6 for the eigensolver), and the longer crack lowers
+    the 1st in-plane bending mode more (its bending stress is largest where the crack cuts)."""
+    summary = run_sweep(
+        ROOT / "sweeps" / "pmma_cracks.yaml",
+        tmp_path / "out",
+        overrides=["discretization.spacing=4e-3", "solver.modes=12"],
+        first=2,
+    )
+    assert (summary["completed"], summary["failed"]) == (2, 0)
+    ds = load_sweep(summary["dataset"])
+    reference = json.loads((tmp_path / "out" / "reference" / RECORD).read_text())["summary"]["modes"]
+    for run_id in ds["run_id"].values:
+        rows = json.loads((tmp_path / "out" / "runs" / run_id / RECORD).read_text())["summary"]["comparison"]
+        assert len(rows) == sum(m["type"] != "rigid" for m in reference)
+        for row in rows:
+            assert row["frequency_change"] == pytest.approx(
+                row["frequency_hz"] / row["reference_frequency_hz"] - 1
+            )
+            assert 0 < row["mac"] <= 1 + 1e-9 and row["frequency_change"] < 1e-6
+    changes = [name for name in ds.data_vars if name.startswith("frequency_change.")]
+    assert changes and all(f"mac.{n.removeprefix('frequency_change.')}" in ds for n in changes)
+
+
+def test_bloch_sweep_reports_rayleigh_lamb_theory(tmp_path):
+    """sweeps/lamb_layers_bloch.yaml, first run (3 layers, 1.2 mm): the theory wavenumbers in
+    the dataset are Rayleigh-Lamb's S0 and A0 of the 2 mm aluminium plate (peridyn.analysis.lamb,
+    checked against the literature in tests/unit/analysis), and the error is k / k0 - 1."""
+    from peridyn.analysis.lamb import lamb_modes
+
+    summary = run_sweep(ROOT / "sweeps" / "lamb_layers_bloch.yaml", tmp_path / "out", first=1)
+    ds = load_sweep(summary["dataset"]).isel(run=0)
+    for m in lamb_modes(68.9e9, 0.33, 2700, 0.002, [110e3, 225e3], max_order=0):
+        key = f"bloch.{m.mode}.{m.frequency_hz:g}"
+        assert float(ds[f"{key}.theory_rad_m"]) == pytest.approx(m.wavenumber_rad_m, rel=1e-12)
+        k = float(ds[f"{key}.wavenumber_rad_m"])
+        assert float(ds[f"{key}.error"]) == pytest.approx(k / m.wavenumber_rad_m - 1, rel=1e-12)

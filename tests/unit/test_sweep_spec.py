@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 import yaml
 
+from peridyn.cli.validate_cmd import check_without_bonds
 from peridyn.errors import CaseFileError, InputError
 from peridyn.jobs.sweep_expr import evaluate
 from peridyn.jobs.sweep_spec import expand
@@ -92,11 +93,16 @@ def test_derived_values_follow_their_expressions_in_order(tmp_path):
 
 
 def test_every_run_of_the_shipped_sweeps_validates():
-    """The shipped sweep files expand, every run's case valid (no body is built)."""
+    """The shipped sweep files expand, every run's case valid; the first and middle runs of each
+    (lamb_damage: the first hole and the first notch; pmma_cracks: the first edge and the first
+    back-face crack) also pass ``peridyn validate``'s checks that build the points (memory,
+    placements, loads, time step). The largest runs of lamb_layers need a cluster's memory."""
     for path in sorted((ROOT / "sweeps").glob("*.yaml")):
         sweep = expand(path)
         assert sweep.runs, path
         assert len({r.run_id for r in sweep.runs}) == len(sweep.runs), path
+        for run in (sweep.runs[0], sweep.runs[len(sweep.runs) // 2]):
+            check_without_bonds(run.case, sweep.base.parent)
 
 
 @pytest.mark.parametrize(
@@ -151,3 +157,33 @@ def test_runs_that_are_the_same_case_are_refused(tmp_path):
 def test_a_missing_sweep_file_is_named(tmp_path):
     with pytest.raises(CaseFileError, match="an existing YAML sweep file"):
         expand(tmp_path / "nope.yaml")
+
+
+def test_derived_by_chooses_the_entries_of_the_label_value():
+    """sweeps/lamb_damage.yaml: a hole is a cylinder of diameter ``size`` at (x, y); a notch a
+    box one spacing wide along x and ``size`` long along y, centred at (x, y)."""
+    sweep = expand(ROOT / "sweeps" / "lamb_damage.yaml")
+    assert len(sweep.runs) == 2 * 50 * 3
+    h = sweep.runs[0].case.discretization.spacing
+    for run in sweep.runs:
+        p, region = run.parameters, run.case.removals[0]
+        if p["damage"] == "hole":
+            assert region.type == "cylinder" and region.center[:2] == [p["x"], p["y"]]
+            assert region.radius == p["size"] / 2
+        else:
+            assert region.type == "box"
+            np.testing.assert_allclose(np.subtract(region.max, region.min)[:2], [h, p["size"]], rtol=1e-12)
+            np.testing.assert_allclose(np.add(region.max, region.min)[:2] / 2, [p["x"], p["y"]], rtol=1e-12)
+    positions = {(r.parameters["x"], r.parameters["y"]) for r in sweep.runs}
+    assert len(positions) == 50  # the same 50 positions for both damages and all sizes
+
+
+def test_derived_by_needs_a_declared_label(tmp_path):
+    spec = {"vary": {"product": {"kind": ["a"]}}, "labels": ["kind"], "derived_by": {"other": {"a": {}}}}
+    with pytest.raises(CaseFileError, match="'other' is not one of labels"):
+        expand(sweep_file(tmp_path, **spec))
+
+
+def test_bloch_command_needs_its_frequencies(tmp_path):
+    with pytest.raises(CaseFileError, match="outputs.bloch"):
+        expand(sweep_file(tmp_path, vary={"product": {"material.E": [1e9]}}, command="bloch"))

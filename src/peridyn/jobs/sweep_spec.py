@@ -20,6 +20,7 @@ before anything runs.
 
 from __future__ import annotations
 
+import copy
 import itertools
 import json
 import math
@@ -32,7 +33,7 @@ import yaml
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
 from peridyn.errors import CaseFileError, InputError
-from peridyn.io.case import Case, apply_override, load_case, parse_yaml, yaml_problem
+from peridyn.io.case import Case, apply_override, load_case, parse_yaml, validate_case, yaml_problem
 from peridyn.jobs.run import case_identity
 from peridyn.jobs.sweep_expr import evaluate
 
@@ -315,10 +316,11 @@ def expand(path, overrides=(), first: int | None = None) -> Sweep:
         {k: v for part in combo for k, v in part.items()}
         for combo in itertools.product(*(block.points() for block in spec.vary))
     ][:first]
+    base_case = _BaseCase(base)
     runs = []
     by_id: dict[str, int] = {}
     for index, values in enumerate(points):
-        parameters, case = _run_case(spec, base, values, list(overrides))
+        parameters, case = _run_case(spec, base_case, values, list(overrides))
         text, digest = case_identity(case, run_length=True)
         run_id = digest[:ID_LENGTH]
         if run_id in by_id:
@@ -330,16 +332,31 @@ def expand(path, overrides=(), first: int | None = None) -> Sweep:
         runs.append(SweepRun(index, parameters, case, run_id, digest))
     reference = None
     if spec.reference is not None:
-        _, case = _run_case(
-            spec, (path.parent / spec.reference).resolve(), {}, list(overrides), derived=False
-        )
+        reference_case = _BaseCase((path.parent / spec.reference).resolve())
+        _, case = _run_case(spec, reference_case, {}, list(overrides), derived=False)
         digest = case_identity(case, run_length=True)[1]
         reference = SweepRun(-1, {}, case, digest[:ID_LENGTH], digest)
     return Sweep(spec, path, base, runs, reference)
 
 
+class _BaseCase:
+    """A case file read once (and checked as ``load_case`` checks it), validated with each
+    run's overrides as ``load_case(path, overrides)`` would."""
+
+    def __init__(self, path: Path):
+        load_case(path)  # a missing, unreadable or invalid base case is reported as for any case
+        self.path = path
+        self.raw = parse_yaml(path.read_text(encoding="utf-8"))
+
+    def case(self, overrides: list) -> Case:
+        raw = copy.deepcopy(self.raw)
+        for item in overrides:
+            apply_override(raw, item, str(self.path))
+        return validate_case(raw, str(self.path))
+
+
 def _run_case(
-    spec: SweepSpec, base: Path, values: dict, extra: list, derived: bool = True
+    spec: SweepSpec, base: _BaseCase, values: dict, extra: list, derived: bool = True
 ) -> tuple[dict, Case]:
     """One run's parameters (varied, then ``derived`` ones) and validated case."""
     overrides = [_override(k, v) for k, v in spec.set.items()] + extra
@@ -348,14 +365,14 @@ def _run_case(
     overrides += [_override(k, v) for k, v in values.items() if k not in spec.labels]
     parameters = dict(values)
     try:
-        case = load_case(base, overrides)
+        case = base.case(overrides)
         expressions = spec.derived_for(parameters) if derived else {}
         if expressions:
             dumped = case.model_dump(mode="json")
             for key, expression in expressions.items():
                 parameters[key] = evaluate(str(expression), lambda p: _lookup(p, parameters, dumped))
-                apply_override(dumped, _override(key, parameters[key]), str(base))  # for later ones
-            case = load_case(base, overrides + [_override(k, parameters[k]) for k in expressions])
+                apply_override(dumped, _override(key, parameters[key]), str(base.path))  # for later ones
+            case = base.case(overrides + [_override(k, parameters[k]) for k in expressions])
     except (CaseFileError, InputError) as exc:
         exc.args = (f"run with {_describe(parameters)}: {exc}",)
         raise
