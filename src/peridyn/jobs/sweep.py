@@ -160,6 +160,7 @@ def run_sweep(
         run_tasks(tasks, on_done, executor, workers, scheduler)
     except KeyboardInterrupt:
         interrupted = "interrupted (SIGINT)"
+        collector.read_finished()  # runs that workers finished after the interrupt reached us
     finally:
         if bar is not None:
             bar.close()
@@ -230,8 +231,14 @@ class Collector:
         self.series: dict[str, dict] = {}
         self.skipped = 0
         self._written = -np.inf
-        for run in sweep.runs:
-            record = read_record(out / "runs" / run.run_id)
+        self.read_finished()
+
+    def read_finished(self) -> None:
+        """Take the records in the run folders of the runs not known to be complete."""
+        for run in self.sweep.runs:
+            if self.is_complete(run):
+                continue
+            record = read_record(self.out / "runs" / run.run_id)
             if record is not None and record.get("case_hash") == run.case_hash:
                 try:
                     self.add(record)

@@ -201,16 +201,18 @@ def run_tasks(
     KeyboardInterrupt
         Ctrl-C: no more runs are started (the records of finished runs are all reported).
     """
+    if executor not in EXECUTORS:
+        raise InputError(f"executor must be one of {EXECUTORS}, got {executor!r}")
+    if not tasks and executor != "dask":
+        return
     if executor == "serial":
         for task in tasks:
             if not on_done(execute(task)):
                 return
     elif executor == "processes":
         _run_processes(tasks, on_done, workers)
-    elif executor == "dask":
-        _run_dask(tasks, on_done, workers, scheduler)
     else:
-        raise InputError(f"executor must be one of {EXECUTORS}, got {executor!r}")
+        _run_dask(tasks, on_done, workers, scheduler)
 
 
 def _run_processes(tasks, on_done, workers: int) -> None:
@@ -280,6 +282,8 @@ def _run_dask(tasks, on_done, workers: int, scheduler: str | None) -> None:
         ) from None
     import logging
 
+    if not tasks:  # nothing to run (dask's presence is checked all the same)
+        return
     cluster = None
     if scheduler is None:
         threads = tasks[0].threads if tasks else 1
