@@ -153,6 +153,7 @@ def test_ctrl_c_keeps_finished_runs_and_a_second_run_does_the_rest(tmp_path):
     assert (again["skipped"], again["completed"], again["runs"]) == (complete, 5, 5)
 
 
+@pytest.mark.filterwarnings("ignore:the spacing does not divide the body")  # 4 mm: 50 -> 48 mm wide
 def test_modal_sweep_against_a_reference_gives_shifts_and_mac(tmp_path):
     """sweeps/pmma_cracks.yaml on a 4 mm grid, its first two runs (edge cracks 2.5 and 5 mm):
     each elastic mode of the healthy plate is paired by MAC and its frequency change is the
@@ -193,3 +194,12 @@ def test_bloch_sweep_reports_rayleigh_lamb_theory(tmp_path):
         assert float(ds[f"{key}.theory_rad_m"]) == pytest.approx(m.wavenumber_rad_m, rel=1e-12)
         k = float(ds[f"{key}.wavenumber_rad_m"])
         assert float(ds[f"{key}.error"]) == pytest.approx(k / m.wavenumber_rad_m - 1, rel=1e-12)
+
+
+def test_bad_executor_arguments_are_refused_before_anything_runs(tmp_path):
+    path = tiny_sweep(tmp_path, {"product": {"material.density": [7850]}})
+    with pytest.raises(InputError, match="use it with --executor dask"):
+        run_sweep(path, tmp_path / "out", executor="processes", scheduler="tcp://127.0.0.1:8786")
+    with pytest.raises(InputError, match="executor must be one of"):
+        run_sweep(path, tmp_path / "out", executor="threads")
+    assert not (tmp_path / "out").exists()
