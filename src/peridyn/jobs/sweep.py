@@ -15,7 +15,11 @@ is recorded and the sweep goes on; Ctrl-C stops starting runs and keeps every fi
 from __future__ import annotations
 
 import json
+import signal
+import threading
 import time
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -142,34 +146,38 @@ def run_sweep(
                 tuple(sweep.spec.outputs.bloch),
             )
         )
+    collector.write(final=True)  # every run pending or done: the dataset exists from the start
     bar = progress(len(tasks)) if progress is not None and tasks else None
     interrupted = None
+    signals = Signals()
 
     def on_done(record: dict) -> bool:
         nonlocal interrupted
-        collector.add(record)
-        if bar is not None:
-            bar.update(1)
-        if record["status"].startswith("interrupted"):
-            interrupted = record["status"]
-            return False
-        collector.write(final=False)
+        with signals.deferred():
+            collector.add(record)
+            if bar is not None:
+                bar.update(1)
+            if record["status"].startswith("interrupted"):
+                interrupted = record["status"].partition("(")[2].rstrip(")") or "SIGINT"
+                return False
+            collector.write(final=False)
         return True
 
-    try:
-        run_tasks(tasks, on_done, executor, workers, scheduler)
-    except KeyboardInterrupt:
-        interrupted = "interrupted (SIGINT)"
-        collector.read_finished()  # runs that workers finished after the interrupt reached us
-    finally:
-        if bar is not None:
-            bar.close()
-        collector.write(final=True)
+    with signals:
+        try:
+            run_tasks(tasks, on_done, executor, workers, scheduler)
+        except KeyboardInterrupt:
+            interrupted = signals.name or "SIGINT"
+        finally:
+            with signals.deferred():
+                if bar is not None:
+                    bar.close()
+                collector.read_finished()  # runs that workers finished after the interrupt
+                collector.write(final=True)
     counts = collector.counts()
     if interrupted is not None:
-        signal_name = interrupted.partition("(")[2].rstrip(")") or "SIGINT"
         raise SweepInterrupted(
-            signal_name, counts["completed"], len(sweep.runs), command or f"run_sweep({str(path)!r}, ...)"
+            interrupted, counts["completed"], len(sweep.runs), command or f"run_sweep({str(path)!r}, ...)"
         )
     figures = _draw_figures(sweep, collector.dataset(), out)
     return {
@@ -184,6 +192,48 @@ def run_sweep(
         "executor": executor,
         "workers": 1 if executor == "serial" else workers,
     }
+
+
+class Signals:
+    """SIGINT and SIGTERM while a sweep runs (in the main thread): each raises KeyboardInterrupt
+    where it arrives (``name`` says which), except within ``deferred()`` (the dataset being
+    written), where it is raised when the block ends. A run's time stepping installs its own
+    handlers (``peridyn.solvers.stepping``) and ends the run with ``Interrupted`` instead."""
+
+    def __init__(self):
+        self.name = None
+        self._depth = 0
+        self._pending = False
+        self._previous = {}
+
+    def __enter__(self):
+        if threading.current_thread() is threading.main_thread():
+            self._previous = {sig: signal.signal(sig, self._note) for sig in (signal.SIGINT, signal.SIGTERM)}
+        return self
+
+    def __exit__(self, *exc):
+        for sig, handler in self._previous.items():
+            signal.signal(sig, signal.SIG_DFL if handler is None else handler)
+        return False
+
+    def _note(self, signum, frame):
+        self.name = signal.Signals(signum).name
+        if self._depth:
+            self._pending = True
+        else:
+            raise KeyboardInterrupt
+
+    @contextmanager
+    def deferred(self) -> Iterator[None]:
+        """A block that a signal does not cut short."""
+        self._depth += 1
+        try:
+            yield
+        finally:
+            self._depth -= 1
+        if self._pending and not self._depth:
+            self._pending = False
+            raise KeyboardInterrupt
 
 
 def _reference(sweep: Sweep, out: Path, overwrite: bool) -> str | None:

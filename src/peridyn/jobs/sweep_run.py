@@ -216,23 +216,30 @@ def run_tasks(
 
 
 def _run_processes(tasks, on_done, workers: int) -> None:
-    """A ProcessPoolExecutor of ``workers`` spawned processes; a broken pool (a worker died)
-    is replaced and the unfinished runs are submitted again."""
+    """A ProcessPoolExecutor of ``workers`` spawned processes, given one run per free worker
+    (so that stopping starts no more runs); a broken pool (a worker died) is replaced and its
+    unfinished runs are submitted again."""
     import multiprocessing
+    from collections import deque
     from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
     from concurrent.futures.process import BrokenProcessPool
 
     attempts = {t.run_id: 0 for t in tasks}
-    todo = list(tasks)
-    with worker_environment(tasks[0].threads if tasks else None):
+    todo = deque(tasks)
+    with worker_environment(tasks[0].threads):
         while todo:
-            pool = ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn"))
-            broken = []
+            pool = ProcessPoolExecutor(
+                workers, mp_context=multiprocessing.get_context("spawn"), initializer=_quiet_worker
+            )
+            pending, broken = {}, []
             try:
-                pending = {pool.submit(execute, t): t for t in todo}
-                for t in todo:
-                    attempts[t.run_id] += 1
-                while pending:
+                while todo or pending:
+                    while todo and not broken and len(pending) < workers:
+                        task = todo.popleft()
+                        attempts[task.run_id] += 1
+                        pending[pool.submit(execute, task)] = task
+                    if not pending:
+                        break
                     done, _ = wait(pending, return_when=FIRST_COMPLETED)
                     for future in done:
                         task = pending.pop(future)
@@ -242,16 +249,22 @@ def _run_processes(tasks, on_done, workers: int) -> None:
                             broken.append(task)
                             continue
                         if not on_done(record):
-                            pool.shutdown(wait=True, cancel_futures=True)
                             return
             finally:
                 pool.shutdown(wait=True, cancel_futures=True)
-            todo = []
-            for task in broken:
+            for task in reversed(broken):
                 if attempts[task.run_id] < MAX_ATTEMPTS:
-                    todo.append(task)
-                else:
-                    on_done(_lost(task, f"its worker process died {MAX_ATTEMPTS} times"))
+                    todo.appendleft(task)
+                elif not on_done(_lost(task, f"its worker process died {MAX_ATTEMPTS} times")):
+                    return
+
+
+def _quiet_worker() -> None:
+    """A pool worker ignores Ctrl-C (the sweep's process stops the sweep), except within a run's
+    time stepping, whose own handlers end the run at the end of a step."""
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 def _lost(task: RunTask, reason: str) -> dict:
