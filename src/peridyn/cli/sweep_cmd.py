@@ -6,7 +6,6 @@ from peridyn.cli.logs import progress_bar
 from peridyn.cli.options import (
     add_common_flags,
     add_output_flag,
-    add_overwrite_flag,
     add_progress_flags,
     positive_int,
 )
@@ -41,7 +40,9 @@ def register(sub) -> None:
     p.add_argument("--first", type=positive_int, default=None, metavar="N", help="run only the first N runs")
     p.add_argument("--scheduler", default=None, metavar="ADDRESS", help="address of a running dask scheduler")
     add_output_flag(p, "output folder (default: peridyn-out/<sweep name>); a second run resumes it")
-    add_overwrite_flag(p)
+    p.add_argument(
+        "--overwrite", action="store_true", help="run again the runs already complete (default: skip them)"
+    )
     add_progress_flags(p)
     add_common_flags(p)
     p.set_defaults(func=run)
