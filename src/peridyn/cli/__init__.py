@@ -32,6 +32,7 @@ COMMAND_MODULES = (
     "peridyn.cli.plot_cmd",
     "peridyn.cli.fatigue_cmd",
     "peridyn.cli.study_cmd",
+    "peridyn.cli.sweep_cmd",
 )
 
 

@@ -268,13 +268,14 @@ def _finish_on_root(case, body, out, summary, plots, start, phi) -> None:
     store_summary(out / RESULTS, body, summary, status="complete")
 
 
-def case_identity(case: Case) -> tuple[str, str]:
-    """The validated case (after ``--set``) as JSON text without its run length
-    (``solver.steps``, ``solver.time``: a restart may extend a run) and output folder, and
-    the SHA-256 of that text."""
+def case_identity(case: Case, run_length: bool = False) -> tuple[str, str]:
+    """The validated case (after ``--set``) as JSON text without its output folder and, unless
+    ``run_length`` (a sweep's runs differ by it), without its run length (``solver.steps``,
+    ``solver.time``: a restart may extend a run), and the SHA-256 of that text."""
     data = case.model_dump(mode="json")
-    for key in ("steps", "time"):
-        data["solver"].pop(key, None)
+    if not run_length:
+        for key in ("steps", "time"):
+            data["solver"].pop(key, None)
     data["output"].pop("directory", None)
     text = json.dumps(data, sort_keys=True)
     return text, hashlib.sha256(text.encode()).hexdigest()

@@ -1,0 +1,88 @@
+"""peridyn sweep SWEEP.yaml: run a parameter sweep (docs/sweeps.md) and collect its dataset."""
+
+from __future__ import annotations
+
+from peridyn.cli.logs import progress_bar
+from peridyn.cli.options import (
+    add_common_flags,
+    add_output_flag,
+    add_progress_flags,
+    positive_int,
+)
+from peridyn.cli.run_cmd import command_line
+
+
+def register(sub) -> None:
+    """Add the ``sweep`` subcommand."""
+    p = sub.add_parser("sweep", help="run a parameter sweep and collect its dataset", description=__doc__)
+    p.add_argument("sweep", help="YAML sweep file")
+    p.add_argument(
+        "--executor",
+        choices=("serial", "processes", "dask"),
+        default="serial",
+        help="where the runs run: this process, a pool of processes, or dask (default: serial)",
+    )
+    p.add_argument(
+        "--workers",
+        type=positive_int,
+        default=1,
+        metavar="N",
+        help="worker processes (processes, local dask cluster); each gets cores // N threads",
+    )
+    p.add_argument(
+        "--set",
+        dest="overrides",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="override a case entry of every run, e.g. discretization.spacing=0.002 (repeatable)",
+    )
+    p.add_argument("--first", type=positive_int, default=None, metavar="N", help="run only the first N runs")
+    p.add_argument("--scheduler", default=None, metavar="ADDRESS", help="address of a running dask scheduler")
+    add_output_flag(p, "output folder (default: peridyn-out/<sweep name>); a second run resumes it")
+    p.add_argument(
+        "--overwrite", action="store_true", help="run again the runs already complete (default: skip them)"
+    )
+    add_progress_flags(p)
+    add_common_flags(p)
+    p.set_defaults(func=run)
+
+
+def run(args) -> dict:
+    """Run the sweep; print a one-paragraph report unless --json."""
+    from peridyn.jobs.sweep import run_sweep
+
+    bar = progress_bar(args.progress, "sweep")
+    summary = run_sweep(
+        args.sweep,
+        args.output,
+        executor=args.executor,
+        workers=args.workers,
+        scheduler=args.scheduler,
+        overwrite=args.overwrite,
+        progress=None if bar is None else _runs(bar),
+        command=command_line(),
+        overrides=args.overrides,
+        first=args.first,
+    )
+    if not args.json:
+        print(
+            f"sweep {summary['sweep']}: {summary['runs']} runs, {summary['completed']} complete, "
+            f"{summary['failed']} failed, {summary['skipped']} skipped (already complete), "
+            f"{summary['seconds']:.1f} s"
+        )
+        print(f"dataset: {summary['dataset']}")
+        for path in summary["figures"]:
+            print(f"  plot: {path}")
+    return summary
+
+
+def _runs(factory):
+    """The progress-bar factory counting runs, not steps."""
+
+    def make(total: int):
+        bar = factory(total)
+        bar.unit = "run"
+        return bar
+
+    return make

@@ -1,0 +1,446 @@
+"""``peridyn sweep``: run every run of a sweep file and collect their results in one dataset.
+
+Layout of the output folder ``OUT``:
+
+- ``OUT/sweep.json``: the sweep (its file, spec and runs: id and parameters);
+- ``OUT/runs/<run-id>/``: each run's own output folder (``results.h5`` or ``fatigue.json``,
+  with provenance) and its record ``run.json`` (:mod:`peridyn.jobs.sweep_run`);
+- ``OUT/dataset.nc``: the dataset (:mod:`peridyn.io.dataset`), rewritten as runs finish;
+- ``OUT/figures/``: a scalar result against the first varied parameter (at the end).
+
+A run whose record says ``complete`` for the same case hash is skipped (resume); a failed run
+is recorded and the sweep goes on; Ctrl-C stops starting runs and keeps every finished one.
+"""
+
+from __future__ import annotations
+
+import json
+import signal
+import threading
+import time
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+
+import numpy as np
+
+from peridyn.errors import InputError, Interrupted
+from peridyn.io.dataset import SeriesColumn, build_dataset, require_xarray, write_dataset
+from peridyn.io.results import Results
+from peridyn.jobs.sweep_run import (
+    EXECUTORS,
+    RunTask,
+    execute,
+    read_record,
+    run_tasks,
+    threads_per_worker,
+)
+from peridyn.jobs.sweep_spec import Sweep, expand
+
+#: The dataset file in a sweep's output folder.
+DATASET = "dataset.nc"
+#: Least time between two rewrites of the dataset while runs finish, s (it is always written
+#: at the end; every finished run is kept in its folder meanwhile).
+REWRITE_INTERVAL = 5.0
+#: Summary keys that are not results of the physics (paths, timings, schema).
+NOT_RESULTS = {"output_dir", "plots", "schema_version", "kind", "seconds", "peak_memory_bytes"}
+#: The most results drawn against a parameter when ``outputs.scalars`` does not choose them.
+MAX_FIGURES = 12
+
+
+class SweepInterrupted(Interrupted):
+    """A sweep stopped by Ctrl-C (or SIGTERM in a run): ``completed`` of ``total`` runs are
+    complete; ``resume`` says how to run the others."""
+
+    def __init__(self, signal_name: str, completed: int, total: int, resume: str):
+        super().__init__(signal_name, completed, resume)
+        self.args = (
+            f"sweep interrupted ({signal_name}): {completed} of {total} runs complete; "
+            f"run the same command again to run the others: {resume}",
+        )
+
+
+def run_sweep(
+    path,
+    output_dir=None,
+    executor: str = "serial",
+    workers: int = 1,
+    scheduler: str | None = None,
+    overwrite: bool = False,
+    progress=None,
+    command: str | None = None,
+    overrides=(),
+    first: int | None = None,
+) -> dict:
+    """Run the sweep file ``path``; returns its summary.
+
+    Parameters
+    ----------
+    path : path
+        The sweep file (docs/sweeps.md).
+    output_dir : path or None
+        Default ``peridyn-out/<sweep name>``.
+    executor : "serial", "processes" or "dask"
+    workers : int
+        Worker processes (``processes`` and a local dask cluster); each runs with
+        ``cores // workers`` numba threads.
+    scheduler : str or None
+        Address of a running dask scheduler (``executor="dask"`` only).
+    overwrite : bool
+        Run again the runs already complete (default: skip them).
+    progress : callable(total) -> bar with update(n) and close(), or None
+    command : str or None
+        The command line, for the resume hint of an interrupted sweep.
+    overrides : sequence of "key.path=value"
+        ``--set`` items for every run (after the sweep file's ``set``).
+    first : int or None
+        Run only the first ``first`` runs of the sweep (a trial).
+
+    Returns
+    -------
+    dict
+        ``runs``, ``completed``, ``failed``, ``skipped``, ``seconds``, ``dataset`` (path),
+        ``output_dir``, ``figures`` and ``executor``, ``workers``.
+
+    Raises
+    ------
+    SweepInterrupted
+        Ctrl-C: the runs finished so far are in the dataset.
+    """
+    start = time.perf_counter()
+    if executor not in EXECUTORS:
+        raise InputError(f"executor must be one of {EXECUTORS}, got {executor!r}")
+    if scheduler is not None and executor != "dask":
+        raise InputError(
+            f"--scheduler is the address of a dask scheduler: use it with --executor dask, not {executor}"
+        )
+    if not isinstance(workers, int) or workers < 1:
+        raise InputError(f"workers must be a whole number >= 1, got {workers!r}")
+    require_xarray()
+    sweep = expand(path, overrides, first)
+    out = Path(output_dir or Path("peridyn-out") / sweep.name)
+    if out.exists() and not out.is_dir():
+        raise InputError(f"output folder {str(out)!r} is a file, not a folder: choose another --output")
+    (out / "runs").mkdir(parents=True, exist_ok=True)
+    _write_manifest(sweep, out)
+    collector = Collector(sweep, out)
+    threads = None if executor == "serial" or scheduler is not None else threads_per_worker(workers)
+    reference_dir = _reference(sweep, out, overwrite)
+    tasks = []
+    for run in sweep.runs:
+        if not overwrite and collector.is_complete(run):
+            collector.skipped += 1
+            continue
+        tasks.append(
+            RunTask(
+                run.run_id,
+                run.index,
+                run.parameters,
+                run.case,
+                run.case_hash,
+                sweep.spec.command,
+                str(out / "runs" / run.run_id),
+                str(sweep.base.parent),
+                threads,
+                reference_dir,
+                tuple(sweep.spec.outputs.bloch),
+            )
+        )
+    collector.write(final=True)  # every run pending or done: the dataset exists from the start
+    bar = progress(len(tasks)) if progress is not None and tasks else None
+    interrupted = None
+    signals = Signals()
+
+    def on_done(record: dict) -> bool:
+        nonlocal interrupted
+        with signals.deferred():
+            collector.add(record)
+            if bar is not None:
+                bar.update(1)
+            if record["status"].startswith("interrupted"):
+                interrupted = record["status"].partition("(")[2].rstrip(")") or "SIGINT"
+                return False
+            collector.write(final=False)
+        return True
+
+    with signals:
+        try:
+            run_tasks(tasks, on_done, executor, workers, scheduler)
+        except KeyboardInterrupt:
+            interrupted = signals.name or "SIGINT"
+        finally:
+            with signals.deferred():
+                if bar is not None:
+                    bar.close()
+                collector.read_finished()  # runs that workers finished after the interrupt
+                collector.write(final=True)
+    counts = collector.counts()
+    if interrupted is not None:
+        raise SweepInterrupted(
+            interrupted, counts["completed"], len(sweep.runs), command or f"run_sweep({str(path)!r}, ...)"
+        )
+    figures = _draw_figures(sweep, collector.dataset(), out)
+    return {
+        "sweep": sweep.name,
+        "runs": len(sweep.runs),
+        **counts,
+        "skipped": collector.skipped,
+        "seconds": time.perf_counter() - start,
+        "dataset": str(out / DATASET),
+        "output_dir": str(out),
+        "figures": [str(p) for p in figures],
+        "executor": executor,
+        "workers": 1 if executor == "serial" else workers,
+    }
+
+
+class Signals:
+    """SIGINT and SIGTERM while a sweep runs (in the main thread): each raises KeyboardInterrupt
+    where it arrives (``name`` says which), except within ``deferred()`` (the dataset being
+    written), where it is raised when the block ends. A run's time stepping installs its own
+    handlers (``peridyn.solvers.stepping``) and ends the run with ``Interrupted`` instead."""
+
+    def __init__(self):
+        self.name = None
+        self._depth = 0
+        self._pending = False
+        self._previous = {}
+
+    def __enter__(self):
+        if threading.current_thread() is threading.main_thread():
+            self._previous = {sig: signal.signal(sig, self._note) for sig in (signal.SIGINT, signal.SIGTERM)}
+        return self
+
+    def __exit__(self, *exc):
+        for sig, handler in self._previous.items():
+            signal.signal(sig, signal.SIG_DFL if handler is None else handler)
+        return False
+
+    def _note(self, signum, frame):
+        self.name = signal.Signals(signum).name
+        if self._depth:
+            self._pending = True
+        else:
+            raise KeyboardInterrupt
+
+    @contextmanager
+    def deferred(self) -> Iterator[None]:
+        """A block that a signal does not cut short."""
+        self._depth += 1
+        try:
+            yield
+        finally:
+            self._depth -= 1
+        if self._pending and not self._depth:
+            self._pending = False
+            raise KeyboardInterrupt
+
+
+def _reference(sweep: Sweep, out: Path, overwrite: bool) -> str | None:
+    """The folder of the sweep's reference run (``OUT/reference``), run here first unless
+    complete for its case; None without a reference.
+
+    Raises
+    ------
+    InputError
+        The reference run failed (every comparison needs it).
+    """
+    if sweep.reference is None:
+        return None
+    ref = sweep.reference
+    base = (sweep.path.parent / sweep.spec.reference).resolve().parent
+    folder = out / "reference"
+    record = read_record(folder)
+    if overwrite or record is None or record["case_hash"] != ref.case_hash or record["status"] != "complete":
+        task = RunTask(ref.run_id, -1, {}, ref.case, ref.case_hash, "modal", str(folder), str(base), None)
+        record = execute(task)
+    if record["status"] != "complete":
+        raise InputError(
+            f"the sweep's reference run ({sweep.spec.reference}) did not complete: {record['status']}"
+        )
+    return str(folder)
+
+
+def _write_manifest(sweep: Sweep, out: Path) -> None:
+    manifest = {
+        "sweep_file": str(sweep.path),
+        "base_case": str(sweep.base),
+        "spec": sweep.spec.model_dump(mode="json"),
+        "runs": [{"run_id": r.run_id, "parameters": r.parameters} for r in sweep.runs],
+    }
+    (out / "sweep.json").write_text(json.dumps(manifest, indent=1) + "\n")
+
+
+class Collector:
+    """The records of a sweep's runs, read from their folders or reported as they finish, and
+    the dataset they make."""
+
+    def __init__(self, sweep: Sweep, out: Path):
+        self.sweep, self.out = sweep, out
+        self.records: dict[str, dict] = {}
+        self.series: dict[str, dict] = {}
+        self.skipped = 0
+        self._written = -np.inf
+        self.read_finished()
+
+    def read_finished(self) -> None:
+        """Take the records in the run folders of the runs not known to be complete."""
+        for run in self.sweep.runs:
+            if self.is_complete(run):
+                continue
+            record = read_record(self.out / "runs" / run.run_id)
+            if record is not None and record.get("case_hash") == run.case_hash:
+                try:
+                    self.add(record)
+                except InputError:  # its results file is gone or unreadable: the run runs again
+                    self.records.pop(run.run_id, None)
+
+    def is_complete(self, run) -> bool:
+        """Whether ``run`` has a complete record for its case."""
+        record = self.records.get(run.run_id)
+        return record is not None and record["status"] == "complete"
+
+    def add(self, record: dict) -> None:
+        """Take a run's record (and read its series when it is complete)."""
+        self.records[record["run_id"]] = record
+        self.series[record["run_id"]] = {}
+        if record["status"] == "complete" and self.sweep.spec.outputs.series:
+            results = Results(self.out / "runs" / record["run_id"] / "results.h5")
+            for name in self.sweep.spec.outputs.series:
+                _, times, values = results.series(name)
+                names = results.series_attrs(name).get("names")
+                self.series[record["run_id"]][name] = (times, values, names)
+
+    def counts(self) -> dict:
+        """``completed`` and ``failed`` runs."""
+        statuses = [r["status"] for r in self.records.values()]
+        return {
+            "completed": sum(s == "complete" for s in statuses),
+            "failed": sum(s.startswith("failed") for s in statuses),
+        }
+
+    def write(self, final: bool) -> None:
+        """Rewrite the dataset (at most every :data:`REWRITE_INTERVAL` s unless ``final``)."""
+        if not final and time.monotonic() - self._written < REWRITE_INTERVAL:
+            return
+        write_dataset(self.dataset(), self.out / DATASET)
+        self._written = time.monotonic()
+
+    def dataset(self):
+        """The dataset of every run of the sweep, in sweep order (runs not yet done have the
+        status ``pending`` and no results)."""
+        runs = self.sweep.runs
+        records = [self.records.get(r.run_id) for r in runs]
+        coords = {"run_id": [r.run_id for r in runs]}
+        for name in self.sweep.spec.parameter_names():
+            coords[name] = [r.parameters.get(name) for r in runs]  # derived_by: not in every run
+        flat = [flatten_summary(rec["summary"]) if rec and rec.get("summary") else {} for rec in records]
+        names = self.sweep.spec.outputs.scalars
+        if names is None:
+            names = list(dict.fromkeys(k for row in flat for k in row))
+        table = {
+            "status": [rec["status"] if rec else "pending" for rec in records],
+            "error": [rec["error"] if rec else "" for rec in records],
+            "seconds": [rec["seconds"] if rec else None for rec in records],
+        }
+        for name in names:
+            table[name] = [row.get(name) for row in flat]
+        series = {}
+        for name in self.sweep.spec.outputs.series:
+            got = [self.series.get(r.run_id, {}).get(name) for r in runs]
+            entry_names = next((g[2] for g in got if g is not None), None)
+            series[name] = SeriesColumn(
+                times=[None if g is None else g[0] for g in got],
+                values=[None if g is None else g[1] for g in got],
+                entry_names=entry_names,
+            )
+        attrs = {
+            "sweep": self.sweep.name,
+            "sweep_file": str(self.sweep.path),
+            "base_case": str(self.sweep.base),
+            "command": self.sweep.spec.command,
+            "parameters": json.dumps(self.sweep.spec.parameter_names()),
+        }
+        return build_dataset(coords, table, series, attrs)
+
+
+def flatten_summary(summary: dict) -> dict:
+    """A job summary's scalar results by dotted name: nested mappings joined with ``.``, the
+    modes of a modal job as ``frequency_hz.<type>.<order>`` (rigid modes left out; a second
+    mode of one type and order gets ``.<index>`` appended), its comparison with the reference
+    as ``frequency_change.<reference mode label>`` and ``mac.<label>``; lists and the keys of
+    :data:`NOT_RESULTS` are left out."""
+    out: dict = {}
+    for key, value in summary.items():
+        if key in NOT_RESULTS:
+            continue
+        if key == "modes" and isinstance(value, list):
+            for row in value:
+                if row["type"] == "rigid":
+                    continue
+                name = f"frequency_hz.{row['type']}.{row['order']}"
+                out[name if name not in out else f"{name}.{row['index']}"] = row["frequency_hz"]
+        elif key == "comparison" and isinstance(value, list):
+            for row in value:
+                label = row["reference_label"].replace(" ", "_")
+                out[f"frequency_change.{label}"] = row["frequency_change"]
+                out[f"mac.{label}"] = row["mac"]
+        elif isinstance(value, dict):
+            out.update({f"{key}.{k}": v for k, v in flatten_summary(value).items()})
+        elif value is None or isinstance(value, bool | int | float | str):
+            out[key] = value
+    return out
+
+
+def _draw_figures(sweep: Sweep, ds, out: Path) -> list[Path]:
+    """Each chosen scalar result against the first varied parameter (``outputs.scalars``, else
+    up to :data:`MAX_FIGURES` numeric results that vary), when the sweep varies a number and
+    its ``outputs.figures`` is on."""
+    if not sweep.runs or not sweep.spec.outputs.figures:
+        return []
+    numeric = [
+        n for n in sweep.spec.parameter_names() if np.issubdtype(ds[n].dtype, np.number) and ds[n].size
+    ]
+    if not numeric:
+        return []
+    chosen = sweep.spec.outputs.scalars
+    if chosen is None:
+        chosen = [
+            n
+            for n in ds.data_vars
+            if ds[n].dims == ("run",)
+            and n != "seconds"
+            and np.issubdtype(ds[n].dtype, np.number)
+            and _varies(ds[n].values)
+        ][:MAX_FIGURES]
+    from peridyn.plotting.sweep import plot_against
+
+    x = numeric[0]
+    others = _independent_of(sweep, x, numeric)
+    (out / "figures").mkdir(exist_ok=True)
+    return [
+        plot_against(ds, x, name, others, out / "figures" / f"{name.replace(' ', '_')}.png")
+        for name in chosen
+        if name in ds and np.issubdtype(ds[name].dtype, np.number) and np.isfinite(ds[name].values).any()
+    ]
+
+
+def _independent_of(sweep: Sweep, x: str, numeric: list[str]) -> list[str]:
+    """The varied parameters that tell the lines of a figure against ``x`` apart: those of the
+    other blocks; in a product block, the block's others; in a zip or list block, its text
+    values (a damage type; the numbers there move with ``x``). Derived ones follow the rest."""
+    names = []
+    for block in sweep.spec.vary:
+        if x not in block.names():
+            names += block.names()
+        elif block.product is not None:
+            names += [n for n in block.names() if n != x]
+        else:
+            names += [n for n in block.names() if n not in numeric]
+    return names
+
+
+def _varies(values: np.ndarray) -> bool:
+    """Whether the finite entries of ``values`` take more than one value."""
+    finite = values[np.isfinite(values)]
+    return finite.size > 0 and finite.max() > finite.min()
