@@ -19,7 +19,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from peridyn.errors import InputError, Interrupted
-from peridyn.io.outdir import failure_status
+from peridyn.io.outdir import end_status
 
 #: Executors of ``peridyn sweep --executor``.
 EXECUTORS = ("serial", "processes", "dask")
@@ -89,7 +89,7 @@ def execute(task: RunTask) -> dict:
     except Interrupted as exc:
         record.update(status=f"interrupted ({exc.signal_name})", error=str(exc), summary=None)
     except Exception as exc:  # noqa: BLE001 - a failed run is recorded and the sweep goes on
-        record.update(status=failure_status(exc), error=f"{type(exc).__name__}: {exc}", summary=None)
+        record.update(status=end_status(exc), error=f"{type(exc).__name__}: {exc}", summary=None)
     record["seconds"] = time.perf_counter() - start
     write_record(task.run_dir, record)
     return record
