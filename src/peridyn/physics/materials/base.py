@@ -160,14 +160,14 @@ class Model:
 
         The default takes the force state of point i as the derivative of its own energy in
         the linearisation (``materials.linearisation``: W_i = sum_j pair_ij e_ij^2 / 4 +
-        c_i theta_i^2), with the deformed extension e = |Y| - |xi| and direction Y / |Y| as the
-        nonlinear tangent does:
+        c_i theta_i^2), with the deformed extension ``e = |Y| - |xi|`` and direction ``Y / |Y|`` as the
+        nonlinear tangent does::
 
             T_ij V_j = [weight_ij |xi_ij| P_i + (pair_ij / 2) e_ij] Y_ij / |Y_ij|,
             P_i = p_coef_i theta_i,  theta_i = theta_coef_i sum_j weight_ij |xi_ij| e_ij,
 
-        exact for the ordinary state-based and bond-based forces (PMB: k e / (2 |xi|), half
-        the pair force; LPS: t = w |xi| P_i + alpha_i g_ij w e). Computed in float64 whatever
+        exact for the ordinary state-based and bond-based forces (PMB: ``k e / (2 |xi|)``, half
+        the pair force; LPS: ``t = w |xi| P_i + alpha_i g_ij w e``). Computed in float64 whatever
         the kernel dtype; broken bonds carry no force.
         """
         b, lin = self.bonds, self.linearisation()
