@@ -76,13 +76,7 @@ def execute(task: RunTask) -> dict:
     if task.threads is not None:
         set_threads(task.threads)
     start = time.perf_counter()
-    record = {
-        "run_id": task.run_id,
-        "index": task.index,
-        "parameters": task.parameters,
-        "case_hash": task.case_hash,
-        "command": task.command,
-    }
+    record = _identity(task)
     try:
         summary = _job(task)
         record.update(status="complete", error="", summary=summary)
@@ -267,14 +261,21 @@ def _quiet_worker() -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
-def _lost(task: RunTask, reason: str) -> dict:
-    """The record of a run that no worker could finish (also written to its folder)."""
-    record = {
+def _identity(task: RunTask) -> dict:
+    """The keys of a run's record that say which run it is."""
+    return {
         "run_id": task.run_id,
         "index": task.index,
         "parameters": task.parameters,
         "case_hash": task.case_hash,
         "command": task.command,
+    }
+
+
+def _lost(task: RunTask, reason: str) -> dict:
+    """The record of a run that no worker could finish (also written to its folder)."""
+    record = {
+        **_identity(task),
         "status": f"failed: {reason}",
         "error": reason,
         "summary": None,
