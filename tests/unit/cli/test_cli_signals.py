@@ -86,10 +86,9 @@ def tiny_disk(tmp_path):
         subprocess.run(["umount", str(mount)], check=True)
 
 
-def test_a_full_disk_during_a_run_names_the_file(tiny_disk, capsys):
-    """The bar's results.h5 outgrows a 64 KiB disk: HDF5's long report becomes PATH: reason."""
-    out = tiny_disk / "out"
-    argv = ["run", "cases/bar_pulse.yaml", "-o", str(out), "--set", "solver.time=0.3e-6"]
+def _run_on(disk: Path, capsys) -> tuple[int, str]:
+    """``peridyn run`` of the shortened bar into ``disk``/out: the exit status and stderr's last line."""
+    argv = ["run", "cases/bar_pulse.yaml", "-o", str(disk / "out"), "--set", "solver.time=0.3e-6"]
     cwd = os.getcwd()
     os.chdir(ROOT)
     try:
@@ -98,6 +97,23 @@ def test_a_full_disk_during_a_run_names_the_file(tiny_disk, capsys):
         os.chdir(cwd)
     err = capsys.readouterr().err
     _no_traceback(err)
+    return status, err.splitlines()[-1]
+
+
+def test_a_run_that_cannot_fit_on_the_disk_is_refused_before_writing(tiny_disk, capsys):
+    """The bar's records (about 10 MB with its snapshots) cannot fit on a 64 KiB disk: refused
+    before the output folder is made (``jobs.run.check_output_fits``)."""
+    status, line = _run_on(tiny_disk, capsys)
+    assert status == 1 and "GB of results, more than the" in line
+    assert not (tiny_disk / "out").exists()
+
+
+def test_a_full_disk_during_a_run_names_the_file(tiny_disk, capsys, monkeypatch):
+    """The disk fills during the run (another process may fill it after the check): HDF5's long
+    report on results.h5 becomes PATH: reason. The up-front check is switched off to get there."""
+    import peridyn.jobs.run
+
+    monkeypatch.setattr(peridyn.jobs.run, "check_output_fits", lambda *args: None)
+    status, line = _run_on(tiny_disk, capsys)
     assert status == 1
-    line = err.splitlines()[-1]
-    assert line.startswith(f"peridyn run: error: {out / 'results.h5'}: {os.strerror(28)} (")
+    assert line.startswith(f"peridyn run: error: {tiny_disk / 'out' / 'results.h5'}: {os.strerror(28)} (")
