@@ -1,28 +1,39 @@
 """peridyn bench: force-kernel throughput (directed bond updates per second).
 
-Times one explicit-step force evaluation of the baseline PMB loop and of the PMB and
-LPS models (float64 and float32, through model.force) on a cube of about 100k
-points (1 mm spacing, horizon 3.015 spacings, no partial volumes unless
---partial-volumes), next to the machine's triad memory bandwidth. Best of
---repeat interleaved rounds after a warm-up. See peridyn.jobs.bench for what
-is counted.
+Without --case: times one explicit-step force evaluation of the baseline PMB loop and
+of the PMB and LPS models (float64 and float32, through model.force) on a cube of
+about 100k points (1 mm spacing, horizon 3.015 spacings, no partial volumes unless
+--partial-volumes), next to the machine's triad memory bandwidth. Best of --repeat
+interleaved rounds after a warm-up. See peridyn.jobs.bench for what is counted.
+
+With --case CASE.yaml (an explicit case, --set overrides applied): builds the case
+as `peridyn run` does and times --steps whole steps (force, breaking test, contact,
+boundary conditions, actuators, damping, integration, and the run's recorder and
+snapshots, written to a temporary folder deleted afterwards) against the force
+evaluation alone on the same bonds (best of --repeat): the whole-step and kernel
+rates, the step's share of the kernel rate and where the step time goes. See
+peridyn.jobs.bench_case.
 """
 
 from __future__ import annotations
 
 import sys
+from pathlib import Path
 
-from peridyn.cli.options import add_common_flags
+from peridyn.cli.options import add_common_flags, positive_int
+from peridyn.errors import InputError
 from peridyn.jobs.bench import DEFAULT_POINTS, format_table, run_benchmark
 
 
 def register(sub) -> None:
     """Add the ``bench`` subcommand."""
-    p = sub.add_parser("bench", help="measure force-kernel throughput", description=__doc__)
+    p = sub.add_parser(
+        "bench", help="measure force-kernel (or a case's whole-step) throughput", description=__doc__
+    )
     p.add_argument(
         "--points",
         type=int,
-        default=DEFAULT_POINTS,
+        default=None,
         metavar="N",
         help=f"approximate number of grid points, rounded to a cube (default {DEFAULT_POINTS} = 46^3)",
     )
@@ -31,12 +42,32 @@ def register(sub) -> None:
         type=int,
         default=10,
         metavar="N",
-        help="timed rounds after the warm-up; each row keeps its best (default 10)",
+        help="timed rounds (force evaluations with --case) after the warm-up; the best counts (default 10)",
     )
     p.add_argument(
         "--partial-volumes",
         action="store_true",
         help="build the bonds with partial volumes (default: full-volume bonds)",
+    )
+    p.add_argument(
+        "--case",
+        metavar="CASE.yaml",
+        help="time an explicit case's whole steps against its force kernel instead of the grid",
+    )
+    p.add_argument(
+        "--set",
+        dest="overrides",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="with --case: override a case entry, e.g. discretization.spacing=0.001 (repeatable)",
+    )
+    p.add_argument(
+        "--steps",
+        type=positive_int,
+        default=None,
+        metavar="N",
+        help="with --case: timed steps (default: the case's step count, at most 200)",
     )
     add_common_flags(p)
     p.set_defaults(func=run)
@@ -44,12 +75,36 @@ def register(sub) -> None:
 
 def run(args) -> dict:
     """Run the benchmark; print the table unless --json (progress goes to stderr)."""
+
+    def log(msg):
+        print(f"peridyn bench: {msg}", file=sys.stderr)
+
+    if args.case is not None:
+        return _run_case(args, log)
+    if args.steps is not None or args.overrides:
+        raise InputError("--steps and --set apply to a case: give --case CASE.yaml")
     result = run_benchmark(
-        points=args.points,
+        points=args.points if args.points is not None else DEFAULT_POINTS,
         repeat=args.repeat,
         partial_volumes=args.partial_volumes,
-        log=lambda msg: print(f"peridyn bench: {msg}", file=sys.stderr),
+        log=log,
     )
     if not args.json:
         print(format_table(result))
+    return result
+
+
+def _run_case(args, log) -> dict:
+    """``peridyn bench --case``: whole steps of the case against its force kernel."""
+    from peridyn.io.case import load_case
+    from peridyn.jobs.bench_case import format_case_result, run_case_benchmark
+
+    if args.points is not None or args.partial_volumes:
+        raise InputError("--points and --partial-volumes set the benchmark grid, not a --case run")
+    case = load_case(args.case, args.overrides)
+    result = run_case_benchmark(
+        case, Path(args.case).parent, args.case, steps=args.steps, repeat=args.repeat, log=log
+    )
+    if not args.json:
+        print(format_case_result(result))
     return result

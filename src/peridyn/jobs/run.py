@@ -136,7 +136,7 @@ def run_case(
         _check_parallel(case)
     setup = build(case, base_dir, comm)
     domain = setup.domain
-    solver = _time_stepper(case, setup) if stepping else None
+    solver = time_stepper(case, setup) if stepping else None
     out = output_directory(case, output_dir)
     if stepping:
         domain.on_root(check_output_fits, case, setup.whole_body, step_count(case, solver), solver.dt, out)
@@ -310,7 +310,7 @@ def _base_summary(setup: Setup) -> dict:
     }
 
 
-def _time_stepper(case, setup):
+def time_stepper(case, setup):
     """The solver of an explicit or newmark case (velocity Verlet or implicit Newmark)."""
     if case.solver.type == "newmark":
         return _newmark_solver(case, setup)
@@ -342,7 +342,7 @@ def _run_explicit(case, setup, solver, out, case_path, checkpoint_every, restart
     case_json, digest = case_identity(case)
     meta = {"case_hash": digest, "case": case_json, "dt": float(solver.dt), "version": package_version()}
     gathered = RootObservers(d, setup.model)
-    cracks = _crack_observer(case, setup, n_steps, gathered.damage)
+    cracks = crack_observer(case, setup, n_steps, gathered.damage)
     parts = {
         name: part
         for name, part in (("damage", setup.damage), ("contact", setup.contact), ("cracks", cracks))
@@ -475,7 +475,7 @@ def explicit_damping(case: Case, body: Body):
         raise CaseFileError(case.name, "absorbing", a.model_dump(), str(exc)) from None
 
 
-def _crack_observer(case, setup, n_steps, damage):
+def crack_observer(case, setup, n_steps, damage):
     """Crack length against time, sampled at the snapshots (or 100 times a run) of a case
     with damage (``damage``: the whole body's damage index, a callable); None without damage."""
     if setup.damage is None:
