@@ -29,12 +29,27 @@ class CaseFileError(InputError):
     has_value : bool
         False where no one value is at fault (a check across keys): the message leaves out
         ``= value``.
+
+    The message shows at most ``SHOWN_CHARACTERS`` of the value's repr (a 10 000-character
+    ``--set`` value is cut, with its length); ``value`` keeps it whole.
+
+    >>> error = CaseFileError("case.yaml", "name", "x" * 500, "a short name")
+    >>> str(error).endswith("x... (502 characters): a short name"), len(error.value)
+    (True, 500)
     """
+
+    #: Characters of the value's repr that the message shows.
+    SHOWN_CHARACTERS = 80
 
     def __init__(self, path: str, key: str, value, expected: str, *, has_value: bool = True):
         self.path, self.key, self.value, self.expected = path, key, value, expected
-        shown = f" = {value!r}" if has_value else ""
+        shown = f" = {_cut(repr(value), self.SHOWN_CHARACTERS)}" if has_value else ""
         super().__init__(f"{path}: {key}{shown}: {expected}")
+
+
+def _cut(text: str, limit: int) -> str:
+    """``text``, or its first ``limit`` characters and its length when it is longer."""
+    return text if len(text) <= limit else f"{text[:limit]}... ({len(text)} characters)"
 
 
 class InstabilityError(PeridynError, RuntimeError):
