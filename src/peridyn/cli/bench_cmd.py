@@ -20,7 +20,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from peridyn.cli.options import add_common_flags, positive_int
+from peridyn.cli.options import add_common_flags, add_set_flag, positive_int
 from peridyn.errors import InputError
 from peridyn.jobs.bench import DEFAULT_POINTS, format_table, run_benchmark
 
@@ -54,14 +54,7 @@ def register(sub) -> None:
         metavar="CASE.yaml",
         help="time an explicit case's whole steps against its force kernel instead of the grid",
     )
-    p.add_argument(
-        "--set",
-        dest="overrides",
-        action="append",
-        default=[],
-        metavar="KEY=VALUE",
-        help="with --case: override a case entry, e.g. discretization.spacing=0.001 (repeatable)",
-    )
+    add_set_flag(p, "with --case: override a case entry, e.g. discretization.spacing=0.001 (repeatable)")
     p.add_argument(
         "--steps",
         type=positive_int,

@@ -10,7 +10,7 @@ import numpy as np
 
 from peridyn.analysis.dispersion import MODELS, Medium, dispersion_relation, parse_direction
 from peridyn.cli.errors import writing
-from peridyn.cli.options import add_common_flags
+from peridyn.cli.options import add_common_flags, add_set_flag
 from peridyn.discretization.bonds import INFLUENCE_FUNCTIONS
 from peridyn.errors import InputError
 
@@ -37,13 +37,8 @@ def register(subparsers) -> None:
     parser.add_argument(
         "--frequencies", metavar="F1,F2,...", help="with a case: frequencies in Hz, e.g. 110e3,150e3,225e3"
     )
-    parser.add_argument(
-        "--set",
-        dest="overrides",
-        action="append",
-        default=[],
-        metavar="KEY=VALUE",
-        help="with a case: override a case entry, e.g. discretization.spacing=0.0004 (repeatable)",
+    add_set_flag(
+        parser, "with a case: override a case entry, e.g. discretization.spacing=0.0004 (repeatable)"
     )
     parser.add_argument("--model", help=f"material model: {' or '.join(MODELS)}")
     parser.add_argument("--rho", help="density, kg/m^3")

@@ -22,13 +22,13 @@ def add_common_flags(parser: argparse.ArgumentParser) -> None:
 def add_case_arguments(parser: argparse.ArgumentParser) -> None:
     """The case path and the repeatable ``--set key.path=value`` override."""
     parser.add_argument("case", help="YAML case file")
+    add_set_flag(parser, "override a case entry, e.g. discretization.spacing=0.001 (repeatable)")
+
+
+def add_set_flag(parser: argparse.ArgumentParser, text: str) -> None:
+    """The repeatable ``--set key.path=value`` override of case entries (``args.overrides``)."""
     parser.add_argument(
-        "--set",
-        dest="overrides",
-        action="append",
-        default=[],
-        metavar="KEY=VALUE",
-        help="override a case entry, e.g. discretization.spacing=0.001 (repeatable)",
+        "--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE", help=text
     )
 
 

@@ -7,6 +7,7 @@ from peridyn.cli.options import (
     add_common_flags,
     add_output_flag,
     add_progress_flags,
+    add_set_flag,
     positive_int,
 )
 from peridyn.cli.run_cmd import command_line
@@ -29,14 +30,7 @@ def register(sub) -> None:
         metavar="N",
         help="worker processes (processes, local dask cluster); each gets cores // N threads",
     )
-    p.add_argument(
-        "--set",
-        dest="overrides",
-        action="append",
-        default=[],
-        metavar="KEY=VALUE",
-        help="override a case entry of every run, e.g. discretization.spacing=0.002 (repeatable)",
-    )
+    add_set_flag(p, "override a case entry of every run, e.g. discretization.spacing=0.002 (repeatable)")
     p.add_argument("--first", type=positive_int, default=None, metavar="N", help="run only the first N runs")
     p.add_argument("--scheduler", default=None, metavar="ADDRESS", help="address of a running dask scheduler")
     add_output_flag(p, "output folder (default: peridyn-out/<sweep name>); a second run resumes it")

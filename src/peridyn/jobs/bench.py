@@ -81,12 +81,17 @@ def triad_bandwidth(elements: int = DEFAULT_TRIAD_ELEMENTS, repeat: int = 10) ->
     c = np.full(elements, 2.0)
     a = np.zeros(elements)
     triad(a, b, c, 3.0)  # compile (or load) and touch the pages
+    return 3 * a.itemsize * elements / best_seconds(lambda: triad(a, b, c, 3.0), repeat)
+
+
+def best_seconds(call: Callable[[], object], repeat: int) -> float:
+    """The shortest of ``max(1, repeat)`` timed calls of ``call``, s (warm it up first)."""
     best = np.inf
     for _ in range(max(1, repeat)):
         t0 = time.perf_counter()
-        triad(a, b, c, 3.0)
+        call()
         best = min(best, time.perf_counter() - t0)
-    return 3 * a.itemsize * elements / best
+    return best
 
 
 def side_for(points: int) -> int:

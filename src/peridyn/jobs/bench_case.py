@@ -42,6 +42,7 @@ from peridyn.io.case import Case
 from peridyn.io.hdf5 import n_records
 from peridyn.io.provenance import provenance
 from peridyn.io.recorder import Recorder
+from peridyn.jobs.bench import best_seconds
 from peridyn.jobs.build import build
 from peridyn.jobs.run import (
     RESULTS,
@@ -227,12 +228,7 @@ def _best_force(model, u: np.ndarray, repeat: int) -> float:
     ``u`` (n_points, 3), m) after one warm-up call."""
     out = np.empty_like(u, dtype=model.dtype)
     model.force(u, out=out)
-    best = np.inf
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        model.force(u, out=out)
-        best = min(best, time.perf_counter() - t0)
-    return best
+    return best_seconds(lambda: model.force(u, out=out), repeat)
 
 
 def _record_counts(path: Path) -> dict[str, int]:
