@@ -5,9 +5,9 @@ whole folder also runs in a minute or two with the JIT off
 (``NUMBA_DISABLE_JIT=1 PYTHONPATH=src python -m pytest -m kernels -q -p no:cacheprovider``),
 where the kernels run as plain Python.
 
-Tolerances. A kernel and its reference evaluate the same sums in different orders (the
-force kernels are compiled with reassociation, the references sum with ``np.add.at``) and
-with different roundings. Each term of a sum then carries a few roundings, so the
+Tolerances. A kernel and its reference evaluate the same sums in different orders and
+with different roundings (the force kernels fuse multiply-adds, the references sum with
+``np.add.at``). Each term of a sum then carries a few roundings, so the
 difference is bounded by a small multiple of the unit roundoff times the sum of the terms'
 magnitudes (the ``scale`` of :func:`assert_close`), with at most ~100 terms per sum here:
 

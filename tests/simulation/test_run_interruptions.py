@@ -4,9 +4,8 @@ the restarted results equal an uninterrupted run's bit for bit (issue 17, items 
 Each run is ``peridyn run`` in a fresh Python process whose ``ExplicitSolver.step`` (or
 ``Recorder.observe``) sends a signal to its own process at a chosen step: SIGKILL ends it
 at once (no handler, no flush, as a crash or the OOM killer would), SIGINT and SIGTERM reach
-the run's handlers as Ctrl-C or ``kill`` would. Every run of a comparison is made with the
-numba cache warm (a first fixture runs each case for two steps), since a kernel's first,
-uncached compilation may round differently.
+the run's handlers as Ctrl-C or ``kill`` would. A first fixture runs each case for two steps
+(one check reads its broken bonds), which also fills numba's cache for the runs that follow.
 """
 
 from __future__ import annotations

@@ -44,9 +44,15 @@ Two forms of the stretch are used:
 
 import numba
 
-#: Fast-math flags used by the force kernels: reassociation lets LLVM vectorise
-#: the per-point sums; NaN/inf semantics are kept so blow-ups are still detected.
-FASTMATH = {"reassoc", "contract", "nsz", "arcp"}
+#: Fast-math flags used by the force kernels: fused multiply-adds, no signed zeros, reciprocal
+#: divisions; NaN/inf semantics are kept so blow-ups are still detected. Not "reassoc": with it
+#: a parallel kernel's sums rounded differently when numba compiled it afresh and when it loaded
+#: it from its on-disk cache (the parallel loop's body is optimised once more when cached), so a
+#: run in a process that compiled the kernels differed in the last bits from one in a process
+#: that loaded them (a sweep's serial and process-pool datasets, a run and its restart). The
+#: per-point sums keep their written order; the force throughput is unchanged (``peridyn bench``,
+#: 50k points: within 1%).
+FASTMATH = {"contract", "nsz", "arcp"}
 
 
 def exact_helper(signature: str):
