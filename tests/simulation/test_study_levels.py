@@ -88,7 +88,8 @@ def test_the_levels_are_the_runs_of_a_sweep(serial):
     assert all(len(f["x"]) == 3 for f in summary["fits"] if f["mode"] == "1st bending")
 
 
-def test_the_process_pool_gives_the_serial_results(serial, tmp_path):
+@pytest.mark.slow  # about 20 s: a serial study in its own process and a pool of two spawned workers
+def test_the_process_pool_gives_the_serial_results(tmp_path):
     """Each pool worker of two runs with cores // 2 numba and BLAS threads; the serial study is run
     with as many (the BLAS thread count changes the last bits of the eigensolver's frequencies),
     in its own process; the two summaries must then agree bit for bit."""

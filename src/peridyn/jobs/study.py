@@ -28,7 +28,7 @@ import numpy as np
 
 from peridyn.analysis.convergence import ConvergenceError, richardson
 from peridyn.errors import CaseFileError, InputError
-from peridyn.io.case import parse_yaml
+from peridyn.io.case import load_case, parse_yaml
 from peridyn.io.results import Results
 from peridyn.jobs.run import RESULTS
 from peridyn.jobs.summary import finish_summary
@@ -206,8 +206,6 @@ def run_levels(
         command=command,
         on_record=None if progress is None else report,
     )
-    from peridyn.io.case import load_case
-
     case = load_case(case_path, overrides)
     return runs_from_dataset(load_sweep(summary["dataset"]), out, case), summary
 
