@@ -76,6 +76,14 @@ def add_executor_flags(parser: argparse.ArgumentParser, what: str = "runs") -> N
     )
 
 
+def add_rerun_flag(parser: argparse.ArgumentParser, what: str = "runs") -> None:
+    """``--overwrite`` of a command that resumes its folder (sweep, study): run again the
+    ``what`` already complete there."""
+    parser.add_argument(
+        "--overwrite", action="store_true", help=f"run again the {what} already complete (default: skip them)"
+    )
+
+
 class DeprecatedAlias(argparse.Action):
     """An old spelling of an option, hidden from the help: stores like the new one and warns."""
 

@@ -22,6 +22,7 @@ from peridyn.cli.options import (
     add_executor_flags,
     add_max_memory,
     add_output_flag,
+    add_rerun_flag,
 )
 from peridyn.errors import InputError
 
@@ -71,9 +72,7 @@ def register(sub) -> None:
     add_executor_flags(p, "levels")
     add_output_flag(p, "output folder (default: peridyn-out/<case name>-study); a second study resumes it")
     p.add_argument("--out", dest="output", action=DeprecatedAlias, new="--output")
-    p.add_argument(
-        "--overwrite", action="store_true", help="run again the levels already complete (default: skip them)"
-    )
+    add_rerun_flag(p, "levels")
     p.add_argument(
         "--plot",
         metavar="FILE",

@@ -8,6 +8,7 @@ from peridyn.cli.options import (
     add_executor_flags,
     add_output_flag,
     add_progress_flags,
+    add_rerun_flag,
     add_set_flag,
     positive_int,
 )
@@ -22,9 +23,7 @@ def register(sub) -> None:
     add_set_flag(p, "override a case entry of every run, e.g. discretization.spacing=0.002 (repeatable)")
     p.add_argument("--first", type=positive_int, default=None, metavar="N", help="run only the first N runs")
     add_output_flag(p, "output folder (default: peridyn-out/<sweep name>); a second run resumes it")
-    p.add_argument(
-        "--overwrite", action="store_true", help="run again the runs already complete (default: skip them)"
-    )
+    add_rerun_flag(p)
     add_progress_flags(p)
     add_common_flags(p)
     p.set_defaults(func=run)
