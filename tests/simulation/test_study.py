@@ -150,19 +150,6 @@ def test_torsional_modes_turn_and_get_no_fit(study):
         assert "value_hz" not in fit and "oscillating" in fit["error"], fit
 
 
-def test_runs_that_would_not_fit_in_memory_are_skipped_and_reported(tmp_path, monkeypatch, capsys):
-    import peridyn.jobs.modal
-
-    monkeypatch.setattr(peridyn.jobs.modal, "MEMORY_SHARE", 1e-12)  # nothing fits
-    status = main(["study", CASE, "--spacing", "4e-3", "--horizon", "1.4143,2.001", "-o", str(tmp_path)])
-    captured = capsys.readouterr()
-    assert status == 0
-    assert "skipped spacing 4 mm, horizon 1.4143 h: the sparse factorisation" in captured.out
-    assert "[2/2] spacing 4 mm, horizon 2.001 h" in captured.err
-    summary = json.loads((tmp_path / "study.json").read_text())
-    assert summary["skipped_runs"] == 2 and summary["fits"] == []
-
-
 def test_a_spacing_that_does_not_divide_the_box_is_noted(tmp_path, capsys):
     # V4 plate at 3 mm: 33 x 17 x 3 cells span 99 x 51 x 9 mm, another body
     status = main(
@@ -189,7 +176,7 @@ def test_bad_arguments_are_named(args, message, capsys):
 
 
 @pytest.mark.slow
-def test_delta_m_limits_of_two_horizons_agree_for_first_bending():
+def test_delta_m_limits_of_two_horizons_agree_for_first_bending(tmp_path):
     # Seed 002 section 6.1: in a delta-m study f_0 "should be the same regardless of delta".
     # The docs' study (docs/user-guide.md, two minutes and 2 GB): fitted on the three finest
     # grids, 1st bending extrapolates to 1940.2 Hz at 1.4143 h and 1933.1 Hz at 3.001 h
@@ -198,9 +185,9 @@ def test_delta_m_limits_of_two_horizons_agree_for_first_bending():
     # Plain LPS, as the docs' study: with the case's default energy correction the 1.6, 2 and
     # 2.67 mm runs at 3.001 h give 1691.3, 1628.7, 1564.8 Hz, differences that do not shrink
     # with h (63.9 then 62.6 Hz for steps of 0.67 then 0.4 mm): "diverging", no limit.
-    from peridyn.jobs.study import fit_series, run_grid
+    from peridyn.jobs.study import fit_series, run_levels
 
-    runs = run_grid(CASE, SPACINGS, (1.4143, 3.001), overrides=[SIZE, PLAIN])
+    runs, _ = run_levels(CASE, SPACINGS, (1.4143, 3.001), tmp_path, overrides=[SIZE, PLAIN])
     fits = {f["group"]: f for f in fit_series(runs, finest=3) if f["mode"] == "1st bending"}
     for fit in fits.values():
         assert "value_hz" in fit, (fit["group"], fit["error"])

@@ -50,6 +50,40 @@ def add_progress_flags(parser: argparse.ArgumentParser) -> None:
     group.add_argument("--no-progress", dest="progress", action="store_false", help="no progress bar")
 
 
+def add_executor_flags(parser: argparse.ArgumentParser, what: str = "runs") -> None:
+    """``--executor``, ``--workers`` and ``--scheduler``: where the runs of a sweep run
+    (``peridyn.jobs.sweep_run``); ``what`` names them in the help."""
+    from peridyn.jobs.sweep_run import EXECUTORS
+
+    parser.add_argument(
+        "--executor",
+        choices=EXECUTORS,
+        default="serial",
+        help=f"where the {what} run: this process, a pool of processes, or dask (default: serial)",
+    )
+    parser.add_argument(
+        "--workers",
+        type=positive_int,
+        default=1,
+        metavar="N",
+        help="worker processes (processes, local dask cluster); each gets cores // N threads",
+    )
+    parser.add_argument(
+        "--scheduler",
+        default=None,
+        metavar="ADDRESS",
+        help="address of a running dask scheduler (with --executor dask)",
+    )
+
+
+def add_rerun_flag(parser: argparse.ArgumentParser, what: str = "runs") -> None:
+    """``--overwrite`` of a command that resumes its folder (sweep, study): run again the
+    ``what`` already complete there."""
+    parser.add_argument(
+        "--overwrite", action="store_true", help=f"run again the {what} already complete (default: skip them)"
+    )
+
+
 class DeprecatedAlias(argparse.Action):
     """An old spelling of an option, hidden from the help: stores like the new one and warns."""
 

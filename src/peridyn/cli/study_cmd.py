@@ -1,7 +1,9 @@
 """peridyn study CASE.yaml: spacing x horizon convergence study of a modal case.
 
-Every (spacing, horizon) combination is solved as a modal run; modes are matched by type
-across runs and each series is extrapolated to zero spacing by Richardson extrapolation
+Every (spacing, horizon) combination is a level, solved as a modal run of a sweep (each in
+OUT/runs/<id>/, collected in OUT/dataset.nc; --executor runs them in parallel, and a second
+study into the same folder skips the levels already complete); modes are matched by type
+across levels and each series is extrapolated to zero spacing by Richardson extrapolation
 (observed order p, continuum value f_inf, grid convergence index).
 """
 
@@ -17,11 +19,15 @@ from peridyn.cli.options import (
     DeprecatedAlias,
     add_case_arguments,
     add_common_flags,
+    add_executor_flags,
     add_max_memory,
     add_output_flag,
-    add_overwrite_flag,
+    add_rerun_flag,
 )
 from peridyn.errors import InputError
+
+#: The sweep's summary keys the study's summary keeps (under ``sweep``).
+SWEEP_KEYS = ("runs", "completed", "failed", "skipped", "dataset", "executor", "workers")
 
 
 def register(sub) -> None:
@@ -63,9 +69,10 @@ def register(sub) -> None:
         help="a reference frequency, e.g. '1st bending=1706.1' (repeatable): "
         "errors of the finest run and of the extrapolation against it",
     )
-    add_output_flag(p, "output folder (default: peridyn-out/<case name>-study)")
+    add_executor_flags(p, "levels")
+    add_output_flag(p, "output folder (default: peridyn-out/<case name>-study); a second study resumes it")
     p.add_argument("--out", dest="output", action=DeprecatedAlias, new="--output")
-    add_overwrite_flag(p)
+    add_rerun_flag(p, "levels")
     p.add_argument(
         "--plot",
         metavar="FILE",
@@ -79,7 +86,7 @@ def register(sub) -> None:
 def run(args) -> dict:
     """Run the grid, fit, write the tables and the figure; print the table unless --json."""
     from peridyn.io.case import load_case
-    from peridyn.io.outdir import json_job_status, prepare_output
+    from peridyn.io.outdir import json_job_status
     from peridyn.jobs.estimate import check_memory, largest_study_run
     from peridyn.jobs.study import SERIES
 
@@ -97,26 +104,43 @@ def run(args) -> dict:
         raise InputError(f"--finest = {args.finest}: a Richardson fit needs at least three runs")
     case = load_case(args.case, args.overrides)  # fail early on a bad case or override
     check_memory(largest_study_run(case, spacings, factors), args.max_memory, Path(args.case).parent)
-    out = prepare_output(
-        args.output or Path("peridyn-out") / f"{case.name}-study", "study.json", args.overwrite
-    )
+    out = Path(args.output or Path("peridyn-out") / f"{case.name}-study")
+    if out.exists() and not out.is_dir():
+        raise InputError(f"output folder {str(out)!r} is a file, not a folder: choose another --output")
+    out.mkdir(parents=True, exist_ok=True)
     with json_job_status(out):
         return _study(args, case, out, spacings, factors, series, references, start)
 
 
 def _study(args, case, out, spacings, factors, series, references, start) -> dict:
     """The grid, fits, tables and figure of ``run`` in its checked output folder."""
-    from peridyn.jobs.study import fit_series, run_grid, write_study
+    from peridyn.cli.run_cmd import command_line
+    from peridyn.jobs.study import check_enough_levels, fit_series, run_levels, write_study
     from peridyn.plotting.convergence import plot_convergence
 
-    runs = run_grid(
+    def say(line: str) -> None:
+        print(line, file=sys.stderr, flush=True)
+
+    runs, sweep = run_levels(
         args.case,
         spacings,
         factors,
+        out,
         args.modes,
         args.overrides,
-        progress=lambda line: print(line, file=sys.stderr, flush=True),
+        executor=args.executor,
+        workers=args.workers,
+        scheduler=args.scheduler,
+        overwrite=args.overwrite,
+        progress=say,
+        command=command_line(),
     )
+    if sweep["skipped"]:
+        say(f"{sweep['skipped']} of {sweep['runs']} levels already complete in {out}: not run again")
+    for r in runs:
+        for note in r.notes:
+            say(f"note: spacing {r.spacing * 1e3:g} mm, horizon {r.horizon_factor:g} h: {note}")
+    check_enough_levels(runs, series)
     fits = fit_series(runs, series, references, args.finest)
     meta = {
         "case": case.name,
@@ -124,6 +148,7 @@ def _study(args, case, out, spacings, factors, series, references, start) -> dic
         "horizon_factors": factors,
         "series": series,
         "finest": args.finest,
+        "sweep": {k: sweep[k] for k in SWEEP_KEYS},
     }
     out.mkdir(parents=True, exist_ok=True)
     plots = [out / "study.png", *([Path(args.plot)] if args.plot else [])]
@@ -144,8 +169,11 @@ def format_table(summary: dict) -> str:
     skipped = [r for r in summary["runs"] if r["skipped"]]
     for r in skipped:
         lines.append(
-            f"skipped spacing {r['spacing_m'] * 1e3:g} mm, horizon {r['horizon_factor']:g} h: {r['skipped']}"
+            f"level spacing {r['spacing_m'] * 1e3:g} mm, horizon {r['horizon_factor']:g} h left out: "
+            f"{r['skipped']}"
         )
+    if skipped:
+        lines.append(f"the fits use the other {len(summary['runs']) - len(skipped)} levels")
     previous = None
     for fit in summary["fits"]:
         if (fit["series"], fit["group"]) != previous:
@@ -174,7 +202,10 @@ def format_table(summary: dict) -> str:
         lines.append(line)
         if "value_hz" not in fit:
             lines.append(f"    {fit['error']}")  # why there is no limit, with the numbers
-    lines.append(f"\nresults written to {summary['output_dir']} (study.csv, runs.csv, study.json, study.png)")
+    lines.append(
+        f"\nresults written to {summary['output_dir']} (study.csv, runs.csv, study.json, study.png; "
+        "the levels in runs/, their dataset dataset.nc)"
+    )
     return "\n".join(lines)
 
 

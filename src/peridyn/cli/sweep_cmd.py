@@ -5,8 +5,10 @@ from __future__ import annotations
 from peridyn.cli.logs import progress_bar
 from peridyn.cli.options import (
     add_common_flags,
+    add_executor_flags,
     add_output_flag,
     add_progress_flags,
+    add_rerun_flag,
     add_set_flag,
     positive_int,
 )
@@ -17,26 +19,11 @@ def register(sub) -> None:
     """Add the ``sweep`` subcommand."""
     p = sub.add_parser("sweep", help="run a parameter sweep and collect its dataset", description=__doc__)
     p.add_argument("sweep", help="YAML sweep file")
-    p.add_argument(
-        "--executor",
-        choices=("serial", "processes", "dask"),
-        default="serial",
-        help="where the runs run: this process, a pool of processes, or dask (default: serial)",
-    )
-    p.add_argument(
-        "--workers",
-        type=positive_int,
-        default=1,
-        metavar="N",
-        help="worker processes (processes, local dask cluster); each gets cores // N threads",
-    )
+    add_executor_flags(p)
     add_set_flag(p, "override a case entry of every run, e.g. discretization.spacing=0.002 (repeatable)")
     p.add_argument("--first", type=positive_int, default=None, metavar="N", help="run only the first N runs")
-    p.add_argument("--scheduler", default=None, metavar="ADDRESS", help="address of a running dask scheduler")
     add_output_flag(p, "output folder (default: peridyn-out/<sweep name>); a second run resumes it")
-    p.add_argument(
-        "--overwrite", action="store_true", help="run again the runs already complete (default: skip them)"
-    )
+    add_rerun_flag(p)
     add_progress_flags(p)
     add_common_flags(p)
     p.set_defaults(func=run)

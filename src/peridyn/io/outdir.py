@@ -1,7 +1,7 @@
 """A job's output folder: checked before anything is written to it, and the job's status.
 
 An earlier job's results are never replaced unless asked: ``prepare_output`` refuses a folder
-that holds one (its ``results.h5``, or the JSON summary of a fatigue or study job) unless the
+that holds one (its ``results.h5``, or the JSON summary of a fatigue job) unless the
 caller passes ``overwrite`` (start again) or ``restart`` (continue from its checkpoint).
 
 A job's status is one of ``running``, ``complete``, ``failed: <reason>``, ``interrupted at

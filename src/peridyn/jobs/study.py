@@ -1,7 +1,10 @@
 """A convergence study: modal runs of one case over a spacing x horizon grid, Richardson fits.
 
-Each run is the case with ``discretization.spacing`` and ``discretization.horizon`` (a
-multiple of the spacing) overridden, solved by :func:`peridyn.jobs.modal.modal_table`.
+Each run (a level) is the case with ``discretization.spacing`` and ``discretization.horizon``
+(a multiple of the spacing) overridden, solved as a ``modal`` run of a sweep
+(:func:`run_levels`: :mod:`peridyn.jobs.sweep`, so the levels run on any of its executors,
+each in its own folder, and a second study into the same folder skips the levels already
+complete); the analysis reads the sweep's dataset (:func:`runs_from_dataset`).
 Modes are matched across runs by type and order ("1st bending", ...; rigid and
 unclassified modes are left out) and each series of runs is extrapolated with
 :func:`peridyn.analysis.convergence.richardson`. The series (seed 002, section 6.1,
@@ -18,15 +21,16 @@ from __future__ import annotations
 
 import csv
 import json
-import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from peridyn import interrupts
 from peridyn.analysis.convergence import ConvergenceError, richardson
-from peridyn.errors import InputError
+from peridyn.errors import CaseFileError, InputError
+from peridyn.io.case import load_case, parse_yaml
+from peridyn.io.results import Results
+from peridyn.jobs.run import RESULTS
 from peridyn.jobs.summary import finish_summary
 
 #: The kinds of series a study can fit, see the module docstring.
@@ -35,15 +39,22 @@ SERIES = ("delta-m", "delta", "m")
 UNMATCHED_TYPES = ("rigid", "other")
 #: Horizons (m) equal to this relative tolerance form one ``m`` series.
 SAME_HORIZON = 1e-6
+#: The study's sweep file in its folder (``peridyn sweep`` runs it too).
+SWEEP_FILE = "study-sweep.yaml"
+#: The sweep parameters of a level: its spacing (m) and horizon (a multiple of the spacing).
+SPACING, HORIZON = "discretization.spacing", "discretization.horizon"
+#: Prefix of a mode's frequency (Hz) in a modal sweep's dataset (``jobs.sweep.flatten_summary``).
+FREQUENCY = "frequency_hz"
 
 
 @dataclass
 class StudyRun:
-    """One modal run of the grid.
+    """One level of the study: a modal run of the grid.
 
     ``modes`` maps a mode label ("1st bending") to its frequency in Hz (the lowest if the
-    label occurs twice); ``bonds`` counts directed bonds; ``seconds`` is the run's time (build
-    and solve); ``skipped`` holds the reason when the run was not solved.
+    label occurs twice); ``bonds`` counts directed bonds; ``seconds`` is the level's run time
+    (build, solve and its files); ``skipped`` holds the level's status (``failed: <reason>``)
+    when it did not complete, and it is left out of the fits.
     """
 
     spacing: float
@@ -74,11 +85,64 @@ class StudyRun:
         }
 
 
-@interrupts.deferred()
-def run_grid(
-    case_path, spacings, horizon_factors, n_modes: int | None = None, overrides=(), progress=None
-) -> list[StudyRun]:
-    """Solve the modal problem of every (spacing, horizon factor) combination.
+def study_sweep(case_path, spacings, horizon_factors, n_modes: int | None = None, overrides=()) -> dict:
+    """The sweep file (as a dict) whose runs are the study's levels.
+
+    A ``modal`` sweep of the case over the product of ``discretization.horizon`` (outer) and
+    ``discretization.spacing`` (inner), with ``set``: ``output.plots`` false (the study draws
+    its own figure; an override may turn the modes' figures back on), then ``overrides``
+    ("key=value", values read as YAML, as ``--set`` reads them), then ``solver.modes`` (when
+    ``n_modes`` is given) and ``discretization.horizon_m`` null, so that the horizon is the
+    multiple of the spacing.
+    """
+    settings: dict = {"output.plots": False}
+    for item in overrides:
+        key, sep, text = item.partition("=")
+        if not sep:
+            raise CaseFileError(str(case_path), item, None, "an override of the form key.path=value")
+        settings.pop(key.strip(), None)  # the last one given wins, as it does for --set
+        settings[key.strip()] = parse_yaml(text)
+    if n_modes is not None:
+        settings.pop("solver.modes", None)
+        settings["solver.modes"] = n_modes
+    settings.pop("discretization.horizon_m", None)
+    settings["discretization.horizon_m"] = None
+    return {
+        "name": f"{Path(case_path).stem}-study",
+        "description": "the levels of a peridyn study (spacing x horizon)",
+        "base": str(Path(case_path).resolve()),
+        "command": "modal",
+        "set": settings,
+        "vary": {
+            "product": {
+                HORIZON: [float(m) for m in horizon_factors],
+                SPACING: [float(h) for h in spacings],
+            }
+        },
+        "outputs": {"figures": False},
+    }
+
+
+def run_levels(
+    case_path,
+    spacings,
+    horizon_factors,
+    out,
+    n_modes: int | None = None,
+    overrides=(),
+    executor: str = "serial",
+    workers: int = 1,
+    scheduler: str | None = None,
+    overwrite: bool = False,
+    progress=None,
+    command: str | None = None,
+) -> tuple[list[StudyRun], dict]:
+    """Solve the modal problem of every (spacing, horizon factor) level as a sweep.
+
+    The sweep file :func:`study_sweep` is written to ``out/`` :data:`SWEEP_FILE` and run by
+    :func:`peridyn.jobs.sweep.run_sweep` into ``out`` (each level in ``out/runs/<id>/``, the
+    dataset ``out/dataset.nc``); a level already complete there for the same case is not run
+    again unless ``overwrite``. A level that fails is recorded and the others go on.
 
     Parameters
     ----------
@@ -87,74 +151,121 @@ def run_grid(
     spacings : sequence of float, m
     horizon_factors : sequence of float
         Horizons as multiples of the spacing.
+    out : path
+        The study's folder.
     n_modes : int or None
         Modes per run (rigid included); None keeps the case's ``solver.modes``.
     overrides : sequence of "key=value"
         Applied to every run before the spacing and horizon.
+    executor, workers, scheduler, overwrite, command
+        As for :func:`peridyn.jobs.sweep.run_sweep`.
     progress : callable(str) or None
-        Receives one line per run.
+        Receives one line per level as it ends.
 
-    Runs whose factorisation would not fit in memory
-    (:func:`peridyn.jobs.modal.check_assembly_fits`) are skipped with the reason.
+    Returns
+    -------
+    (runs, sweep summary)
+        The levels in sweep order (:func:`runs_from_dataset`) and ``run_sweep``'s summary.
+
+    Raises
+    ------
+    peridyn.jobs.sweep.SweepInterrupted
+        Ctrl-C: the levels finished so far are kept; the same command runs the others.
     """
-    from peridyn.io.case import load_case
-    from peridyn.jobs.build import build
-    from peridyn.jobs.modal import check_assembly_fits, modal_table
+    from peridyn.io.dataset import load_sweep
+    from peridyn.jobs.sweep import run_sweep
 
-    combos = [(h, m) for m in horizon_factors for h in spacings]
-    runs = []
-    for k, (h, m) in enumerate(combos, 1):
-        interrupts.check(where=f"running the study (run {k} of {len(combos)})")
-        run = StudyRun(float(h), float(m))
-        start = time.perf_counter()
-        case = load_case(
-            case_path,
-            [
-                *overrides,
-                "solver.type=modal",
-                *([f"solver.modes={n_modes}"] if n_modes is not None else []),
-                f"discretization.spacing={h!r}",
-                f"discretization.horizon={m!r}",
-                "discretization.horizon_m=null",
-            ],
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    spec = study_sweep(case_path, spacings, horizon_factors, n_modes, overrides)
+    path = out / SWEEP_FILE
+    try:
+        path.write_text(json.dumps(spec, indent=1) + "\n")  # JSON is YAML: floats read back bit for bit
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"--set: a value the study cannot write to its sweep file ({exc})") from None
+    total = len(spacings) * len(horizon_factors)
+    ended = []
+
+    def report(record: dict) -> None:
+        ended.append(record)
+        params = record["parameters"]
+        summary = record.get("summary") or {}
+        points = f"{summary['points']} points, " if "points" in summary else ""
+        progress(
+            f"[{len(ended)}/{total}] spacing {params[SPACING] * 1e3:g} mm, horizon {params[HORIZON]:g} h: "
+            f"{points}{record['seconds']:.1f} s, {record['status']}"
         )
-        setup = build(case, Path(case_path).parent)
-        run.points = setup.body.n_points
-        run.bonds = setup.bonds.n_bonds
-        run.notes += _geometry_notes(case, setup.body)
-        try:
-            check_assembly_fits(setup.model)
-        except InputError as exc:
-            run.skipped = str(exc)
-        if run.skipped is None:
-            fixed = setup.loading.constrained if setup.loading.has_loads else None
-            _, _, rows = modal_table(setup.model, case.solver.modes, fixed=fixed)
-            for row in rows:
-                label = row["label"]
-                if row["type"] in UNMATCHED_TYPES:
-                    continue
-                if label in run.modes:
-                    run.notes.append(f"two modes classified {label}: kept the lower one")
-                    continue
-                run.modes[label] = row["frequency_hz"]
-        run.seconds = time.perf_counter() - start
+
+    summary = run_sweep(
+        path,
+        out,
+        executor=executor,
+        workers=workers,
+        scheduler=scheduler,
+        overwrite=overwrite,
+        command=command,
+        on_record=None if progress is None else report,
+    )
+    case = load_case(case_path, overrides)
+    return runs_from_dataset(load_sweep(summary["dataset"]), out, case), summary
+
+
+def runs_from_dataset(ds, out, case) -> list[StudyRun]:
+    """The study's levels from its sweep's dataset (:mod:`peridyn.io.dataset`), in its order.
+
+    A complete level's ``modes`` are the dataset's ``frequency_hz.<type>.<order>`` (rigid and
+    unclassified modes left out; a second mode of one type and order, ``...<index>``, is noted
+    and left out: the first is the lower); ``points`` and ``bonds`` are its own, ``seconds``
+    its run's time. A level that did not complete gets its status as ``skipped``.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        The dataset of :func:`run_levels`'s sweep (dimension ``run``).
+    out : path
+        The study's folder (the levels' ``runs/<id>/results.h5`` give the grid notes).
+    case : Case
+        The study's case with its overrides (geometry of the grid notes).
+    """
+    from peridyn.jobs.modal import mode_label
+
+    names = [n for n in ds.data_vars if n.startswith(FREQUENCY + ".") and ds[n].dims == ("run",)]
+    runs = []
+    for i in range(ds.sizes["run"]):
+        run = StudyRun(float(ds[SPACING].values[i]), float(ds[HORIZON].values[i]))
+        run.seconds = float(ds["seconds"].values[i])
+        status = str(ds["status"].values[i])
+        if status != "complete":
+            run.skipped = status
+            runs.append(run)
+            continue
+        run.points = int(ds["points"].values[i])
+        run.bonds = int(ds["bonds"].values[i])
+        points = Results(Path(out) / "runs" / str(ds["run_id"].values[i]) / RESULTS).array("geometry/points")
+        run.notes += _geometry_notes(case, points, run.spacing)
+        found = []
+        for name in names:
+            value = float(ds[name].values[i])
+            _, kind, order, *second = name.split(".")
+            if np.isnan(value) or kind in UNMATCHED_TYPES:
+                continue
+            found.append((value, mode_label({"type": kind, "order": int(order)}), bool(second)))
+        for value, label, second in sorted(found):
+            if second:
+                run.notes.append(f"two modes classified {label}: kept the lower one")
+            else:
+                run.modes[label] = value
         runs.append(run)
-        if progress is not None:
-            state = f"skipped: {run.skipped}" if run.skipped else f"{len(run.modes)} modes matched"
-            progress(
-                f"[{k}/{len(combos)}] spacing {h * 1e3:g} mm, horizon {m:g} h: {run.points} "
-                f"points, {run.seconds:.1f} s, {state}"
-            )
-            for note in run.notes:
-                progress(f"      note: {note}")
     return runs
 
 
-def _geometry_notes(case, body) -> list[str]:
-    """Warn when a box's sides are not whole multiples of the spacing (the grid rounds them)."""
+def _geometry_notes(case, points, spacing: float) -> list[str]:
+    """Warn when a box's sides are not whole multiples of the spacing (the grid rounds them).
+
+    ``points`` (n_points, 3) m: the level's grid; ``spacing`` m: its cell side."""
     if case.geometry.type != "box":
         return []
-    grid = np.ptp(body.points, axis=0) + body.cells[0]
+    grid = np.ptp(points, axis=0) + np.full(3, spacing)
     size = np.asarray(case.geometry.size, dtype=float)
     if np.allclose(grid, size, rtol=1e-6, atol=0.0):
         return []
@@ -228,6 +339,31 @@ def fit_series(
                     row["value_error"] = row["value_hz"] / ref - 1 if "value_hz" in row else None
                 fits.append(row)
     return fits
+
+
+def check_enough_levels(runs: list[StudyRun], series=("delta-m",)) -> None:
+    """Refuse a study whose failed levels leave no series group with the three solved levels a
+    Richardson fit needs (a study that asked for fewer levels is fitted as asked, each fit
+    saying why it has no limit).
+
+    Raises
+    ------
+    InputError
+        Naming the failed levels and why each failed.
+    """
+    failed = [r for r in runs if r.skipped is not None]
+    solved = [r for r in runs if r.skipped is None]
+    wanted = max((len(members) for kind in series for _, members, _ in _groups(runs, kind)), default=0)
+    fittable = max((len(members) for kind in series for _, members, _ in _groups(solved, kind)), default=0)
+    if failed and wanted >= 3 > fittable:
+        reasons = "; ".join(
+            f"spacing {r.spacing * 1e3:g} mm, horizon {r.horizon_factor:g} h: {r.skipped}" for r in failed
+        )
+        raise InputError(
+            f"{len(failed)} of {len(runs)} levels did not complete, leaving no series with the three "
+            f"levels a Richardson fit needs ({reasons}); the completed levels are kept: run the study "
+            "again to retry the others"
+        )
 
 
 def _labels_in_order(runs: list[StudyRun]) -> list[str]:

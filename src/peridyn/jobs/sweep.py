@@ -71,6 +71,7 @@ def run_sweep(
     command: str | None = None,
     overrides=(),
     first: int | None = None,
+    on_record=None,
 ) -> dict:
     """Run the sweep file ``path``; returns its summary.
 
@@ -95,6 +96,9 @@ def run_sweep(
         ``--set`` items for every run (after the sweep file's ``set``).
     first : int or None
         Run only the first ``first`` runs of the sweep (a trial).
+    on_record : callable(record) or None
+        Called in this process with each run's record as the run ends
+        (:mod:`peridyn.jobs.sweep_run`), in the order the runs end.
 
     Returns
     -------
@@ -155,6 +159,8 @@ def run_sweep(
         nonlocal interrupted
         with signals.deferred():
             collector.add(record)
+            if on_record is not None:
+                on_record(record)
             if bar is not None:
                 bar.update(1)
             if record["status"].startswith("interrupted"):
