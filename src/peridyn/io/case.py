@@ -16,6 +16,7 @@ import yaml
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, ValidationError, model_validator
 
 from peridyn.errors import CaseFileError, InputError, did_you_mean
+from peridyn.io.exodus_write import PERIDIGM_VARIABLES
 from peridyn.physics.loads import parse_components
 
 #: Deepest nesting of collections a YAML text may have (a case nests 5 levels; PyYAML composes
@@ -277,9 +278,9 @@ class Material(Strict):
 
 class Region(Strict):
     """A region of points: box (min, max), sphere (center, radius), cylinder (center, radius,
-    axis), face (face, depth), layer (index), or all."""
+    axis), face (face, depth), layer (index), points (0-based ``indices``), or all."""
 
-    type: Literal["box", "sphere", "cylinder", "face", "layer", "all"]
+    type: Literal["box", "sphere", "cylinder", "face", "layer", "points", "all"]
     min: Vector3 | None = None
     max: Vector3 | None = None
     center: Vector3 | None = None
@@ -288,10 +289,13 @@ class Region(Strict):
     face: Literal["x-", "x+", "y-", "y+", "z-", "z+"] | None = None
     depth: Positive | None = None
     index: Index | None = None
+    #: ``points``: 0-based point indices
+    indices: Annotated[list[Annotated[int, NotBool, Field(ge=0)]], Field(min_length=1)] | None = None
 
     @model_validator(mode="after")
     def _complete(self):
         needs = {
+            "points": ("indices",),
             "box": ("min", "max"),
             "sphere": ("center", "radius"),
             "cylinder": ("center", "radius"),
@@ -455,9 +459,30 @@ class LineSpec(Strict):
     points: Annotated[int, NotBool, Field(ge=2)]
 
 
+class ExodusOutput(Strict):
+    """Exodus II output as Peridigm writes it: the ``variables`` named as Peridigm names them
+    (``peridyn.io.exodus_write.PERIDIGM_VARIABLES``) in ``file`` (in the output folder), at
+    every ``every``-th step from step 0."""
+
+    file: Annotated[str, Field(pattern=r"^[^/\\]+$")] = "results.e"
+    every: Annotated[int, NotBool, Field(ge=1)] = 1
+    variables: Annotated[list[str], Field(min_length=1)]
+
+    @model_validator(mode="after")
+    def _known(self):
+        for name in self.variables:
+            if name not in PERIDIGM_VARIABLES:
+                raise ValueError(
+                    f"variables: unknown output variable {name!r}{did_you_mean(name, PERIDIGM_VARIABLES)}; "
+                    f"known: {sorted(PERIDIGM_VARIABLES)}"
+                )
+        return self
+
+
 class Output(Strict):
     """Where and what to write (folder default: ``peridyn-out/<case name>``); ``exodus``: also
-    write the snapshots as Exodus II, ``results.e`` (``peridyn.io.exodus_write``)."""
+    write the snapshots as Exodus II, ``results.e`` (``peridyn.io.exodus_write``), or, given
+    as a mapping, Peridigm's named variables (``ExodusOutput``)."""
 
     directory: str | None = None
     every: Annotated[int, NotBool, Field(ge=1)] = 1
@@ -469,7 +494,7 @@ class Output(Strict):
     pzt_sensors: dict[str, PZTSensor] = {}
     series_dtype: Literal["float64", "float32"] = "float64"
     vtu: bool = True
-    exodus: bool = False
+    exodus: bool | ExodusOutput = False
     plots: bool = True
     #: per-point partial stress and Green-Lagrange strain in the final fields and VTU snapshots
     stress: bool = False

@@ -147,10 +147,24 @@ def region_mask(body: Body, region: Region, where: str) -> np.ndarray:
         return in_cylinder(pad(region.center), region.radius, region.axis)(body.points)
     if region.type == "face":
         return geometry.face(body, region.face, region.depth)
+    if region.type == "points":
+        return point_mask(body, region.indices, where)
     try:
         return geometry.layer(body, region.index)
     except InputError as exc:
         raise InputError(f"{where}: {exc}") from None
+
+
+def point_mask(body: Body, indices: list[int], where: str) -> np.ndarray:
+    """(n_points,) bool mask of 0-based point ``indices``; an index past the body is refused."""
+    idx = np.asarray(indices, dtype=np.int64)
+    if idx.max() >= body.n_points:
+        raise InputError(
+            f"{where}.indices: point {int(idx.max())} does not exist (the body has {body.n_points} points)"
+        )
+    mask = np.zeros(body.n_points, dtype=bool)
+    mask[idx] = True
+    return mask
 
 
 def pad3(v) -> list:

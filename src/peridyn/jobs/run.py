@@ -25,6 +25,7 @@ from peridyn.io.outdir import end_status, prepare_output
 from peridyn.io.provenance import package_version, provenance
 from peridyn.io.recorder import LineProbe, Recorder, RecorderSpec
 from peridyn.jobs.build import Setup, build, pad3
+from peridyn.jobs.exodus_variables import check_variables, variable_values
 from peridyn.jobs.figures import draw_crack_figures, draw_run_figures, final_crack_paths
 from peridyn.jobs.lamb_analysis import analyse
 from peridyn.jobs.summary import finish_summary
@@ -55,8 +56,20 @@ def recorder_spec(case: Case, body: Body, dt: float) -> RecorderSpec:
         vtu=out.vtu,
         stress=out.stress,
         strain=out.strain,
-        exodus=out.exodus,
+        **exodus_spec(out.exodus),
     )
+
+
+def exodus_spec(exodus) -> dict:
+    """The recorder's Exodus settings of ``output.exodus`` (a bool or an ``ExodusOutput``)."""
+    if isinstance(exodus, bool):
+        return {"exodus": exodus}
+    return {
+        "exodus": True,
+        "exodus_file": exodus.file,
+        "exodus_every": exodus.every,
+        "exodus_variables": tuple(exodus.variables),
+    }
 
 
 def _pzt_weights(body: Body, sensor) -> tuple[np.ndarray, np.ndarray]:
@@ -167,6 +180,10 @@ def _check_parallel(case: Case) -> None:
         raise InputError(
             f"an MPI run (mpiexec -n N) is an explicit run for now, not a {case.solver.type} run"
         )
+    if not isinstance(case.output.exodus, bool):
+        raise CaseFileError(
+            case.name, "output.exodus", case.output.exodus.model_dump(), "true or false in an MPI run"
+        )
     for key in ("stress", "strain"):
         if getattr(case.output, key):
             raise CaseFileError(case.name, f"output.{key}", True, "false in an MPI run (not written yet)")
@@ -189,6 +206,15 @@ def point_tensors(setup: Setup, spec: RecorderSpec):
         return out
 
     return fields
+
+
+def exodus_values(case: Case, setup: Setup, spec: RecorderSpec):
+    """The recorder's ``fields``: the values of the named Exodus variables (``output.exodus``
+    as a mapping) at a state, or None without them. Serial runs (the whole model)."""
+    if not spec.exodus_variables:
+        return None
+    check_variables(case.name, setup.model, spec.exodus_variables)
+    return variable_values(setup.model, spec.exodus_variables)
 
 
 def step_count(case: Case, solver) -> int:
@@ -362,7 +388,10 @@ def _run_explicit(case, setup, solver, out, case_path, checkpoint_every, restart
     if d.size > 1:
         info.update(d.provenance())
     tensors = point_tensors(setup, spec)
-    recorder = d.on_root(Recorder, setup.whole_body, out, spec, info, gathered.damage, resume, tensors)
+    fields = exodus_values(case, setup, spec)
+    recorder = d.on_root(
+        Recorder, setup.whole_body, out, spec, info, gathered.damage, resume, tensors, fields
+    )
     checkpointer, prepare = _checkpointer(
         ckpt_path, checkpoint_every or n_steps + 1, setup, meta, parts, whole_bonds
     )
@@ -529,6 +558,7 @@ def _record_equilibrium(case, setup, out, case_path, u, results: dict) -> dict:
         provenance(case_path, case=case),
         lambda: damage_field(setup.model),
         tensors=point_tensors(setup, spec),
+        fields=exodus_values(case, setup, spec),
     )
     recorder.record_series(state)
     recorder.snapshot(state)

@@ -1,0 +1,140 @@
+"""Peridigm decks in: reading XML and YAML decks (``peridyn.io.peridigm_deck``) and their
+translation to peridyn cases (``peridyn.io.peridigm_case``), with the refusals that name the
+deck parameter. Decks from tests/data/peridigm (Peridigm's test suite)."""
+
+import copy
+from pathlib import Path
+
+import pytest
+
+from peridyn.cli import main
+from peridyn.errors import CaseFileError
+from peridyn.io.case import load_case
+from peridyn.io.peridigm_case import convert_deck, deck_case, load_deck
+from peridyn.io.peridigm_deck import is_peridigm_deck, read_deck
+
+DATA = Path(__file__).parents[2] / "data" / "peridigm"
+WAVE = DATA / "WaveInBar.xml"
+COMPRESSION = DATA / "Compression_2x1x1.yaml"
+
+
+def test_xml_parameters_are_typed():
+    """WaveInBar.xml's parameters as their declared types (values as written in the deck)."""
+    deck = read_deck(WAVE)
+    assert deck["Verbose"] is False
+    assert deck["Materials"]["My Elastic Material"]["Density"] == 2200.0
+    assert deck["Output"]["Output Frequency"] == 20 and isinstance(deck["Output"]["Output Frequency"], int)
+    assert deck["Solver"]["Verlet"]["Fixed dt"] == 9.0659e-08
+    assert deck["Boundary Conditions"]["Left Side Initial Velocity"]["Value"] == "-100.0"
+
+
+def test_yaml_deck_is_the_peridigm_mapping():
+    deck = read_deck(COMPRESSION)
+    assert deck["Blocks"]["My Group of Blocks"]["Horizon"] == 2.0
+    assert is_peridigm_deck(COMPRESSION) and is_peridigm_deck(WAVE)
+    assert not is_peridigm_deck(Path(__file__).parents[3] / "cases" / "bar_pulse.yaml")
+
+
+@pytest.mark.parametrize(
+    "text, key",
+    [
+        ('<ParameterList><Parameter name="A" type="double" value="x"/></ParameterList>', "A"),
+        ('<ParameterList><Parameter name="A" type="float" value="1"/></ParameterList>', "A (type)"),
+        (
+            '<ParameterList><Parameter name="A" type="int" value="1"/>'
+            '<Parameter name="A" type="int" value="2"/></ParameterList>',
+            "A",
+        ),
+        ("<ParameterList><Parameter", "<file>"),
+        ("<Other/>", "<root>"),
+    ],
+)
+def test_bad_xml_names_the_parameter(tmp_path, text, key):
+    deck = tmp_path / "deck.xml"
+    deck.write_text(text)
+    with pytest.raises(CaseFileError) as err:
+        read_deck(deck)
+    assert err.value.key == key
+
+
+def test_translation_of_a_pdquickgrid_deck():
+    """Compression_2x1x1: two cells of 2 x 1 x 1 m from x = -2 m, LPS with K = 130 GPa and
+    mu = 78 GPa (E = 9 K mu / (3 K + mu) = 195 GPa, nu = 0.25), floor(5e-5 / 1e-5) = 5 steps,
+    the node sets' 1-based ids as 0-based points, and the deck's Exodus file and variables."""
+    case = load_deck(COMPRESSION)
+    assert case.geometry.size == [4.0, 1.0, 1.0] and case.geometry.origin == [-2.0, -0.5, -0.5]
+    assert case.discretization.spacing == [2.0, 1.0, 1.0] and case.discretization.partial_volumes is False
+    assert case.material.E == pytest.approx(195e9, rel=1e-15) and case.material.nu == pytest.approx(0.25)
+    assert (case.solver.steps, case.solver.dt) == (5, 1e-5)
+    assert case.node_sets["Min X Node Set"].indices == [0]
+    assert case.node_sets["Max X Node Set"].indices == [1]
+    assert case.output.exodus.file == "Compression_2x1x1.e" and case.output.exodus.every == 1
+    assert "Stored_Elastic_Energy" in case.output.exodus.variables
+
+
+def test_pdquickgrid_ids_are_x_fastest():
+    """PdQuickGrid numbers its points x fastest; peridyn's box z fastest: id 2 of a 2 x 2 x 2
+    grid is (i, j, k) = (1, 0, 0), peridyn's point 4."""
+    deck = read_deck(COMPRESSION)
+    grid = deck["Discretization"]["TensorProduct3DMeshGenerator"]
+    grid.update({"Number Points X": 2, "Number Points Y": 2, "Number Points Z": 2, "Y Length": 2.0})
+    grid["Z Length"] = 2.0
+    deck["Discretization"]["NeighborhoodType"] = "Spherical"
+    deck["Boundary Conditions"]["Max X Node Set"] = "2 3"
+    case = deck_case(deck, "grid")
+    assert case["node_sets"]["Max X Node Set"]["indices"] == [2, 4]
+
+
+def _refusal(deck: dict, key_start: str):
+    with pytest.raises(CaseFileError) as err:
+        deck_case(deck, "x", "deck.yaml", DATA)
+    assert err.value.key.startswith(key_start), err.value
+    return err.value
+
+
+def test_refusals_name_the_deck_parameter():
+    base = read_deck(COMPRESSION)
+    deck = copy.deepcopy(base)
+    deck["Blocks"]["Other"] = dict(deck["Blocks"]["My Group of Blocks"])
+    _refusal(deck, "Blocks")
+    deck = copy.deepcopy(base)
+    deck["Materials"]["My Elastic Material"]["Material Model"] = "Viscoplastic"
+    _refusal(deck, "Materials.My Elastic Material.Material Model")
+    deck = copy.deepcopy(base)
+    deck["Solver"]["Implicit"] = deck["Solver"].pop("Verlet")
+    _refusal(deck, "Solver")
+    deck = copy.deepcopy(base)
+    del deck["Solver"]["Verlet"]["Fixed dt"]
+    _refusal(deck, "Solver.Verlet.Fixed dt")
+    deck = copy.deepcopy(base)
+    deck["Output"]["Output Variables"]["Partial_Stress"] = True
+    _refusal(deck, "Output.Output Variables.Partial_Stress")
+    deck = copy.deepcopy(base)
+    deck["Contact"] = {"Search Radius": 0.1}
+    _refusal(deck, "Contact")
+    deck = copy.deepcopy(base)
+    deck["Boundary Conditions"]["Initial Velocity Min X Face"]["Node Set"] = "Nowhere"
+    _refusal(deck, "Boundary Conditions.Initial Velocity Min X Face.Node Set")
+    deck = copy.deepcopy(base)
+    deck["Solver"]["Initial Time"] = 1e-6
+    _refusal(deck, "Solver.Initial Time")
+
+
+def test_box_neighbourhood_unlike_a_sphere_is_refused():
+    """A 3 x 3 x 1 grid of unit cells with horizon 1.2: the box of round(1.2) = 1 cell holds
+    the diagonal neighbour at sqrt(2) = 1.41 m, the sphere does not."""
+    deck = read_deck(COMPRESSION)
+    grid = deck["Discretization"]["TensorProduct3DMeshGenerator"]
+    grid.update({"Number Points X": 3, "Number Points Y": 3, "X Length": 3.0, "Y Length": 3.0})
+    deck["Blocks"]["My Group of Blocks"]["Horizon"] = 1.2
+    _refusal(deck, "Discretization.NeighborhoodType")
+    deck["Discretization"]["NeighborhoodType"] = "Spherical"
+    assert deck_case(deck, "x")["discretization"]["horizon_m"] == 1.2
+
+
+def test_convert_writes_a_case_that_loads_as_the_deck(tmp_path):
+    """``peridyn convert DECK -o case.yaml`` writes the case that ``peridyn run DECK`` runs."""
+    out = tmp_path / "case.yaml"
+    assert main(["convert", str(WAVE), "-o", str(out)]) == 0
+    assert load_case(out) == load_deck(WAVE)
+    assert convert_deck(WAVE)["geometry"]["file"] == str((DATA / "WaveInBar.g").resolve())
