@@ -330,7 +330,9 @@ class Precrack(Strict):
 
 class BoundaryConditionSpec(Strict):
     """A condition on node set ``set``: kind, components ("x", "xy", ...) and a value
-    (a number or a time function mapping, see ``peridyn.physics.timefunctions.from_spec``)."""
+    (a number, a time function mapping, see ``peridyn.physics.timefunctions.from_spec``, or
+    ``{type: expression, text: ...}``, an expression in x, y, z and t evaluated on the set's
+    points, see ``peridyn.physics.expressions``)."""
 
     set: str
     kind: Literal["displacement", "velocity", "force", "body_force"]
@@ -339,12 +341,13 @@ class BoundaryConditionSpec(Strict):
 
 
 class InitialConditionSpec(Strict):
-    """Initial displacement (m) or velocity (m/s) of node set ``set``."""
+    """Initial displacement (m) or velocity (m/s) of node set ``set``: a number or
+    ``{type: expression, text: ...}`` in x, y, z (and t = 0)."""
 
     set: str
     kind: Literal["displacement", "velocity"]
     components: str | list[str] = "xyz"
-    value: Finite = 0.0
+    value: Finite | dict = 0.0
 
 
 class Actuator(Strict):
@@ -426,6 +429,9 @@ class Solver(Strict):
     breaking_rounds: Annotated[int, NotBool, Field(ge=1)] = 100
     displacement_tolerance: Positive = 1e-10
     linear_solver: Literal["lu", "cg"] = "lu"
+    #: explicit: the reported velocity of a DOF with a prescribed displacement, ``rate`` (its
+    #: time function's derivative) or ``difference`` (Peridigm's, see ``ExplicitSolver``)
+    prescribed_velocity: Literal["rate", "difference"] = "rate"
     #: modal: ``shift-invert`` (factorised), ``lobpcg`` (matrix-free) or ``auto`` (by the
     #: estimated factor size, ``jobs.modal.choose_eigensolver``).
     eigensolver: Literal["auto", "shift-invert", "lobpcg"] = "auto"
@@ -459,14 +465,23 @@ class LineSpec(Strict):
     points: Annotated[int, NotBool, Field(ge=2)]
 
 
+class SetSum(Strict):
+    """A global output variable: the sum of the nodal vector ``variable`` over node set ``set``
+    (Peridigm's "Block_Data" compute class with "Calculation Type: Sum")."""
+
+    variable: Literal["Displacement", "Velocity", "Force", "Force_Density", "Acceleration"]
+    set: str
+
+
 class ExodusOutput(Strict):
     """Exodus II output as Peridigm writes it: the ``variables`` named as Peridigm names them
-    (``peridyn.io.exodus_write.PERIDIGM_VARIABLES``) in ``file`` (in the output folder), at
-    every ``every``-th step from step 0."""
+    (``peridyn.io.exodus_write.PERIDIGM_VARIABLES``) and the global ``sums`` (name ->
+    ``SetSum``) in ``file`` (in the output folder), at every ``every``-th step from step 0."""
 
     file: Annotated[str, Field(pattern=r"^[^/\\]+$")] = "results.e"
     every: Annotated[int, NotBool, Field(ge=1)] = 1
     variables: Annotated[list[str], Field(min_length=1)]
+    sums: dict[str, SetSum] = {}
 
     @model_validator(mode="after")
     def _known(self):
@@ -569,6 +584,8 @@ class Case(Strict):
         used = [(f"boundary_conditions[{i}].set", bc.set) for i, bc in enumerate(self.boundary_conditions)]
         used += [(f"initial_conditions[{i}].set", ic.set) for i, ic in enumerate(self.initial_conditions)]
         used += [(f"output.planes.{k}", v) for k, v in self.output.planes.items()]
+        if not isinstance(self.output.exodus, bool):
+            used += [(f"output.exodus.sums.{k}.set", v.set) for k, v in self.output.exodus.sums.items()]
         if self.material.damage:
             used += [("material.damage.no_damage_sets", s) for s in self.material.damage.no_damage_sets]
         return used

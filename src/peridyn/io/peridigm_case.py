@@ -20,19 +20,31 @@ from pathlib import Path
 
 import numpy as np
 
-from peridyn.errors import CaseFileError
+from peridyn.errors import CaseFileError, InputError
 from peridyn.io.case import Case, apply_override, load_case, validate_case
 from peridyn.io.exodus_write import PERIDIGM_VARIABLES
 from peridyn.io.peridigm_deck import is_peridigm_deck, read_deck
+from peridyn.physics.expressions import SpaceTime
 
 #: Peridigm's material models that peridyn runs: name -> peridyn model.
 MATERIALS = {"Elastic": "lps", "Linear LPS": "lps", "Elastic Bond Based": "pmb"}
 #: Peridigm's influence functions that peridyn has: name -> peridyn name.
 INFLUENCE = {"One": "constant"}
 #: Top-level deck sections read (others are refused by name).
-SECTIONS = {"Verbose", "Discretization", "Materials", "Blocks", "Boundary Conditions", "Solver", "Output"}
+SECTIONS = {
+    "Verbose",
+    "Discretization",
+    "Materials",
+    "Blocks",
+    "Boundary Conditions",
+    "Solver",
+    "Output",
+    "Compute Class Parameters",
+}
 #: Initial-condition kinds of the deck's boundary conditions.
 INITIAL = {"Initial Displacement": "displacement", "Initial Velocity": "velocity"}
+#: Boundary-condition kinds of the deck's boundary conditions.
+BOUNDARY = {"Prescribed Displacement": "displacement", "Body Force": "body_force"}
 
 
 class _Deck:
@@ -102,8 +114,27 @@ def deck_case(params: dict, name: str, source: str = "<deck>", deck_dir=".") -> 
         case["boundary_conditions"] = bcs
     if ics:
         case["initial_conditions"] = ics
-    case["output"] = _output(deck, case["material"]["model"])
+    case["output"] = _output(deck, case["material"]["model"], _compute_classes(deck))
     return case
+
+
+def _compute_classes(deck: _Deck) -> dict:
+    """Output label -> ``{variable, set}`` of each "Block_Data" sum of ``Compute Class Parameters``."""
+    out = {}
+    for name in deck.get("Compute Class Parameters", dict, {}):
+        where = f"Compute Class Parameters.{name}"
+        for key, expected in (("Compute Class", "Block_Data"), ("Calculation Type", "Sum")):
+            value = deck.get(f"{where}.{key}", str)
+            if value != expected:
+                raise deck.error(f"{where}.{key}", value, f"{expected!r} (the one compute class peridyn has)")
+        variable = deck.get(f"{where}.Variable", str)
+        if PERIDIGM_VARIABLES.get(variable) != ("nodal", True):
+            raise deck.error(f"{where}.Variable", variable, "a nodal vector variable, e.g. Force")
+        out[deck.get(f"{where}.Output Label", str)] = {
+            "variable": variable,
+            "set": deck.get(f"{where}.Block", str),
+        }
+    return out
 
 
 def _block(deck: _Deck) -> tuple[float, str]:
@@ -113,7 +144,7 @@ def _block(deck: _Deck) -> tuple[float, str]:
         raise deck.error("Blocks", sorted(blocks), "one block group (several blocks are not supported yet)")
     (group,) = blocks
     where = f"Blocks.{group}"
-    deck.get(f"{where}.Block Names", str)
+    deck.get(f"{where}.Block Names", str)  # one group of one material and horizon: any blocks
     for key in deck.get(where, dict):
         if key not in ("Block Names", "Material", "Horizon"):
             raise deck.error(f"{where}.{key}", None, "Block Names, Material and Horizon only", False)
@@ -226,7 +257,7 @@ def _solver(deck: _Deck) -> dict:
     steps = math.floor((final - initial) / dt)  # Peridigm's step count
     if steps < 1:
         raise deck.error("Solver.Final Time", final, f"at least one step of {dt:g} s after the initial time")
-    return {"type": "explicit", "dt": dt, "steps": steps}
+    return {"type": "explicit", "dt": dt, "steps": steps, "prescribed_velocity": "difference"}
 
 
 def _conditions(deck: _Deck, deck_dir: Path, grid, mesh_sets: bool) -> tuple[dict, list, list]:
@@ -251,15 +282,28 @@ def _conditions(deck: _Deck, deck_dir: Path, grid, mesh_sets: bool) -> tuple[dic
         axis = deck.get(f"{where}.Coordinate", str)
         if axis not in ("x", "y", "z"):
             raise deck.error(f"{where}.Coordinate", axis, "x, y or z")
-        text = deck.get(f"{where}.Value", str)
-        if kind not in INITIAL:
-            raise deck.error(f"{where}.Type", kind, f"one of {sorted(INITIAL)}")
-        try:
-            value = float(text)
-        except ValueError:
-            raise deck.error(f"{where}.Value", text, "a number (expressions are not supported yet)") from None
-        ics.append({"set": set_name, "kind": INITIAL[kind], "components": axis, "value": value})
+        value = _value(deck, f"{where}.Value")
+        if kind in INITIAL:
+            ics.append({"set": set_name, "kind": INITIAL[kind], "components": axis, "value": value})
+        elif kind in BOUNDARY:
+            bcs.append({"set": set_name, "kind": BOUNDARY[kind], "components": axis, "value": value})
+        else:
+            raise deck.error(f"{where}.Type", kind, f"one of {sorted(INITIAL) + sorted(BOUNDARY)}")
     return sets, bcs, ics
+
+
+def _value(deck: _Deck, key: str):
+    """A condition's value: a number, or an expression in x, y, z and t (checked now)."""
+    text = deck.get(key, str)
+    try:
+        return float(text)
+    except ValueError:
+        pass
+    try:
+        SpaceTime(text)
+    except InputError as exc:
+        raise deck.error(key, text, f"a number or an expression in x, y, z, t ({exc})") from None
+    return {"type": "expression", "text": text}
 
 
 def _set_indices(deck: _Deck, key: str, deck_dir: Path, grid) -> list[int]:
@@ -287,7 +331,7 @@ def _set_indices(deck: _Deck, key: str, deck_dir: Path, grid) -> list[int]:
     return sorted(int(p) for p in index)
 
 
-def _output(deck: _Deck, model: str) -> dict:
+def _output(deck: _Deck, model: str, sums: dict) -> dict:
     """The output section: plots and VTU off, the deck's Exodus file and variables."""
     outputs = [k for k in deck.params if k.startswith("Output")]
     if not outputs:
@@ -304,6 +348,8 @@ def _output(deck: _Deck, model: str) -> dict:
         extra = [v for v, on in deck.get(f"{k}.Output Variables", dict).items() if on and v not in names]
         if extra:
             raise deck.error(f"{k}.Output Variables", extra, f"variables that {first} writes")
+    asked_sums = {name: sums[name] for name in names if name in sums}
+    names = [name for name in names if name not in sums]
     for name in names:
         if name not in PERIDIGM_VARIABLES:
             raise deck.error(f"{first}.Output Variables.{name}", True, f"one of {sorted(PERIDIGM_VARIABLES)}")
@@ -313,6 +359,8 @@ def _output(deck: _Deck, model: str) -> dict:
     if every < 1:
         raise deck.error(f"{first}.Output Frequency", every, "at least 1 step")
     exodus = {"file": deck.get(f"{first}.Output Filename", str) + ".e", "every": every, "variables": names}
+    if asked_sums:
+        exodus["sums"] = asked_sums
     return {"plots": False, "vtu": False, "exodus": exodus}
 
 

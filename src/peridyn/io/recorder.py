@@ -80,6 +80,8 @@ class RecorderSpec:
     exodus_variables : tuple of str
         Peridigm's names of the variables written (``peridyn.io.exodus_write.PERIDIGM_VARIABLES``),
         their values from the recorder's ``fields``; empty: ``snapshot_exodus``'s fields.
+    exodus_sums : dict of name -> (variable, node set name)
+        Global vector variables written with the named ones: a nodal variable's sum over a set.
     """
 
     every: int = 1
@@ -95,6 +97,7 @@ class RecorderSpec:
     exodus_file: str = "results.e"
     exodus_every: int | None = None
     exodus_variables: tuple = ()
+    exodus_sums: dict = field(default_factory=dict)
     stress: bool = False
     strain: bool = False
 
@@ -154,7 +157,7 @@ class Recorder:
         time (s), for a restart from a checkpoint.
     fields : callable (state) -> dict, or None
         The values of ``spec.exodus_variables`` at a state: ``{"nodal": {...}, "element":
-        {...}, "global": {...}}`` of name -> array, as ``ExodusWriter.append`` takes them;
+        {...}, "global_": {...}}`` of name -> array, as ``ExodusWriter.append`` takes them;
         required when variables are named.
     """
 
@@ -212,7 +215,9 @@ class Recorder:
         self._exodus_step = None  # the step of the last Exodus record
         self.exodus = None
         if spec.exodus and spec.exodus_variables:
-            self.exodus = variables_exodus(body, self.directory / spec.exodus_file, spec.exodus_variables)
+            self.exodus = variables_exodus(
+                body, self.directory / spec.exodus_file, spec.exodus_variables, spec.exodus_sums
+            )
         elif spec.exodus:
             self.exodus = snapshot_exodus(body, self.directory / spec.exodus_file, damage is not None)
         if resume is not None:
@@ -344,16 +349,22 @@ def snapshot_exodus(body: Body, path, damage: bool = False) -> ExodusWriter:
     )
 
 
-def variables_exodus(body: Body, path, variables) -> ExodusWriter:
+def variables_exodus(body: Body, path, variables, sums=None) -> ExodusWriter:
     """An Exodus writer of Peridigm's named ``variables`` (``PERIDIGM_VARIABLES`` gives each one's
-    placement, nodal or element, and size), one block, the body's node sets."""
+    placement, nodal or element, and size) and global vectors named by ``sums``' keys, one
+    block, the body's node sets."""
     fields = {"nodal": {}, "element": {}}
     for name in variables:
         placement, vector = PERIDIGM_VARIABLES[name]
         fields[placement][name] = body.dim if vector else 1
     sets = {k: v for k, v in body.node_sets.items() if len(v)}
     return ExodusWriter(
-        path, body.points[:, : body.dim], node_sets=sets, nodal=fields["nodal"], element=fields["element"]
+        path,
+        body.points[:, : body.dim],
+        node_sets=sets,
+        nodal=fields["nodal"],
+        element=fields["element"],
+        global_=dict.fromkeys(sums or {}, body.dim),
     )
 
 

@@ -30,6 +30,7 @@ from peridyn.parallel.halo import Halo, ghost_layers, plan_halo
 from peridyn.parallel.partition import rcb
 from peridyn.physics.contact import Contact
 from peridyn.physics.damage import BondDamage, protected_points
+from peridyn.physics.expressions import SpaceTime
 from peridyn.physics.loads import BoundaryCondition, InitialCondition, Loading
 from peridyn.physics.materials import Model, make_model
 from peridyn.physics.timefunctions import from_spec
@@ -225,12 +226,35 @@ def build_loading(case: Case, body: Body, extra=()) -> Loading:
     """Boundary and initial conditions of the case (plus ``extra`` ones), checked for conflicts."""
     bcs = [
         BoundaryCondition(
-            bc.set, bc.kind, bc.components, from_spec(bc.value, f"boundary_conditions[{k}].value")
+            bc.set, bc.kind, bc.components, value_function(bc.value, f"boundary_conditions[{k}]")
         )
         for k, bc in enumerate(case.boundary_conditions)
     ]
-    ics = [InitialCondition(ic.set, ic.kind, ic.components, ic.value) for ic in case.initial_conditions]
+    ics = []
+    for k, ic in enumerate(case.initial_conditions):
+        value = ic.value
+        if isinstance(value, dict):
+            where = f"initial_conditions[{k}].value"
+            if value.get("type") != "expression":
+                raise InputError(f"{where}: a number or {{type: expression, text: ...}}, got {value!r}")
+            at = body.points[body.node_set(ic.set)]
+            values = value_function(value, f"initial_conditions[{k}]").at(at, 0.0)
+            value = np.repeat(values[:, None], len(ic.components), axis=1)
+        ics.append(InitialCondition(ic.set, ic.kind, ic.components, value))
     return Loading(body, [*extra, *bcs], ics)
+
+
+def value_function(spec, where: str):
+    """The time function of a condition's ``value`` (``from_spec``), or for ``{type:
+    expression, text}`` its expression in x, y, z and t (``SpaceTime``)."""
+    if not (isinstance(spec, dict) and spec.get("type") == "expression"):
+        return from_spec(spec, f"{where}.value")
+    if set(spec) != {"type", "text"} or not isinstance(spec["text"], str):
+        raise InputError(f"{where}.value: an expression takes one 'text' (a string), got {spec!r}")
+    try:
+        return SpaceTime(spec["text"])
+    except InputError as exc:
+        raise InputError(f"{where}.value: {exc}") from None
 
 
 def check_placements(case: Case, body: Body) -> None:

@@ -24,16 +24,20 @@ def check_variables(case_name: str, model: Model, variables) -> None:
             )
 
 
-def variable_values(model: Model, variables):
+def variable_values(model: Model, variables, sums=None):
     """A function of a state (u, v, a: (n_points, 3)) giving the ``variables``' values as
-    ``ExodusWriter.append`` takes them: ``{"nodal": {...}, "element": {...}}``, vectors
-    (n_points, dim), scalars (n_points,). Force density is the internal force density
-    (N/m^3) at u, force that times the point's volume (N); acceleration the solver's."""
+    ``ExodusWriter.append`` takes them: ``{"nodal": {...}, "element": {...}, "global_":
+    {...}}``, vectors (n_points, dim), scalars (n_points,), and per ``sums`` entry (name ->
+    (nodal variable, node set name)) that variable's sum over the set, (dim,). Force density
+    is the internal force density (N/m^3) at u, force that times the point's volume (N);
+    acceleration the solver's."""
+    sums = sums or {}
+    needed = set(variables) | {variable for variable, _ in sums.values()}
     body = model.body
     dim = body.dim
 
     def values(state: State) -> dict:
-        force_density = model.force(state.u)[:, :dim] if {"Force", "Force_Density"} & set(variables) else None
+        force_density = model.force(state.u)[:, :dim] if {"Force", "Force_Density"} & needed else None
         computed = {
             "Displacement": lambda: state.u[:, :dim],
             "Velocity": lambda: state.v[:, :dim],
@@ -49,9 +53,11 @@ def variable_values(model: Model, variables):
             "Number_Of_Neighbors": lambda: np.diff(model.bonds.offsets).astype(np.float64),
             "Damage": lambda: damage_field(model),
         }
-        out = {"nodal": {}, "element": {}}
+        out = {"nodal": {}, "element": {}, "global_": {}}
         for name in variables:
             out[PERIDIGM_VARIABLES[name][0]][name] = computed[name]()
+        for name, (variable, set_name) in sums.items():
+            out["global_"][name] = computed[variable]()[body.node_set(set_name)].sum(axis=0)
         return out
 
     return values

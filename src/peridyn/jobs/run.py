@@ -69,6 +69,7 @@ def exodus_spec(exodus) -> dict:
         "exodus_file": exodus.file,
         "exodus_every": exodus.every,
         "exodus_variables": tuple(exodus.variables),
+        "exodus_sums": {k: (v.variable, v.set) for k, v in exodus.sums.items()},
     }
 
 
@@ -214,7 +215,7 @@ def exodus_values(case: Case, setup: Setup, spec: RecorderSpec):
     if not spec.exodus_variables:
         return None
     check_variables(case.name, setup.model, spec.exodus_variables)
-    return variable_values(setup.model, spec.exodus_variables)
+    return variable_values(setup.model, spec.exodus_variables, spec.exodus_sums)
 
 
 def step_count(case: Case, solver) -> int:
@@ -353,6 +354,7 @@ def time_stepper(case, setup):
         damage=setup.damage,
         contact=setup.contact,
         domain=setup.domain,
+        prescribed_velocity=s.prescribed_velocity,
     )
 
 

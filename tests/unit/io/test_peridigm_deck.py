@@ -138,3 +138,31 @@ def test_convert_writes_a_case_that_loads_as_the_deck(tmp_path):
     assert main(["convert", str(WAVE), "-o", str(out)]) == 0
     assert load_case(out) == load_deck(WAVE)
     assert convert_deck(WAVE)["geometry"]["file"] == str((DATA / "WaveInBar.g").resolve())
+
+
+def test_translation_of_expressions_and_compute_classes():
+    """ElasticBondBased3D: prescribed displacements, one an expression in y and t; the bulk
+    modulus alone (E = 1.5 K: peridyn's PMB has nu = 1/4, K = E / (3 (1 - 2 nu))); the
+    "Block_Data" sums as global outputs; Peridigm's velocity of prescribed points."""
+    case = load_deck(DATA / "ElasticBondBased3D.yaml")
+    assert case.material.model == "pmb" and case.material.E == 1.5 * 200e9
+    values = [bc.value for bc in case.boundary_conditions]
+    assert values == [0.0, {"type": "expression", "text": "0.001*y*t/1.0e-8"}, 0.0]
+    assert [bc.kind for bc in case.boundary_conditions] == ["displacement"] * 3
+    assert case.solver.prescribed_velocity == "difference"
+    sums = case.output.exodus.sums
+    assert (sums["Top_Reaction_Force"].variable, sums["Top_Reaction_Force"].set) == ("Force", "block_3")
+    assert "Top_Reaction_Force" not in case.output.exodus.variables
+
+
+def test_bad_expressions_and_compute_classes_are_refused():
+    base = read_deck(DATA / "ElasticBondBased3D.yaml")
+    deck = copy.deepcopy(base)
+    deck["Boundary Conditions"]["Prescribed Displacement Y"]["Value"] = "open('x').read()"
+    _refusal(deck, "Boundary Conditions.Prescribed Displacement Y.Value")
+    deck = copy.deepcopy(base)
+    deck["Compute Class Parameters"]["Top Reaction Force"]["Calculation Type"] = "Maximum"
+    _refusal(deck, "Compute Class Parameters.Top Reaction Force.Calculation Type")
+    deck = copy.deepcopy(base)
+    deck["Output1"]["Output Variables"]["Dilatation"] = True
+    _refusal(deck, "Output1.Output Variables.Dilatation")
