@@ -28,6 +28,11 @@ def run_deck(deck: Path, out: Path) -> Path:
         ("Compression_3x1x1.yaml", "Compression_3x1x1_gold.e", "Compression_3x1x1.comp"),
         ("WaveInBar.xml", "WaveInBar_gold.e", "WaveInBar.comp"),
         ("ElasticBondBased3D.yaml", "ElasticBondBased3D_gold.e", "ElasticBondBased.comp"),
+        (
+            "Compression_QS_3x2x2_TextFile/Compression_QS_3x2x2_TextFile.xml",
+            "Compression_QS_3x2x2_TextFile/Compression_QS_3x2x2_TextFile_gold.e",
+            "Compression_QS_3x2x2_TextFile/Compression_QS_3x2x2_TextFile.comp",
+        ),
     ],
 )
 def test_deck_matches_gold(tmp_path, deck, gold, comp):

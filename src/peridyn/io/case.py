@@ -408,8 +408,9 @@ class Solver(Strict):
     ``max_iterations`` and ``load_steps`` (the loads at t = 1 s, ramped linearly in steps);
     ``modal``: the ``modes`` lowest free-vibration modes (zero displacement conditions fix
     their dofs; free-free otherwise); ``newton``: Newton-Raphson equilibrium with ``tolerance``
-    (relative residual), ``load_steps``, ``newton_iterations`` per solve and ``breaking_rounds``
-    (re-equilibrations per step after bonds break); ``newmark``: implicit dynamics (average
+    (relative residual), ``load_steps`` (the loads at t = ``time``, default 1 s, ramped),
+    ``newton_iterations`` per solve and ``breaking_rounds`` (re-equilibrations per step after
+    bonds break); ``newmark``: implicit dynamics (average
     acceleration) with ``steps`` or ``time``, ``dt`` (s, required), ``displacement_tolerance``
     (m, Newton increment; seed 004: 0.1 nm), ``newton_iterations`` and ``damping``; both take
     ``linear_solver`` (``lu``, or ``cg`` for large 3D bodies)."""
@@ -428,6 +429,9 @@ class Solver(Strict):
     newton_iterations: Annotated[int, NotBool, Field(ge=1)] = 30
     breaking_rounds: Annotated[int, NotBool, Field(ge=1)] = 100
     displacement_tolerance: Positive = 1e-10
+    #: newton: converged when the residual force's norm (N) is below it, instead of the
+    #: relative ``tolerance`` (Peridigm's "Absolute Tolerance")
+    absolute_tolerance: Positive | None = None
     linear_solver: Literal["lu", "cg"] = "lu"
     #: explicit: the reported velocity of a DOF with a prescribed displacement, ``rate`` (its
     #: time function's derivative) or ``difference`` (Peridigm's, see ``ExplicitSolver``)

@@ -242,8 +242,12 @@ def _solver(deck: _Deck) -> dict:
     final = deck.get("Solver.Final Time", float)
     solver = deck.get("Solver", dict)
     kinds = [k for k in solver if isinstance(solver[k], dict)]
+    if kinds == ["QuasiStatic"]:
+        return _quasi_static(deck, final)
     if kinds != ["Verlet"]:
-        raise deck.error("Solver", kinds, "one 'Verlet' solver list (other solvers are not supported yet)")
+        raise deck.error(
+            "Solver", kinds, "one 'Verlet' or 'QuasiStatic' solver list (others are not supported yet)"
+        )
     if "Fixed dt" not in solver["Verlet"]:
         raise deck.error(
             "Solver.Verlet.Fixed dt",
@@ -258,6 +262,40 @@ def _solver(deck: _Deck) -> dict:
     if steps < 1:
         raise deck.error("Solver.Final Time", final, f"at least one step of {dt:g} s after the initial time")
     return {"type": "explicit", "dt": dt, "steps": steps, "prescribed_velocity": "difference"}
+
+
+#: QuasiStatic parameters read: deck name -> newton solver key.
+QUASI_STATIC = {
+    "Number of Load Steps": "load_steps",
+    "Absolute Tolerance": "absolute_tolerance",
+    "Maximum Solver Iterations": "newton_iterations",
+}
+
+
+def _quasi_static(deck: _Deck, final: float) -> dict:
+    """Peridigm's QuasiStatic solver as Newton load steps to the final time, converged on the
+    absolute residual (N), velocities the change of u over a load step's time."""
+    where = "Solver.QuasiStatic"
+    for key in deck.get(where, dict):
+        if key not in QUASI_STATIC:
+            raise deck.error(f"{where}.{key}", None, f"only the parameters {sorted(QUASI_STATIC)}", False)
+    if not final > 0:
+        raise deck.error("Solver.Final Time", final, "a positive time (s)")
+    steps = deck.get(f"{where}.Number of Load Steps", int)
+    iterations = deck.get(f"{where}.Maximum Solver Iterations", int, 10)
+    tolerance = deck.get(f"{where}.Absolute Tolerance", float)
+    for key, value in (("Number of Load Steps", steps), ("Maximum Solver Iterations", iterations)):
+        if value < 1:
+            raise deck.error(f"{where}.{key}", value, "at least 1")
+    if not tolerance > 0:
+        raise deck.error(f"{where}.Absolute Tolerance", tolerance, "a positive tolerance")
+    return {
+        "type": "newton",
+        "time": final,
+        "load_steps": steps,
+        "absolute_tolerance": tolerance,
+        "newton_iterations": iterations,
+    }
 
 
 def _conditions(deck: _Deck, deck_dir: Path, grid, mesh_sets: bool) -> tuple[dict, list, list]:

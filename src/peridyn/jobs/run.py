@@ -549,11 +549,10 @@ def _run_static(case, setup, out, case_path) -> dict:
     )
 
 
-def _record_equilibrium(case, setup, out, case_path, u, results: dict) -> dict:
-    """Record a quasi-static solution ``u`` as one state at t = 1 s; the run's summary."""
-    state = State(u, np.zeros_like(u), np.zeros_like(u), 1.0, results["steps"])
+def _equilibrium_recorder(case, setup, out, case_path) -> Recorder:
+    """The recorder of a quasi-static run."""
     spec = recorder_spec(case, setup.body, 1.0)
-    recorder = Recorder(
+    return Recorder(
         setup.body,
         out,
         spec,
@@ -562,6 +561,14 @@ def _record_equilibrium(case, setup, out, case_path, u, results: dict) -> dict:
         tensors=point_tensors(setup, spec),
         fields=exodus_values(case, setup, spec),
     )
+
+
+def _record_equilibrium(case, setup, out, case_path, u, results: dict, recorder=None, time=1.0) -> dict:
+    """Record a quasi-static solution ``u`` as one state at ``time`` (s; ``recorder``: the
+    run's, else a new one); the run's summary."""
+    state = State(u, np.zeros_like(u), np.zeros_like(u), time, results["steps"])
+    if recorder is None:
+        recorder = _equilibrium_recorder(case, setup, out, case_path)
     recorder.record_series(state)
     recorder.snapshot(state)
     summary = _base_summary(setup)
@@ -593,15 +600,21 @@ def _run_newton(case, setup, out, case_path) -> dict:
     from peridyn.solvers.newton import newton
 
     s = case.solver
+    end = s.time if s.time is not None else 1.0
+    recorder = _equilibrium_recorder(case, setup, out, case_path)
+    on_step = _load_step_records(recorder, setup.loading, end / s.load_steps)
     result = newton(
         setup.model,
         setup.loading,
         load_steps=s.load_steps,
+        time=end,
         tolerance=s.tolerance,
         max_iterations=s.newton_iterations,
         damage=setup.damage,
         max_breaking_rounds=s.breaking_rounds,
         linear_solver=s.linear_solver,
+        absolute_tolerance=s.absolute_tolerance,
+        on_step=on_step,
     )
     if not result.converged:
         step = len(result.steps)
@@ -623,4 +636,30 @@ def _run_newton(case, setup, out, case_path) -> dict:
             "residual": result.residual,
             "residual_history": [step.residuals for step in result.steps],
         },
+        recorder,
+        end,
     )
+
+
+def _load_step_records(recorder: Recorder, loading, step_time: float):
+    """Newton's ``on_step`` writing the Exodus records that ``output.exodus`` asks at its load
+    steps (with the state at t = 0 first), as Peridigm's quasi-static solver writes them: the
+    load step as the step, velocity the displacement's change over the step's time
+    ``step_time`` (s), acceleration zero; at t = 0 the initial conditions. None when the
+    Exodus file is written at the end only."""
+    spec = recorder.spec
+    if spec.exodus_every is None:
+        return None
+    u0, v0, zero = (np.zeros((loading.body.n_points, 3)) for _ in range(3))
+    loading.apply_initial(u0, v0)
+    recorder.write_exodus(State(u0, v0, zero, 0.0, 0))
+    last = {"u": u0}
+
+    def on_step(step, u):
+        k = int(round(step.time / step_time))
+        if spec.exodus_due(k):
+            v = (u - last["u"]) / step_time
+            recorder.write_exodus(State(u, v, zero, step.time, k))
+        last["u"] = u.copy()
+
+    return on_step

@@ -85,9 +85,9 @@ def test_pdquickgrid_ids_are_x_fastest():
     assert case["node_sets"]["Max X Node Set"]["indices"] == [2, 4]
 
 
-def _refusal(deck: dict, key_start: str):
+def _refusal(deck: dict, key_start: str, folder=DATA):
     with pytest.raises(CaseFileError) as err:
-        deck_case(deck, "x", "deck.yaml", DATA)
+        deck_case(deck, "x", "deck.yaml", folder)
     assert err.value.key.startswith(key_start), err.value
     return err.value
 
@@ -166,3 +166,30 @@ def test_bad_expressions_and_compute_classes_are_refused():
     deck = copy.deepcopy(base)
     deck["Output1"]["Output Variables"]["Dilatation"] = True
     _refusal(deck, "Output1.Output Variables.Dilatation")
+
+
+def test_translation_of_a_quasi_static_text_file_deck():
+    """Compression_QS_3x2x2_TextFile: the text mesh, node sets from files and inline lists
+    (1-based ids), QuasiStatic as 20 Newton load steps to the final time converged on the
+    absolute residual, at most 10 iterations each."""
+    folder = DATA / "Compression_QS_3x2x2_TextFile"
+    case = load_deck(folder / "Compression_QS_3x2x2_TextFile.xml")
+    assert case.geometry.type == "mesh"
+    assert case.node_sets["Node Set One"].indices == [0, 1, 2, 3]
+    assert case.node_sets["Node Set Two"].indices == [8, 9, 10, 11]
+    assert case.node_sets["Node Set Three"].indices == [1, 3]
+    s = case.solver
+    assert (s.type, s.time, s.load_steps, s.absolute_tolerance, s.newton_iterations) == (
+        "newton",
+        5e-5,
+        20,
+        1e-2,
+        10,
+    )
+    deck = read_deck(folder / "Compression_QS_3x2x2_TextFile.xml")
+    deck["Solver"]["QuasiStatic"]["Stabilization Type"] = "Kinetic"
+    _refusal(deck, "Solver.QuasiStatic.Stabilization Type", folder)
+    deck = read_deck(folder / "Compression_QS_3x2x2_TextFile.xml")
+    deck["Boundary Conditions"]["Node Set One"] = "missing.txt"
+    with pytest.raises(CaseFileError, match="Node Set One"):
+        deck_case(deck, "x", "deck.xml", folder)
