@@ -228,6 +228,9 @@ class Discretization(Strict):
     horizon_m: Positive | None = None
     influence: Literal["constant", "inverse", "gaussian", "conical"] = "constant"
     partial_volumes: bool = True
+    #: ``sphere``: |xi| <= horizon; ``box`` (a box geometry, no partial volumes): the points
+    #: within round(horizon / spacing) cells along each axis, Peridigm's PdQuickGrid families
+    neighbourhood: Literal["sphere", "box"] = "sphere"
 
     @model_validator(mode="after")
     def _one_horizon(self):
@@ -557,6 +560,16 @@ class Case(Strict):
     contact: ContactSpec | None = None
     fatigue: Fatigue | None = None
     absorbing: AbsorbingSpec | None = None
+
+    @model_validator(mode="after")
+    def _box_neighbourhood(self):
+        d = self.discretization
+        if d.neighbourhood == "box" and (self.geometry.type != "box" or d.partial_volumes):
+            raise ValueError(
+                "discretization.neighbourhood: a box neighbourhood needs a box geometry and "
+                "partial_volumes: false"
+            )
+        return self
 
     @model_validator(mode="after")
     def _absorbing_solver(self):

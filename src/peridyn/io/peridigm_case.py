@@ -14,7 +14,6 @@ model, a contact section, ...).
 
 from __future__ import annotations
 
-import itertools
 import math
 from pathlib import Path
 
@@ -169,16 +168,14 @@ def _discretization(deck: _Deck, deck_dir: Path, horizon: float) -> tuple[dict, 
             if n < 1:
                 raise deck.error(f"{where}.Number Points {a}", n, "at least 1 point")
         spacing = [s / n for s, n in zip(size, counts, strict=True)]
-        if neighbourhood.lower() != "spherical" and not _box_is_sphere(spacing, counts, horizon):
+        if neighbourhood and neighbourhood.lower() != "spherical":
             raise deck.error(
-                "Discretization.NeighborhoodType",
-                neighbourhood or None,
-                "'Spherical': this grid's box neighbourhood (round(horizon/spacing) cells per axis, "
-                "Peridigm's default) holds other neighbours than the sphere |xi| <= horizon, and "
-                "peridyn builds spherical families only",
+                "Discretization.NeighborhoodType", neighbourhood, "'Spherical', or none for boxes"
             )
         geometry = {"type": "box", "size": size, "origin": origin}
         discretization["spacing"] = spacing
+        if not neighbourhood:  # PdQuickGrid's own families: round(horizon / spacing) cells
+            discretization["neighbourhood"] = "box"
         return geometry, discretization, np.array(counts)
     if neighbourhood and neighbourhood.lower() != "spherical":
         raise deck.error("Discretization.NeighborhoodType", neighbourhood, "'Spherical' for a mesh")
@@ -189,21 +186,6 @@ def _discretization(deck: _Deck, deck_dir: Path, horizon: float) -> tuple[dict, 
         raise deck.error("Discretization.Input Mesh File", str(mesh), "an existing mesh file")
     geometry = {"type": "exodus" if kind == "Exodus" else "mesh", "file": str(mesh.resolve())}
     return geometry, discretization, None
-
-
-def _box_is_sphere(spacing: list[float], counts: list[int], horizon: float) -> bool:
-    """Whether the box neighbourhood of a PdQuickGrid point (``round(horizon / h)`` cells along
-    each axis) holds the same lattice neighbours as the sphere |xi| <= horizon, for every point
-    of a grid of ``counts`` points."""
-    box = [min(round(horizon / h), n - 1) for h, n in zip(spacing, counts, strict=True)]
-    reach = [min(math.ceil(horizon / h), n - 1) for h, n in zip(spacing, counts, strict=True)]
-    reach = [max(r, b) for r, b in zip(reach, box, strict=True)]
-    for offset in itertools.product(*(range(-r, r + 1) for r in reach)):
-        inside_box = all(abs(d) <= b for d, b in zip(offset, box, strict=True))
-        inside_sphere = math.dist([d * h for d, h in zip(offset, spacing, strict=True)], [0, 0, 0])
-        if inside_box != (inside_sphere <= horizon * (1 + 1e-12)):
-            return False
-    return True
 
 
 def _material(deck: _Deck, name: str) -> dict:

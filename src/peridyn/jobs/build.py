@@ -183,7 +183,11 @@ def build_bonds(case: Case, body: Body, required=None) -> Bonds:
     """Families of the case's discretisation, with its pre-cracks cut (``required``: the
     points that must have a neighbour, default all; see ``find_bonds``)."""
     d = case.discretization
-    bonds = find_bonds(body, case_horizon(case, body), d.influence, d.partial_volumes, required=required)
+    horizon = case_horizon(case, body)
+    box = None
+    if d.neighbourhood == "box":  # round(horizon / spacing) cells along each axis, halves up
+        box = np.floor(horizon / body.cells[0] + 0.5) * body.cells[0]
+    bonds = find_bonds(body, horizon, d.influence, d.partial_volumes, required=required, box=box)
     for crack in case.precracks:
         if crack.type == "rectangle":
 

@@ -181,6 +181,8 @@ def _check_parallel(case: Case) -> None:
         raise InputError(
             f"an MPI run (mpiexec -n N) is an explicit run for now, not a {case.solver.type} run"
         )
+    if case.discretization.neighbourhood != "sphere":
+        raise CaseFileError(case.name, "discretization.neighbourhood", "box", "sphere in an MPI run")
     if not isinstance(case.output.exodus, bool):
         raise CaseFileError(
             case.name, "output.exodus", case.output.exodus.model_dump(), "true or false in an MPI run"

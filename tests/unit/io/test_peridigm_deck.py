@@ -5,13 +5,15 @@ deck parameter. Decks from tests/data/peridigm (Peridigm's test suite)."""
 import copy
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from peridyn.cli import main
 from peridyn.errors import CaseFileError
-from peridyn.io.case import load_case
+from peridyn.io.case import load_case, validate_case
 from peridyn.io.peridigm_case import convert_deck, deck_case, load_deck
 from peridyn.io.peridigm_deck import is_peridigm_deck, read_deck
+from peridyn.jobs.build import build
 
 DATA = Path(__file__).parents[2] / "data" / "peridigm"
 WAVE = DATA / "WaveInBar.xml"
@@ -120,16 +122,26 @@ def test_refusals_name_the_deck_parameter():
     _refusal(deck, "Solver.Initial Time")
 
 
-def test_box_neighbourhood_unlike_a_sphere_is_refused():
-    """A 3 x 3 x 1 grid of unit cells with horizon 1.2: the box of round(1.2) = 1 cell holds
-    the diagonal neighbour at sqrt(2) = 1.41 m, the sphere does not."""
+def test_pdquickgrid_families_are_boxes():
+    """A 3 x 3 x 1 grid of unit cells with horizon 1.2: PdQuickGrid's box of round(1.2) = 1 cell
+    holds the diagonal neighbours at sqrt(2) = 1.41 m (8 around the centre point), the sphere
+    |xi| <= 1.2 m of ``NeighborhoodType: Spherical`` only the 4 along the axes."""
     deck = read_deck(COMPRESSION)
     grid = deck["Discretization"]["TensorProduct3DMeshGenerator"]
     grid.update({"Number Points X": 3, "Number Points Y": 3, "X Length": 3.0, "Y Length": 3.0})
     deck["Blocks"]["My Group of Blocks"]["Horizon"] = 1.2
+    deck["Boundary Conditions"]["Max X Node Set"] = "9"
+    counts = {}
+    for kind in ("box", "Spherical"):
+        if kind == "Spherical":
+            deck["Discretization"]["NeighborhoodType"] = kind
+        case = validate_case(deck_case(deck, "grid"))
+        assert case.discretization.neighbourhood == ("box" if kind == "box" else "sphere")
+        counts[kind] = np.diff(build(case).bonds.offsets)
+    assert counts["box"][4] == 8 and counts["Spherical"][4] == 4
+    assert counts["box"].tolist() == [3, 5, 3, 5, 8, 5, 3, 5, 3]
+    deck["Discretization"]["NeighborhoodType"] = "Cubic"
     _refusal(deck, "Discretization.NeighborhoodType")
-    deck["Discretization"]["NeighborhoodType"] = "Spherical"
-    assert deck_case(deck, "x")["discretization"]["horizon_m"] == 1.2
 
 
 def test_convert_writes_a_case_that_loads_as_the_deck(tmp_path):
