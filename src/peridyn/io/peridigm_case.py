@@ -39,6 +39,7 @@ SECTIONS = {
     "Solver",
     "Output",
     "Compute Class Parameters",
+    "Damage Models",
 }
 #: Initial-condition kinds of the deck's boundary conditions.
 INITIAL = {"Initial Displacement": "displacement", "Initial Velocity": "velocity"}
@@ -97,13 +98,14 @@ def deck_case(params: dict, name: str, source: str = "<deck>", deck_dir=".") -> 
         if key not in SECTIONS and not key.startswith("Output"):
             raise deck.error(key, None, f"one of the sections peridyn reads: {sorted(SECTIONS)}", False)
     horizon, material_name = _block(deck)
+    group = next(iter(deck.get("Blocks", dict)))
     geometry, discretization, grid = _discretization(deck, deck_dir, horizon)
     case = {
         "name": name,
         "description": f"Peridigm deck {Path(source).name}, translated by peridyn",
         "geometry": geometry,
         "discretization": discretization,
-        "material": _material(deck, material_name),
+        "material": _material(deck, material_name) | _damage(deck, f"Blocks.{group}.Damage Model"),
         "solver": _solver(deck),
     }
     sets, bcs, ics = _conditions(deck, deck_dir, grid, geometry["type"] == "exodus")
@@ -145,8 +147,10 @@ def _block(deck: _Deck) -> tuple[float, str]:
     where = f"Blocks.{group}"
     deck.get(f"{where}.Block Names", str)  # one group of one material and horizon: any blocks
     for key in deck.get(where, dict):
-        if key not in ("Block Names", "Material", "Horizon"):
-            raise deck.error(f"{where}.{key}", None, "Block Names, Material and Horizon only", False)
+        if key not in ("Block Names", "Material", "Horizon", "Damage Model"):
+            raise deck.error(
+                f"{where}.{key}", None, "Block Names, Material, Horizon and Damage Model only", False
+            )
     horizon = deck.get(f"{where}.Horizon", float)
     if not horizon > 0:
         raise deck.error(f"{where}.Horizon", horizon, "a positive horizon (m)")
@@ -215,6 +219,26 @@ def _material(deck: _Deck, name: str) -> dict:
     if deck.get(f"{where}.Apply Shear Correction Factor", bool, False):
         material["surface_correction"] = "shear-factor"
     return material
+
+
+def _damage(deck: _Deck, key: str) -> dict:
+    """``{"damage": {"critical_stretch": s_c}}`` of the block's "Critical Stretch" damage model
+    (a bond breaks once (|y| - |xi|) / |xi| exceeds s_c, as in peridyn), or {} without one."""
+    name = deck.get(key, str, None)
+    if name is None:
+        return {}
+    where = f"Damage Models.{name}"
+    deck.get(where, dict)
+    for param in deck.get(where, dict):
+        if param not in ("Damage Model", "Critical Stretch"):
+            raise deck.error(f"{where}.{param}", None, "Damage Model and Critical Stretch only", False)
+    model = deck.get(f"{where}.Damage Model", str)
+    if model != "Critical Stretch":
+        raise deck.error(f"{where}.Damage Model", model, "'Critical Stretch'")
+    stretch = deck.get(f"{where}.Critical Stretch", float)
+    if not stretch > 0:
+        raise deck.error(f"{where}.Critical Stretch", stretch, "a positive stretch")
+    return {"damage": {"critical_stretch": stretch}}
 
 
 def _solver(deck: _Deck) -> dict:

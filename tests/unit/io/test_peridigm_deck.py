@@ -205,3 +205,17 @@ def test_translation_of_a_quasi_static_text_file_deck():
     deck["Boundary Conditions"]["Node Set One"] = "missing.txt"
     with pytest.raises(CaseFileError, match="Node Set One"):
         deck_case(deck, "x", "deck.xml", folder)
+
+
+def test_critical_stretch_damage():
+    """A block's "Critical Stretch" damage model becomes the material's critical stretch; other
+    damage models are refused naming the parameter."""
+    deck = read_deck(WAVE)
+    deck["Damage Models"] = {"My Damage": {"Damage Model": "Critical Stretch", "Critical Stretch": 5e-4}}
+    deck["Blocks"]["My Group of Blocks"]["Damage Model"] = "My Damage"
+    case = validate_case(deck_case(deck, "wave", str(WAVE), DATA))
+    assert case.material.damage.critical_stretch == 5e-4
+    deck["Damage Models"]["My Damage"]["Damage Model"] = "Time Dependent Critical Stretch"
+    _refusal(deck, "Damage Models.My Damage.Damage Model")
+    deck["Blocks"]["My Group of Blocks"]["Damage Model"] = "Other"
+    _refusal(deck, "Damage Models.Other")
