@@ -149,6 +149,7 @@ def test_convert_writes_a_case_that_loads_as_the_deck(tmp_path):
     out = tmp_path / "case.yaml"
     assert main(["convert", str(WAVE), "-o", str(out)]) == 0
     assert load_case(out) == load_deck(WAVE)
+    assert main(["validate", str(WAVE), "--json"]) == 0  # validate reads decks as run does
     assert convert_deck(WAVE)["geometry"]["file"] == str((DATA / "WaveInBar.g").resolve())
 
 
