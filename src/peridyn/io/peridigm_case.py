@@ -25,8 +25,9 @@ from peridyn.io.exodus_write import PERIDIGM_VARIABLES
 from peridyn.io.peridigm_deck import is_peridigm_deck, read_deck
 from peridyn.physics.expressions import SpaceTime
 
-#: Peridigm's material models that peridyn runs: name -> peridyn model.
-MATERIALS = {"Elastic": "lps", "Linear LPS": "lps", "Elastic Bond Based": "pmb"}
+#: Peridigm's material models that peridyn runs: name -> peridyn model. ("Linear LPS", the
+#: small-displacement LPS, is refused: peridyn's LPS keeps the exact bond extension.)
+MATERIALS = {"Elastic": "lps", "Elastic Bond Based": "pmb"}
 #: Peridigm's influence functions that peridyn has: name -> peridyn name.
 INFLUENCE = {"One": "constant"}
 #: Top-level deck sections read (others are refused by name).

@@ -100,8 +100,9 @@ def test_refusals_name_the_deck_parameter():
     deck["Blocks"]["Other"] = dict(deck["Blocks"]["My Group of Blocks"])
     _refusal(deck, "Blocks")
     deck = copy.deepcopy(base)
-    deck["Materials"]["My Elastic Material"]["Material Model"] = "Viscoplastic"
-    _refusal(deck, "Materials.My Elastic Material.Material Model")
+    for model in ("Viscoplastic", "Linear LPS"):
+        deck["Materials"]["My Elastic Material"]["Material Model"] = model
+        _refusal(deck, "Materials.My Elastic Material.Material Model")
     deck = copy.deepcopy(base)
     deck["Solver"]["Implicit"] = deck["Solver"].pop("Verlet")
     _refusal(deck, "Solver")
