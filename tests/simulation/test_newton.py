@@ -6,12 +6,13 @@ import pytest
 from peridyn.discretization import geometry
 from peridyn.discretization.bonds import find_bonds
 from peridyn.errors import InputError
+from peridyn.linalg.dofs import free_dofs
 from peridyn.physics.damage import BondDamage
 from peridyn.physics.loads import BoundaryCondition, Loading
 from peridyn.physics.materials import make_model
 from peridyn.physics.timefunctions import Constant, Ramp
 from peridyn.solvers import relax
-from peridyn.solvers.newton import newton
+from peridyn.solvers.newton import newton, rigid_support
 
 E_AL, RHO_AL = 70e9, 2700.0
 
@@ -184,3 +185,25 @@ def test_newton_bad_input(kwargs, message):
     model, loading = _bar((0.006, 0.003, 0.003))
     with pytest.raises(InputError, match=message):
         newton(model, loading, **kwargs)
+
+
+def test_absolute_tolerance_stops_on_the_residual_force():
+    """With ``absolute_tolerance`` (N) a solve stops once the out-of-balance force's norm is
+    below it (Peridigm's criterion): a loose one stops earlier than a tight one, and the
+    residual force of each result is below its own tolerance; ``on_step`` sees each step."""
+    model, loading = _bar((0.010, 0.003, 0.003))
+    seen = []
+    loose = newton(
+        model, loading, load_steps=2, absolute_tolerance=1.0, on_step=lambda s, u: seen.append(s.time)
+    )
+    tight = newton(model, loading, load_steps=2, absolute_tolerance=1e-6)
+    assert loose.converged and tight.converged and seen == [0.5, 1.0]
+    assert loose.iterations < tight.iterations
+    vol = model.body.volumes[:, None]
+    free = free_dofs(model, rigid_support(model))  # the free bar's 3-2-1 support
+    b = loading.body_force_density(1.0, np.zeros((model.body.n_points, 3)))
+    for result, tol in ((loose, 1.0), (tight, 1e-6)):
+        residual = (vol * (model.force(result.u) + b)).ravel()[free]
+        assert np.linalg.norm(residual) < tol
+    with pytest.raises(InputError, match="absolute tolerance"):
+        newton(model, loading, absolute_tolerance=0.0)

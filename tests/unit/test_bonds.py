@@ -158,3 +158,25 @@ def test_cut_bonds_cuts_both_copies_of_a_bond_ending_on_the_crack_edge():
     cut = cut_bonds(body, bonds, lambda a, b: crossing_segment(a, b, [-1.0, 0.004], [0.012, 0.004]))
     assert cut > 0
     np.testing.assert_array_equal(bonds.intact, bonds.intact[bonds.reverse()])
+
+
+def test_box_neighbourhood_is_every_point_within_the_half_widths():
+    """``box``: the neighbours of each point are exactly the other points with |x_j - x_i| <=
+    the half-widths along every axis (brute force over all pairs), with no partial volumes
+    and the lengths |xi|; a box asked with partial volumes is refused."""
+    body = geometry.box((0.6, 0.4, 0.3), [0.1, 0.1, 0.1])
+    half = np.array([0.2, 0.1, 0.1])
+    bonds = find_bonds(body, 0.2, partial_volumes=False, box=half)
+    x = body.points
+    near = np.all(np.abs(x[:, None, :] - x[None, :, :]) <= half * (1 + 1e-12), axis=2)
+    np.fill_diagonal(near, False)
+    for i in range(body.n_points):
+        family = bonds.neighbours[bonds.offsets[i] : bonds.offsets[i + 1]]
+        assert family.tolist() == np.flatnonzero(near[i]).tolist()
+    owners = bonds.owners()
+    np.testing.assert_allclose(
+        bonds.length, np.linalg.norm(x[bonds.neighbours] - x[owners], axis=1), rtol=1e-15
+    )
+    assert np.all(bonds.volume_factor == 1.0)
+    with pytest.raises(InputError, match="box neighbourhood"):
+        find_bonds(body, 0.2, box=half)

@@ -14,8 +14,8 @@ import yaml
 
 from peridyn.cli.validate_cmd import check_without_bonds
 from peridyn.errors import CaseFileError, InputError
-from peridyn.jobs.sweep_expr import evaluate
 from peridyn.jobs.sweep_spec import expand
+from peridyn.physics.expressions import evaluate
 
 ROOT = Path(__file__).resolve().parents[2]
 BAR = str(ROOT / "cases" / "bar_pulse.yaml")

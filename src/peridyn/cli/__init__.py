@@ -24,6 +24,7 @@ from peridyn.errors import InputError
 COMMAND_MODULES = (
     "peridyn.cli.run_cmd",
     "peridyn.cli.validate_cmd",
+    "peridyn.cli.convert_cmd",
     "peridyn.cli.demo_cmd",
     "peridyn.cli.bench_cmd",
     "peridyn.cli.lamb_cmd",

@@ -1,4 +1,6 @@
-"""peridyn run CASE.yaml: run a case (a progress bar on a terminal) and print its summary."""
+"""peridyn run CASE.yaml: run a case (a progress bar on a terminal) and print its summary.
+A Peridigm input deck (DECK.xml or DECK.yaml) runs as its translation (peridyn convert;
+docs/peridigm.md)."""
 
 from __future__ import annotations
 
@@ -17,14 +19,14 @@ from peridyn.cli.options import (
     add_progress_flags,
     positive_int,
 )
-from peridyn.io.case import load_case
+from peridyn.io.peridigm_case import load_case_or_deck
 from peridyn.io.provenance import provenance
 from peridyn.parallel.comm import world
 
 
 def register(sub) -> None:
     """Add the ``run`` subcommand."""
-    p = sub.add_parser("run", help="run a case file", description=__doc__)
+    p = sub.add_parser("run", help="run a case file or a Peridigm deck", description=__doc__)
     add_case_arguments(p)
     add_output_flag(p, "output folder (default: the case's output.directory or peridyn-out/<case name>)")
     p.add_argument(
@@ -53,7 +55,7 @@ def run(args) -> dict:
     from peridyn.jobs.estimate import check_memory
     from peridyn.jobs.run import run_case
 
-    case = load_case(args.case, args.overrides)
+    case = load_case_or_deck(args.case, args.overrides)
     check_memory(case, getattr(args, "max_memory", None), Path(args.case).parent)  # demo: no flag
     info = provenance()
     print(

@@ -1,11 +1,12 @@
-"""peridyn validate CASE.yaml: check a case file (and build its body) without running."""
+"""peridyn validate CASE.yaml: check a case file or a Peridigm deck (and build its body) without
+running."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
 from peridyn.cli.options import add_case_arguments, add_common_flags
-from peridyn.io.case import load_case
+from peridyn.io.peridigm_case import load_case_or_deck
 
 
 def register(sub) -> None:
@@ -25,7 +26,7 @@ def run(args) -> dict:
     """Validate all that needs no bonds (memory, regions, placements, loads, signals, the
     time step against its estimate); with --build also construct the bonds and model and
     check the time step against the model's own bound."""
-    case = load_case(args.case, args.overrides)
+    case = load_case_or_deck(args.case, args.overrides)
     summary = {"case": case.name, "valid": True, **check_without_bonds(case, Path(args.case).parent)}
     if args.build:
         from peridyn.jobs.build import build

@@ -136,6 +136,7 @@ def find_bonds(
     partial_volumes: bool = True,
     quadrature_points: int = 8,
     required=None,
+    box=None,
 ) -> Bonds:
     """Search the families of all points and build the CSR bond arrays.
 
@@ -156,6 +157,10 @@ def find_bonds(
         The points that must have a neighbour (default: every point). A rank's part of a
         body (``peridyn.parallel``) requires it of its owned points only: an outer ghost may
         see none of its neighbours.
+    box : (3,) float or None, m
+        Half-widths of a box neighbourhood instead of the sphere: the neighbours are the points
+        with |x_j - x_i| <= box along every axis (Peridigm's PdQuickGrid families); no partial
+        volumes. The influence function still takes ``horizon``.
 
     Raises
     ------
@@ -171,11 +176,17 @@ def find_bonds(
         )
     cells = search_cells(body)
     reach = search_reach(body, horizon, partial_volumes)
+    if box is not None:
+        if partial_volumes:
+            raise InputError("a box neighbourhood has no partial volumes: set partial_volumes false")
+        box = np.asarray(box, dtype=float) * (1 + HORIZON_RTOL)
+        reach = float(np.linalg.norm(box))
     pairs = cKDTree(x).query_pairs(reach, output_type="ndarray")
+    if box is not None:
+        pairs = pairs[np.all(np.abs(x[pairs[:, 1]] - x[pairs[:, 0]]) <= box, axis=1)]
     offsets, j = bond_families(pairs, body.n_points)
-    length, factor = bond_geometry(
-        x, cells, offsets, j, horizon * (1 + HORIZON_RTOL), partial_volumes, quadrature_points
-    )
+    radius = horizon * (1 + HORIZON_RTOL) if box is None else reach
+    length, factor = bond_geometry(x, cells, offsets, j, radius, partial_volumes, quadrature_points)
     if partial_volumes:  # drop neighbours whose cell lies wholly outside the sphere
         keep = factor > 0
         counts = family_sums(offsets, keep).astype(np.int64)

@@ -16,6 +16,7 @@ import yaml
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, ValidationError, model_validator
 
 from peridyn.errors import CaseFileError, InputError, did_you_mean
+from peridyn.io.exodus_write import PERIDIGM_VARIABLES
 from peridyn.physics.loads import parse_components
 
 #: Deepest nesting of collections a YAML text may have (a case nests 5 levels; PyYAML composes
@@ -227,6 +228,9 @@ class Discretization(Strict):
     horizon_m: Positive | None = None
     influence: Literal["constant", "inverse", "gaussian", "conical"] = "constant"
     partial_volumes: bool = True
+    #: ``sphere``: |xi| <= horizon; ``box`` (a box geometry, no partial volumes): the points
+    #: within round(horizon / spacing) cells along each axis, Peridigm's PdQuickGrid families
+    neighbourhood: Literal["sphere", "box"] = "sphere"
 
     @model_validator(mode="after")
     def _one_horizon(self):
@@ -277,9 +281,9 @@ class Material(Strict):
 
 class Region(Strict):
     """A region of points: box (min, max), sphere (center, radius), cylinder (center, radius,
-    axis), face (face, depth), layer (index), or all."""
+    axis), face (face, depth), layer (index), points (0-based ``indices``), or all."""
 
-    type: Literal["box", "sphere", "cylinder", "face", "layer", "all"]
+    type: Literal["box", "sphere", "cylinder", "face", "layer", "points", "all"]
     min: Vector3 | None = None
     max: Vector3 | None = None
     center: Vector3 | None = None
@@ -288,10 +292,13 @@ class Region(Strict):
     face: Literal["x-", "x+", "y-", "y+", "z-", "z+"] | None = None
     depth: Positive | None = None
     index: Index | None = None
+    #: ``points``: 0-based point indices
+    indices: Annotated[list[Annotated[int, NotBool, Field(ge=0)]], Field(min_length=1)] | None = None
 
     @model_validator(mode="after")
     def _complete(self):
         needs = {
+            "points": ("indices",),
             "box": ("min", "max"),
             "sphere": ("center", "radius"),
             "cylinder": ("center", "radius"),
@@ -326,7 +333,9 @@ class Precrack(Strict):
 
 class BoundaryConditionSpec(Strict):
     """A condition on node set ``set``: kind, components ("x", "xy", ...) and a value
-    (a number or a time function mapping, see ``peridyn.physics.timefunctions.from_spec``)."""
+    (a number, a time function mapping, see ``peridyn.physics.timefunctions.from_spec``, or
+    ``{type: expression, text: ...}``, an expression in x, y, z and t evaluated on the set's
+    points, see ``peridyn.physics.expressions``)."""
 
     set: str
     kind: Literal["displacement", "velocity", "force", "body_force"]
@@ -335,12 +344,13 @@ class BoundaryConditionSpec(Strict):
 
 
 class InitialConditionSpec(Strict):
-    """Initial displacement (m) or velocity (m/s) of node set ``set``."""
+    """Initial displacement (m) or velocity (m/s) of node set ``set``: a number or
+    ``{type: expression, text: ...}`` in x, y, z (and t = 0)."""
 
     set: str
     kind: Literal["displacement", "velocity"]
     components: str | list[str] = "xyz"
-    value: Finite = 0.0
+    value: Finite | dict = 0.0
 
 
 class Actuator(Strict):
@@ -401,8 +411,9 @@ class Solver(Strict):
     ``max_iterations`` and ``load_steps`` (the loads at t = 1 s, ramped linearly in steps);
     ``modal``: the ``modes`` lowest free-vibration modes (zero displacement conditions fix
     their dofs; free-free otherwise); ``newton``: Newton-Raphson equilibrium with ``tolerance``
-    (relative residual), ``load_steps``, ``newton_iterations`` per solve and ``breaking_rounds``
-    (re-equilibrations per step after bonds break); ``newmark``: implicit dynamics (average
+    (relative residual), ``load_steps`` (the loads at t = ``time``, default 1 s, ramped),
+    ``newton_iterations`` per solve and ``breaking_rounds`` (re-equilibrations per step after
+    bonds break); ``newmark``: implicit dynamics (average
     acceleration) with ``steps`` or ``time``, ``dt`` (s, required), ``displacement_tolerance``
     (m, Newton increment; seed 004: 0.1 nm), ``newton_iterations`` and ``damping``; both take
     ``linear_solver`` (``lu``, or ``cg`` for large 3D bodies)."""
@@ -421,7 +432,13 @@ class Solver(Strict):
     newton_iterations: Annotated[int, NotBool, Field(ge=1)] = 30
     breaking_rounds: Annotated[int, NotBool, Field(ge=1)] = 100
     displacement_tolerance: Positive = 1e-10
+    #: newton: converged when the residual force's norm (N) is below it, instead of the
+    #: relative ``tolerance`` (Peridigm's "Absolute Tolerance")
+    absolute_tolerance: Positive | None = None
     linear_solver: Literal["lu", "cg"] = "lu"
+    #: explicit: the reported velocity of a DOF with a prescribed displacement, ``rate`` (its
+    #: time function's derivative) or ``difference`` (Peridigm's, see ``ExplicitSolver``)
+    prescribed_velocity: Literal["rate", "difference"] = "rate"
     #: modal: ``shift-invert`` (factorised), ``lobpcg`` (matrix-free) or ``auto`` (by the
     #: estimated factor size, ``jobs.modal.choose_eigensolver``).
     eigensolver: Literal["auto", "shift-invert", "lobpcg"] = "auto"
@@ -455,9 +472,39 @@ class LineSpec(Strict):
     points: Annotated[int, NotBool, Field(ge=2)]
 
 
+class SetSum(Strict):
+    """A global output variable: the sum of the nodal vector ``variable`` over node set ``set``
+    (Peridigm's "Block_Data" compute class with "Calculation Type: Sum")."""
+
+    variable: Literal["Displacement", "Velocity", "Force", "Force_Density", "Acceleration"]
+    set: str
+
+
+class ExodusOutput(Strict):
+    """Exodus II output as Peridigm writes it: the ``variables`` named as Peridigm names them
+    (``peridyn.io.exodus_write.PERIDIGM_VARIABLES``) and the global ``sums`` (name ->
+    ``SetSum``) in ``file`` (in the output folder), at every ``every``-th step from step 0."""
+
+    file: Annotated[str, Field(pattern=r"^[^/\\]+$")] = "results.e"
+    every: Annotated[int, NotBool, Field(ge=1)] = 1
+    variables: Annotated[list[str], Field(min_length=1)]
+    sums: dict[str, SetSum] = {}
+
+    @model_validator(mode="after")
+    def _known(self):
+        for name in self.variables:
+            if name not in PERIDIGM_VARIABLES:
+                raise ValueError(
+                    f"variables: unknown output variable {name!r}{did_you_mean(name, PERIDIGM_VARIABLES)}; "
+                    f"known: {sorted(PERIDIGM_VARIABLES)}"
+                )
+        return self
+
+
 class Output(Strict):
     """Where and what to write (folder default: ``peridyn-out/<case name>``); ``exodus``: also
-    write the snapshots as Exodus II, ``results.e`` (``peridyn.io.exodus_write``)."""
+    write the snapshots as Exodus II, ``results.e`` (``peridyn.io.exodus_write``), or, given
+    as a mapping, Peridigm's named variables (``ExodusOutput``)."""
 
     directory: str | None = None
     every: Annotated[int, NotBool, Field(ge=1)] = 1
@@ -469,7 +516,7 @@ class Output(Strict):
     pzt_sensors: dict[str, PZTSensor] = {}
     series_dtype: Literal["float64", "float32"] = "float64"
     vtu: bool = True
-    exodus: bool = False
+    exodus: bool | ExodusOutput = False
     plots: bool = True
     #: per-point partial stress and Green-Lagrange strain in the final fields and VTU snapshots
     stress: bool = False
@@ -515,6 +562,16 @@ class Case(Strict):
     absorbing: AbsorbingSpec | None = None
 
     @model_validator(mode="after")
+    def _box_neighbourhood(self):
+        d = self.discretization
+        if d.neighbourhood == "box" and (self.geometry.type != "box" or d.partial_volumes):
+            raise ValueError(
+                "discretization.neighbourhood: a box neighbourhood needs a box geometry and "
+                "partial_volumes: false"
+            )
+        return self
+
+    @model_validator(mode="after")
     def _absorbing_solver(self):
         if self.absorbing is not None and self.solver.type != "explicit":
             raise ValueError(
@@ -544,6 +601,8 @@ class Case(Strict):
         used = [(f"boundary_conditions[{i}].set", bc.set) for i, bc in enumerate(self.boundary_conditions)]
         used += [(f"initial_conditions[{i}].set", ic.set) for i, ic in enumerate(self.initial_conditions)]
         used += [(f"output.planes.{k}", v) for k, v in self.output.planes.items()]
+        if not isinstance(self.output.exodus, bool):
+            used += [(f"output.exodus.sums.{k}.set", v.set) for k, v in self.output.exodus.sums.items()]
         if self.material.damage:
             used += [("material.damage.no_damage_sets", s) for s in self.material.damage.no_damage_sets]
         return used

@@ -34,6 +34,25 @@ NUMRECS_OFFSET = 4
 #: Longest name the Exodus library reads.
 MAX_NAME = 255
 COMPONENTS = "XYZ"
+#: Peridigm's output variables that peridyn writes: name -> (placement, vector). Nodal vectors:
+#: displacement (m), velocity (m/s), force (N), force density (N/m^3), acceleration (m/s^2);
+#: element scalars: 1-based id, rank, volume (m^3), dilatation, weighted volume (m^5), stored
+#: elastic energy (J, energy density times volume), number of neighbours and damage.
+PERIDIGM_VARIABLES = {
+    "Displacement": ("nodal", True),
+    "Velocity": ("nodal", True),
+    "Force": ("nodal", True),
+    "Force_Density": ("nodal", True),
+    "Acceleration": ("nodal", True),
+    "Element_Id": ("element", False),
+    "Proc_Num": ("element", False),
+    "Volume": ("element", False),
+    "Dilatation": ("element", False),
+    "Weighted_Volume": ("element", False),
+    "Stored_Elastic_Energy": ("element", False),
+    "Number_Of_Neighbors": ("element", False),
+    "Damage": ("element", False),
+}
 
 
 def component_names(fields: dict[str, int], dim: int) -> list[str]:

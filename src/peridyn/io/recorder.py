@@ -27,7 +27,7 @@ from scipy.spatial import cKDTree
 from peridyn.discretization.body import Body
 from peridyn.discretization.state import State, check_state, runaway_limit
 from peridyn.errors import InputError
-from peridyn.io.exodus_write import ExodusWriter
+from peridyn.io.exodus_write import PERIDIGM_VARIABLES, ExodusWriter
 from peridyn.io.hdf5 import HDF5Writer
 from peridyn.io.vtk import PVDCollection, write_vtu
 
@@ -72,6 +72,16 @@ class RecorderSpec:
         Write the per-point partial stress / Green-Lagrange strain (final fields and VTU).
     exodus : bool
         Write the snapshots to ``results.e`` (``snapshot_exodus``).
+    exodus_file : str
+        The Exodus file's name in the output folder.
+    exodus_every : int or None
+        Steps between Exodus records, written at these steps only (step 0 included); None:
+        at every snapshot.
+    exodus_variables : tuple of str
+        Peridigm's names of the variables written (``peridyn.io.exodus_write.PERIDIGM_VARIABLES``),
+        their values from the recorder's ``fields``; empty: ``snapshot_exodus``'s fields.
+    exodus_sums : dict of name -> (variable, node set name)
+        Global vector variables written with the named ones: a nodal variable's sum over a set.
     """
 
     every: int = 1
@@ -84,6 +94,10 @@ class RecorderSpec:
     series_dtype: str = "float64"
     vtu: bool = True
     exodus: bool = False
+    exodus_file: str = "results.e"
+    exodus_every: int | None = None
+    exodus_variables: tuple = ()
+    exodus_sums: dict = field(default_factory=dict)
     stress: bool = False
     strain: bool = False
 
@@ -95,9 +109,15 @@ class RecorderSpec:
         """True when a field snapshot is written at ``step``."""
         return bool(self.snapshot_every and step % self.snapshot_every == 0) or step in self.snapshot_steps
 
+    def exodus_due(self, step: int) -> bool:
+        """True when the Exodus file gets a record at ``step``."""
+        if not self.exodus:
+            return False
+        return self.snapshot_due(step) if self.exodus_every is None else step % self.exodus_every == 0
+
     def due(self, step: int) -> bool:
         """True when anything is recorded at ``step``."""
-        return self.series_due(step) or self.snapshot_due(step)
+        return self.series_due(step) or self.snapshot_due(step) or self.exodus_due(step)
 
     def output_bytes(self, n_points: int, n_steps: int) -> float:
         """Bytes a run of ``n_steps`` steps on ``n_points`` points writes, about: the probe
@@ -135,6 +155,10 @@ class Recorder:
     resume : (step, time) or None
         Reopen an existing results file and drop the records after this step and
         time (s), for a restart from a checkpoint.
+    fields : callable (state) -> dict, or None
+        The values of ``spec.exodus_variables`` at a state: ``{"nodal": {...}, "element":
+        {...}, "global_": {...}}`` of name -> array, as ``ExodusWriter.append`` takes them;
+        required when variables are named.
     """
 
     def __init__(
@@ -146,6 +170,7 @@ class Recorder:
         damage=None,
         resume: tuple[int, float] | None = None,
         tensors=None,
+        fields=None,
     ):
         self.body = body
         self.directory = Path(directory)
@@ -184,9 +209,17 @@ class Recorder:
         if spec.vtu:
             (self.directory / "snapshots").mkdir(exist_ok=True)
             self.pvd = PVDCollection(self.directory / "snapshots.pvd", mode=mode)
-        self.exodus = (
-            snapshot_exodus(body, self.directory / "results.e", damage is not None) if spec.exodus else None
-        )
+        if spec.exodus_variables and fields is None:
+            raise InputError("named Exodus variables need a fields function: the recorder has none")
+        self.fields = fields
+        self._exodus_step = None  # the step of the last Exodus record
+        self.exodus = None
+        if spec.exodus and spec.exodus_variables:
+            self.exodus = variables_exodus(
+                body, self.directory / spec.exodus_file, spec.exodus_variables, spec.exodus_sums
+            )
+        elif spec.exodus:
+            self.exodus = snapshot_exodus(body, self.directory / spec.exodus_file, damage is not None)
         if resume is not None:
             self.h5.truncate(resume[0])
             if self.pvd is not None:
@@ -218,6 +251,8 @@ class Recorder:
             self.record_series(state)
         if self.spec.snapshot_due(state.step):
             self.snapshot(state)
+        elif self.spec.exodus_every is not None and self.spec.exodus_due(state.step):
+            self.write_exodus(state)
 
     def record_series(self, state: State) -> None:
         """Append one record to every probe series.
@@ -245,8 +280,8 @@ class Recorder:
         InstabilityError, writing nothing, for a non-finite or runaway state."""
         check_state(state, self.max_displacement)
         self.h5.append("field_u", state.step, state.time, state.u)
-        if self.exodus is not None:
-            self.exodus.append(state.time, **exodus_fields(self.body, state, self.damage))
+        if self.exodus is not None and (self.spec.exodus_every is None or self.spec.exodus_due(state.step)):
+            self.write_exodus(state)
         if self.pvd is None:
             return
         data = {"displacement": state.u[:, : self.body.dim], "velocity": state.v[:, : self.body.dim]}
@@ -257,6 +292,17 @@ class Recorder:
         name = f"snapshots/step_{state.step:08d}.vtu"
         write_vtu(self.directory / name, self.body.points[:, : self.body.dim], data)
         self.pvd.add(state.time, name)
+
+    def write_exodus(self, state: State) -> None:
+        """Append ``state`` to the Exodus file (once per step: the end-of-run snapshot of a
+        step already written adds nothing)."""
+        if state.step == self._exodus_step:
+            return
+        self._exodus_step = state.step
+        if self.spec.exodus_variables:
+            self.exodus.append(state.time, **self.fields(state))
+        else:
+            self.exodus.append(state.time, **exodus_fields(self.body, state, self.damage))
 
     def finish(self, state: State) -> None:
         """Write the final state, then close the file."""
@@ -300,6 +346,25 @@ def snapshot_exodus(body: Body, path, damage: bool = False) -> ExodusWriter:
         node_sets=sets,
         nodal={"Displacement": body.dim, "Velocity": body.dim},
         element=element,
+    )
+
+
+def variables_exodus(body: Body, path, variables, sums=None) -> ExodusWriter:
+    """An Exodus writer of Peridigm's named ``variables`` (``PERIDIGM_VARIABLES`` gives each one's
+    placement, nodal or element, and size) and global vectors named by ``sums``' keys, one
+    block, the body's node sets."""
+    fields = {"nodal": {}, "element": {}}
+    for name in variables:
+        placement, vector = PERIDIGM_VARIABLES[name]
+        fields[placement][name] = body.dim if vector else 1
+    sets = {k: v for k, v in body.node_sets.items() if len(v)}
+    return ExodusWriter(
+        path,
+        body.points[:, : body.dim],
+        node_sets=sets,
+        nodal=fields["nodal"],
+        element=fields["element"],
+        global_=dict.fromkeys(sums or {}, body.dim),
     )
 
 

@@ -30,6 +30,7 @@ from peridyn.parallel.halo import Halo, ghost_layers, plan_halo
 from peridyn.parallel.partition import rcb
 from peridyn.physics.contact import Contact
 from peridyn.physics.damage import BondDamage, protected_points
+from peridyn.physics.expressions import SpaceTime
 from peridyn.physics.loads import BoundaryCondition, InitialCondition, Loading
 from peridyn.physics.materials import Model, make_model
 from peridyn.physics.timefunctions import from_spec
@@ -147,10 +148,24 @@ def region_mask(body: Body, region: Region, where: str) -> np.ndarray:
         return in_cylinder(pad(region.center), region.radius, region.axis)(body.points)
     if region.type == "face":
         return geometry.face(body, region.face, region.depth)
+    if region.type == "points":
+        return point_mask(body, region.indices, where)
     try:
         return geometry.layer(body, region.index)
     except InputError as exc:
         raise InputError(f"{where}: {exc}") from None
+
+
+def point_mask(body: Body, indices: list[int], where: str) -> np.ndarray:
+    """(n_points,) bool mask of 0-based point ``indices``; an index past the body is refused."""
+    idx = np.asarray(indices, dtype=np.int64)
+    if idx.max() >= body.n_points:
+        raise InputError(
+            f"{where}.indices: point {int(idx.max())} does not exist (the body has {body.n_points} points)"
+        )
+    mask = np.zeros(body.n_points, dtype=bool)
+    mask[idx] = True
+    return mask
 
 
 def pad3(v) -> list:
@@ -168,7 +183,11 @@ def build_bonds(case: Case, body: Body, required=None) -> Bonds:
     """Families of the case's discretisation, with its pre-cracks cut (``required``: the
     points that must have a neighbour, default all; see ``find_bonds``)."""
     d = case.discretization
-    bonds = find_bonds(body, case_horizon(case, body), d.influence, d.partial_volumes, required=required)
+    horizon = case_horizon(case, body)
+    box = None
+    if d.neighbourhood == "box":  # round(horizon / spacing) cells along each axis, halves up
+        box = np.floor(horizon / body.cells[0] + 0.5) * body.cells[0]
+    bonds = find_bonds(body, horizon, d.influence, d.partial_volumes, required=required, box=box)
     for crack in case.precracks:
         if crack.type == "rectangle":
 
@@ -211,12 +230,35 @@ def build_loading(case: Case, body: Body, extra=()) -> Loading:
     """Boundary and initial conditions of the case (plus ``extra`` ones), checked for conflicts."""
     bcs = [
         BoundaryCondition(
-            bc.set, bc.kind, bc.components, from_spec(bc.value, f"boundary_conditions[{k}].value")
+            bc.set, bc.kind, bc.components, value_function(bc.value, f"boundary_conditions[{k}]")
         )
         for k, bc in enumerate(case.boundary_conditions)
     ]
-    ics = [InitialCondition(ic.set, ic.kind, ic.components, ic.value) for ic in case.initial_conditions]
+    ics = []
+    for k, ic in enumerate(case.initial_conditions):
+        value = ic.value
+        if isinstance(value, dict):
+            where = f"initial_conditions[{k}].value"
+            if value.get("type") != "expression":
+                raise InputError(f"{where}: a number or {{type: expression, text: ...}}, got {value!r}")
+            at = body.points[body.node_set(ic.set)]
+            values = value_function(value, f"initial_conditions[{k}]").at(at, 0.0)
+            value = np.repeat(values[:, None], len(ic.components), axis=1)
+        ics.append(InitialCondition(ic.set, ic.kind, ic.components, value))
     return Loading(body, [*extra, *bcs], ics)
+
+
+def value_function(spec, where: str):
+    """The time function of a condition's ``value`` (``from_spec``), or for ``{type:
+    expression, text}`` its expression in x, y, z and t (``SpaceTime``)."""
+    if not (isinstance(spec, dict) and spec.get("type") == "expression"):
+        return from_spec(spec, f"{where}.value")
+    if set(spec) != {"type", "text"} or not isinstance(spec["text"], str):
+        raise InputError(f"{where}.value: an expression takes one 'text' (a string), got {spec!r}")
+    try:
+        return SpaceTime(spec["text"])
+    except InputError as exc:
+        raise InputError(f"{where}.value: {exc}") from None
 
 
 def check_placements(case: Case, body: Body) -> None:

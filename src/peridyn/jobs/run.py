@@ -25,6 +25,7 @@ from peridyn.io.outdir import end_status, prepare_output
 from peridyn.io.provenance import package_version, provenance
 from peridyn.io.recorder import LineProbe, Recorder, RecorderSpec
 from peridyn.jobs.build import Setup, build, pad3
+from peridyn.jobs.exodus_variables import check_variables, variable_values
 from peridyn.jobs.figures import draw_crack_figures, draw_run_figures, final_crack_paths
 from peridyn.jobs.lamb_analysis import analyse
 from peridyn.jobs.summary import finish_summary
@@ -55,8 +56,21 @@ def recorder_spec(case: Case, body: Body, dt: float) -> RecorderSpec:
         vtu=out.vtu,
         stress=out.stress,
         strain=out.strain,
-        exodus=out.exodus,
+        **exodus_spec(out.exodus),
     )
+
+
+def exodus_spec(exodus) -> dict:
+    """The recorder's Exodus settings of ``output.exodus`` (a bool or an ``ExodusOutput``)."""
+    if isinstance(exodus, bool):
+        return {"exodus": exodus}
+    return {
+        "exodus": True,
+        "exodus_file": exodus.file,
+        "exodus_every": exodus.every,
+        "exodus_variables": tuple(exodus.variables),
+        "exodus_sums": {k: (v.variable, v.set) for k, v in exodus.sums.items()},
+    }
 
 
 def _pzt_weights(body: Body, sensor) -> tuple[np.ndarray, np.ndarray]:
@@ -167,6 +181,12 @@ def _check_parallel(case: Case) -> None:
         raise InputError(
             f"an MPI run (mpiexec -n N) is an explicit run for now, not a {case.solver.type} run"
         )
+    if case.discretization.neighbourhood != "sphere":
+        raise CaseFileError(case.name, "discretization.neighbourhood", "box", "sphere in an MPI run")
+    if not isinstance(case.output.exodus, bool):
+        raise CaseFileError(
+            case.name, "output.exodus", case.output.exodus.model_dump(), "true or false in an MPI run"
+        )
     for key in ("stress", "strain"):
         if getattr(case.output, key):
             raise CaseFileError(case.name, f"output.{key}", True, "false in an MPI run (not written yet)")
@@ -189,6 +209,15 @@ def point_tensors(setup: Setup, spec: RecorderSpec):
         return out
 
     return fields
+
+
+def exodus_values(case: Case, setup: Setup, spec: RecorderSpec):
+    """The recorder's ``fields``: the values of the named Exodus variables (``output.exodus``
+    as a mapping) at a state, or None without them. Serial runs (the whole model)."""
+    if not spec.exodus_variables:
+        return None
+    check_variables(case.name, setup.model, spec.exodus_variables)
+    return variable_values(setup.model, spec.exodus_variables, spec.exodus_sums)
 
 
 def step_count(case: Case, solver) -> int:
@@ -327,6 +356,7 @@ def time_stepper(case, setup):
         damage=setup.damage,
         contact=setup.contact,
         domain=setup.domain,
+        prescribed_velocity=s.prescribed_velocity,
     )
 
 
@@ -362,7 +392,10 @@ def _run_explicit(case, setup, solver, out, case_path, checkpoint_every, restart
     if d.size > 1:
         info.update(d.provenance())
     tensors = point_tensors(setup, spec)
-    recorder = d.on_root(Recorder, setup.whole_body, out, spec, info, gathered.damage, resume, tensors)
+    fields = exodus_values(case, setup, spec)
+    recorder = d.on_root(
+        Recorder, setup.whole_body, out, spec, info, gathered.damage, resume, tensors, fields
+    )
     checkpointer, prepare = _checkpointer(
         ckpt_path, checkpoint_every or n_steps + 1, setup, meta, parts, whole_bonds
     )
@@ -518,18 +551,26 @@ def _run_static(case, setup, out, case_path) -> dict:
     )
 
 
-def _record_equilibrium(case, setup, out, case_path, u, results: dict) -> dict:
-    """Record a quasi-static solution ``u`` as one state at t = 1 s; the run's summary."""
-    state = State(u, np.zeros_like(u), np.zeros_like(u), 1.0, results["steps"])
+def _equilibrium_recorder(case, setup, out, case_path) -> Recorder:
+    """The recorder of a quasi-static run."""
     spec = recorder_spec(case, setup.body, 1.0)
-    recorder = Recorder(
+    return Recorder(
         setup.body,
         out,
         spec,
         provenance(case_path, case=case),
         lambda: damage_field(setup.model),
         tensors=point_tensors(setup, spec),
+        fields=exodus_values(case, setup, spec),
     )
+
+
+def _record_equilibrium(case, setup, out, case_path, u, results: dict, recorder=None, time=1.0) -> dict:
+    """Record a quasi-static solution ``u`` as one state at ``time`` (s; ``recorder``: the
+    run's, else a new one); the run's summary."""
+    state = State(u, np.zeros_like(u), np.zeros_like(u), time, results["steps"])
+    if recorder is None:
+        recorder = _equilibrium_recorder(case, setup, out, case_path)
     recorder.record_series(state)
     recorder.snapshot(state)
     summary = _base_summary(setup)
@@ -561,15 +602,21 @@ def _run_newton(case, setup, out, case_path) -> dict:
     from peridyn.solvers.newton import newton
 
     s = case.solver
+    end = s.time if s.time is not None else 1.0
+    recorder = _equilibrium_recorder(case, setup, out, case_path)
+    on_step = _load_step_records(recorder, setup.loading, end / s.load_steps)
     result = newton(
         setup.model,
         setup.loading,
         load_steps=s.load_steps,
+        time=end,
         tolerance=s.tolerance,
         max_iterations=s.newton_iterations,
         damage=setup.damage,
         max_breaking_rounds=s.breaking_rounds,
         linear_solver=s.linear_solver,
+        absolute_tolerance=s.absolute_tolerance,
+        on_step=on_step,
     )
     if not result.converged:
         step = len(result.steps)
@@ -591,4 +638,30 @@ def _run_newton(case, setup, out, case_path) -> dict:
             "residual": result.residual,
             "residual_history": [step.residuals for step in result.steps],
         },
+        recorder,
+        end,
     )
+
+
+def _load_step_records(recorder: Recorder, loading, step_time: float):
+    """Newton's ``on_step`` writing the Exodus records that ``output.exodus`` asks at its load
+    steps (with the state at t = 0 first), as Peridigm's quasi-static solver writes them: the
+    load step as the step, velocity the displacement's change over the step's time
+    ``step_time`` (s), acceleration zero; at t = 0 the initial conditions. None when the
+    Exodus file is written at the end only."""
+    spec = recorder.spec
+    if spec.exodus_every is None:
+        return None
+    u0, v0, zero = (np.zeros((loading.body.n_points, 3)) for _ in range(3))
+    loading.apply_initial(u0, v0)
+    recorder.write_exodus(State(u0, v0, zero, 0.0, 0))
+    last = {"u": u0}
+
+    def on_step(step, u):
+        k = int(round(step.time / step_time))
+        if spec.exodus_due(k):
+            v = (u - last["u"]) / step_time
+            recorder.write_exodus(State(u, v, zero, step.time, k))
+        last["u"] = u.copy()
+
+    return on_step

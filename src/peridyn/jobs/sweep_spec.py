@@ -7,7 +7,7 @@ compared with by MAC), ``set`` (overrides for every run), ``vary`` (one block or
 blocks, combined as a product; a block is ``product``,
 ``zip``, ``list`` or ``random``), ``labels`` (varied names that are not case entries, e.g. a
 damage type, usable in expressions), ``derived`` (case entries computed from the others with
-the expressions of :mod:`peridyn.jobs.sweep_expr`, in order), ``derived_by`` (more derived
+the expressions of :mod:`peridyn.physics.expressions`, in order), ``derived_by`` (more derived
 entries chosen by the value of a label: ``{label: {value: {key: expression}}}``) and
 ``outputs`` (which summary scalars and which results series to collect). A parameter is named
 by its ``--set`` path (``material.E``, ``precracks.0.end.1``). docs/sweeps.md describes the
@@ -35,7 +35,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_valida
 from peridyn.errors import CaseFileError, InputError
 from peridyn.io.case import Case, apply_override, load_case, parse_yaml, validate_case, yaml_problem
 from peridyn.jobs.run import case_identity
-from peridyn.jobs.sweep_expr import evaluate
+from peridyn.physics.expressions import evaluate
 
 #: The jobs a sweep's runs can be (``bloch``: only the Bloch prediction of the case's
 #: discretisation, no simulation).

@@ -9,7 +9,8 @@ Kinds of boundary condition:
 - ``body_force``: body-force density b[set, c] = profile * f(t) (N/m^3).
 
 ``profile`` is an optional spatial amplitude, (n_set,) or (n_set, n_components),
-e.g. the radial displacement field of a PZT patch.
+e.g. the radial displacement field of a PZT patch. ``f`` may instead be an expression in
+x, y, z and t (``peridyn.physics.expressions.SpaceTime``), evaluated on the set's points.
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ import numpy as np
 
 from peridyn.discretization.body import Body
 from peridyn.errors import InputError, did_you_mean
+from peridyn.physics.expressions import SpaceTime
 from peridyn.physics.timefunctions import Constant, TimeFunction
 
 BC_KINDS = ("displacement", "velocity", "force", "body_force")
@@ -53,7 +55,7 @@ class BoundaryCondition:
     node_set: str
     kind: str
     components: tuple = (0, 1, 2)
-    function: TimeFunction = field(default_factory=lambda: Constant(0.0))
+    function: TimeFunction | SpaceTime = field(default_factory=lambda: Constant(0.0))
     profile: np.ndarray | None = None
 
     def __post_init__(self):
@@ -84,8 +86,21 @@ class InitialCondition:
 class _Bound:
     index: np.ndarray  # (n_set,) point indices
     components: tuple
-    function: TimeFunction
+    function: TimeFunction | SpaceTime
     amplitude: np.ndarray  # (n_set, n_comp)
+    points: np.ndarray | None = None  # (n_set, 3) m, the set's points for a SpaceTime function
+
+    def value(self, t: float) -> np.ndarray:
+        """amplitude * f(t), (n_set, n_comp)."""
+        if self.points is None:
+            return self.amplitude * self.function(t)
+        return self.amplitude * self.function.at(self.points, t)[:, None]
+
+    def rate(self, t: float, dt: float) -> np.ndarray:
+        """amplitude * f'(t) by f's central difference, (n_set, n_comp)."""
+        if self.points is None:
+            return self.amplitude * self.function.derivative(t, dt)
+        return self.amplitude * self.function.derivative(self.points, t, dt)[:, None]
 
 
 class Loading:
@@ -137,9 +152,9 @@ class Loading:
 
     def _bind(self, bc: BoundaryCondition) -> _Bound:
         idx = self.body.node_set(bc.node_set)
-        return _Bound(
-            idx, bc.components, bc.function, _amplitude(bc.profile, len(idx), len(bc.components), bc.node_set)
-        )
+        amplitude = _amplitude(bc.profile, len(idx), len(bc.components), bc.node_set)
+        points = self.body.points[idx] if isinstance(bc.function, SpaceTime) else None
+        return _Bound(idx, bc.components, bc.function, amplitude, points)
 
     def _bind_initial(self, ic: InitialCondition) -> _Bound:
         idx = self.body.node_set(ic.node_set)
@@ -156,7 +171,8 @@ class Loading:
         def restrict(b: _Bound) -> _Bound:
             local = new_index[b.index]
             keep = local >= 0
-            return _Bound(local[keep], b.components, b.function, b.amplitude[keep])
+            points = None if b.points is None else b.points[keep]
+            return _Bound(local[keep], b.components, b.function, b.amplitude[keep], points)
 
         part = Loading(body)
         part.displacement = [restrict(b) for b in self.displacement]
@@ -178,30 +194,41 @@ class Loading:
             target = u if kind == "displacement" else v
             target[np.ix_(b.index, list(b.components))] = b.amplitude
 
-    def apply_start(self, dt: float, u: np.ndarray, v: np.ndarray) -> None:
+    def apply_start(self, dt: float, u: np.ndarray, v: np.ndarray, rates: bool = True) -> None:
         """The state of a dynamic run at t = 0 (IN/OUT): initial conditions, then the
-        prescribed displacements and velocities at t = 0 (``dt``: step, for derivatives)."""
+        prescribed displacements and velocities at t = 0 (``dt``: step, for derivatives;
+        ``rates``: see ``apply_kinematics``)."""
         self.apply_initial(u, v)
-        self.apply_kinematics(0.0, dt, u, v)
+        self.apply_kinematics(0.0, dt, u, v, rates)
         self.apply_velocities(0.0, v)
 
-    def apply_kinematics(self, t: float, dt: float, u: np.ndarray, v: np.ndarray) -> None:
-        """Impose the prescribed displacements (and their velocity) at time ``t`` (IN/OUT)."""
+    def apply_kinematics(self, t: float, dt: float, u: np.ndarray, v: np.ndarray, rates: bool = True) -> None:
+        """Impose the prescribed displacements at time ``t`` (IN/OUT) and, with ``rates``,
+        their velocity (the time function's central difference over ``dt``)."""
         for b in self.displacement:
             cols = list(b.components)
-            u[np.ix_(b.index, cols)] = b.amplitude * b.function(t)
-            v[np.ix_(b.index, cols)] = b.amplitude * b.function.derivative(t, dt)
+            u[np.ix_(b.index, cols)] = b.value(t)
+            if rates:
+                v[np.ix_(b.index, cols)] = b.rate(t, dt)
+
+    @property
+    def displaced(self) -> np.ndarray:
+        """(n_points, 3) bool: the DOFs with a prescribed displacement."""
+        mask = np.zeros((self.body.n_points, 3), dtype=bool)
+        for b in self.displacement:
+            mask[np.ix_(b.index, list(b.components))] = True
+        return mask
 
     def apply_velocities(self, t: float, v: np.ndarray) -> None:
         """Impose the prescribed velocities at time ``t`` (IN/OUT ``v``)."""
         for b in self.velocity:
-            v[np.ix_(b.index, list(b.components))] = b.amplitude * b.function(t)
+            v[np.ix_(b.index, list(b.components))] = b.value(t)
 
     def body_force_density(self, t: float, out: np.ndarray) -> np.ndarray:
         """External body-force density at ``t``, N/m^3, written into ``out`` (n_points, 3)."""
         out[:] = 0.0
         for b in self.body_force:
-            out[np.ix_(b.index, list(b.components))] += b.amplitude * b.function(t)
+            out[np.ix_(b.index, list(b.components))] += b.value(t)
         return out
 
 

@@ -52,6 +52,11 @@ class ExplicitSolver:
         The rank's part of the body under MPI (``peridyn.parallel``): the model, loading and
         damping are the rank's, u's ghost rows are exchanged after every update of u, and the
         stable step, checks and energies are taken over the whole body. None: one process.
+    prescribed_velocity : {"rate", "difference"}
+        The velocity of a DOF with a prescribed displacement: ``rate``, the central difference
+        of its time function (peridyn's); ``difference``, Peridigm's (u(n+1) - u(n)) / dt +
+        dt/2 a(n+1), a the acceleration of the forces on the point (zero at t = 0, where it
+        keeps its initial velocity). Either way the motion of every point is the same.
     """
 
     def __init__(
@@ -65,7 +70,12 @@ class ExplicitSolver:
         check_every: int = 10,
         contact: Contact | None = None,
         domain: Domain | None = None,
+        prescribed_velocity: str = "rate",
     ):
+        if prescribed_velocity not in ("rate", "difference"):
+            raise InputError(
+                f"prescribed_velocity must be 'rate' or 'difference', got {prescribed_velocity!r}"
+            )
         if not 0 < safety <= 1:
             raise InputError(f"time-step safety factor must lie in (0, 1], got {safety!r}")
         damping = _damping_coefficients(damping, model.body.n_points)
@@ -96,6 +106,9 @@ class ExplicitSolver:
         self._force = np.zeros((n, 3), dtype=model.dtype)
         self._body_force = np.zeros((n, 3))
         self._inv_rho = (1.0 / model.density)[:, None]
+        #: the DOFs whose velocity is Peridigm's difference, and their force acceleration
+        self._differenced = self.loading.displaced if prescribed_velocity == "difference" else None
+        self._free = None
 
     def __repr__(self) -> str:
         damping = self.damping if np.isscalar(self.damping) else f"up to {np.max(self.damping):g}"
@@ -104,7 +117,7 @@ class ExplicitSolver:
     def initial_state(self) -> State:
         """The state at t = 0: initial conditions applied and accelerations computed."""
         state = State.zeros(self.model.body.n_points)
-        self.loading.apply_start(self.dt, state.u, state.v)
+        self.loading.apply_start(self.dt, state.u, state.v, rates=self._differenced is None)
         self.domain.exchange(state.u)
         self._acceleration(state)
         return state
@@ -119,21 +132,28 @@ class ExplicitSolver:
         a *= self._inv_rho
         if self._damping is not None:
             a -= self._damping * state.v
+        if self._differenced is not None:
+            self._free = a[self._differenced]
         a[self.loading.constrained] = 0.0
 
     def step(self, state: State) -> int:
         """Advance ``state`` by one step in place; returns the number of bonds broken."""
         dt = self.dt
+        differenced = self._differenced
+        if differenced is not None:
+            u_before = state.u[differenced]
         state.v += 0.5 * dt * state.a
         state.u += dt * state.v
         state.time += dt
         state.step += 1
-        self.loading.apply_kinematics(state.time, dt, state.u, state.v)
+        self.loading.apply_kinematics(state.time, dt, state.u, state.v, rates=differenced is None)
         self.domain.exchange(state.u)
         broken = self.damage.update(state.u) if self.damage is not None else 0
         self._acceleration(state)
         state.v += 0.5 * dt * state.a
         self.loading.apply_velocities(state.time, state.v)
+        if differenced is not None:
+            state.v[differenced] = (state.u[differenced] - u_before) / dt + 0.5 * dt * self._free
         if state.step % self.check_every == 0:
             self.domain.check_state(state, self.max_displacement)
         return broken

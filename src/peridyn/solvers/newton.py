@@ -97,6 +97,8 @@ def newton(
     damage: BondDamage | None = None,
     max_breaking_rounds: int = 100,
     linear_solver: str = "lu",
+    absolute_tolerance: float | None = None,
+    on_step=None,
 ) -> NewtonResult:
     """Equilibrium under the loads ramped in ``load_steps`` steps up to ``time`` (s).
 
@@ -114,7 +116,14 @@ def newton(
         Re-equilibrations allowed per load step.
     linear_solver : {"lu", "cg"}
         Sparse LU, or Jacobi-preconditioned conjugate gradients for large systems.
+    absolute_tolerance : float or None, N
+        Converged when the norm of the out-of-balance force at the free dofs is below it
+        (Peridigm's "Absolute Tolerance"), instead of the relative ``tolerance``.
+    on_step : callable (NewtonStep, u) or None
+        Called after each converged load step with its displacement (n_points, 3), m.
     """
+    if absolute_tolerance is not None and not absolute_tolerance > 0:
+        raise InputError(f"Newton absolute tolerance must be positive, got {absolute_tolerance!r}")
     if not tolerance > 0:
         raise InputError(f"Newton tolerance must be positive, got {tolerance!r}")
     for name, value in (
@@ -141,7 +150,7 @@ def newton(
         step = NewtonStep(t)
         for _ in range(max_breaking_rounds + 1):
             u, history, converged = equilibrate(
-                model, u, b, loading.constrained, tolerance, max_iterations, linear_solver
+                model, u, b, loading.constrained, tolerance, max_iterations, linear_solver, absolute_tolerance
             )
             step.residuals.append(history)
             iterations += len(history) - 1
@@ -157,6 +166,8 @@ def newton(
         steps.append(step)
         if not step.converged:
             break
+        if on_step is not None:
+            on_step(step, u)
     converged = len(steps) == load_steps and steps[-1].converged
     return NewtonResult(u, float(residual), iterations, converged, broken_total, steps)
 
@@ -169,11 +180,13 @@ def equilibrate(
     tolerance: float,
     max_iterations: int,
     linear_solver: str = "lu",
+    absolute_tolerance: float | None = None,
 ) -> tuple[np.ndarray, list, bool]:
     """Newton iterations at fixed loads from ``u`` (n, 3), m; ``b`` body force density N/m^3.
 
     Returns the displacement, the relative residual before each iteration and at the
-    end, and whether it converged.
+    end, and whether it converged (the relative residual below ``tolerance`` or, when
+    ``absolute_tolerance`` (N) is given, the residual force's norm below it).
     """
     u = u.copy()
     vol = np.repeat(model.body.volumes, 3)
@@ -191,7 +204,9 @@ def equilibrate(
         history.append(residual)
         if not np.isfinite(residual):
             return u, history, False
-        if residual < tolerance:
+        if absolute_tolerance is None and residual < tolerance:
+            return u, history, True
+        if absolute_tolerance is not None and np.linalg.norm(r) < absolute_tolerance:
             return u, history, True
         if it == max_iterations:
             break

@@ -1,7 +1,11 @@
-"""The small arithmetic language of a sweep's ``derived:`` values.
+"""A small, safe arithmetic language: a sweep's ``derived:`` values and the values of boundary
+conditions given as expressions in x, y, z (m) and t (s) (``SpaceTime``, e.g. a Peridigm
+deck's ``"0.001*y*t/1.0e-8"``).
 
 An expression is numbers, names, ``+ - * / **``, unary minus, brackets, list indexing by a whole
-number (``geometry.size[0]``) and the functions ``min``, ``max``, ``abs``, ``sqrt``, ``round``.
+number (``geometry.size[0]``) and the functions ``min``, ``max``, ``abs``, ``sqrt``, ``round``,
+``sin``, ``cos``, ``exp``, ``log``; names may stand for NumPy arrays, and the whole
+expression is then evaluated element by element (``min``/``max`` of arrays element-wise).
 A name is a dotted path (``discretization.spacing``, ``crack_cells``; ``precracks[0].end[1]``
 for ``precracks.0.end.1``): ``lookup(path)`` gives its value (a varied parameter, or a case
 entry). Nothing else is accepted: the text is parsed with :mod:`ast` and only these nodes are
@@ -18,6 +22,9 @@ from __future__ import annotations
 import ast
 import math
 import operator
+from dataclasses import dataclass
+
+import numpy as np
 
 from peridyn.errors import InputError
 
@@ -28,7 +35,35 @@ _BINARY = {
     ast.Div: operator.truediv,
     ast.Pow: operator.pow,
 }
-_FUNCTIONS = {"min": min, "max": max, "abs": abs, "sqrt": math.sqrt, "round": round}
+
+
+def _either(scalar, array):
+    """A function that is ``scalar`` on plain numbers (their values and types unchanged) and
+    ``array`` as soon as one argument is a NumPy array."""
+
+    def call(*args):
+        if any(isinstance(a, np.ndarray) for a in args):
+            return array(*args)
+        return scalar(*args)
+
+    return call
+
+
+def _elementwise(reduce):
+    return lambda *args: reduce(np.broadcast_arrays(*args), axis=0)
+
+
+_FUNCTIONS = {
+    "min": _either(min, _elementwise(np.min)),
+    "max": _either(max, _elementwise(np.max)),
+    "abs": _either(abs, np.abs),
+    "sqrt": _either(math.sqrt, np.sqrt),
+    "round": _either(round, np.round),
+    "sin": _either(math.sin, np.sin),
+    "cos": _either(math.cos, np.cos),
+    "exp": _either(math.exp, np.exp),
+    "log": _either(math.log, np.log),
+}
 
 
 def evaluate(text: str, lookup):
@@ -112,3 +147,41 @@ def _eval(node, lookup, text):
         f"expression {text!r}: {ast.unparse(node)!r} is not allowed (numbers, names, + - * / **, "
         f"[index] and {', '.join(_FUNCTIONS)} only)"
     )
+
+
+#: The names of a space-time expression.
+SPACE_TIME_NAMES = ("x", "y", "z", "t")
+
+
+@dataclass(frozen=True)
+class SpaceTime:
+    """A value given by an expression ``text`` in the coordinates x, y, z (m) of a point and
+    the time t (s), e.g. a prescribed displacement ``0.001*y*t/1.0e-8`` (m).
+
+    >>> SpaceTime("2*x + t").at(np.array([[1.0, 0, 0], [3.0, 0, 0]]), 0.5).tolist()
+    [2.5, 6.5]
+    """
+
+    text: str
+
+    def __post_init__(self):
+        self.at(np.zeros((1, 3)), 0.0)  # refuses a bad expression or an unknown name now
+
+    def at(self, points: np.ndarray, t: float) -> np.ndarray:
+        """(n,) values at the points (n, 3), m, at time ``t`` (s)."""
+        names = {"x": points[:, 0], "y": points[:, 1], "z": points[:, 2], "t": float(t)}
+
+        def lookup(name):
+            if name not in names:
+                raise InputError(f"expression {self.text!r}: unknown name {name!r}; use x, y, z and t")
+            return names[name]
+
+        with np.errstate(all="ignore"):
+            value = np.broadcast_to(np.asarray(evaluate(self.text, lookup), dtype=float), len(points))
+        if not np.all(np.isfinite(value)):
+            raise InputError(f"expression {self.text!r}: not finite at t = {t:g} s on some points")
+        return value
+
+    def derivative(self, points: np.ndarray, t: float, dt: float) -> np.ndarray:
+        """(n,) central difference in time, (f(t + dt/2) - f(t - dt/2)) / dt, as time functions have."""
+        return (self.at(points, t + 0.5 * dt) - self.at(points, t - 0.5 * dt)) / dt

@@ -1,0 +1,432 @@
+"""A Peridigm deck (``peridyn.io.peridigm_deck.read_deck``) as a peridyn case (``deck_case``).
+
+The case dict that ``deck_case`` returns is one that ``peridyn.io.case.validate_case`` accepts
+(``peridyn convert DECK`` writes it as YAML), with each of Peridigm's conventions written out
+as a case key: the PdQuickGrid cells as a box geometry, |xi| <= horizon families without
+partial volumes, the material constants from the bulk and shear moduli, the step count
+floor((final - initial) / dt), and Exodus output of the deck's variables, under Peridigm's
+names, in ``<Output Filename>.e`` at the deck's output frequency (docs/peridigm.md).
+
+Anything a deck asks that peridyn cannot do is a ``CaseFileError`` naming the deck parameter
+(``Blocks`` with several blocks, ``Solver.Verlet`` without ``Fixed dt``, an unknown material
+model, a contact section, ...).
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from peridyn.errors import CaseFileError, InputError
+from peridyn.io.case import Case, apply_override, load_case, validate_case
+from peridyn.io.exodus_write import PERIDIGM_VARIABLES
+from peridyn.io.peridigm_deck import is_peridigm_deck, read_deck
+from peridyn.physics.expressions import SpaceTime
+
+#: Peridigm's material models that peridyn runs: name -> peridyn model. ("Linear LPS", the
+#: small-displacement LPS, is refused: peridyn's LPS keeps the exact bond extension.)
+MATERIALS = {"Elastic": "lps", "Elastic Bond Based": "pmb"}
+#: Peridigm's influence functions that peridyn has: name -> peridyn name.
+INFLUENCE = {"One": "constant"}
+#: Top-level deck sections read (others are refused by name).
+SECTIONS = {
+    "Verbose",
+    "Discretization",
+    "Materials",
+    "Blocks",
+    "Boundary Conditions",
+    "Solver",
+    "Output",
+    "Compute Class Parameters",
+    "Damage Models",
+}
+#: Initial-condition kinds of the deck's boundary conditions.
+INITIAL = {"Initial Displacement": "displacement", "Initial Velocity": "velocity"}
+#: Boundary-condition kinds of the deck's boundary conditions.
+BOUNDARY = {"Prescribed Displacement": "displacement", "Body Force": "body_force"}
+
+
+class _Deck:
+    """Access to a deck's parameters that names the parameter in every error."""
+
+    def __init__(self, params: dict, source: str):
+        self.params, self.source = params, source
+
+    def error(self, key: str, value, expected: str, has_value: bool = True) -> CaseFileError:
+        return CaseFileError(self.source, key, value, expected, has_value=has_value)
+
+    def get(self, key: str, kind=None, default=...):
+        """The value at the dotted path ``key`` (names may hold spaces, not dots)."""
+        node = self.params
+        for part in key.split("."):
+            if not isinstance(node, dict) or part not in node:
+                if default is not ...:
+                    return default
+                raise self.error(key, None, "a parameter that the deck must give", has_value=False)
+            node = node[part]
+        if kind is float and isinstance(node, int) and not isinstance(node, bool):
+            node = float(node)
+        if kind is not None and (not isinstance(node, kind) or (kind is not bool and isinstance(node, bool))):
+            raise self.error(key, node, f"a {getattr(kind, '__name__', kind)}")
+        return node
+
+
+def deck_case(params: dict, name: str, source: str = "<deck>", deck_dir=".") -> dict:
+    """The peridyn case (a dict for ``validate_case``) of a deck's parameters.
+
+    Parameters
+    ----------
+    params : dict
+        The deck, as ``read_deck`` gives it.
+    name : str
+        The case name (``peridyn convert`` and ``peridyn run`` use the deck's file stem).
+    source : str
+        The deck's path, for error messages.
+    deck_dir : path
+        The folder that the deck's mesh and node-set files are relative to; the case refers to
+        the mesh by its absolute path.
+
+    Raises
+    ------
+    CaseFileError
+        Naming the deck parameter that peridyn cannot run or that is missing.
+    """
+    deck = _Deck(params, source)
+    deck_dir = Path(deck_dir)
+    for key in params:
+        if key not in SECTIONS and not key.startswith("Output"):
+            raise deck.error(key, None, f"one of the sections peridyn reads: {sorted(SECTIONS)}", False)
+    horizon, material_name = _block(deck)
+    group = next(iter(deck.get("Blocks", dict)))
+    geometry, discretization, grid = _discretization(deck, deck_dir, horizon)
+    case = {
+        "name": name,
+        "description": f"Peridigm deck {Path(source).name}, translated by peridyn",
+        "geometry": geometry,
+        "discretization": discretization,
+        "material": _material(deck, material_name) | _damage(deck, f"Blocks.{group}.Damage Model"),
+        "solver": _solver(deck),
+    }
+    sets, bcs, ics = _conditions(deck, deck_dir, grid, geometry["type"] == "exodus")
+    if sets:
+        case["node_sets"] = sets
+    if bcs:
+        case["boundary_conditions"] = bcs
+    if ics:
+        case["initial_conditions"] = ics
+    case["output"] = _output(deck, case["material"]["model"], _compute_classes(deck))
+    return case
+
+
+def _compute_classes(deck: _Deck) -> dict:
+    """Output label -> ``{variable, set}`` of each "Block_Data" sum of ``Compute Class Parameters``."""
+    out = {}
+    for name in deck.get("Compute Class Parameters", dict, {}):
+        where = f"Compute Class Parameters.{name}"
+        for key, expected in (("Compute Class", "Block_Data"), ("Calculation Type", "Sum")):
+            value = deck.get(f"{where}.{key}", str)
+            if value != expected:
+                raise deck.error(f"{where}.{key}", value, f"{expected!r} (the one compute class peridyn has)")
+        variable = deck.get(f"{where}.Variable", str)
+        if PERIDIGM_VARIABLES.get(variable) != ("nodal", True):
+            raise deck.error(f"{where}.Variable", variable, "a nodal vector variable, e.g. Force")
+        out[deck.get(f"{where}.Output Label", str)] = {
+            "variable": variable,
+            "set": deck.get(f"{where}.Block", str),
+        }
+    return out
+
+
+def _block(deck: _Deck) -> tuple[float, str]:
+    """The one block's horizon (m) and material name."""
+    blocks = deck.get("Blocks", dict)
+    if len(blocks) != 1:
+        raise deck.error("Blocks", sorted(blocks), "one block group (several blocks are not supported yet)")
+    (group,) = blocks
+    where = f"Blocks.{group}"
+    deck.get(f"{where}.Block Names", str)  # one group of one material and horizon: any blocks
+    for key in deck.get(where, dict):
+        if key not in ("Block Names", "Material", "Horizon", "Damage Model"):
+            raise deck.error(
+                f"{where}.{key}", None, "Block Names, Material, Horizon and Damage Model only", False
+            )
+    horizon = deck.get(f"{where}.Horizon", float)
+    if not horizon > 0:
+        raise deck.error(f"{where}.Horizon", horizon, "a positive horizon (m)")
+    return horizon, deck.get(f"{where}.Material", str)
+
+
+def _discretization(deck: _Deck, deck_dir: Path, horizon: float) -> tuple[dict, dict, np.ndarray | None]:
+    """Geometry and discretisation sections, and the PdQuickGrid's (nx, ny, nz) (None for a mesh)."""
+    kind = deck.get("Discretization.Type", str)
+    neighbourhood = deck.get("Discretization.NeighborhoodType", str, "")
+    discretization = {"horizon_m": horizon, "partial_volumes": False}
+    if kind == "PdQuickGrid":
+        where = "Discretization.TensorProduct3DMeshGenerator"
+        deck.get(where, dict)
+        origin = [deck.get(f"{where}.{a} Origin", float) for a in "XYZ"]
+        size = [deck.get(f"{where}.{a} Length", float) for a in "XYZ"]
+        counts = [deck.get(f"{where}.Number Points {a}", int) for a in "XYZ"]
+        for a, n in zip("XYZ", counts, strict=True):
+            if n < 1:
+                raise deck.error(f"{where}.Number Points {a}", n, "at least 1 point")
+        spacing = [s / n for s, n in zip(size, counts, strict=True)]
+        if neighbourhood and neighbourhood.lower() != "spherical":
+            raise deck.error(
+                "Discretization.NeighborhoodType", neighbourhood, "'Spherical', or none for boxes"
+            )
+        geometry = {"type": "box", "size": size, "origin": origin}
+        discretization["spacing"] = spacing
+        if not neighbourhood:  # PdQuickGrid's own families: round(horizon / spacing) cells
+            discretization["neighbourhood"] = "box"
+        return geometry, discretization, np.array(counts)
+    if neighbourhood and neighbourhood.lower() != "spherical":
+        raise deck.error("Discretization.NeighborhoodType", neighbourhood, "'Spherical' for a mesh")
+    if kind not in ("Exodus", "Text File"):
+        raise deck.error("Discretization.Type", kind, "one of 'PdQuickGrid', 'Exodus', 'Text File'")
+    mesh = deck_dir / deck.get("Discretization.Input Mesh File", str)
+    if not mesh.is_file():
+        raise deck.error("Discretization.Input Mesh File", str(mesh), "an existing mesh file")
+    geometry = {"type": "exodus" if kind == "Exodus" else "mesh", "file": str(mesh.resolve())}
+    return geometry, discretization, None
+
+
+def _material(deck: _Deck, name: str) -> dict:
+    where = f"Materials.{name}"
+    deck.get(where, dict)
+    model = deck.get(f"{where}.Material Model", str)
+    if model not in MATERIALS:
+        raise deck.error(f"{where}.Material Model", model, f"one of {sorted(MATERIALS)}")
+    density = deck.get(f"{where}.Density", float)
+    bulk = deck.get(f"{where}.Bulk Modulus", float)
+    known = {"Material Model", "Density", "Bulk Modulus", "Shear Modulus", "Apply Shear Correction Factor"}
+    known |= {"Influence Function"}
+    for key in deck.get(where, dict):
+        if key not in known:
+            raise deck.error(f"{where}.{key}", None, f"only the parameters {sorted(known)}", False)
+    influence = deck.get(f"{where}.Influence Function", str, "One")
+    if influence not in INFLUENCE:
+        raise deck.error(f"{where}.Influence Function", influence, f"one of {sorted(INFLUENCE)}")
+    if MATERIALS[model] == "pmb":
+        # c = 18 K / (pi delta^4) from K alone: peridyn's PMB has nu = 1/4, so K = E / 1.5
+        return {"model": "pmb", "E": 1.5 * bulk, "density": density}
+    shear = deck.get(f"{where}.Shear Modulus", float)
+    # E and nu of the bulk and shear moduli (LPS turns them back into K and mu)
+    E = 9.0 * bulk * shear / (3.0 * bulk + shear)
+    nu = (3.0 * bulk - 2.0 * shear) / (2.0 * (3.0 * bulk + shear))
+    material = {"model": "lps", "E": E, "nu": nu, "density": density}
+    if deck.get(f"{where}.Apply Shear Correction Factor", bool, False):
+        material["surface_correction"] = "shear-factor"
+    return material
+
+
+def _damage(deck: _Deck, key: str) -> dict:
+    """``{"damage": {"critical_stretch": s_c}}`` of the block's "Critical Stretch" damage model
+    (a bond breaks once (|y| - |xi|) / |xi| exceeds s_c, as in peridyn), or {} without one."""
+    name = deck.get(key, str, None)
+    if name is None:
+        return {}
+    where = f"Damage Models.{name}"
+    deck.get(where, dict)
+    for param in deck.get(where, dict):
+        if param not in ("Damage Model", "Critical Stretch"):
+            raise deck.error(f"{where}.{param}", None, "Damage Model and Critical Stretch only", False)
+    model = deck.get(f"{where}.Damage Model", str)
+    if model != "Critical Stretch":
+        raise deck.error(f"{where}.Damage Model", model, "'Critical Stretch'")
+    stretch = deck.get(f"{where}.Critical Stretch", float)
+    if not stretch > 0:
+        raise deck.error(f"{where}.Critical Stretch", stretch, "a positive stretch")
+    return {"damage": {"critical_stretch": stretch}}
+
+
+def _solver(deck: _Deck) -> dict:
+    initial = deck.get("Solver.Initial Time", float, 0.0)
+    if initial != 0.0:
+        raise deck.error("Solver.Initial Time", initial, "0 (runs start at t = 0 s)")
+    final = deck.get("Solver.Final Time", float)
+    solver = deck.get("Solver", dict)
+    kinds = [k for k in solver if isinstance(solver[k], dict)]
+    if kinds == ["QuasiStatic"]:
+        return _quasi_static(deck, final)
+    if kinds != ["Verlet"]:
+        raise deck.error(
+            "Solver", kinds, "one 'Verlet' or 'QuasiStatic' solver list (others are not supported yet)"
+        )
+    if "Fixed dt" not in solver["Verlet"]:
+        raise deck.error(
+            "Solver.Verlet.Fixed dt",
+            None,
+            "a fixed time step (Peridigm's default step, the bond-based stable step, is not supported yet)",
+            has_value=False,
+        )
+    dt = deck.get("Solver.Verlet.Fixed dt", float)
+    if not dt > 0:
+        raise deck.error("Solver.Verlet.Fixed dt", dt, "a positive time step (s)")
+    steps = math.floor((final - initial) / dt)  # Peridigm's step count
+    if steps < 1:
+        raise deck.error("Solver.Final Time", final, f"at least one step of {dt:g} s after the initial time")
+    return {"type": "explicit", "dt": dt, "steps": steps, "prescribed_velocity": "difference"}
+
+
+#: QuasiStatic parameters read: deck name -> newton solver key.
+QUASI_STATIC = {
+    "Number of Load Steps": "load_steps",
+    "Absolute Tolerance": "absolute_tolerance",
+    "Maximum Solver Iterations": "newton_iterations",
+}
+
+
+def _quasi_static(deck: _Deck, final: float) -> dict:
+    """Peridigm's QuasiStatic solver as Newton load steps to the final time, converged on the
+    absolute residual (N), velocities the change of u over a load step's time."""
+    where = "Solver.QuasiStatic"
+    for key in deck.get(where, dict):
+        if key not in QUASI_STATIC:
+            raise deck.error(f"{where}.{key}", None, f"only the parameters {sorted(QUASI_STATIC)}", False)
+    if not final > 0:
+        raise deck.error("Solver.Final Time", final, "a positive time (s)")
+    steps = deck.get(f"{where}.Number of Load Steps", int)
+    iterations = deck.get(f"{where}.Maximum Solver Iterations", int, 10)
+    tolerance = deck.get(f"{where}.Absolute Tolerance", float)
+    for key, value in (("Number of Load Steps", steps), ("Maximum Solver Iterations", iterations)):
+        if value < 1:
+            raise deck.error(f"{where}.{key}", value, "at least 1")
+    if not tolerance > 0:
+        raise deck.error(f"{where}.Absolute Tolerance", tolerance, "a positive tolerance")
+    return {
+        "type": "newton",
+        "time": final,
+        "load_steps": steps,
+        "absolute_tolerance": tolerance,
+        "newton_iterations": iterations,
+    }
+
+
+def _conditions(deck: _Deck, deck_dir: Path, grid, mesh_sets: bool) -> tuple[dict, list, list]:
+    """Node sets, boundary conditions and initial conditions of ``Boundary Conditions``."""
+    section = deck.get("Boundary Conditions", dict, {})
+    definitions = {k: v for k, v in section.items() if not isinstance(v, dict)}
+    sets, bcs, ics = {}, [], []
+    for name, spec in section.items():
+        if not isinstance(spec, dict):
+            continue
+        where = f"Boundary Conditions.{name}"
+        kind = deck.get(f"{where}.Type", str)
+        set_name = deck.get(f"{where}.Node Set", str)
+        if set_name in definitions:
+            if set_name not in sets:
+                sets[set_name] = {
+                    "type": "points",
+                    "indices": _set_indices(deck, f"Boundary Conditions.{set_name}", deck_dir, grid),
+                }
+        elif not mesh_sets:
+            raise deck.error(f"{where}.Node Set", set_name, f"a node set of the deck: {sorted(definitions)}")
+        axis = deck.get(f"{where}.Coordinate", str)
+        if axis not in ("x", "y", "z"):
+            raise deck.error(f"{where}.Coordinate", axis, "x, y or z")
+        value = _value(deck, f"{where}.Value")
+        if kind in INITIAL:
+            ics.append({"set": set_name, "kind": INITIAL[kind], "components": axis, "value": value})
+        elif kind in BOUNDARY:
+            bcs.append({"set": set_name, "kind": BOUNDARY[kind], "components": axis, "value": value})
+        else:
+            raise deck.error(f"{where}.Type", kind, f"one of {sorted(INITIAL) + sorted(BOUNDARY)}")
+    return sets, bcs, ics
+
+
+def _value(deck: _Deck, key: str):
+    """A condition's value: a number, or an expression in x, y, z and t (checked now)."""
+    text = deck.get(key, str)
+    try:
+        return float(text)
+    except ValueError:
+        pass
+    try:
+        SpaceTime(text)
+    except InputError as exc:
+        raise deck.error(key, text, f"a number or an expression in x, y, z, t ({exc})") from None
+    return {"type": "expression", "text": text}
+
+
+def _set_indices(deck: _Deck, key: str, deck_dir: Path, grid) -> list[int]:
+    """0-based peridyn point indices of a node set given as 1-based ids inline or in a file."""
+    text = deck.get(key, str)
+    path = deck_dir / text
+    if not text.split()[0].isdigit() or path.is_file():
+        if not path.is_file():
+            raise deck.error(key, text, "1-based node ids, or a file of them")
+        text = path.read_text(encoding="utf-8")
+    try:
+        ids = np.array([int(t) for t in text.split()], dtype=np.int64)
+    except ValueError:
+        raise deck.error(key, text[:80], "whitespace-separated 1-based node ids") from None
+    if len(ids) == 0 or ids.min() < 1:
+        raise deck.error(key, text[:80], "1-based node ids (at least one)")
+    index = ids - 1
+    if grid is not None:
+        nx, ny, nz = (int(n) for n in grid)
+        if index.max() >= nx * ny * nz:
+            raise deck.error(key, int(ids.max()), f"node ids up to {nx * ny * nz} (the grid's points)")
+        # PdQuickGrid numbers x fastest, peridyn's box z fastest
+        i, j, k = index % nx, (index // nx) % ny, index // (nx * ny)
+        index = (i * ny + j) * nz + k
+    return sorted(int(p) for p in index)
+
+
+def _output(deck: _Deck, model: str, sums: dict) -> dict:
+    """The output section: plots and VTU off, the deck's Exodus file and variables."""
+    outputs = [k for k in deck.params if k.startswith("Output")]
+    if not outputs:
+        return {"plots": False, "vtu": False}
+    first = outputs[0]
+    fmt = deck.get(f"{first}.Output File Type", str, "ExodusII")
+    if fmt != "ExodusII":
+        raise deck.error(f"{first}.Output File Type", fmt, "ExodusII")
+    names = [k for k, on in deck.get(f"{first}.Output Variables", dict).items() if on is True]
+    for k in outputs[1:]:  # more output lists: the same file, variables and frequency only
+        for key in ("Output Filename", "Output Frequency"):
+            if deck.get(f"{k}.{key}", default=None) != deck.get(f"{first}.{key}", default=None):
+                raise deck.error(f"{k}.{key}", deck.get(f"{k}.{key}", default=None), f"as in {first}")
+        extra = [v for v, on in deck.get(f"{k}.Output Variables", dict).items() if on and v not in names]
+        if extra:
+            raise deck.error(f"{k}.Output Variables", extra, f"variables that {first} writes")
+    asked_sums = {name: sums[name] for name in names if name in sums}
+    names = [name for name in names if name not in sums]
+    for name in names:
+        if name not in PERIDIGM_VARIABLES:
+            raise deck.error(f"{first}.Output Variables.{name}", True, f"one of {sorted(PERIDIGM_VARIABLES)}")
+        if model == "pmb" and name in ("Dilatation", "Weighted_Volume"):
+            raise deck.error(f"{first}.Output Variables.{name}", True, "a state-based material's variable")
+    every = deck.get(f"{first}.Output Frequency", int, 1)
+    if every < 1:
+        raise deck.error(f"{first}.Output Frequency", every, "at least 1 step")
+    exodus = {"file": deck.get(f"{first}.Output Filename", str) + ".e", "every": every, "variables": names}
+    if asked_sums:
+        exodus["sums"] = asked_sums
+    return {"plots": False, "vtu": False, "exodus": exodus}
+
+
+def convert_deck(path) -> dict:
+    """The case dict of the Peridigm deck at ``path`` (named after the file's stem)."""
+    path = Path(path)
+    return deck_case(read_deck(path), path.stem, str(path), path.parent)
+
+
+def load_deck(path, overrides=()) -> Case:
+    """A Peridigm deck as a validated peridyn ``Case``, ``--set`` overrides applied to the
+    translated case (``peridyn.io.case.apply_override``)."""
+    raw = convert_deck(path)
+    for item in overrides:
+        apply_override(raw, item, str(path))
+    return validate_case(raw, str(path))
+
+
+def load_case_or_deck(path, overrides=()) -> Case:
+    """``peridyn.io.case.load_case``, or for a Peridigm deck (``is_peridigm_deck``) its
+    translation (``load_deck``)."""
+    if is_peridigm_deck(path):
+        return load_deck(path, overrides)
+    return load_case(path, overrides)

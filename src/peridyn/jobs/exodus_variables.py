@@ -1,0 +1,63 @@
+"""Values of Peridigm's named output variables (``output.exodus.variables``) at a state of a
+run, for the recorder's Exodus file (``peridyn.io.recorder.variables_exodus``)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from peridyn.discretization.state import State
+from peridyn.errors import CaseFileError
+from peridyn.io.exodus_write import PERIDIGM_VARIABLES
+from peridyn.physics.damage import damage_field
+from peridyn.physics.materials.base import Model
+
+#: Variables that only a state-based material has (its per-point dilatation and weighted volume).
+STATE_BASED = ("Dilatation", "Weighted_Volume")
+
+
+def check_variables(case_name: str, model: Model, variables) -> None:
+    """Refuse variables the case's material does not define (a bond-based one has no dilatation)."""
+    for name in variables:
+        if name in STATE_BASED and not model.has_dilatation:
+            raise CaseFileError(
+                case_name, "output.exodus.variables", name, "a variable of the material (no dilatation)"
+            )
+
+
+def variable_values(model: Model, variables, sums=None):
+    """A function of a state (u, v, a: (n_points, 3)) giving the ``variables``' values as
+    ``ExodusWriter.append`` takes them: ``{"nodal": {...}, "element": {...}, "global_":
+    {...}}``, vectors (n_points, dim), scalars (n_points,), and per ``sums`` entry (name ->
+    (nodal variable, node set name)) that variable's sum over the set, (dim,). Force density
+    is the internal force density (N/m^3) at u, force that times the point's volume (N);
+    acceleration the solver's."""
+    sums = sums or {}
+    needed = set(variables) | {variable for variable, _ in sums.values()}
+    body = model.body
+    dim = body.dim
+
+    def values(state: State) -> dict:
+        force_density = model.force(state.u)[:, :dim] if {"Force", "Force_Density"} & needed else None
+        computed = {
+            "Displacement": lambda: state.u[:, :dim],
+            "Velocity": lambda: state.v[:, :dim],
+            "Acceleration": lambda: state.a[:, :dim],
+            "Force_Density": lambda: force_density,
+            "Force": lambda: force_density * body.volumes[:, None],
+            "Element_Id": lambda: np.arange(1.0, body.n_points + 1.0),
+            "Proc_Num": lambda: np.zeros(body.n_points),
+            "Volume": lambda: body.volumes,
+            "Dilatation": lambda: model.dilatation(state.u),
+            "Weighted_Volume": lambda: model.weighted_volume,
+            "Stored_Elastic_Energy": lambda: model.energy_density(state.u) * body.volumes,
+            "Number_Of_Neighbors": lambda: np.diff(model.bonds.offsets).astype(np.float64),
+            "Damage": lambda: damage_field(model),
+        }
+        out = {"nodal": {}, "element": {}, "global_": {}}
+        for name in variables:
+            out[PERIDIGM_VARIABLES[name][0]][name] = computed[name]()
+        for name, (variable, set_name) in sums.items():
+            out["global_"][name] = computed[variable]()[body.node_set(set_name)].sum(axis=0)
+        return out
+
+    return values

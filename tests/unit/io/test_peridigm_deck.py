@@ -1,0 +1,223 @@
+"""Peridigm decks in: reading XML and YAML decks (``peridyn.io.peridigm_deck``) and their
+translation to peridyn cases (``peridyn.io.peridigm_case``), with the refusals that name the
+deck parameter. Decks from tests/data/peridigm (Peridigm's test suite)."""
+
+import copy
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from peridyn.cli import main
+from peridyn.errors import CaseFileError
+from peridyn.io.case import load_case, validate_case
+from peridyn.io.peridigm_case import convert_deck, deck_case, load_deck
+from peridyn.io.peridigm_deck import is_peridigm_deck, read_deck
+from peridyn.jobs.build import build
+
+DATA = Path(__file__).parents[2] / "data" / "peridigm"
+WAVE = DATA / "WaveInBar.xml"
+COMPRESSION = DATA / "Compression_2x1x1.yaml"
+
+
+def test_xml_parameters_are_typed():
+    """WaveInBar.xml's parameters as their declared types (values as written in the deck)."""
+    deck = read_deck(WAVE)
+    assert deck["Verbose"] is False
+    assert deck["Materials"]["My Elastic Material"]["Density"] == 2200.0
+    assert deck["Output"]["Output Frequency"] == 20 and isinstance(deck["Output"]["Output Frequency"], int)
+    assert deck["Solver"]["Verlet"]["Fixed dt"] == 9.0659e-08
+    assert deck["Boundary Conditions"]["Left Side Initial Velocity"]["Value"] == "-100.0"
+
+
+def test_yaml_deck_is_the_peridigm_mapping():
+    deck = read_deck(COMPRESSION)
+    assert deck["Blocks"]["My Group of Blocks"]["Horizon"] == 2.0
+    assert is_peridigm_deck(COMPRESSION) and is_peridigm_deck(WAVE)
+    assert not is_peridigm_deck(Path(__file__).parents[3] / "cases" / "bar_pulse.yaml")
+
+
+@pytest.mark.parametrize(
+    "text, key",
+    [
+        ('<ParameterList><Parameter name="A" type="double" value="x"/></ParameterList>', "A"),
+        ('<ParameterList><Parameter name="A" type="float" value="1"/></ParameterList>', "A (type)"),
+        (
+            '<ParameterList><Parameter name="A" type="int" value="1"/>'
+            '<Parameter name="A" type="int" value="2"/></ParameterList>',
+            "A",
+        ),
+        ("<ParameterList><Parameter", "<file>"),
+        ("<Other/>", "<root>"),
+    ],
+)
+def test_bad_xml_names_the_parameter(tmp_path, text, key):
+    deck = tmp_path / "deck.xml"
+    deck.write_text(text)
+    with pytest.raises(CaseFileError) as err:
+        read_deck(deck)
+    assert err.value.key == key
+
+
+def test_translation_of_a_pdquickgrid_deck():
+    """Compression_2x1x1: two cells of 2 x 1 x 1 m from x = -2 m, LPS with K = 130 GPa and
+    mu = 78 GPa (E = 9 K mu / (3 K + mu) = 195 GPa, nu = 0.25), floor(5e-5 / 1e-5) = 5 steps,
+    the node sets' 1-based ids as 0-based points, and the deck's Exodus file and variables."""
+    case = load_deck(COMPRESSION)
+    assert case.geometry.size == [4.0, 1.0, 1.0] and case.geometry.origin == [-2.0, -0.5, -0.5]
+    assert case.discretization.spacing == [2.0, 1.0, 1.0] and case.discretization.partial_volumes is False
+    assert case.material.E == pytest.approx(195e9, rel=1e-15) and case.material.nu == pytest.approx(0.25)
+    assert (case.solver.steps, case.solver.dt) == (5, 1e-5)
+    assert case.node_sets["Min X Node Set"].indices == [0]
+    assert case.node_sets["Max X Node Set"].indices == [1]
+    assert case.output.exodus.file == "Compression_2x1x1.e" and case.output.exodus.every == 1
+    assert "Stored_Elastic_Energy" in case.output.exodus.variables
+
+
+def test_pdquickgrid_ids_are_x_fastest():
+    """PdQuickGrid numbers its points x fastest; peridyn's box z fastest: id 2 of a 2 x 2 x 2
+    grid is (i, j, k) = (1, 0, 0), peridyn's point 4."""
+    deck = read_deck(COMPRESSION)
+    grid = deck["Discretization"]["TensorProduct3DMeshGenerator"]
+    grid.update({"Number Points X": 2, "Number Points Y": 2, "Number Points Z": 2, "Y Length": 2.0})
+    grid["Z Length"] = 2.0
+    deck["Discretization"]["NeighborhoodType"] = "Spherical"
+    deck["Boundary Conditions"]["Max X Node Set"] = "2 3"
+    case = deck_case(deck, "grid")
+    assert case["node_sets"]["Max X Node Set"]["indices"] == [2, 4]
+
+
+def _refusal(deck: dict, key_start: str, folder=DATA):
+    with pytest.raises(CaseFileError) as err:
+        deck_case(deck, "x", "deck.yaml", folder)
+    assert err.value.key.startswith(key_start), err.value
+    return err.value
+
+
+def test_refusals_name_the_deck_parameter():
+    base = read_deck(COMPRESSION)
+    deck = copy.deepcopy(base)
+    deck["Blocks"]["Other"] = dict(deck["Blocks"]["My Group of Blocks"])
+    _refusal(deck, "Blocks")
+    deck = copy.deepcopy(base)
+    for model in ("Viscoplastic", "Linear LPS"):
+        deck["Materials"]["My Elastic Material"]["Material Model"] = model
+        _refusal(deck, "Materials.My Elastic Material.Material Model")
+    deck = copy.deepcopy(base)
+    deck["Solver"]["Implicit"] = deck["Solver"].pop("Verlet")
+    _refusal(deck, "Solver")
+    deck = copy.deepcopy(base)
+    del deck["Solver"]["Verlet"]["Fixed dt"]
+    _refusal(deck, "Solver.Verlet.Fixed dt")
+    deck = copy.deepcopy(base)
+    deck["Output"]["Output Variables"]["Partial_Stress"] = True
+    _refusal(deck, "Output.Output Variables.Partial_Stress")
+    deck = copy.deepcopy(base)
+    deck["Contact"] = {"Search Radius": 0.1}
+    _refusal(deck, "Contact")
+    deck = copy.deepcopy(base)
+    deck["Boundary Conditions"]["Initial Velocity Min X Face"]["Node Set"] = "Nowhere"
+    _refusal(deck, "Boundary Conditions.Initial Velocity Min X Face.Node Set")
+    deck = copy.deepcopy(base)
+    deck["Solver"]["Initial Time"] = 1e-6
+    _refusal(deck, "Solver.Initial Time")
+
+
+def test_pdquickgrid_families_are_boxes():
+    """A 3 x 3 x 1 grid of unit cells with horizon 1.2: PdQuickGrid's box of round(1.2) = 1 cell
+    holds the diagonal neighbours at sqrt(2) = 1.41 m (8 around the centre point), the sphere
+    |xi| <= 1.2 m of ``NeighborhoodType: Spherical`` only the 4 along the axes."""
+    deck = read_deck(COMPRESSION)
+    grid = deck["Discretization"]["TensorProduct3DMeshGenerator"]
+    grid.update({"Number Points X": 3, "Number Points Y": 3, "X Length": 3.0, "Y Length": 3.0})
+    deck["Blocks"]["My Group of Blocks"]["Horizon"] = 1.2
+    deck["Boundary Conditions"]["Max X Node Set"] = "9"
+    counts = {}
+    for kind in ("box", "Spherical"):
+        if kind == "Spherical":
+            deck["Discretization"]["NeighborhoodType"] = kind
+        case = validate_case(deck_case(deck, "grid"))
+        assert case.discretization.neighbourhood == ("box" if kind == "box" else "sphere")
+        counts[kind] = np.diff(build(case).bonds.offsets)
+    assert counts["box"][4] == 8 and counts["Spherical"][4] == 4
+    assert counts["box"].tolist() == [3, 5, 3, 5, 8, 5, 3, 5, 3]
+    deck["Discretization"]["NeighborhoodType"] = "Cubic"
+    _refusal(deck, "Discretization.NeighborhoodType")
+
+
+def test_convert_writes_a_case_that_loads_as_the_deck(tmp_path):
+    """``peridyn convert DECK -o case.yaml`` writes the case that ``peridyn run DECK`` runs."""
+    out = tmp_path / "case.yaml"
+    assert main(["convert", str(WAVE), "-o", str(out)]) == 0
+    assert load_case(out) == load_deck(WAVE)
+    assert main(["validate", str(WAVE), "--json"]) == 0  # validate reads decks as run does
+    assert convert_deck(WAVE)["geometry"]["file"] == str((DATA / "WaveInBar.g").resolve())
+
+
+def test_translation_of_expressions_and_compute_classes():
+    """ElasticBondBased3D: prescribed displacements, one an expression in y and t; the bulk
+    modulus alone (E = 1.5 K: peridyn's PMB has nu = 1/4, K = E / (3 (1 - 2 nu))); the
+    "Block_Data" sums as global outputs; Peridigm's velocity of prescribed points."""
+    case = load_deck(DATA / "ElasticBondBased3D.yaml")
+    assert case.material.model == "pmb" and case.material.E == 1.5 * 200e9
+    values = [bc.value for bc in case.boundary_conditions]
+    assert values == [0.0, {"type": "expression", "text": "0.001*y*t/1.0e-8"}, 0.0]
+    assert [bc.kind for bc in case.boundary_conditions] == ["displacement"] * 3
+    assert case.solver.prescribed_velocity == "difference"
+    sums = case.output.exodus.sums
+    assert (sums["Top_Reaction_Force"].variable, sums["Top_Reaction_Force"].set) == ("Force", "block_3")
+    assert "Top_Reaction_Force" not in case.output.exodus.variables
+
+
+def test_bad_expressions_and_compute_classes_are_refused():
+    base = read_deck(DATA / "ElasticBondBased3D.yaml")
+    deck = copy.deepcopy(base)
+    deck["Boundary Conditions"]["Prescribed Displacement Y"]["Value"] = "open('x').read()"
+    _refusal(deck, "Boundary Conditions.Prescribed Displacement Y.Value")
+    deck = copy.deepcopy(base)
+    deck["Compute Class Parameters"]["Top Reaction Force"]["Calculation Type"] = "Maximum"
+    _refusal(deck, "Compute Class Parameters.Top Reaction Force.Calculation Type")
+    deck = copy.deepcopy(base)
+    deck["Output1"]["Output Variables"]["Dilatation"] = True
+    _refusal(deck, "Output1.Output Variables.Dilatation")
+
+
+def test_translation_of_a_quasi_static_text_file_deck():
+    """Compression_QS_3x2x2_TextFile: the text mesh, node sets from files and inline lists
+    (1-based ids), QuasiStatic as 20 Newton load steps to the final time converged on the
+    absolute residual, at most 10 iterations each."""
+    folder = DATA / "Compression_QS_3x2x2_TextFile"
+    case = load_deck(folder / "Compression_QS_3x2x2_TextFile.xml")
+    assert case.geometry.type == "mesh"
+    assert case.node_sets["Node Set One"].indices == [0, 1, 2, 3]
+    assert case.node_sets["Node Set Two"].indices == [8, 9, 10, 11]
+    assert case.node_sets["Node Set Three"].indices == [1, 3]
+    s = case.solver
+    assert (s.type, s.time, s.load_steps, s.absolute_tolerance, s.newton_iterations) == (
+        "newton",
+        5e-5,
+        20,
+        1e-2,
+        10,
+    )
+    deck = read_deck(folder / "Compression_QS_3x2x2_TextFile.xml")
+    deck["Solver"]["QuasiStatic"]["Stabilization Type"] = "Kinetic"
+    _refusal(deck, "Solver.QuasiStatic.Stabilization Type", folder)
+    deck = read_deck(folder / "Compression_QS_3x2x2_TextFile.xml")
+    deck["Boundary Conditions"]["Node Set One"] = "missing.txt"
+    with pytest.raises(CaseFileError, match="Node Set One"):
+        deck_case(deck, "x", "deck.xml", folder)
+
+
+def test_critical_stretch_damage():
+    """A block's "Critical Stretch" damage model becomes the material's critical stretch; other
+    damage models are refused naming the parameter."""
+    deck = read_deck(WAVE)
+    deck["Damage Models"] = {"My Damage": {"Damage Model": "Critical Stretch", "Critical Stretch": 5e-4}}
+    deck["Blocks"]["My Group of Blocks"]["Damage Model"] = "My Damage"
+    case = validate_case(deck_case(deck, "wave", str(WAVE), DATA))
+    assert case.material.damage.critical_stretch == 5e-4
+    deck["Damage Models"]["My Damage"]["Damage Model"] = "Time Dependent Critical Stretch"
+    _refusal(deck, "Damage Models.My Damage.Damage Model")
+    deck["Blocks"]["My Group of Blocks"]["Damage Model"] = "Other"
+    _refusal(deck, "Damage Models.Other")
