@@ -304,6 +304,22 @@ class Region(Strict):
         return self
 
 
+class Block(Strict):
+    """One block of a body made of several materials (``Case.blocks``, docs/blocks.md): the points
+    of ``region`` or of the node set ``set`` (exactly one of them), made of ``material``, a name
+    in ``Case.materials``. Every point of the body lies in exactly one block."""
+
+    material: str
+    region: Region | None = None
+    set: str | None = None
+
+    @model_validator(mode="after")
+    def _one_selection(self):
+        if (self.region is None) == (self.set is None):
+            raise ValueError("give exactly one of region or set (the points of the block)")
+        return self
+
+
 class Precrack(Strict):
     """Bonds crossing a planar rectangle (origin, edge_u, edge_v; 3D) or a segment
     (start, end; 2D) are cut."""
@@ -500,7 +516,9 @@ class Case(Strict):
     description: str = ""
     geometry: Geometry
     discretization: Discretization
-    material: Material
+    material: Material | None = None
+    materials: dict[str, Material] = {}
+    blocks: dict[str, Block] = {}
     removals: list[Region] = []
     node_sets: dict[str, Region] = {}
     precracks: list[Precrack] = []
@@ -513,6 +531,49 @@ class Case(Strict):
     contact: ContactSpec | None = None
     fatigue: Fatigue | None = None
     absorbing: AbsorbingSpec | None = None
+
+    @model_validator(mode="after")
+    def _materials(self):
+        if self.blocks and self.material is not None:
+            raise ValueError(
+                "blocks: give either material (one material for the whole body) or materials "
+                "and blocks (docs/blocks.md), not both"
+            )
+        if not self.blocks:
+            if self.material is None:
+                raise ValueError("material: a required key that is missing (or give materials and blocks)")
+            if self.materials:
+                raise ValueError("materials: named materials are used by blocks; give blocks too")
+            return self
+        for name, block in self.blocks.items():
+            if block.material not in self.materials:
+                raise ValueError(
+                    f"blocks.{name}.material: unknown material {block.material!r}"
+                    f"{did_you_mean(block.material, self.materials)}; defined: {sorted(self.materials)}"
+                )
+        unused = sorted(set(self.materials) - {b.material for b in self.blocks.values()})
+        if unused:
+            raise ValueError(f"materials.{unused[0]}: no block is made of it")
+        first_name, first = next(iter(self.materials.items()))
+        for name, mat in self.materials.items():
+            for key in ("model", "surface_correction"):
+                if getattr(mat, key) != getattr(first, key):
+                    raise ValueError(
+                        f"materials.{name}.{key}: {getattr(mat, key)!r}, but materials.{first_name} has "
+                        f"{getattr(first, key)!r}: the blocks of a body share one model and surface "
+                        "correction (docs/blocks.md)"
+                    )
+            if mat.model == "lps" and mat.nu is None:
+                raise ValueError(f"materials.{name}.nu: an LPS material needs Poisson's ratio nu")
+        for key in ("contact", "fatigue", "analysis"):
+            if getattr(self, key) is not None:
+                raise ValueError(f"{key}: not available for a body of several blocks (yet); use one material")
+        return self
+
+    def block_materials(self) -> dict[str, Material]:
+        """Every material of the case by the key it is given under: ``{"material": material}``
+        for one material, else ``materials``."""
+        return {"material": self.material} if self.material is not None else dict(self.materials)
 
     @model_validator(mode="after")
     def _absorbing_solver(self):
@@ -544,8 +605,12 @@ class Case(Strict):
         used = [(f"boundary_conditions[{i}].set", bc.set) for i, bc in enumerate(self.boundary_conditions)]
         used += [(f"initial_conditions[{i}].set", ic.set) for i, ic in enumerate(self.initial_conditions)]
         used += [(f"output.planes.{k}", v) for k, v in self.output.planes.items()]
-        if self.material.damage:
-            used += [("material.damage.no_damage_sets", s) for s in self.material.damage.no_damage_sets]
+        used += [(f"blocks.{k}.set", b.set) for k, b in self.blocks.items() if b.set is not None]
+        for key, mat in self.block_materials().items():
+            if key != "material":
+                key = f"materials.{key}"
+            if mat.damage:
+                used += [(f"{key}.damage.no_damage_sets", s) for s in mat.damage.no_damage_sets]
         return used
 
     @model_validator(mode="after")

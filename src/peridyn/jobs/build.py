@@ -32,6 +32,7 @@ from peridyn.physics.contact import Contact
 from peridyn.physics.damage import BondDamage, protected_points
 from peridyn.physics.loads import BoundaryCondition, InitialCondition, Loading
 from peridyn.physics.materials import Model, make_model
+from peridyn.physics.materials.blocks import BlockMaterial, assign_blocks, make_block_model
 from peridyn.physics.timefunctions import from_spec
 from peridyn.physics.transducers import pin_force_actuator, pzt_radial_actuator
 
@@ -326,6 +327,13 @@ def _build_part(case: Case, comm, base_dir):
         raise CaseFileError(
             case.name, "contact", case.contact.model_dump(exclude_none=True), "no contact in an MPI run (yet)"
         )
+    if case.blocks:
+        raise CaseFileError(
+            case.name,
+            "blocks",
+            sorted(case.blocks),
+            "one material in an MPI run (several blocks: yet to come)",
+        )
     body = build_body(case, base_dir)
     check_placements(case, body)
     body, actuation = add_actuators(case, body)
@@ -352,8 +360,40 @@ def _build_part(case: Case, comm, base_dir):
     return setup, owned, ghosts, owner[ghosts]
 
 
+def block_index(case: Case, body: Body) -> np.ndarray:
+    """(n_points,) int64: each point's block, an index into ``case.blocks`` (in order).
+
+    Raises
+    ------
+    CaseFileError
+        At ``blocks``, when a block holds no point or a point lies in two blocks or in none.
+    """
+    masks = {
+        name: region_mask(body, b.region, f"blocks.{name}.region")
+        if b.region is not None
+        else np.isin(np.arange(body.n_points), body.node_set(b.set))
+        for name, b in case.blocks.items()
+    }
+    try:
+        return assign_blocks(masks)
+    except InputError as exc:
+        raise CaseFileError(case.name, "blocks", None, str(exc), has_value=False) from None
+
+
 def build_model(case: Case, body: Body, bonds: Bonds) -> Model:
-    """The case's material bound to ``body`` and ``bonds``."""
+    """The case's material bound to ``body`` and ``bonds``: one material, or the materials of
+    its blocks (``peridyn.physics.materials.blocks``)."""
+    if case.blocks:
+        mats = [case.materials[b.material] for b in case.blocks.values()]
+        return make_block_model(
+            mats[0].model,
+            body,
+            bonds,
+            block_index(case, body),
+            [BlockMaterial(m.E, m.density, m.nu) for m in mats],
+            surface_correction=mats[0].surface_correction,
+            dtype=case.solver.dtype,
+        )
     mat = case.material
     return make_model(
         mat.model,
@@ -368,9 +408,11 @@ def build_model(case: Case, body: Body, bonds: Bonds) -> Model:
 
 
 def build_damage(case: Case, model: Model, protected=None) -> BondDamage | None:
-    """The case's bond breaking on ``model`` (None without ``material.damage``); ``protected``
-    ((n_points,) bool or None): the points of the no-damage sets, given by a rank's part
-    instead of the set names."""
+    """The case's bond breaking on ``model`` (None without ``material.damage``, or with blocks
+    none of whose materials has damage); ``protected`` ((n_points,) bool or None): the points of
+    the no-damage sets, given by a rank's part instead of the set names."""
+    if case.blocks:
+        return block_damage(case, model)
     d = case.material.damage
     if d is None:
         return None
@@ -382,6 +424,30 @@ def build_damage(case: Case, model: Model, protected=None) -> BondDamage | None:
         critical_bond_stress=d.critical_bond_stress,
         protected=protected,
     )
+
+
+def block_damage(case: Case, model: Model) -> BondDamage | None:
+    """Bond breaking of a body of several blocks (docs/blocks.md): each point's critical stretch
+    from its block's material damage (inf, never, where it has none), a bond breaking at the
+    smaller of its ends' (``BondDamage``); the no-damage sets of every material's damage."""
+    blocks = list(case.blocks.values())
+    specs = [case.materials[b.material].damage for b in blocks]
+    if all(d is None for d in specs):
+        return None
+    of_point = block_index(case, model.body)
+    stretch = np.full(model.body.n_points, np.inf)
+    for k, (block, d) in enumerate(zip(blocks, specs, strict=True)):
+        if d is None:
+            continue
+        mine = of_point == k
+        if d.critical_stretch is not None:
+            stretch[mine] = d.critical_stretch
+        elif d.fracture_energy is not None:
+            stretch[mine] = model.critical_stretch(d.fracture_energy)[mine]
+        else:
+            stretch[mine] = d.critical_bond_stress / case.materials[block.material].E
+    no_damage = sorted({name for d in specs if d is not None for name in d.no_damage_sets})
+    return BondDamage(model, critical_stretch=stretch, no_damage_sets=no_damage)
 
 
 def check_loading(case: Case, loading: Loading) -> None:
