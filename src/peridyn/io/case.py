@@ -540,10 +540,10 @@ class Case(Strict):
                 "and blocks (docs/blocks.md), not both"
             )
         if not self.blocks:
-            if self.material is None:
-                raise ValueError("material: a required key that is missing (or give materials and blocks)")
             if self.materials:
                 raise ValueError("materials: named materials are used by blocks; give blocks too")
+            if self.material is None:
+                raise ValueError("material: a required key that is missing (or give materials and blocks)")
             return self
         for name, block in self.blocks.items():
             if block.material not in self.materials:
