@@ -9,6 +9,7 @@ import pytest
 from peridyn.analysis.bloch import Discretisation
 from peridyn.errors import CaseFileError, InputError
 from peridyn.io.case import validate_case
+from peridyn.io.mesh_text import to_text_mesh
 from peridyn.jobs.build import _build_part, build
 from peridyn.jobs.stable_step import STEP_MARGIN, estimated_stable_step
 from peridyn.physics.materials.blocks import assign_blocks
@@ -211,3 +212,26 @@ def test_assign_blocks_and_per_point_constants_errors():
         assign_blocks({"a": np.array([True, False])})
     with pytest.raises(InputError, match="material E must be positive and finite, got -1.0"):
         check_elastic(np.array([1.0, -1.0]), 0.25, 1.0)
+
+
+def test_blocks_of_a_text_mesh_by_their_sets(tmp_path):
+    """A Peridigm text mesh's block ids are node sets ``block_<id>`` (``io.mesh_text``), so a
+    case's blocks can name them; a set the mesh lacks is refused when the mesh is read."""
+    grid = validate_case(_raw())
+    body = build(grid).body
+    to_text_mesh(body, tmp_path / "bar.txt", block_ids=np.where(body.points[:, 0] < 0.003, 1, 2))
+    raw = _raw(
+        geometry={"type": "mesh", "file": str(tmp_path / "bar.txt")},
+        blocks={
+            "left": {"set": "block_1", "material": "steel"},
+            "right": {"set": "block_2", "material": "aluminium"},
+        },
+    )
+    raw["discretization"].pop("spacing", None)
+    mesh, direct = build(validate_case(raw)), build(grid)
+    u = np.random.default_rng(2).normal(scale=1e-6, size=body.points.shape)
+    np.testing.assert_allclose(mesh.model.force(u), direct.model.force(u), rtol=1e-12, atol=0)
+    raw["blocks"]["right"]["set"] = "block_3"
+    with pytest.raises(CaseFileError, match="block_3") as err:
+        build(validate_case(raw))
+    assert err.value.key == "blocks.right.set"

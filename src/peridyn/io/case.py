@@ -619,7 +619,7 @@ class Case(Strict):
         if clash:
             raise ValueError(f"actuators: name {sorted(clash)[0]!r} is already a node set")
         known = set(self.node_sets) | {"all"} | set(self.actuators)
-        in_file = self.geometry.type == "exodus"  # its sets are known once the mesh is read
+        in_file = self.geometry.is_mesh  # its sets are known once the mesh is read
         for where, name in self.set_references():
             if name not in known and not in_file:
                 raise ValueError(

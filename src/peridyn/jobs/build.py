@@ -80,7 +80,7 @@ def build_body(case: Case, base_dir=".") -> Body:
                 "a region that contains at least one point",
             )
         body = body.with_node_set(name, mask)
-    if case.geometry.type == "exodus":
+    if case.geometry.is_mesh:
         check_mesh_sets(case, body)
     return body
 
