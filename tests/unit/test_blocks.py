@@ -235,3 +235,54 @@ def test_blocks_of_a_text_mesh_by_their_sets(tmp_path):
     with pytest.raises(CaseFileError, match="block_3") as err:
         build(validate_case(raw))
     assert err.value.key == "blocks.right.set"
+
+
+def test_blocks_of_their_own_horizons():
+    """docs/blocks.md: a bond between blocks exists within the smaller of its ends' horizons,
+    and weighs its influence and partial volume with it. A point whose family lies in its own
+    block has the family of the one-material body of its block's horizon (bit for bit), and
+    its PMB c0 is that of its horizon (Silling and Askari 2005: c0 = 18 K / (pi delta^4))."""
+    raw = _raw(materials={"steel": STEEL, "aluminium": STEEL})
+    raw["geometry"]["size"] = [0.012, 0.006, 0.006]
+    raw["discretization"]["partial_volumes"] = True
+    raw["blocks"]["left"]["region"]["max"][0] = raw["blocks"]["right"]["region"]["min"][0] = 0.006
+    raw["blocks"]["right"]["horizon_m"] = 3.015e-3
+    setup = build(validate_case(raw))
+    b, x = setup.bonds, setup.body.points
+    delta = np.where(x[:, 0] < 0.006, 2.015e-3, 3.015e-3)
+    np.testing.assert_allclose(b.point_horizon, delta, rtol=1e-15)
+    i, j = b.owners(), b.neighbours
+    near = np.minimum(delta[i], delta[j])
+    assert np.all(b.length <= near + 0.5 * np.sqrt(3) * 1e-3)  # partial volumes: the cell reaches in
+    for wide, key, value, inner in ((2.015e-3, "horizon", 2.015, 1), (3.015e-3, "horizon_m", 3.015e-3, 10)):
+        one = _raw(material=STEEL)
+        one.pop("materials"), one.pop("blocks")
+        one["geometry"]["size"] = raw["geometry"]["size"]
+        one["discretization"] = {"spacing": 1e-3, key: value}
+        alone = build(validate_case(one))
+        p = int(np.flatnonzero((np.abs(x[:, 0] - (0.0005 + 1e-3 * inner)) < 1e-9) & (x[:, 1] > 0.002))[0])
+        mine, theirs = (
+            slice(b.offsets[p], b.offsets[p + 1]),
+            slice(alone.bonds.offsets[p], alone.bonds.offsets[p + 1]),
+        )
+        assert np.array_equal(b.neighbours[mine], alone.bonds.neighbours[theirs])
+        assert np.array_equal(b.volume_factor[mine], alone.bonds.volume_factor[theirs])
+        assert np.array_equal(b.influence[mine], alone.bonds.influence[theirs])
+        assert setup.model.c0[p] == alone.model.c0
+        assert alone.model.c0 == pytest.approx(pmb_micromodulus(200e9, 3, wide, "constant"), rel=1e-14)
+
+
+@pytest.mark.parametrize(
+    "block, key, message",
+    [
+        ({"horizon": 2.0, "horizon_m": 2e-3}, "blocks.left", "at most one of horizon"),
+        ({"horizon": 0.5}, "blocks.left", "at least 1"),
+        ({"horizon_m": 0.5e-3}, "blocks.left.horizon_m", "below the spacing"),
+    ],
+)
+def test_bad_block_horizons_are_refused(block, key, message):
+    raw = _raw()
+    raw["blocks"]["left"].update(block)
+    with pytest.raises(CaseFileError, match=message) as err:
+        validate_case(raw)
+    assert err.value.key == key

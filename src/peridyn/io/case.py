@@ -232,18 +232,24 @@ class Discretization(Strict):
     def _one_horizon(self):
         if (self.horizon is None) == (self.horizon_m is None):
             raise ValueError("give exactly one of horizon (multiple of the spacing) or horizon_m")
-        if self.horizon is not None and self.horizon < 1:
-            raise ValueError(
-                f"horizon = {self.horizon:g} spacings: at least 1 (below the spacing a point "
-                "has no neighbours along the axes)"
-            )
-        spacing = max(self.spacing) if isinstance(self.spacing, list) else self.spacing
-        if self.horizon_m is not None and spacing is not None and self.horizon_m < spacing:
-            raise ValueError(
-                f"horizon_m = {self.horizon_m:g} m is below the spacing {spacing:g} m: "
-                "at least the spacing (else a point has no neighbours along the axes)"
-            )
+        check_horizon(self.horizon, self.horizon_m, self.spacing)
         return self
+
+
+def check_horizon(horizon: float | None, horizon_m: float | None, spacing) -> None:
+    """Refuse a horizon (in spacings, or ``horizon_m`` in m) below the ``spacing`` (m, one value,
+    a list, or None for a mesh), where a point has no neighbours along the axes (ValueError)."""
+    if horizon is not None and horizon < 1:
+        raise ValueError(
+            f"horizon = {horizon:g} spacings: at least 1 (below the spacing a point "
+            "has no neighbours along the axes)"
+        )
+    spacing = max(spacing) if isinstance(spacing, list) else spacing
+    if horizon_m is not None and spacing is not None and horizon_m < spacing:
+        raise ValueError(
+            f"horizon_m = {horizon_m:g} m is below the spacing {spacing:g} m: "
+            "at least the spacing (else a point has no neighbours along the axes)"
+        )
 
 
 class Damage(Strict):
@@ -307,16 +313,22 @@ class Region(Strict):
 class Block(Strict):
     """One block of a body made of several materials (``Case.blocks``, docs/blocks.md): the points
     of ``region`` or of the node set ``set`` (exactly one of them), made of ``material``, a name
-    in ``Case.materials``. Every point of the body lies in exactly one block."""
+    in ``Case.materials``, with its own horizon (``horizon`` in spacings or ``horizon_m``; at most
+    one; default the discretization's). Every point of the body lies in exactly one block."""
 
     material: str
     region: Region | None = None
     set: str | None = None
+    horizon: Positive | None = None
+    horizon_m: Positive | None = None
 
     @model_validator(mode="after")
     def _one_selection(self):
         if (self.region is None) == (self.set is None):
             raise ValueError("give exactly one of region or set (the points of the block)")
+        if self.horizon is not None and self.horizon_m is not None:
+            raise ValueError("give at most one of horizon (multiple of the spacing) or horizon_m")
+        check_horizon(self.horizon, None, None)
         return self
 
 
@@ -565,6 +577,11 @@ class Case(Strict):
                     )
             if mat.model == "lps" and mat.nu is None:
                 raise ValueError(f"materials.{name}.nu: an LPS material needs Poisson's ratio nu")
+        for name, block in self.blocks.items():
+            try:
+                check_horizon(None, block.horizon_m, self.discretization.spacing)
+            except ValueError as exc:
+                raise ValueError(f"blocks.{name}.horizon_m: {exc}") from None
         for key in ("contact", "fatigue", "analysis"):
             if getattr(self, key) is not None:
                 raise ValueError(f"{key}: not available for a body of several blocks (yet); use one material")

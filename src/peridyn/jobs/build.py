@@ -165,11 +165,35 @@ def case_horizon(case: Case, body: Body) -> float:
     return d.horizon_m if d.horizon_m is not None else d.horizon * body.spacing
 
 
+def block_horizons(case: Case, body: Body) -> np.ndarray | None:
+    """(n_points,) each point's horizon (m) when the case's blocks have horizons of their own
+    that differ (docs/blocks.md); None when every point's is ``case_horizon``."""
+    default = case_horizon(case, body)
+    values = np.array(
+        [
+            b.horizon_m
+            if b.horizon_m is not None
+            else default
+            if b.horizon is None
+            else b.horizon * body.spacing
+            for b in case.blocks.values()
+        ]
+    )
+    if np.all(values == default):
+        return None
+    return values[block_index(case, body)]
+
+
 def build_bonds(case: Case, body: Body, required=None) -> Bonds:
     """Families of the case's discretisation, with its pre-cracks cut (``required``: the
-    points that must have a neighbour, default all; see ``find_bonds``)."""
+    points that must have a neighbour, default all; see ``find_bonds``); with blocks of their
+    own horizons, each bond within the smaller of its ends' (``block_horizons``)."""
     d = case.discretization
-    bonds = find_bonds(body, case_horizon(case, body), d.influence, d.partial_volumes, required=required)
+    point_horizon = block_horizons(case, body)
+    horizon = case_horizon(case, body) if point_horizon is None else float(np.max(point_horizon))
+    bonds = find_bonds(
+        body, horizon, d.influence, d.partial_volumes, required=required, point_horizon=point_horizon
+    )
     for crack in case.precracks:
         if crack.type == "rectangle":
 

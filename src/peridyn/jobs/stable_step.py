@@ -13,7 +13,9 @@ influence function, so it is summed here over the lattice offsets of the family
 
 A body of several blocks (docs/blocks.md) is bounded with the largest E (PMB), mu and K (LPS)
 of its materials and divided by the smallest density: a point at an interface has bonds of
-both blocks' constants, and these bound them all.
+both blocks' constants, and these bound them all; with blocks of different horizons, the
+largest bound over the horizons is taken (an interface between horizons is not estimated:
+``validate --build`` computes it).
 
 Plates are summed for every layer (the family cut by the faces) and the largest B taken.
 What the lattice cannot see makes the real step shorter: surface corrections (stiffer
@@ -47,18 +49,28 @@ def estimated_stable_step(case: Case, base_dir=".") -> float:
     d, g = case.discretization, case.geometry
     stiffest = _stiffest(case, dim)
     spacing = float(cell[0]) if g.type == "plate" else float(np.max(cell[:dim]))
-    horizon = d.horizon_m if d.horizon_m is not None else d.horizon * spacing
+    default = d.horizon_m if d.horizon_m is not None else d.horizon * spacing
     volume = float(np.prod(cell)) if not g.is_mesh else spacing**3
-    offsets, factor = neighbour_offsets(counts, cell, horizon, d.partial_volumes, dim)
     bound = 0.0
-    for low in itertools.product(*(_positions(offsets[:, a], int(counts[a])) for a in range(3))):
-        lo, hi = np.array([p[0] for p in low]), np.array([p[1] for p in low])
-        keep = np.all((offsets >= lo) & (offsets <= hi), axis=1)
-        bound = max(
-            bound, _row_bound(case, stiffest, offsets[keep] * cell, factor[keep], horizon, volume, dim)
-        )
+    for horizon in _horizons(case, default, spacing):
+        offsets, factor = neighbour_offsets(counts, cell, horizon, d.partial_volumes, dim)
+        for low in itertools.product(*(_positions(offsets[:, a], int(counts[a])) for a in range(3))):
+            lo, hi = np.array([p[0] for p in low]), np.array([p[1] for p in low])
+            keep = np.all((offsets >= lo) & (offsets <= hi), axis=1)
+            bound = max(
+                bound, _row_bound(case, stiffest, offsets[keep] * cell, factor[keep], horizon, volume, dim)
+            )
     density = min(m.density for m in case.block_materials().values())
     return float(2.0 / np.sqrt(bound / density))
+
+
+def _horizons(case: Case, default: float, spacing: float) -> list[float]:
+    """The distinct horizons (m) of the case: ``default``, or those of its blocks."""
+    found = {
+        b.horizon_m if b.horizon_m is not None else default if b.horizon is None else b.horizon * spacing
+        for b in case.blocks.values()
+    }
+    return sorted(found) or [default]
 
 
 def _stiffest(case: Case, dim: int) -> tuple[str, float, float, float]:

@@ -52,6 +52,15 @@ def radial_moment(influence: str, horizon: float, power: int) -> float:
     return value
 
 
+def radial_moments(influence: str, horizon, power: int):
+    """``radial_moment`` of a horizon (m): a float for a float, else (n,) for (n,) horizons (one
+    quadrature per distinct value: a body whose blocks have different horizons)."""
+    if np.ndim(horizon) == 0:
+        return radial_moment(influence, horizon, power)
+    values, index = np.unique(horizon, return_inverse=True)
+    return np.array([radial_moment(influence, float(v), power) for v in values])[index]
+
+
 def mean_fourth_power(dim: int) -> float:
     """Integral of n_x^4 over the unit sphere (3D: 4 pi / 5) or circle (2D: 3 pi / 4)."""
     return 4.0 * np.pi / 5.0 if dim == 3 else 3.0 * np.pi / 4.0

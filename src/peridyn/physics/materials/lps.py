@@ -304,7 +304,7 @@ class LPSModel(Model):
         2D: s_c = sqrt(G / ((6 mu / pi + 16 / (9 pi^2) (kappa - 2 mu)) delta)).
         Per point, (n_points,), from each point's own mu and kappa in a body of several blocks.
         """
-        delta, mu, k = self.bonds.horizon, self.shear, self.bulk
+        delta, mu, k = self.bonds.horizons(), self.shear, self.bulk
         if self.dim == 3:
             denom = (3.0 * mu + (0.75**4) * (k - 5.0 * mu / 3.0)) * delta
         else:

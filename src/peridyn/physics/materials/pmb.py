@@ -33,7 +33,7 @@ from peridyn.physics.materials.elastic import (
     check_elastic,
     mean_fourth_power,
     plane_bulk_modulus,
-    radial_moment,
+    radial_moments,
 )
 from peridyn.physics.materials.linearisation import BondLinearisation
 from peridyn.physics.materials.registry import register_material
@@ -54,12 +54,13 @@ def pmb_micromodulus(
     plane: str | None = None,
     thickness: float | None = None,
 ) -> float:
-    """c0 of c(xi) = c0 omega(|xi|), N/m^6 (3D) — see the module docstring."""
+    """c0 of c(xi) = c0 omega(|xi|), N/m^6 (3D) — see the module docstring. E (Pa) and the
+    horizon (m) may be (n_points,) arrays (a body of several blocks), giving c0 per point."""
     nu = pmb_poisson_ratio(dim, plane)
     if dim == 3:
-        return 18.0 * bulk_modulus(E, nu) / (4.0 * np.pi * radial_moment(influence, horizon, 3))
+        return 18.0 * bulk_modulus(E, nu) / (4.0 * np.pi * radial_moments(influence, horizon, 3))
     kappa = plane_bulk_modulus(E, nu, plane)
-    return 8.0 * kappa / (thickness * 2.0 * np.pi * radial_moment(influence, horizon, 2))
+    return 8.0 * kappa / (thickness * 2.0 * np.pi * radial_moments(influence, horizon, 2))
 
 
 def bond_micromodulus(c0, bonds: Bonds):
@@ -118,7 +119,7 @@ class PMBModel(Model):
             )
         super().__init__(body, bonds, E=E, density=density, dtype=dtype)
         self.c0 = pmb_micromodulus(
-            E, body.dim, bonds.horizon, bonds.influence_name, body.plane, body.thickness
+            E, body.dim, bonds.horizons(), bonds.influence_name, body.plane, body.thickness
         )
         self.bond_c0 = bond_micromodulus(self.c0, bonds)
         self.length = bonds.length.astype(self.dtype)
@@ -191,11 +192,11 @@ class PMBModel(Model):
         stress: s_c = sqrt(4 pi G / (9 E delta)), Ha and Bobaru 2010). Per point, (n_points,),
         from each point's own c0 in a body of several blocks.
         """
-        delta, name = self.bonds.horizon, self.bonds.influence_name
+        delta, name = self.bonds.horizons(), self.bonds.influence_name
         if self.body.dim == 3:
-            per_s2 = 0.5 * self.c0 * np.pi * radial_moment(name, delta, 4)
+            per_s2 = 0.5 * self.c0 * np.pi * radial_moments(name, delta, 4)
         else:
-            per_s2 = self.body.thickness * self.c0 * radial_moment(name, delta, 3)
+            per_s2 = self.body.thickness * self.c0 * radial_moments(name, delta, 3)
         s_c = np.sqrt(fracture_energy / per_s2)
         return float(s_c) if np.ndim(s_c) == 0 else s_c
 
@@ -204,7 +205,7 @@ class PMBModel(Model):
         dim = body.dim
         strain = 1e-3
         # continuum energy density of a uniaxial strain: (c0/4) eps^2 int omega r^d dr * <n^4>
-        moment = radial_moment(b.influence_name, b.horizon, dim)
+        moment = radial_moments(b.influence_name, b.horizons(), dim)
         thickness = body.thickness if dim == 2 else 1.0
         w_bulk = 0.25 * self.c0 * strain**2 * moment * mean_fourth_power(dim) * thickness
         owners = b.owners()
