@@ -70,6 +70,8 @@ class Discretisation:
     def from_case(cls, case) -> Discretisation:
         """The discretisation of a validated ``io.case.Case`` (``box`` or ``plate`` geometry)."""
         g, d, mat = case.geometry, case.discretization, case.material
+        if mat is None:
+            raise InputError(f"Bloch analysis needs a body of one material, got blocks {sorted(case.blocks)}")
         if g.type not in ("box", "plate"):
             raise InputError(f"Bloch analysis needs a box or plate case, got geometry.type {g.type!r}")
         spacing = np.atleast_1d(np.asarray(d.spacing if d.spacing is not None else [], float))

@@ -74,7 +74,12 @@ class Bonds:
     intact : (n_bonds,) bool
         False for bonds cut by a pre-crack or broken during a run.
     horizon : float, m
+        The horizon; with ``point_horizon``, the largest of them.
     influence_name : str
+    point_horizon : (n_points,) float64 or None, m
+        Each point's own horizon in a body whose blocks have different horizons
+        (docs/blocks.md): a bond joins i and j within the smaller of their horizons, which its
+        influence function and partial volume use. None: every point's is ``horizon``.
     """
 
     offsets: np.ndarray
@@ -85,6 +90,11 @@ class Bonds:
     intact: np.ndarray
     horizon: float
     influence_name: str
+    point_horizon: np.ndarray | None = None
+
+    def horizons(self):
+        """Each point's horizon (m): ``point_horizon``, or the float ``horizon`` shared by all."""
+        return self.horizon if self.point_horizon is None else self.point_horizon
 
     @property
     def n_bonds(self) -> int:
@@ -137,6 +147,7 @@ def find_bonds(
     quadrature_points: int = 8,
     required=None,
     box=None,
+    point_horizon=None,
 ) -> Bonds:
     """Search the families of all points and build the CSR bond arrays.
 
@@ -160,7 +171,11 @@ def find_bonds(
     box : (3,) float or None, m
         Half-widths of a box neighbourhood instead of the sphere: the neighbours are the points
         with |x_j - x_i| <= box along every axis (Peridigm's PdQuickGrid families); no partial
-        volumes. The influence function still takes ``horizon``.
+        volumes, one horizon. The influence function still takes ``horizon``.
+    point_horizon : (n_points,) float or None, m
+        Each point's horizon (blocks of different horizons, docs/blocks.md); ``horizon`` must
+        then be their largest. A bond i-j is kept, weighed and given its partial volume
+        within min(point_horizon_i, point_horizon_j).
 
     Raises
     ------
@@ -179,19 +194,39 @@ def find_bonds(
     if box is not None:
         if partial_volumes:
             raise InputError("a box neighbourhood has no partial volumes: set partial_volumes false")
+        if point_horizon is not None:
+            raise InputError("a box neighbourhood takes one horizon, not one per point")
         box = np.asarray(box, dtype=float) * (1 + HORIZON_RTOL)
         reach = float(np.linalg.norm(box))
     pairs = cKDTree(x).query_pairs(reach, output_type="ndarray")
     if box is not None:
         pairs = pairs[np.all(np.abs(x[pairs[:, 1]] - x[pairs[:, 0]]) <= box, axis=1)]
     offsets, j = bond_families(pairs, body.n_points)
-    radius = horizon * (1 + HORIZON_RTOL) if box is None else reach
-    length, factor = bond_geometry(x, cells, offsets, j, radius, partial_volumes, quadrature_points)
-    if partial_volumes:  # drop neighbours whose cell lies wholly outside the sphere
+    if point_horizon is None:
+        radius = horizon * (1 + HORIZON_RTOL) if box is None else reach
+        length, factor = bond_geometry(x, cells, offsets, j, radius, partial_volumes, quadrature_points)
+    else:
+        point_horizon = np.asarray(point_horizon, dtype=np.float64)
+        if point_horizon.shape != (body.n_points,) or not horizon == np.max(point_horizon):
+            raise InputError(
+                f"point_horizon: one horizon per point ({body.n_points},), the largest equal to the "
+                f"horizon {horizon:g} m; got shape {point_horizon.shape}"
+            )
+        bond_horizon = np.minimum(np.repeat(point_horizon, np.diff(offsets)), point_horizon[j])
+        factor = np.zeros(len(j))
+        for radius in np.unique(point_horizon):  # the kernel takes one radius: once per horizon
+            length, within = bond_geometry(
+                x, cells, offsets, j, radius * (1 + HORIZON_RTOL), partial_volumes, quadrature_points
+            )
+            factor = np.where(bond_horizon == radius, within, factor)
+    # drop neighbours whose cell lies wholly outside the sphere (of the bond's horizon)
+    if partial_volumes or point_horizon is not None:
         keep = factor > 0
         counts = family_sums(offsets, keep).astype(np.int64)
         offsets = np.concatenate([[0], np.cumsum(counts)])
         j, length, factor = j[keep], length[keep], factor[keep]
+        if point_horizon is not None:
+            bond_horizon = bond_horizon[keep]
     counts = np.diff(offsets)
     if required is not None:
         counts = counts[np.asarray(required, dtype=np.int64)]
@@ -206,11 +241,12 @@ def find_bonds(
         offsets=offsets,
         neighbours=j,
         length=length,
-        influence=omega(length, horizon),
+        influence=omega(length, horizon if point_horizon is None else bond_horizon),
         volume_factor=factor,
         intact=np.ones(len(j), dtype=bool),
         horizon=float(horizon),
         influence_name=influence,
+        point_horizon=point_horizon,
     )
 
 
@@ -255,6 +291,7 @@ def reorder_bonds(bonds: Bonds, order: np.ndarray, n_points: int) -> Bonds:
         intact=bonds.intact[rows],
         horizon=bonds.horizon,
         influence_name=bonds.influence_name,
+        point_horizon=None if bonds.point_horizon is None else bonds.point_horizon[order],
     )
 
 

@@ -236,18 +236,24 @@ class Discretization(Strict):
     def _one_horizon(self):
         if (self.horizon is None) == (self.horizon_m is None):
             raise ValueError("give exactly one of horizon (multiple of the spacing) or horizon_m")
-        if self.horizon is not None and self.horizon < 1:
-            raise ValueError(
-                f"horizon = {self.horizon:g} spacings: at least 1 (below the spacing a point "
-                "has no neighbours along the axes)"
-            )
-        spacing = max(self.spacing) if isinstance(self.spacing, list) else self.spacing
-        if self.horizon_m is not None and spacing is not None and self.horizon_m < spacing:
-            raise ValueError(
-                f"horizon_m = {self.horizon_m:g} m is below the spacing {spacing:g} m: "
-                "at least the spacing (else a point has no neighbours along the axes)"
-            )
+        check_horizon(self.horizon, self.horizon_m, self.spacing)
         return self
+
+
+def check_horizon(horizon: float | None, horizon_m: float | None, spacing) -> None:
+    """Refuse a horizon (in spacings, or ``horizon_m`` in m) below the ``spacing`` (m, one value,
+    a list, or None for a mesh), where a point has no neighbours along the axes (ValueError)."""
+    if horizon is not None and horizon < 1:
+        raise ValueError(
+            f"horizon = {horizon:g} spacings: at least 1 (below the spacing a point "
+            "has no neighbours along the axes)"
+        )
+    spacing = max(spacing) if isinstance(spacing, list) else spacing
+    if horizon_m is not None and spacing is not None and horizon_m < spacing:
+        raise ValueError(
+            f"horizon_m = {horizon_m:g} m is below the spacing {spacing:g} m: "
+            "at least the spacing (else a point has no neighbours along the axes)"
+        )
 
 
 class Damage(Strict):
@@ -308,6 +314,28 @@ class Region(Strict):
         missing = [k for k in needs.get(self.type, ()) if getattr(self, k) is None]
         if missing:
             raise ValueError(f"a {self.type} region needs {', '.join(missing)}")
+        return self
+
+
+class Block(Strict):
+    """One block of a body made of several materials (``Case.blocks``, docs/blocks.md): the points
+    of ``region`` or of the node set ``set`` (exactly one of them), made of ``material``, a name
+    in ``Case.materials``, with its own horizon (``horizon`` in spacings or ``horizon_m``; at most
+    one; default the discretization's). Every point of the body lies in exactly one block."""
+
+    material: str
+    region: Region | None = None
+    set: str | None = None
+    horizon: Positive | None = None
+    horizon_m: Positive | None = None
+
+    @model_validator(mode="after")
+    def _one_selection(self):
+        if (self.region is None) == (self.set is None):
+            raise ValueError("give exactly one of region or set (the points of the block)")
+        if self.horizon is not None and self.horizon_m is not None:
+            raise ValueError("give at most one of horizon (multiple of the spacing) or horizon_m")
+        check_horizon(self.horizon, None, None)
         return self
 
 
@@ -547,7 +575,9 @@ class Case(Strict):
     description: str = ""
     geometry: Geometry
     discretization: Discretization
-    material: Material
+    material: Material | None = None
+    materials: dict[str, Material] = {}
+    blocks: dict[str, Block] = {}
     removals: list[Region] = []
     node_sets: dict[str, Region] = {}
     precracks: list[Precrack] = []
@@ -570,6 +600,54 @@ class Case(Strict):
                 "partial_volumes: false"
             )
         return self
+
+    @model_validator(mode="after")
+    def _materials(self):
+        if self.blocks and self.material is not None:
+            raise ValueError(
+                "blocks: give either material (one material for the whole body) or materials "
+                "and blocks (docs/blocks.md), not both"
+            )
+        if not self.blocks:
+            if self.materials:
+                raise ValueError("materials: named materials are used by blocks; give blocks too")
+            if self.material is None:
+                raise ValueError("material: a required key that is missing (or give materials and blocks)")
+            return self
+        for name, block in self.blocks.items():
+            if block.material not in self.materials:
+                raise ValueError(
+                    f"blocks.{name}.material: unknown material {block.material!r}"
+                    f"{did_you_mean(block.material, self.materials)}; defined: {sorted(self.materials)}"
+                )
+        unused = sorted(set(self.materials) - {b.material for b in self.blocks.values()})
+        if unused:
+            raise ValueError(f"materials.{unused[0]}: no block is made of it")
+        first_name, first = next(iter(self.materials.items()))
+        for name, mat in self.materials.items():
+            for key in ("model", "surface_correction"):
+                if getattr(mat, key) != getattr(first, key):
+                    raise ValueError(
+                        f"materials.{name}.{key}: {getattr(mat, key)!r}, but materials.{first_name} has "
+                        f"{getattr(first, key)!r}: the blocks of a body share one model and surface "
+                        "correction (docs/blocks.md)"
+                    )
+            if mat.model == "lps" and mat.nu is None:
+                raise ValueError(f"materials.{name}.nu: an LPS material needs Poisson's ratio nu")
+        for name, block in self.blocks.items():
+            try:
+                check_horizon(None, block.horizon_m, self.discretization.spacing)
+            except ValueError as exc:
+                raise ValueError(f"blocks.{name}.horizon_m: {exc}") from None
+        for key in ("contact", "fatigue", "analysis"):
+            if getattr(self, key) is not None:
+                raise ValueError(f"{key}: not available for a body of several blocks (yet); use one material")
+        return self
+
+    def block_materials(self) -> dict[str, Material]:
+        """Every material of the case by the key it is given under: ``{"material": material}``
+        for one material, else ``materials``."""
+        return {"material": self.material} if self.material is not None else dict(self.materials)
 
     @model_validator(mode="after")
     def _absorbing_solver(self):
@@ -603,8 +681,12 @@ class Case(Strict):
         used += [(f"output.planes.{k}", v) for k, v in self.output.planes.items()]
         if not isinstance(self.output.exodus, bool):
             used += [(f"output.exodus.sums.{k}.set", v.set) for k, v in self.output.exodus.sums.items()]
-        if self.material.damage:
-            used += [("material.damage.no_damage_sets", s) for s in self.material.damage.no_damage_sets]
+        used += [(f"blocks.{k}.set", b.set) for k, b in self.blocks.items() if b.set is not None]
+        for key, mat in self.block_materials().items():
+            if key != "material":
+                key = f"materials.{key}"
+            if mat.damage:
+                used += [(f"{key}.damage.no_damage_sets", s) for s in mat.damage.no_damage_sets]
         return used
 
     @model_validator(mode="after")
@@ -613,7 +695,7 @@ class Case(Strict):
         if clash:
             raise ValueError(f"actuators: name {sorted(clash)[0]!r} is already a node set")
         known = set(self.node_sets) | {"all"} | set(self.actuators)
-        in_file = self.geometry.type == "exodus"  # its sets are known once the mesh is read
+        in_file = self.geometry.is_mesh  # its sets are known once the mesh is read
         for where, name in self.set_references():
             if name not in known and not in_file:
                 raise ValueError(

@@ -33,6 +33,7 @@ from peridyn.physics.damage import BondDamage, protected_points
 from peridyn.physics.expressions import SpaceTime
 from peridyn.physics.loads import BoundaryCondition, InitialCondition, Loading
 from peridyn.physics.materials import Model, make_model
+from peridyn.physics.materials.blocks import BlockMaterial, assign_blocks, make_block_model
 from peridyn.physics.timefunctions import from_spec
 from peridyn.physics.transducers import pin_force_actuator, pzt_radial_actuator
 
@@ -80,7 +81,7 @@ def build_body(case: Case, base_dir=".") -> Body:
                 "a region that contains at least one point",
             )
         body = body.with_node_set(name, mask)
-    if case.geometry.type == "exodus":
+    if case.geometry.is_mesh:
         check_mesh_sets(case, body)
     return body
 
@@ -179,15 +180,38 @@ def case_horizon(case: Case, body: Body) -> float:
     return d.horizon_m if d.horizon_m is not None else d.horizon * body.spacing
 
 
+def block_horizons(case: Case, body: Body) -> np.ndarray | None:
+    """(n_points,) each point's horizon (m) when the case's blocks have horizons of their own
+    that differ (docs/blocks.md); None when every point's is ``case_horizon``."""
+    default = case_horizon(case, body)
+    values = np.array(
+        [
+            b.horizon_m
+            if b.horizon_m is not None
+            else default
+            if b.horizon is None
+            else b.horizon * body.spacing
+            for b in case.blocks.values()
+        ]
+    )
+    if np.all(values == default):
+        return None
+    return values[block_index(case, body)]
+
+
 def build_bonds(case: Case, body: Body, required=None) -> Bonds:
     """Families of the case's discretisation, with its pre-cracks cut (``required``: the
-    points that must have a neighbour, default all; see ``find_bonds``)."""
+    points that must have a neighbour, default all; see ``find_bonds``); with blocks of their
+    own horizons, each bond within the smaller of its ends' (``block_horizons``)."""
     d = case.discretization
-    horizon = case_horizon(case, body)
+    point_horizon = block_horizons(case, body)
+    horizon = case_horizon(case, body) if point_horizon is None else float(np.max(point_horizon))
     box = None
     if d.neighbourhood == "box":  # round(horizon / spacing) cells along each axis, halves up
         box = np.floor(horizon / body.cells[0] + 0.5) * body.cells[0]
-    bonds = find_bonds(body, horizon, d.influence, d.partial_volumes, required=required, box=box)
+    bonds = find_bonds(
+        body, horizon, d.influence, d.partial_volumes, required=required, box=box, point_horizon=point_horizon
+    )
     for crack in case.precracks:
         if crack.type == "rectangle":
 
@@ -368,6 +392,13 @@ def _build_part(case: Case, comm, base_dir):
         raise CaseFileError(
             case.name, "contact", case.contact.model_dump(exclude_none=True), "no contact in an MPI run (yet)"
         )
+    if case.blocks:
+        raise CaseFileError(
+            case.name,
+            "blocks",
+            sorted(case.blocks),
+            "one material in an MPI run (several blocks: yet to come)",
+        )
     body = build_body(case, base_dir)
     check_placements(case, body)
     body, actuation = add_actuators(case, body)
@@ -394,8 +425,40 @@ def _build_part(case: Case, comm, base_dir):
     return setup, owned, ghosts, owner[ghosts]
 
 
+def block_index(case: Case, body: Body) -> np.ndarray:
+    """(n_points,) int64: each point's block, an index into ``case.blocks`` (in order).
+
+    Raises
+    ------
+    CaseFileError
+        At ``blocks``, when a block holds no point or a point lies in two blocks or in none.
+    """
+    masks = {
+        name: region_mask(body, b.region, f"blocks.{name}.region")
+        if b.region is not None
+        else np.isin(np.arange(body.n_points), body.node_set(b.set))
+        for name, b in case.blocks.items()
+    }
+    try:
+        return assign_blocks(masks)
+    except InputError as exc:
+        raise CaseFileError(case.name, "blocks", None, str(exc), has_value=False) from None
+
+
 def build_model(case: Case, body: Body, bonds: Bonds) -> Model:
-    """The case's material bound to ``body`` and ``bonds``."""
+    """The case's material bound to ``body`` and ``bonds``: one material, or the materials of
+    its blocks (``peridyn.physics.materials.blocks``)."""
+    if case.blocks:
+        mats = [case.materials[b.material] for b in case.blocks.values()]
+        return make_block_model(
+            mats[0].model,
+            body,
+            bonds,
+            block_index(case, body),
+            [BlockMaterial(m.E, m.density, m.nu) for m in mats],
+            surface_correction=mats[0].surface_correction,
+            dtype=case.solver.dtype,
+        )
     mat = case.material
     return make_model(
         mat.model,
@@ -410,9 +473,11 @@ def build_model(case: Case, body: Body, bonds: Bonds) -> Model:
 
 
 def build_damage(case: Case, model: Model, protected=None) -> BondDamage | None:
-    """The case's bond breaking on ``model`` (None without ``material.damage``); ``protected``
-    ((n_points,) bool or None): the points of the no-damage sets, given by a rank's part
-    instead of the set names."""
+    """The case's bond breaking on ``model`` (None without ``material.damage``, or with blocks
+    none of whose materials has damage); ``protected`` ((n_points,) bool or None): the points of
+    the no-damage sets, given by a rank's part instead of the set names."""
+    if case.blocks:
+        return block_damage(case, model)
     d = case.material.damage
     if d is None:
         return None
@@ -424,6 +489,30 @@ def build_damage(case: Case, model: Model, protected=None) -> BondDamage | None:
         critical_bond_stress=d.critical_bond_stress,
         protected=protected,
     )
+
+
+def block_damage(case: Case, model: Model) -> BondDamage | None:
+    """Bond breaking of a body of several blocks (docs/blocks.md): each point's critical stretch
+    from its block's material damage (inf, never, where it has none), a bond breaking at the
+    smaller of its ends' (``BondDamage``); the no-damage sets of every material's damage."""
+    blocks = list(case.blocks.values())
+    specs = [case.materials[b.material].damage for b in blocks]
+    if all(d is None for d in specs):
+        return None
+    of_point = block_index(case, model.body)
+    stretch = np.full(model.body.n_points, np.inf)
+    for k, (block, d) in enumerate(zip(blocks, specs, strict=True)):
+        if d is None:
+            continue
+        mine = of_point == k
+        if d.critical_stretch is not None:
+            stretch[mine] = d.critical_stretch
+        elif d.fracture_energy is not None:
+            stretch[mine] = model.critical_stretch(d.fracture_energy)[mine]
+        else:
+            stretch[mine] = d.critical_bond_stress / case.materials[block.material].E
+    no_damage = sorted({name for d in specs if d is not None for name in d.no_damage_sets})
+    return BondDamage(model, critical_stretch=stretch, no_damage_sets=no_damage)
 
 
 def check_loading(case: Case, loading: Loading) -> None:

@@ -236,7 +236,8 @@ def modal_factor_bytes(case: Case, base_dir, points: float, horizon: float) -> f
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         body = build_points(case, base_dir)
-    unknowns = 4 if case.material.model == "lps" else 3
+    models = {m.model for m in case.block_materials().values()}  # one model, blocks or not
+    unknowns = 4 if "lps" in models else 3
     needed = FACTOR_ENTRY_BYTES * estimated_factor_entries(body.points, horizon, unknowns)
     if method == "auto" and needed > min(FACTOR_BUDGET, MEMORY_SHARE * geometry.memory_limit()):
         return 0.0

@@ -88,7 +88,7 @@ def redraw_crack_figures(case: Case, body: Body, out: Path):
     """Crack paths and figures (``draw_crack_figures``) of a finished run with damage, from
     its results.h5: the final damage and the crack length history of the stored summary.
     Returns (paths, figure paths); (None, []) for a case without damage."""
-    if case.material.damage is None:
+    if all(m.damage is None for m in case.block_materials().values()):
         return None, []
     results = Results(out / "results.h5")
     paths = final_crack_paths(case, body, results.array("final/damage"))

@@ -11,6 +11,12 @@ influence function, so it is summed here over the lattice offsets of the family
   theta coefficient d / m, S = (d / m) sum w |xi|):
   B = sum_j (4 alpha w_j + 2 K (d / m) w_j |xi_j| S) + 2 K S^2.
 
+A body of several blocks (docs/blocks.md) is bounded with the largest E (PMB), mu and K (LPS)
+of its materials and divided by the smallest density: a point at an interface has bonds of
+both blocks' constants, and these bound them all; with blocks of different horizons, the
+largest bound over the horizons is taken (an interface between horizons is not estimated:
+``validate --build`` computes it).
+
 Plates are summed for every layer (the family cut by the faces) and the largest B taken.
 What the lattice cannot see makes the real step shorter: surface corrections (stiffer
 bonds near faces), removals and pre-cracks (cut families, larger alpha), text meshes,
@@ -40,17 +46,44 @@ STEP_MARGIN = 0.15
 def estimated_stable_step(case: Case, base_dir=".") -> float:
     """Estimated largest stable explicit step of ``case``, s (undamped, without contact)."""
     counts, cell, dim = grid_shape(case, base_dir)
-    d, mat, g = case.discretization, case.material, case.geometry
+    d, g = case.discretization, case.geometry
+    stiffest = _stiffest(case, dim)
     spacing = float(cell[0]) if g.type == "plate" else float(np.max(cell[:dim]))
-    horizon = d.horizon_m if d.horizon_m is not None else d.horizon * spacing
+    default = d.horizon_m if d.horizon_m is not None else d.horizon * spacing
     volume = float(np.prod(cell)) if not g.is_mesh else spacing**3
-    offsets, factor = neighbour_offsets(counts, cell, horizon, d.partial_volumes, dim)
     bound = 0.0
-    for low in itertools.product(*(_positions(offsets[:, a], int(counts[a])) for a in range(3))):
-        lo, hi = np.array([p[0] for p in low]), np.array([p[1] for p in low])
-        keep = np.all((offsets >= lo) & (offsets <= hi), axis=1)
-        bound = max(bound, _row_bound(case, offsets[keep] * cell, factor[keep], horizon, volume, dim))
-    return float(2.0 / np.sqrt(bound / mat.density))
+    for horizon in _horizons(case, default, spacing):
+        offsets, factor = neighbour_offsets(counts, cell, horizon, d.partial_volumes, dim)
+        for low in itertools.product(*(_positions(offsets[:, a], int(counts[a])) for a in range(3))):
+            lo, hi = np.array([p[0] for p in low]), np.array([p[1] for p in low])
+            keep = np.all((offsets >= lo) & (offsets <= hi), axis=1)
+            bound = max(
+                bound, _row_bound(case, stiffest, offsets[keep] * cell, factor[keep], horizon, volume, dim)
+            )
+    density = min(m.density for m in case.block_materials().values())
+    return float(2.0 / np.sqrt(bound / density))
+
+
+def _horizons(case: Case, default: float, spacing: float) -> list[float]:
+    """The distinct horizons (m) of the case: ``default``, or those of its blocks."""
+    found = {
+        b.horizon_m if b.horizon_m is not None else default if b.horizon is None else b.horizon * spacing
+        for b in case.blocks.values()
+    }
+    return sorted(found) or [default]
+
+
+def _stiffest(case: Case, dim: int) -> tuple[str, float, float, float]:
+    """(model, E, mu, K) of the case's materials, each the largest over them, Pa (K: the 2D
+    bulk modulus in 2D; mu and K nan for PMB)."""
+    plane = case.geometry.plane if dim == 2 else None
+    mats = list(case.block_materials().values())
+    E = max(m.E for m in mats)
+    if mats[0].model == "pmb":
+        return "pmb", E, np.nan, np.nan
+    mu = max(shear_modulus(m.E, m.nu) for m in mats)
+    bulk = max(bulk_modulus(m.E, m.nu) if dim == 3 else plane_bulk_modulus(m.E, m.nu, plane) for m in mats)
+    return "lps", E, mu, bulk
 
 
 def _positions(offsets: np.ndarray, count: int) -> list[tuple[int, int]]:
@@ -63,19 +96,18 @@ def _positions(offsets: np.ndarray, count: int) -> list[tuple[int, int]]:
     return sorted(limits)
 
 
-def _row_bound(case: Case, xi_vec: np.ndarray, factor: np.ndarray, horizon, volume, dim) -> float:
+def _row_bound(case: Case, constants, xi_vec: np.ndarray, factor: np.ndarray, horizon, volume, dim) -> float:
     """Block-Gershgorin bound B (N/m^5) of a point whose family has bond vectors ``xi_vec``
-    (k, 3) m and volume factors (k,); LPS takes the neighbours' alpha, m and S equal to the
-    point's own."""
-    d, mat, g = case.discretization, case.material, case.geometry
+    (k, 3) m and volume factors (k,), with the ``constants`` (model, E, mu, K) of ``_stiffest``;
+    LPS takes the neighbours' alpha, m and S equal to the point's own."""
+    d, g = case.discretization, case.geometry
+    model, E, mu, bulk = constants
     plane = g.plane if dim == 2 else None
     xi = np.linalg.norm(xi_vec, axis=1)
     w = influence_function(d.influence)(xi, horizon) * volume * factor
-    if mat.model == "pmb":
-        c0 = pmb_micromodulus(mat.E, dim, horizon, d.influence, plane, g.thickness if dim == 2 else None)
+    if model == "pmb":
+        c0 = pmb_micromodulus(E, dim, horizon, d.influence, plane, g.thickness if dim == 2 else None)
         return float(2.0 * np.sum(c0 * w / xi))
-    mu = shear_modulus(mat.E, mat.nu)
-    bulk = bulk_modulus(mat.E, mat.nu) if dim == 3 else plane_bulk_modulus(mat.E, mat.nu, plane)
     m = np.sum(w * xi**2)
     alpha = (15.0 if dim == 3 else 8.0) * mu / m
     s = dim / m * np.sum(w * xi)

@@ -41,17 +41,20 @@ from peridyn.kernels.damage import MAX_QUANTA, damage_index, flag_moved_points, 
 from peridyn.physics.materials.base import Model
 
 
-def stretch_from_bond_stress(critical_bond_stress: float, E: float) -> float:
+def stretch_from_bond_stress(critical_bond_stress: float, E):
     """Critical stretch s_c = sigma_u / E of the bond stress sigma_b = E s (module docstring).
 
     Parameters
     ----------
     critical_bond_stress : float, Pa
-    E : float, Pa (Young's modulus)
+    E : float or (n_points,), Pa (Young's modulus; per point in a body of several blocks, which
+        gives s_c per point)
     """
     if not critical_bond_stress > 0:
         raise InputError(f"critical_bond_stress must be positive, got {critical_bond_stress!r}")
-    return float(critical_bond_stress) / float(E)
+    if np.ndim(E) == 0:
+        return float(critical_bond_stress) / float(E)
+    return float(critical_bond_stress) / np.asarray(E, dtype=float)
 
 
 def protected_points(body, names) -> np.ndarray:
@@ -68,8 +71,11 @@ class BondDamage:
     Parameters
     ----------
     model : Model
-    critical_stretch : float or None
+    critical_stretch : float, (n_points,) or None
         Dimensionless; give exactly one of this, ``fracture_energy`` or ``critical_bond_stress``.
+        Per point (a body of several blocks, docs/blocks.md; also what ``fracture_energy`` and
+        ``critical_bond_stress`` give on such a body): a bond breaks at the smaller of its two
+        ends' values, and never where both are inf.
     fracture_energy : float or None, J/m^2
     no_damage_sets : sequence of str
         Node sets whose bonds never break.
@@ -110,14 +116,20 @@ class BondDamage:
             if not fracture_energy > 0:
                 raise InputError(f"fracture_energy must be positive, got {fracture_energy!r}")
             critical_stretch = model.critical_stretch(fracture_energy)
-        if not critical_stretch > 0:
+        if not np.all(np.asarray(critical_stretch) > 0):
             raise InputError(f"critical_stretch must be positive, got {critical_stretch!r}")
         self.model = model
-        self.value = float(critical_stretch)
         bonds = model.bonds
-        self.critical_stretch = np.full(bonds.n_bonds, self.value)
         protected = protected_points(model.body, no_damage_sets) | (False if protected is None else protected)
         self.breakable = ~(protected[bonds.owners()] | protected[bonds.neighbours])
+        if np.ndim(critical_stretch) == 0:
+            self.value = float(critical_stretch)
+            self.critical_stretch = np.full(bonds.n_bonds, self.value)
+        else:
+            per_point = np.asarray(critical_stretch, dtype=float)
+            self.critical_stretch = np.minimum(per_point[bonds.owners()], per_point[bonds.neighbours])
+            self.breakable &= np.isfinite(self.critical_stretch)
+            self.value = float(np.min(per_point))
         n = model.body.n_points
         self.full_tests = 0  # calls of ``update`` that tested every bond
         self.partial_tests = 0  # calls that tested only the flagged families

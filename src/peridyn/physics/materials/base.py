@@ -27,6 +27,7 @@ import numpy as np
 
 from peridyn.discretization.body import Body
 from peridyn.discretization.bonds import Bonds
+from peridyn.errors import InputError
 from peridyn.kernels.lps import lps_dilatation
 from peridyn.kernels.stress import partial_stress
 from peridyn.physics.materials.linearisation import BondLinearisation
@@ -46,8 +47,9 @@ class Model:
     body : Body
     bonds : Bonds
         ``bonds.intact`` is shared and updated in place when bonds break.
-    E : float, Pa
-        Young's modulus (damage's critical bond stress, contact's short-range constant).
+    E : float or (n_points,) float64, Pa
+        Young's modulus (damage's critical bond stress, contact's short-range constant); per
+        point in a body of several blocks (docs/blocks.md).
     dtype : numpy dtype
         Floating type of the kernels (float64 or float32).
     x : (n_points, 3) dtype, m
@@ -59,13 +61,16 @@ class Model:
 
     name = "model"
 
-    def __init__(self, body: Body, bonds: Bonds, E: float, density: float, dtype=np.float64):
+    def __init__(self, body: Body, bonds: Bonds, E, density, dtype=np.float64):
         self.body = body
         self.bonds = bonds
-        self.E = float(E)
+        self.E = float(E) if np.ndim(E) == 0 else per_point(E, body.n_points, "E")
         self.dtype = np.dtype(dtype)
         self.x = np.ascontiguousarray(body.points, dtype=self.dtype)
-        self.density = np.full(body.n_points, float(density))
+        n = body.n_points
+        self.density = (
+            np.full(n, float(density)) if np.ndim(density) == 0 else per_point(density, n, "density")
+        )
         self.neighbours = bonds.neighbours
         self.offsets = bonds.offsets
         # neighbour volume times its volume factor, (n_bonds,) m^3
@@ -78,9 +83,9 @@ class Model:
         body: Body,
         bonds: Bonds,
         *,
-        E: float,
-        density: float,
-        nu: float | None = None,
+        E,
+        density,
+        nu=None,
         surface_correction: str = "none",
         dtype=np.float64,
     ) -> Model:
@@ -88,8 +93,9 @@ class Model:
 
         E (Pa), density (kg/m^3), Poisson's ratio ``nu`` (None: not given), the name of a
         ``surface_correction`` and the kernel ``dtype``; each material checks them and raises
-        ``InputError`` for values it cannot take. By default the constructor takes them as
-        keywords.
+        ``InputError`` for values it cannot take. E, density and nu are numbers, or (n_points,)
+        arrays for a body of several blocks (``peridyn.physics.materials.blocks``). By default
+        the constructor takes them as keywords.
         """
         return cls(
             body, bonds, E=E, density=density, nu=nu, surface_correction=surface_correction, dtype=dtype
@@ -129,8 +135,9 @@ class Model:
         """
         raise NotImplementedError
 
-    def critical_stretch(self, fracture_energy: float) -> float:
-        """Critical bond stretch for a fracture energy ``fracture_energy`` (J/m^2)."""
+    def critical_stretch(self, fracture_energy: float):
+        """Critical bond stretch for a fracture energy ``fracture_energy`` (J/m^2): a float, or
+        (n_points,) for a body of several blocks (each point's from its own constants)."""
         raise NotImplementedError
 
     def linearisation(self) -> BondLinearisation:
@@ -205,3 +212,13 @@ class Model:
         if points is not None:
             bound = bound[points]
         return float(2.0 / np.sqrt(np.max(bound)))
+
+
+def per_point(value, n_points: int, name: str) -> np.ndarray:
+    """(n_points,) float64 copy of a per-point material constant ``value`` (an array of that shape)."""
+    array = np.array(value, dtype=np.float64)
+    if array.shape != (n_points,):
+        raise InputError(
+            f"material {name}: a number or one value per point ({n_points},), got shape {array.shape}"
+        )
+    return array

@@ -9,13 +9,21 @@ from peridyn.discretization.bonds import influence_function
 from peridyn.errors import InputError
 
 
-def check_elastic(E: float, nu: float, rho: float) -> None:
-    """Raise InputError unless 0 < E, -1 < nu < 1/2 and 0 < rho (SI units)."""
+def check_elastic(E, nu, rho) -> None:
+    """Raise InputError unless 0 < E, -1 < nu < 1/2 and 0 < rho (SI units); each a number or,
+    for a body of several blocks, an (n_points,) array checked point by point."""
     for name, value in (("E", E), ("rho", rho)):
-        if not (np.isfinite(value) and value > 0):
-            raise InputError(f"material {name} must be positive and finite, got {value!r}")
-    if not (np.isfinite(nu) and -1.0 < nu < 0.5):
-        raise InputError(f"material nu must lie in (-1, 0.5), got {nu!r}")
+        bad = ~(np.isfinite(value) & (np.asarray(value) > 0))
+        if np.any(bad):
+            raise InputError(f"material {name} must be positive and finite, got {_first(value, bad)!r}")
+    bad = ~(np.isfinite(nu) & (np.asarray(nu) > -1.0) & (np.asarray(nu) < 0.5))
+    if np.any(bad):
+        raise InputError(f"material nu must lie in (-1, 0.5), got {_first(nu, bad)!r}")
+
+
+def _first(value, bad):
+    """``value`` if a number, else its first entry where ``bad``."""
+    return value if np.ndim(value) == 0 else float(np.asarray(value)[np.flatnonzero(bad)[0]])
 
 
 def bulk_modulus(E: float, nu: float) -> float:
@@ -42,6 +50,15 @@ def radial_moment(influence: str, horizon: float, power: int) -> float:
     omega = influence_function(influence)
     value, _ = quad(lambda r: float(omega(np.array(r), horizon)) * r**power, 0.0, horizon, limit=200)
     return value
+
+
+def radial_moments(influence: str, horizon, power: int):
+    """``radial_moment`` of a horizon (m): a float for a float, else (n,) for (n,) horizons (one
+    quadrature per distinct value: a body whose blocks have different horizons)."""
+    if np.ndim(horizon) == 0:
+        return radial_moment(influence, horizon, power)
+    values, index = np.unique(horizon, return_inverse=True)
+    return np.array([radial_moment(influence, float(v), power) for v in values])[index]
 
 
 def mean_fourth_power(dim: int) -> float:

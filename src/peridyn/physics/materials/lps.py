@@ -64,15 +64,19 @@ class LPSModel(Model):
     Parameters
     ----------
     body, bonds : Body, Bonds
-    E : float, Pa
-    nu : float
+    E : float or (n_points,), Pa
+    nu : float or (n_points,)
         Required (an LPS material has any Poisson ratio in (-1, 1/2)).
-    density : float, kg/m^3
+    density : float or (n_points,), kg/m^3
     surface_correction : {"none", "shear-factor", "energy"}
         ``shear-factor`` scales each point's deviatoric coefficient alpha by
         Peridigm's shear correction factor (see ``_shear_correction_factor``);
         ``energy`` sets per-bond deviatoric factors (module docstring).
     dtype : float64 or float32
+
+    Per-point E, nu and density describe a body of several blocks (docs/blocks.md): each
+    point's kappa, mu, alpha and P_i then come from its own block, and a bond's deviatoric
+    stiffness w (alpha_i g_ij + alpha_j g_ji) sums its two ends' as it always does.
 
     Attributes (beyond ``Model``'s)
     -------------------------------
@@ -102,7 +106,7 @@ class LPSModel(Model):
             )
         super().__init__(body, bonds, E=E, density=density, dtype=dtype)
         dim = body.dim
-        self.nu, self.dim = float(nu), dim
+        self.nu, self.dim = (float(nu) if np.ndim(nu) == 0 else np.asarray(nu, dtype=float)), dim
         self.shear = shear_modulus(E, nu)
         self.bulk = bulk_modulus(E, nu) if dim == 3 else plane_bulk_modulus(E, nu, body.plane)
         b = bonds
@@ -287,20 +291,23 @@ class LPSModel(Model):
         b = self.bonds
         w = np.where(b.intact, b.influence * self.bond_volume, 0.0)
         nbr = b.neighbours
+        bulk = np.broadcast_to(self.bulk, (self.body.n_points,))
         s = self.theta_coef * family_sums(b.offsets, w * b.length)
         pair = 2.0 * np.where(b.intact, self.dev.astype(np.float64), 0.0)
-        dil = 2.0 * self.bulk * self.theta_coef[nbr] * w * b.length * s[nbr]
-        return family_sums(b.offsets, pair + dil) + 2.0 * self.bulk * s**2
+        dil = 2.0 * bulk[nbr] * self.theta_coef[nbr] * w * b.length * s[nbr]
+        return family_sums(b.offsets, pair + dil) + 2.0 * bulk * s**2
 
     def critical_stretch(self, fracture_energy):
         """s_c from G_c for LPS with a constant influence function (Madenci and Oterkus 2014).
 
         3D: s_c = sqrt(G / ((3 mu + (3/4)^4 (K - 5 mu / 3)) delta));
         2D: s_c = sqrt(G / ((6 mu / pi + 16 / (9 pi^2) (kappa - 2 mu)) delta)).
+        Per point, (n_points,), from each point's own mu and kappa in a body of several blocks.
         """
-        delta, mu, k = self.bonds.horizon, self.shear, self.bulk
+        delta, mu, k = self.bonds.horizons(), self.shear, self.bulk
         if self.dim == 3:
             denom = (3.0 * mu + (0.75**4) * (k - 5.0 * mu / 3.0)) * delta
         else:
             denom = (6.0 * mu / np.pi + 16.0 / (9.0 * np.pi**2) * (k - 2.0 * mu)) * delta
-        return float(np.sqrt(fracture_energy / denom))
+        s_c = np.sqrt(fracture_energy / denom)
+        return float(s_c) if np.ndim(s_c) == 0 else s_c

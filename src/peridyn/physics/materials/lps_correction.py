@@ -61,18 +61,19 @@ def energy_factors(owners, n_vec, length, w, alpha, shear, dim, n_points) -> np.
     ``owners`` (n_bonds,) the point i of each bond; ``n_vec`` (n_bonds, 3) unit bond
     vectors; ``length`` (n_bonds,) m; ``w`` (n_bonds,) omega beta V_j, m^3, zero on broken
     bonds; ``alpha`` (n_points,) the deviatoric coefficient 15 mu / m_i (8 mu / m_i in 2D);
-    ``shear`` mu, Pa.
+    ``shear`` mu, Pa: a number, or (n_points,) each point's own (a body of several blocks).
     """
     tests = deviatoric_tests(dim)
     n_tests = len(tests)
     m = np.bincount(owners, w * length**2, minlength=n_points)
     r = np.empty((len(owners), n_tests))
-    continuum = np.empty(n_tests)
+    norms = np.empty(n_tests)
     for k, eps in enumerate(tests):
         stretch = np.einsum("ba,ac,bc->b", n_vec, eps, n_vec)
         theta = dim * np.bincount(owners, w * length**2 * stretch, minlength=n_points) / m
         r[:, k] = stretch**2 - (theta[owners] / dim) ** 2
-        continuum[k] = shear * np.sum(eps * eps)
+        norms[k] = np.sum(eps * eps)
+    continuum = np.asarray(shear)[..., None] * norms  # W_k = mu eps_k : eps_k, (n_tests,) or (n, n_tests)
     weight = 0.5 * alpha[owners] * w * length**2
     gram = np.empty((n_points, n_tests, n_tests))
     for k in range(n_tests):

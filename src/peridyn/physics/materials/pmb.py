@@ -33,7 +33,7 @@ from peridyn.physics.materials.elastic import (
     check_elastic,
     mean_fourth_power,
     plane_bulk_modulus,
-    radial_moment,
+    radial_moments,
 )
 from peridyn.physics.materials.linearisation import BondLinearisation
 from peridyn.physics.materials.registry import register_material
@@ -54,12 +54,28 @@ def pmb_micromodulus(
     plane: str | None = None,
     thickness: float | None = None,
 ) -> float:
-    """c0 of c(xi) = c0 omega(|xi|), N/m^6 (3D) — see the module docstring."""
+    """c0 of c(xi) = c0 omega(|xi|), N/m^6 (3D) — see the module docstring. E (Pa) and the
+    horizon (m) may be (n_points,) arrays (a body of several blocks), giving c0 per point."""
     nu = pmb_poisson_ratio(dim, plane)
     if dim == 3:
-        return 18.0 * bulk_modulus(E, nu) / (4.0 * np.pi * radial_moment(influence, horizon, 3))
+        return 18.0 * bulk_modulus(E, nu) / (4.0 * np.pi * radial_moments(influence, horizon, 3))
     kappa = plane_bulk_modulus(E, nu, plane)
-    return 8.0 * kappa / (thickness * 2.0 * np.pi * radial_moment(influence, horizon, 2))
+    return 8.0 * kappa / (thickness * 2.0 * np.pi * radial_moments(influence, horizon, 2))
+
+
+def bond_micromodulus(c0, bonds: Bonds):
+    """c0 of each bond, N/m^6 (3D): ``c0`` itself if one number, else the mean of its two end
+    points' c0 (``c0`` (n_points,), a body of several blocks), an (n_bonds,) array.
+
+    The mean is the bond-based rule of docs/blocks.md: each end point's energy holds its half
+    of the bond energy with its own micromodulus, c0_i s^2 |xi| / 4 (per unit volume squared),
+    so the bond's force, the derivative of the sum, carries (c0_i + c0_j) / 2; it is what
+    Peridigm gives when each block's material applies half of the bond force to both ends.
+    A bond within one block keeps that block's c0 exactly ((c + c) / 2 = c in floating point).
+    """
+    if np.ndim(c0) == 0:
+        return c0
+    return 0.5 * (c0[bonds.owners()] + c0[bonds.neighbours])
 
 
 @register_material("pmb")
@@ -69,10 +85,13 @@ class PMBModel(Model):
     Parameters
     ----------
     body, bonds : Body, Bonds
-    E : float, Pa
-    density : float, kg/m^3
-    nu : float or None
+    E : float or (n_points,), Pa
+    density : float or (n_points,), kg/m^3
+    nu : float, (n_points,) or None
         Only checked against the model's implied Poisson ratio.
+
+    Per-point E and density describe a body of several blocks: each bond's micromodulus is
+    then the mean of its ends' (``bond_micromodulus``, docs/blocks.md).
     surface_correction : {"none", "energy"}
     dtype : float64 or float32
     """
@@ -89,7 +108,7 @@ class PMBModel(Model):
     ):
         implied = self.implied_poisson_ratio(body.dim, body.plane)
         check_elastic(E, implied if nu is None else nu, density)
-        if nu is not None and abs(nu - implied) > 1e-3:
+        if nu is not None and np.any(np.abs(np.asarray(nu) - implied) > 1e-3):
             raise InputError(
                 f"nu = {nu}: a bond-based PMB material has Poisson ratio {implied:.4g} here "
                 "(1/4 in 3D and plane strain, 1/3 in plane stress): omit nu or use lps"
@@ -100,11 +119,12 @@ class PMBModel(Model):
             )
         super().__init__(body, bonds, E=E, density=density, dtype=dtype)
         self.c0 = pmb_micromodulus(
-            E, body.dim, bonds.horizon, bonds.influence_name, body.plane, body.thickness
+            E, body.dim, bonds.horizons(), bonds.influence_name, body.plane, body.thickness
         )
+        self.bond_c0 = bond_micromodulus(self.c0, bonds)
         self.length = bonds.length.astype(self.dtype)
         self.inv_length = (1.0 / bonds.length).astype(self.dtype)
-        base = self.c0 * bonds.influence * self.bond_volume
+        base = self.bond_c0 * bonds.influence * self.bond_volume
         self.bond_stiffness = base.astype(self.dtype)
         self.surface_factor = np.ones(bonds.n_bonds)
         if surface_correction == "energy":
@@ -169,27 +189,29 @@ class PMBModel(Model):
 
         3D: G = (c0 s^2 / 2) pi int omega r^4 dr (constant omega: s_c = sqrt(5 G / (9 K delta)),
         Silling and Askari 2005); 2D: G = t c0 s^2 int omega r^3 dr (constant omega, plane
-        stress: s_c = sqrt(4 pi G / (9 E delta)), Ha and Bobaru 2010).
+        stress: s_c = sqrt(4 pi G / (9 E delta)), Ha and Bobaru 2010). Per point, (n_points,),
+        from each point's own c0 in a body of several blocks.
         """
-        delta, name = self.bonds.horizon, self.bonds.influence_name
+        delta, name = self.bonds.horizons(), self.bonds.influence_name
         if self.body.dim == 3:
-            per_s2 = 0.5 * self.c0 * np.pi * radial_moment(name, delta, 4)
+            per_s2 = 0.5 * self.c0 * np.pi * radial_moments(name, delta, 4)
         else:
-            per_s2 = self.body.thickness * self.c0 * radial_moment(name, delta, 3)
-        return float(np.sqrt(fracture_energy / per_s2))
+            per_s2 = self.body.thickness * self.c0 * radial_moments(name, delta, 3)
+        s_c = np.sqrt(fracture_energy / per_s2)
+        return float(s_c) if np.ndim(s_c) == 0 else s_c
 
     def _energy_surface_factor(self) -> np.ndarray:
         body, b = self.body, self.bonds
         dim = body.dim
         strain = 1e-3
         # continuum energy density of a uniaxial strain: (c0/4) eps^2 int omega r^d dr * <n^4>
-        moment = radial_moment(b.influence_name, b.horizon, dim)
+        moment = radial_moments(b.influence_name, b.horizons(), dim)
         thickness = body.thickness if dim == 2 else 1.0
         w_bulk = 0.25 * self.c0 * strain**2 * moment * mean_fourth_power(dim) * thickness
         owners = b.owners()
         xi = body.points[b.neighbours] - body.points[owners]
         n = xi / b.length[:, None]
-        base = self.c0 * b.influence * self.bond_volume
+        base = self.bond_c0 * b.influence * self.bond_volume
         inv_g2 = np.zeros(b.n_bonds)
         for axis in range(dim):
             u = np.zeros_like(body.points)

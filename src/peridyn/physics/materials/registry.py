@@ -45,26 +45,31 @@ def register_material(name: str):
     return register
 
 
+def model_class(name: str) -> type[Model]:
+    """The registered material class ``name``; InputError naming the choices if there is none."""
+    if name not in MODELS:
+        raise InputError(
+            f"unknown material model {name!r}{did_you_mean(name, MODELS)}; choose one of {sorted(MODELS)}"
+        )
+    return MODELS[name]
+
+
 def make_model(
     name: str,
     body: Body,
     bonds: Bonds,
     *,
-    E: float,
-    density: float,
-    nu: float | None = None,
+    E,
+    density,
+    nu=None,
     surface_correction: str = "none",
     dtype=np.float64,
 ) -> Model:
     """Bind the registered material ``name`` (e.g. "pmb", "lps") to a body and its bonds.
 
-    E in Pa, density in kg/m^3, ``nu`` Poisson's ratio (None: not given); see
-    ``Model.from_parameters``.
+    E in Pa, density in kg/m^3, ``nu`` Poisson's ratio (None: not given), numbers or (n_points,)
+    arrays (a body of several blocks, ``materials.blocks``); see ``Model.from_parameters``.
     """
-    if name not in MODELS:
-        raise InputError(
-            f"unknown material model {name!r}{did_you_mean(name, MODELS)}; choose one of {sorted(MODELS)}"
-        )
-    return MODELS[name].from_parameters(
+    return model_class(name).from_parameters(
         body, bonds, E=E, density=density, nu=nu, surface_correction=surface_correction, dtype=dtype
     )
