@@ -2,7 +2,9 @@
 acceptance): every dataset under ``final/`` and ``series/`` equal with np.array_equal, same dtype
 and shape. Shipped cases, shortened: LPS in 3D (bar_pulse), PMB in 2D with pre-crack and breaking
 bonds (plate2d_stretch, a lower bond strength so that it cracks within the shorter run) and the
-Kalthoff-Winkler plate (notches, pre-cracks, fracture energy, velocity loading) at 1 mm.
+Kalthoff-Winkler plate (notches, pre-cracks, fracture energy, velocity loading) at 1 mm, also with
+contact (radius one spacing: the impacted notch flank moves 1 mm in 30 us, so the contact list is
+rebuilt, with new contact ghosts, during the run).
 
 Run with ``PYTHONPATH=src python -m pytest -m mpi -q -p no:cacheprovider`` (NUMBA_NUM_THREADS=1
 per rank; the runs start after a serial warm-up run that fills numba's cache).
@@ -33,6 +35,10 @@ CASES = {
         ["solver.time=40e-6", "material.damage.critical_bond_stress=15e6"],
     ),
     "kalthoff_winkler": ("kalthoff_winkler.yaml", ["discretization.spacing=1e-3", "solver.time=30e-6"]),
+    "kalthoff_contact": (
+        "kalthoff_winkler.yaml",
+        ["discretization.spacing=1e-3", "solver.time=30e-6", "contact.radius=1.0"],
+    ),
 }
 
 
@@ -104,6 +110,26 @@ def test_mpi_run_equals_the_serial_run_bit_for_bit(case, ranks, serial, tmp_path
     with h5py.File(tmp_path / case / "results.h5") as f:
         assert f.attrs["mpi_ranks"] == ranks
         assert sum(int(n) for n in f.attrs["points_per_rank"][1:-1].split(",")) == len(want["final/u"])
+
+
+def test_contact_acts_and_its_list_is_rebuilt_during_the_mpi_run(serial):
+    """The contact comparison is not vacuous: the contact list was rebuilt after the first build
+    (the rebuild and its new contact ghosts are covered) and the contact forces changed the
+    result (the same run without ``contact`` ends elsewhere)."""
+    (with_contact, summary), without = serial["kalthoff_contact"], serial["kalthoff_winkler"][0]
+    assert summary["contact_rebuilds"] >= 2
+    assert not np.array_equal(with_contact["final/u"], without["final/u"])
+
+
+def test_contact_on_four_ranks_equals_the_serial_run_bit_for_bit(serial, tmp_path):
+    """Issue 20 asks for 1 to 4 ranks: contact, the case with the most collectives, on four."""
+    done = _run("kalthoff_contact", tmp_path / "run", 4)
+    assert done.returncode == 0, done.stderr
+    got, want = _datasets(tmp_path / "run" / "results.h5"), serial["kalthoff_contact"][0]
+    assert got.keys() == want.keys()
+    for name, value in want.items():
+        assert got[name].dtype == value.dtype and np.array_equal(got[name], value), name
+    assert json.loads(done.stdout)["contact_rebuilds"] == serial["kalthoff_contact"][1]["contact_rebuilds"]
 
 
 def test_an_error_ends_every_rank_with_one_line(tmp_path):

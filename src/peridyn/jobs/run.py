@@ -109,9 +109,9 @@ def run_case(
     comm : communicator or None
         ``peridyn.parallel.comm.world()`` under ``mpiexec -n N`` (N > 1): each rank runs its
         part of the body (``peridyn.parallel``), rank 0 writes the one results.h5 with every
-        record equal to a serial run's, and every rank returns the summary. An explicit run
-        without contact, for now; checkpoints hold the whole body, so a run may restart on
-        another number of ranks. None: one process.
+        record equal to a serial run's, and every rank returns the summary. An explicit run,
+        for now; checkpoints hold the whole body, so a run may restart on another number of
+        ranks. None: one process.
 
     Raises
     ------
@@ -446,7 +446,8 @@ def _restart(path, setup: Setup, meta: dict, parts: dict, whole_bonds: np.ndarra
 def _checkpointer(path, every: int, setup: Setup, meta: dict, parts: dict, whole_bonds: np.ndarray):
     """The run's ``Checkpointer`` and what must be gathered before it saves (``RootObservers``):
     under MPI it writes, on rank 0, the whole body's state and intact mask in serial numbering
-    and the parts that hold whole-body state (not a rank's damage skin)."""
+    and the parts that hold whole-body state (the contact list's build displacement, gathered;
+    not a rank's damage skin)."""
     d = setup.domain
     if d.size == 1:
         return Checkpointer(path, every, setup.bonds.intact, meta, parts), []
@@ -455,12 +456,14 @@ def _checkpointer(path, every: int, setup: Setup, meta: dict, parts: dict, whole
         path, every, whole_intact, meta, {k: v for k, v in parts.items() if k != "damage"}
     )
 
-    def gather_intact():
+    def gather_whole():
         intact = d.gather_bonds(setup.bonds.intact, setup.bonds.offsets, whole_bonds)
         if d.is_root:
             whole_intact[:] = intact
+        if setup.contact is not None:
+            setup.contact.gather_built()
 
-    return checkpointer, [(checkpointer.due, gather_intact)]
+    return checkpointer, [(checkpointer.due, gather_whole)]
 
 
 def explicit_damping(case: Case, body: Body):
