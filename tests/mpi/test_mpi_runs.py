@@ -1,7 +1,8 @@
 """``mpiexec -n 2`` and ``-n 3 peridyn run`` give the serial run's results.h5 bit for bit (issue 20,
 acceptance): every dataset under ``final/`` and ``series/`` equal with np.array_equal, same dtype
 and shape. Shipped cases, shortened: LPS in 3D (bar_pulse), PMB in 2D with pre-crack and breaking
-bonds (plate2d_stretch, a lower bond strength so that it cracks within the shorter run) and the
+bonds (plate2d_stretch, a lower bond strength so that it cracks within the shorter run), both with
+the stress and strain tensors (``output.stress``, ``output.strain``), and the
 Kalthoff-Winkler plate (notches, pre-cracks, fracture energy, velocity loading) at 1 mm, also with
 contact (radius one spacing: the impacted notch flank moves 1 mm in 30 us, so the contact list is
 rebuilt, with new contact ghosts, during the run).
@@ -28,11 +29,14 @@ pytestmark = pytest.mark.mpi
 ROOT = Path(__file__).resolve().parents[2]
 SRC = str(Path(peridyn.__file__).parents[1])
 
+#: per-point stress and strain tensors, written at the snapshots and the end
+TENSORS = ["output.stress=true", "output.strain=true"]
+
 CASES = {
-    "bar_pulse": ("bar_pulse.yaml", ["solver.time=10e-6"]),
+    "bar_pulse": ("bar_pulse.yaml", ["solver.time=10e-6", *TENSORS]),
     "plate2d_stretch": (
         "plate2d_stretch.yaml",
-        ["solver.time=40e-6", "material.damage.critical_bond_stress=15e6"],
+        ["solver.time=40e-6", "material.damage.critical_bond_stress=15e6", *TENSORS],
     ),
     "kalthoff_winkler": ("kalthoff_winkler.yaml", ["discretization.spacing=1e-3", "solver.time=30e-6"]),
     "kalthoff_contact": (
@@ -107,6 +111,10 @@ def test_mpi_run_equals_the_serial_run_bit_for_bit(case, ranks, serial, tmp_path
         assert np.array_equal(got[name], value), name
     if case != "bar_pulse":  # the damage cases broke bonds: the comparison covers breaking
         assert want["final/damage"].max() > 0
+    if TENSORS[0] in CASES[case][1]:  # the tensors are compared too
+        assert {"final/stress", "final/strain", "final/strain_valid"} <= want.keys()
+    summary = json.loads(done.stdout)  # the time loop is part of the run (docs/user-guide.md)
+    assert 0.0 < summary["step_seconds"] < summary["seconds"]
     with h5py.File(tmp_path / case / "results.h5") as f:
         assert f.attrs["mpi_ranks"] == ranks
         assert sum(int(n) for n in f.attrs["points_per_rank"][1:-1].split(",")) == len(want["final/u"])

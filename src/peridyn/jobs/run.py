@@ -167,15 +167,13 @@ def _check_parallel(case: Case) -> None:
         raise InputError(
             f"an MPI run (mpiexec -n N) is an explicit run for now, not a {case.solver.type} run"
         )
-    for key in ("stress", "strain"):
-        if getattr(case.output, key):
-            raise CaseFileError(case.name, f"output.{key}", True, "false in an MPI run (not written yet)")
 
 
 def point_tensors(setup: Setup, spec: RecorderSpec):
     """The recorder's ``tensors``: u (n_points, 3) m -> the per-point ``stress`` (Pa) and
     ``strain`` (with ``strain_valid``) that ``output.stress`` and ``output.strain`` ask for,
-    (n_points, dim, dim); None when neither is asked. Serial runs (the whole model)."""
+    (n_points, dim, dim); None when neither is asked. Under MPI, of the rank's part (its owned
+    rows are the serial ones: ``RootObservers`` gathers them)."""
     if not (spec.stress or spec.strain):
         return None
     dim = setup.body.dim
@@ -341,7 +339,9 @@ def _run_explicit(case, setup, solver, out, case_path, checkpoint_every, restart
     ckpt_path = out / "checkpoint.h5"
     case_json, digest = case_identity(case)
     meta = {"case_hash": digest, "case": case_json, "dt": float(solver.dt), "version": package_version()}
-    gathered = RootObservers(d, setup.model)
+    spec = recorder_spec(case, setup.whole_body, solver.dt)
+    tensors = point_tensors(setup, spec)
+    gathered = RootObservers(d, setup.model, tensors)
     cracks = crack_observer(case, setup, n_steps, gathered.damage)
     parts = {
         name: part
@@ -357,11 +357,11 @@ def _run_explicit(case, setup, solver, out, case_path, checkpoint_every, restart
         )
     else:
         state, resume = solver.initial_state(), None
-    spec = recorder_spec(case, setup.whole_body, solver.dt)
     info = provenance(case_path, case=case)
     if d.size > 1:
         info.update(d.provenance())
-    tensors = point_tensors(setup, spec)
+    if d.size > 1 and tensors is not None:
+        tensors = gathered.tensor_fields
     recorder = d.on_root(Recorder, setup.whole_body, out, spec, info, gathered.damage, resume, tensors)
     checkpointer, prepare = _checkpointer(
         ckpt_path, checkpoint_every or n_steps + 1, setup, meta, parts, whole_bonds
@@ -370,20 +370,24 @@ def _run_explicit(case, setup, solver, out, case_path, checkpoint_every, restart
     due = [spec.due, *([cracks.due] if cracks is not None else [])]
     if d.size > 1 and checkpoint_every:  # saved on rank 0 from the gathered state
         watched, due = [*watched, checkpointer], [*due, checkpointer.due]
-    gathered.attach(watched, due, prepare)
+    gathered.attach(watched, due, prepare, spec.snapshot_due if spec.vtu else None)
     try:
         if resume is None:
-            gathered.call(state, lambda whole: (recorder.record_series(whole), recorder.snapshot(whole)))
+            gathered.call(
+                state, lambda whole: (recorder.record_series(whole), recorder.snapshot(whole)), spec.vtu
+            )
         observers = [gathered]
         if checkpoint_every and d.size == 1:
             observers.append(checkpointer)
         remaining = n_steps - state.step
         bar = progress(remaining) if progress is not None else None
+        loop_start = time.perf_counter()
         try:
             solver.run(state, remaining, observers, bar)
         finally:
             if bar is not None:
                 bar.close()
+        step_seconds = d.max(time.perf_counter() - loop_start)
     except Interrupted as exc:
         saved = bool(checkpoint_every) or time.perf_counter() - start > CHECKPOINT_AFTER_S
         saved = saved and d.size == 1  # the ranks of an MPI run may stop at different steps
@@ -397,7 +401,7 @@ def _run_explicit(case, setup, solver, out, case_path, checkpoint_every, restart
             recorder.close(end_status(exc))
         raise
     if not spec.snapshot_due(state.step):
-        gathered.call(state, lambda whole: recorder.snapshot(whole))
+        gathered.call(state, lambda whole: recorder.snapshot(whole), spec.vtu)
     n = d.n_owned
     summary = _base_summary(setup)
     summary.update(
@@ -408,13 +412,14 @@ def _run_explicit(case, setup, solver, out, case_path, checkpoint_every, restart
             "stable_dt_s": solver.stable_dt,
             "kinetic_energy_j": solver.kinetic_energy(state),
             "strain_energy_j": float(d.dot(setup.model.energy_density(state.u)[:n], setup.body.volumes[:n])),
+            "step_seconds": step_seconds,
         }
     )
     if setup.contact is not None:
         summary["contact_rebuilds"] = setup.contact.rebuilds
     if cracks is not None:
         summary["crack_length_history"] = cracks.history()  # rank 0's is the one returned
-    gathered.call(state, lambda whole: recorder.finish(whole))
+    gathered.call(state, lambda whole: recorder.finish(whole), True)
     return summary
 
 

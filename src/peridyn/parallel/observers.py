@@ -2,8 +2,11 @@
 
 ``RootObservers`` is the one observer every rank attaches. At a step where one of its observers
 is due, the ranks gather the state (and the damage index) in global point order on rank 0,
-which calls the observers with it; their errors reach every rank (``Domain.on_root``). In one
-process the observers get the run's own state, and the damage is computed when asked.
+which calls the observers with it; their errors reach every rank (``Domain.on_root``). Per-point
+tensors (``output.stress``, ``output.strain``) are computed by each rank on its owned points
+(their families and the neighbours' displacements are on the rank) and gathered likewise, at
+the steps that write them. In one process the observers get the run's own state, and the
+damage and tensors are computed when asked.
 """
 
 from __future__ import annotations
@@ -26,31 +29,49 @@ class RootObservers:
     model : Model
         The rank's part of the model (its ``bonds.intact`` gives the damage index).
 
-    The observers are given by ``attach`` (they may take ``damage`` as their damage index).
+    tensors : callable (u) -> dict of str to array, or None
+        The rank's per-point tensor fields at its local displacement ``u`` (n_local, 3), m
+        (``peridyn.jobs.run.point_tensors``); None: none asked.
+
+    The observers are given by ``attach`` (they may take ``damage`` as their damage index and
+    ``tensor_fields`` as their tensors).
     """
 
-    def __init__(self, domain: Domain, model):
+    def __init__(self, domain: Domain, model, tensors=None):
         self.domain = domain
         self.model = model
+        self.tensors = tensors
         self.observers: list = []
         self.due: list = []
         self.prepare: list = []
+        self.tensors_due = None
         self._damage: np.ndarray | None = None
+        self._tensors: dict = {}
 
-    def attach(self, observers: Sequence, due: Sequence[Callable[[int], bool]], prepare=()) -> None:
+    def attach(
+        self, observers: Sequence, due: Sequence[Callable[[int], bool]], prepare=(), tensors_due=None
+    ) -> None:
         """Watch with ``observers`` (objects with ``observe(state, solver)``, used on rank 0 only:
         None elsewhere) at the steps where one of ``due`` (callables step -> bool, known on every
         rank) is True; ``prepare``: (due, collective callable) pairs run on every rank first at
-        their steps (e.g. gathering the bonds' intact mask for a checkpoint)."""
+        their steps (e.g. gathering the bonds' intact mask for a checkpoint); ``tensors_due``
+        (step -> bool, or None): the steps whose observers read ``tensor_fields``."""
         self.observers = list(observers) if self.domain.is_root else []
         self.due = list(due)
         self.prepare = list(prepare)
+        self.tensors_due = tensors_due
 
     def damage(self) -> np.ndarray:
         """The damage index (n_points,) of the whole body at the last gathered state (rank 0)."""
         if self.domain.size == 1:
             return damage_field(self.model)
         return self._damage
+
+    def tensor_fields(self, u: np.ndarray) -> dict:
+        """The whole body's tensor fields gathered by the last ``call`` with ``tensors`` (rank 0,
+        several ranks; ``u`` is that call's gathered displacement): the ``tensors`` of a
+        ``Recorder`` on rank 0."""
+        return self._tensors
 
     def observe(self, state: State, solver) -> None:
         """Gather and call the observers when one is due (every rank calls it); in one process,
@@ -59,12 +80,16 @@ class RootObservers:
             for due, gather in self.prepare:
                 if due(state.step):
                     gather()
-            self.call(state, lambda whole: [obs.observe(whole, solver) for obs in self.observers])
+            tensors = self.tensors_due is not None and self.tensors_due(state.step)
+            self.call(state, lambda whole: [obs.observe(whole, solver) for obs in self.observers], tensors)
 
-    def call(self, state: State, fn):
+    def call(self, state: State, fn, tensors: bool = False):
         """``fn(state of the whole body)`` on rank 0 after gathering (collective); its result on
-        rank 0, None elsewhere."""
+        rank 0, None elsewhere. ``tensors``: gather the tensor fields too (for ``fn`` to read
+        through ``tensor_fields``)."""
         whole = self.domain.gather_state(state)
         if self.domain.size > 1:
             self._damage = self.domain.gather(damage_field(self.model))
+            if tensors and self.tensors is not None:
+                self._tensors = {k: self.domain.gather(v) for k, v in self.tensors(state.u).items()}
         return self.domain.on_root(fn, whole)
