@@ -24,6 +24,7 @@ from peridyn.io.hdf5 import HDF5Writer
 from peridyn.io.outdir import end_status, prepare_output
 from peridyn.io.provenance import package_version, provenance
 from peridyn.io.recorder import LineProbe, Recorder, RecorderSpec
+from peridyn.io.vtu_pieces import VtuPieces
 from peridyn.jobs.build import Setup, build, pad3
 from peridyn.jobs.figures import draw_crack_figures, draw_run_figures, final_crack_paths
 from peridyn.jobs.lamb_analysis import analyse
@@ -360,22 +361,30 @@ def _run_explicit(case, setup, solver, out, case_path, checkpoint_every, restart
     info = provenance(case_path, case=case)
     if d.size > 1:
         info.update(d.provenance())
+    pieces = None  # under MPI, each rank writes its piece of the VTU snapshots
+    if d.size > 1 and spec.vtu:
+        pieces = VtuPieces(d, setup.body, out, lambda: damage_field(setup.model), tensors)
     if d.size > 1 and tensors is not None:
         tensors = gathered.tensor_fields
-    recorder = d.on_root(Recorder, setup.whole_body, out, spec, info, gathered.damage, resume, tensors)
-    checkpointer, prepare = _checkpointer(
+    recorder = d.on_root(
+        Recorder, setup.whole_body, out, spec, info, gathered.damage, resume, tensors, d.size > 1
+    )
+    checkpointer, gather_checkpoint = _checkpointer(
         ckpt_path, checkpoint_every or n_steps + 1, setup, meta, parts, whole_bonds
     )
     watched = [recorder, *([cracks] if cracks is not None else [])]
     due = [spec.due, *([cracks.due] if cracks is not None else [])]
     if d.size > 1 and checkpoint_every:  # saved on rank 0 from the gathered state
         watched, due = [*watched, checkpointer], [*due, checkpointer.due]
-    gathered.attach(watched, due, prepare, spec.snapshot_due if spec.vtu else None)
+    prepare = gather_checkpoint
+    if pieces is not None:
+        prepare = [*prepare, (spec.snapshot_due, pieces.write)]
+    gathered.attach(watched, due, prepare)
     try:
         if resume is None:
-            gathered.call(
-                state, lambda whole: (recorder.record_series(whole), recorder.snapshot(whole)), spec.vtu
-            )
+            if pieces is not None:
+                pieces.write(state)
+            gathered.call(state, lambda whole: (recorder.record_series(whole), recorder.snapshot(whole)))
         observers = [gathered]
         if checkpoint_every and d.size == 1:
             observers.append(checkpointer)
@@ -388,11 +397,15 @@ def _run_explicit(case, setup, solver, out, case_path, checkpoint_every, restart
             if bar is not None:
                 bar.close()
         step_seconds = d.max(time.perf_counter() - loop_start)
-    except Interrupted as exc:
+    except Interrupted as exc:  # under MPI: on every rank after the same step
         saved = bool(checkpoint_every) or time.perf_counter() - start > CHECKPOINT_AFTER_S
-        saved = saved and d.size == 1  # the ranks of an MPI run may stop at different steps
-        if saved:
+        saved = bool(d.max(int(saved)))  # the ranks' clocks differ: all save if one would
+        if saved and d.size == 1:
             checkpointer.save(state)
+        elif saved:
+            for _, gather in gather_checkpoint:
+                gather(state)
+            gathered.call(state, checkpointer.save)
         if recorder is not None:
             recorder.close(f"interrupted at step {exc.step}")
         raise Interrupted(exc.signal_name, exc.step, "resume" if saved else "") from None
@@ -401,7 +414,9 @@ def _run_explicit(case, setup, solver, out, case_path, checkpoint_every, restart
             recorder.close(end_status(exc))
         raise
     if not spec.snapshot_due(state.step):
-        gathered.call(state, lambda whole: recorder.snapshot(whole), spec.vtu)
+        if pieces is not None:
+            pieces.write(state)
+        gathered.call(state, lambda whole: recorder.snapshot(whole))
     n = d.n_owned
     summary = _base_summary(setup)
     summary.update(
@@ -461,7 +476,7 @@ def _checkpointer(path, every: int, setup: Setup, meta: dict, parts: dict, whole
         path, every, whole_intact, meta, {k: v for k, v in parts.items() if k != "damage"}
     )
 
-    def gather_whole():
+    def gather_whole(state):  # the state itself is gathered by RootObservers.call
         intact = d.gather_bonds(setup.bonds.intact, setup.bonds.offsets, whole_bonds)
         if d.is_root:
             whole_intact[:] = intact

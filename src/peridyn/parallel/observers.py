@@ -4,9 +4,10 @@
 is due, the ranks gather the state (and the damage index) in global point order on rank 0,
 which calls the observers with it; their errors reach every rank (``Domain.on_root``). Per-point
 tensors (``output.stress``, ``output.strain``) are computed by each rank on its owned points
-(their families and the neighbours' displacements are on the rank) and gathered likewise, at
-the steps that write them. In one process the observers get the run's own state, and the
-damage and tensors are computed when asked.
+(their families and the neighbours' displacements are on the rank) and gathered likewise for
+the final state (the VTU snapshots are written per rank: ``peridyn.io.vtu_pieces``). In one
+process the observers get the run's own state, and the damage and tensors are computed when
+asked.
 """
 
 from __future__ import annotations
@@ -44,22 +45,18 @@ class RootObservers:
         self.observers: list = []
         self.due: list = []
         self.prepare: list = []
-        self.tensors_due = None
         self._damage: np.ndarray | None = None
         self._tensors: dict = {}
 
-    def attach(
-        self, observers: Sequence, due: Sequence[Callable[[int], bool]], prepare=(), tensors_due=None
-    ) -> None:
+    def attach(self, observers: Sequence, due: Sequence[Callable[[int], bool]], prepare=()) -> None:
         """Watch with ``observers`` (objects with ``observe(state, solver)``, used on rank 0 only:
         None elsewhere) at the steps where one of ``due`` (callables step -> bool, known on every
-        rank) is True; ``prepare``: (due, collective callable) pairs run on every rank first at
-        their steps (e.g. gathering the bonds' intact mask for a checkpoint); ``tensors_due``
-        (step -> bool, or None): the steps whose observers read ``tensor_fields``."""
+        rank) is True; ``prepare``: (due, collective callable(state)) pairs run on every rank
+        first at their steps, with the rank's state (e.g. gathering the bonds' intact mask for a
+        checkpoint, writing the pieces of a VTU snapshot)."""
         self.observers = list(observers) if self.domain.is_root else []
         self.due = list(due)
         self.prepare = list(prepare)
-        self.tensors_due = tensors_due
 
     def damage(self) -> np.ndarray:
         """The damage index (n_points,) of the whole body at the last gathered state (rank 0)."""
@@ -77,11 +74,10 @@ class RootObservers:
         """Gather and call the observers when one is due (every rank calls it); in one process,
         call them at every step (nothing to gather)."""
         if self.domain.size == 1 or any(due(state.step) for due in self.due):
-            for due, gather in self.prepare:
+            for due, prepare in self.prepare:
                 if due(state.step):
-                    gather()
-            tensors = self.tensors_due is not None and self.tensors_due(state.step)
-            self.call(state, lambda whole: [obs.observe(whole, solver) for obs in self.observers], tensors)
+                    prepare(state)
+            self.call(state, lambda whole: [obs.observe(whole, solver) for obs in self.observers])
 
     def call(self, state: State, fn, tensors: bool = False):
         """``fn(state of the whole body)`` on rank 0 after gathering (collective); its result on
