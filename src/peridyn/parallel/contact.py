@@ -126,15 +126,12 @@ class RankContact(Contact):
             if r != d.comm.rank and box is not None:
                 inside = np.all((y >= box[0]) & (y <= box[1]), axis=1)
             sends.append((self._ids[inside], y[inside]))
-        got = d.comm.alltoall(sends)
-        ids = np.concatenate([gid for gid, _ in got])
-        points = np.concatenate([p for _, p in got])
-        owner = np.repeat(np.arange(d.size), [len(gid) for gid, _ in got])
-        mine = d.comm.rank
+        got = d.comm.alltoall(sends)  # nothing from this rank itself
+        counts = [len(y), *(len(gid) for gid, _ in got)]
         return (
-            np.concatenate([self._ids, ids[owner != mine]]),
-            np.concatenate([y, points[owner != mine]]),
-            np.concatenate([np.full(len(y), mine), owner[owner != mine]]),
+            np.concatenate([self._ids, *(gid for gid, _ in got)]),
+            np.concatenate([y, *(p for _, p in got)]),
+            np.repeat([d.comm.rank, *range(d.size)], counts),
         )
 
     def gather_built(self) -> None:
@@ -163,6 +160,8 @@ class RankContact(Contact):
         self._u[:n] = u[:n]
         self._halo.exchange(self._u)
         y = self._x + self._u
+        if self._f.dtype != out.dtype:
+            self._f = np.zeros(self._f.shape, dtype=out.dtype)
         f = self._f
         f[:n] = out[:n]
         f[n:] = 0.0
