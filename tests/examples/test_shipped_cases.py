@@ -50,10 +50,15 @@ def _check_common_keys(summary: dict, kind: str, out: Path, elapsed: float) -> N
 @pytest.mark.parametrize("path", CASES, ids=[p.stem for p in CASES])
 def test_case_runs(path, tmp_path, capsys):
     """Each case runs; its summary (stored in results.h5 as printed) has the common keys and
-    counts the points of the stored geometry."""
+    counts the points of the stored geometry; a time-stepping run's ``step_seconds`` (its time
+    loop, docs/user-guide.md) is part of its ``seconds``."""
     case = load_case(path)
     summary, elapsed = _job(["run", str(path), *SHORTEN[case.solver.type]], tmp_path, capsys)
     _check_common_keys(summary, "modal" if case.solver.type == "modal" else "run", tmp_path, elapsed)
+    if case.solver.type in ("explicit", "newmark"):
+        assert 0.0 < summary["step_seconds"] < summary["seconds"]
+    else:
+        assert "step_seconds" not in summary
     results = Results(tmp_path / "results.h5")
     assert results.schema_version == SCHEMA_VERSION and results.summary() == summary
     assert summary["points"] == len(results.array("geometry/points"))

@@ -1,8 +1,12 @@
 """``mpiexec -n 2`` and ``-n 3 peridyn run`` give the serial run's results.h5 bit for bit (issue 20,
 acceptance): every dataset under ``final/`` and ``series/`` equal with np.array_equal, same dtype
 and shape. Shipped cases, shortened: LPS in 3D (bar_pulse), PMB in 2D with pre-crack and breaking
-bonds (plate2d_stretch, a lower bond strength so that it cracks within the shorter run) and the
-Kalthoff-Winkler plate (notches, pre-cracks, fracture energy, velocity loading) at 1 mm.
+bonds (plate2d_stretch, a lower bond strength so that it cracks within the shorter run), both with
+the stress and strain tensors (``output.stress``, ``output.strain``) and VTU snapshots (per-rank
+pieces under MPI, compared with the serial snapshots point by point), and the
+Kalthoff-Winkler plate (notches, pre-cracks, fracture energy, velocity loading) at 1 mm, also with
+contact (radius one spacing: the impacted notch flank moves 1 mm in 30 us, so the contact list is
+rebuilt, with new contact ghosts, during the run).
 
 Run with ``PYTHONPATH=src python -m pytest -m mpi -q -p no:cacheprovider`` (NUMBA_NUM_THREADS=1
 per rank; the runs start after a serial warm-up run that fills numba's cache).
@@ -10,29 +14,43 @@ per rank; the runs start after a serial warm-up run that fills numba's cache).
 
 import json
 import os
+import re
 import shutil
+import signal
 import subprocess
 import sys
+import textwrap
+import time
+import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import h5py
+import meshio
 import numpy as np
 import pytest
 
 import peridyn
+from peridyn.io.vtk import read_pvtu_pieces
 
 pytestmark = pytest.mark.mpi
 
 ROOT = Path(__file__).resolve().parents[2]
 SRC = str(Path(peridyn.__file__).parents[1])
 
+#: per-point stress and strain tensors, written at the snapshots and the end
+TENSORS = ["output.stress=true", "output.strain=true"]
+
 CASES = {
-    "bar_pulse": ("bar_pulse.yaml", ["solver.time=10e-6"]),
+    "bar_pulse": ("bar_pulse.yaml", ["solver.time=10e-6", "output.snapshot_every=50", *TENSORS]),
     "plate2d_stretch": (
         "plate2d_stretch.yaml",
-        ["solver.time=40e-6", "material.damage.critical_bond_stress=15e6"],
+        ["solver.time=40e-6", "material.damage.critical_bond_stress=15e6", "output.vtu=true", *TENSORS],
     ),
     "kalthoff_winkler": ("kalthoff_winkler.yaml", ["discretization.spacing=1e-3", "solver.time=30e-6"]),
+    "kalthoff_contact": (
+        "kalthoff_winkler.yaml",
+        ["discretization.spacing=1e-3", "solver.time=30e-6", "contact.radius=1.0"],
+    ),
 }
 
 
@@ -84,8 +102,32 @@ def serial(tmp_path_factory):
         assert warm.returncode == 0, warm.stderr
         done = _run(case, base / case, 1)
         assert done.returncode == 0, done.stderr
-        refs[case] = _datasets(base / case / "results.h5"), json.loads(done.stdout)
+        refs[case] = _datasets(base / case / "results.h5"), json.loads(done.stdout), base / case
     return refs
+
+
+def _snapshots(folder: Path) -> list[str]:
+    """The files that a run's snapshots.pvd lists, in order."""
+    root = ET.parse(folder / "snapshots.pvd").getroot()
+    return [item.attrib["file"] for item in root.iter("DataSet")]
+
+
+def _assert_same_snapshots(pieces_run: Path, serial_run: Path) -> None:
+    """The .pvtu snapshots of an MPI run (per-rank .vtu pieces, read by meshio) hold every point of
+    the serial run's .vtu snapshots once, with the same point data bit for bit."""
+    serial, parallel = _snapshots(serial_run), _snapshots(pieces_run)
+    assert len(parallel) == len(serial) > 1
+    for whole_file, pvtu in zip(serial, parallel, strict=True):
+        assert pvtu == whole_file.replace(".vtu", ".pvtu")
+        whole = meshio.read(serial_run / whole_file)
+        pieces = [meshio.read(p) for p in read_pvtu_pieces(pieces_run / pvtu)]
+        points = np.concatenate([p.points for p in pieces])
+        by_whole, by_pieces = np.lexsort(whole.points.T), np.lexsort(points.T)
+        assert np.array_equal(whole.points[by_whole], points[by_pieces])  # every point once
+        assert all(p.point_data.keys() == whole.point_data.keys() for p in pieces)
+        for name, value in whole.point_data.items():
+            got = np.concatenate([p.point_data[name] for p in pieces])
+            assert got.dtype == value.dtype and np.array_equal(got[by_pieces], value[by_whole]), name
 
 
 @pytest.mark.parametrize("ranks", [2, 3])
@@ -101,9 +143,35 @@ def test_mpi_run_equals_the_serial_run_bit_for_bit(case, ranks, serial, tmp_path
         assert np.array_equal(got[name], value), name
     if case != "bar_pulse":  # the damage cases broke bonds: the comparison covers breaking
         assert want["final/damage"].max() > 0
+    if TENSORS[0] in CASES[case][1]:  # the tensors are compared too
+        assert {"final/stress", "final/strain", "final/strain_valid"} <= want.keys()
+    summary = json.loads(done.stdout)  # the time loop is part of the run (docs/user-guide.md)
+    assert 0.0 < summary["step_seconds"] < summary["seconds"]
+    if TENSORS[0] in CASES[case][1]:  # these two write VTU snapshots
+        _assert_same_snapshots(tmp_path / case, serial[case][2])
     with h5py.File(tmp_path / case / "results.h5") as f:
         assert f.attrs["mpi_ranks"] == ranks
         assert sum(int(n) for n in f.attrs["points_per_rank"][1:-1].split(",")) == len(want["final/u"])
+
+
+def test_contact_acts_and_its_list_is_rebuilt_during_the_mpi_run(serial):
+    """The contact comparison is not vacuous: the contact list was rebuilt after the first build
+    (the rebuild and its new contact ghosts are covered) and the contact forces changed the
+    result (the same run without ``contact`` ends elsewhere)."""
+    (with_contact, summary, _), without = serial["kalthoff_contact"], serial["kalthoff_winkler"][0]
+    assert summary["contact_rebuilds"] >= 2
+    assert not np.array_equal(with_contact["final/u"], without["final/u"])
+
+
+def test_contact_on_four_ranks_equals_the_serial_run_bit_for_bit(serial, tmp_path):
+    """Issue 20 asks for 1 to 4 ranks: contact, the case with the most collectives, on four."""
+    done = _run("kalthoff_contact", tmp_path / "run", 4)
+    assert done.returncode == 0, done.stderr
+    got, want = _datasets(tmp_path / "run" / "results.h5"), serial["kalthoff_contact"][0]
+    assert got.keys() == want.keys()
+    for name, value in want.items():
+        assert got[name].dtype == value.dtype and np.array_equal(got[name], value), name
+    assert json.loads(done.stdout)["contact_rebuilds"] == serial["kalthoff_contact"][1]["contact_rebuilds"]
 
 
 def test_an_error_ends_every_rank_with_one_line(tmp_path):
@@ -120,6 +188,97 @@ def test_an_error_ends_every_rank_with_one_line(tmp_path):
     assert len(lines) == 1 and "holds an earlier run's results.h5" in lines[0]
 
 
+#: ``python -c`` wrapper of ``peridyn`` that acts on one rank before its step ``at`` (argv: rank,
+#: at, action, then peridyn's arguments): "raise" raises a MemoryError there (an error no other
+#: rank knows of, as from a kernel), "mark" writes the file $PERIDYN_TEST_MARK (for the test to
+#: press Ctrl-C once the run has got that far).
+HOOK = textwrap.dedent(
+    """
+    import os, sys
+    from pathlib import Path
+    from peridyn.cli import main
+    from peridyn.parallel.comm import world
+    from peridyn.solvers.explicit import ExplicitSolver
+
+    rank, at, action = int(sys.argv[1]), int(sys.argv[2]), sys.argv[3]
+    original = ExplicitSolver.step
+
+    def step(self, state):
+        if world().rank == rank and state.step + 1 == at:
+            if action == "raise":
+                raise MemoryError("injected on one rank")
+            Path(os.environ["PERIDYN_TEST_MARK"]).touch()
+        return original(self, state)
+
+    ExplicitSolver.step = step
+    sys.exit(main(sys.argv[4:]))
+    """
+)
+
+
+def _hooked(case, out, ranks, rank, at, action, *extra, flags=(), env=None):
+    """``mpiexec -n ranks`` of ``HOOK`` on ``case`` (started, not waited for), in its own
+    process group, as from a terminal."""
+    path, sets = CASES[case]
+    argv = ["run", str(ROOT / "cases" / path), "-o", str(out), "--no-progress", *flags]
+    for s in ["output.plots=false", *sets, *extra]:
+        argv += ["--set", s]
+    command = ["mpiexec", "-n", str(ranks), sys.executable, "-c", HOOK, str(rank), str(at), action, *argv]
+    env = dict(os.environ, PYTHONPATH=SRC, NUMBA_NUM_THREADS="1", **(env or {}))
+    return subprocess.Popen(
+        command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env, start_new_session=True
+    )
+
+
+@pytest.mark.parametrize("rank", [0, 1])
+def test_an_error_on_one_rank_inside_a_step_ends_every_rank_with_one_line(serial, rank, tmp_path):
+    """An error that one rank alone raises inside a step (the others wait for its halo messages)
+    ends the run at once, not a hang: the failing rank prints the one error line (rank 1's
+    output is otherwise silenced) and MPI_Abort ends the others (status 1)."""
+    run = _hooked("bar_pulse", tmp_path / "run", 2, rank, 5, "raise")
+    stdout, stderr = run.communicate(timeout=120)
+    assert run.returncode == 1, stderr
+    lines = [line for line in stderr.splitlines() if "error:" in line]
+    assert len(lines) == 1 and "out of memory (injected on one rank)" in lines[0], stderr
+
+
+def test_ctrl_c_stops_every_rank_at_one_step_with_a_checkpoint_and_restart_is_bit_for_bit(serial, tmp_path):
+    """SIGINT to mpiexec's process group (Ctrl-C in a terminal; mpiexec forwards it to the ranks)
+    after step 300 of plate2d_stretch on 2 ranks: the ranks agree on the step to stop after, the
+    checkpoint holds that step, the status says it, the exit status is 130 (docs/user-guide.md);
+    ``--restart`` on 3 ranks then gives the serial run's datasets bit for bit."""
+    out, mark = tmp_path / "run", tmp_path / "mark"
+    run = _hooked(
+        "plate2d_stretch",
+        out,
+        2,
+        0,
+        300,
+        "mark",
+        flags=["--checkpoint-every", "100000"],
+        env={"PERIDYN_TEST_MARK": str(mark)},
+    )
+    while not mark.exists() and run.poll() is None:
+        time.sleep(0.02)
+    os.killpg(run.pid, signal.SIGINT)
+    stdout, stderr = run.communicate(timeout=120)
+    assert run.returncode == 130, stderr
+    stopped = int(re.search(r"interrupted \(SIGINT\) at step (\d+); resume with: .* --restart", stderr)[1])
+    assert stopped >= 300
+    with h5py.File(out / "checkpoint.h5") as f:
+        assert f.attrs["step"] == stopped
+    with h5py.File(out / "results.h5") as f:
+        assert f.attrs["status"] == f"interrupted at step {stopped}"
+    done = _run("plate2d_stretch", out, 3, flags=["--restart"])
+    assert done.returncode == 0, done.stderr
+    want = serial["plate2d_stretch"][0]
+    got = _datasets(out / "results.h5")
+    assert got.keys() == want.keys()
+    for name, value in want.items():
+        assert got[name].dtype == value.dtype and np.array_equal(got[name], value), name
+    _assert_same_snapshots(out, serial["plate2d_stretch"][2])
+
+
 def test_restart_on_three_ranks_from_a_two_rank_checkpoint_equals_the_serial_run(serial, tmp_path):
     """Checkpoints hold the whole body in serial numbering: a 2-rank run stopped at 38 us (its
     last checkpoint at step 1500, after the crack has started: plate2d_stretch's crack history
@@ -131,11 +290,12 @@ def test_restart_on_three_ranks_from_a_two_rank_checkpoint_equals_the_serial_run
     assert json.loads(first.stdout)["crack_length_history"]["length_m"][-1] > 0  # cracked before
     done = _run("plate2d_stretch", out, 3, flags=["--restart"])
     assert done.returncode == 0, done.stderr
-    want, summary = serial["plate2d_stretch"]
+    want, summary, folder = serial["plate2d_stretch"]
     got = _datasets(out / "results.h5")
     assert got.keys() == want.keys()
     for name, value in want.items():
         assert got[name].dtype == value.dtype and np.array_equal(got[name], value), name
+    _assert_same_snapshots(out, folder)  # the 2-rank pieces after the checkpoint rewritten by 3
     resumed = json.loads(done.stdout)
     for key in ("steps", "broken_bonds", "max_damage", "crack_length_history", "strain_energy_j"):
         assert resumed[key] == summary[key], key

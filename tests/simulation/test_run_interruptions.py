@@ -69,7 +69,7 @@ SCRIPT = textwrap.dedent(
 )
 
 #: Summary keys that depend on the machine, the folder or the wall clock.
-VOLATILE = {"seconds", "peak_memory_bytes", "output_dir", "plots", "build_seconds"}
+VOLATILE = {"seconds", "step_seconds", "peak_memory_bytes", "output_dir", "plots", "build_seconds"}
 
 
 def _argv(case: str, out: Path, *extra: str) -> list[str]:

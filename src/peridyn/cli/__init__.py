@@ -77,8 +77,12 @@ def main(argv: list[str] | None = None) -> int:
                 filter(None, ["peridyn", getattr(args, "command", None)])
             )
             as_json = getattr(args, "json", "--json" in argv)
+            if getattr(exc, "failed_rank", None) is not None:
+                _speak()  # this rank alone knows of the error
             status = report(exc, prog, as_json, getattr(args, "debug", "--debug" in argv))
             _drop_unwritable_stdout()
+            if getattr(exc, "failed_rank", None) is not None:
+                _abort_every_rank(status)
     return status
 
 
@@ -134,6 +138,23 @@ def _quiet_unless_first_rank() -> None:
 
     if launched_by_mpi() and world().rank > 0:
         sys.stdout = sys.stderr = open(os.devnull, "w")  # noqa: SIM115 - for the process's lifetime
+
+
+def _speak() -> None:
+    """Give this rank back its stdout and stderr (``_quiet_unless_first_rank``)."""
+    sys.stdout, sys.stderr = sys.__stdout__, sys.__stderr__
+
+
+def _abort_every_rank(status: int) -> None:
+    """End every MPI rank after an error of this rank alone (``failed_rank``, raised inside a time
+    step). The last resort, and the only one: the other ranks may be blocked in a halo exchange or
+    a collective that this rank will never join, and MPI cancels neither but by ``MPI_Abort``
+    (results.h5 keeps the status ``running``, as after a kill)."""
+    from peridyn.parallel.comm import world
+
+    sys.stdout.flush()
+    sys.stderr.flush()
+    world().abort(status)
 
 
 def _drop_unwritable_stdout() -> None:

@@ -8,7 +8,8 @@ Series in ``results.h5`` (see ``peridyn.io.hdf5`` for the layout):
 - ``plane_<name>``: (n, 3) displacement of a plane probe (a node set or a plate layer);
 - ``pzt_signal``: (n_pzt,) mean in-plane strain under each PZT sensor patch;
 - ``field_u``: (n_points, 3) displacement at every snapshot, with ``snapshots/*.vtu``
-  files and ``snapshots.pvd`` for ParaView, and ``results.e`` (Exodus II) when asked.
+  files (under MPI ``snapshots/*.pvtu`` and their per-rank pieces) and ``snapshots.pvd`` for
+  ParaView, and ``results.e`` (Exodus II) when asked.
 
 When asked (``stress``, ``strain``), the final fields ``final/stress`` (partial stress, Pa) and
 ``final/strain`` (Green-Lagrange strain) with ``final/strain_valid``, (n_points, dim, dim)
@@ -159,6 +160,9 @@ class Recorder:
         The values of ``spec.exodus_variables`` at a state: ``{"nodal": {...}, "element":
         {...}, "global_": {...}}`` of name -> array, as ``ExodusWriter.append`` takes them;
         required when variables are named.
+    vtu_pieces : bool
+        The VTU snapshots are per-rank pieces that the ranks of an MPI run write with their
+        ``.pvtu`` (``peridyn.io.vtu_pieces``): ``snapshots.pvd`` lists the ``.pvtu`` files.
     """
 
     def __init__(
@@ -171,8 +175,10 @@ class Recorder:
         resume: tuple[int, float] | None = None,
         tensors=None,
         fields=None,
+        vtu_pieces: bool = False,
     ):
         self.body = body
+        self.vtu_pieces = vtu_pieces
         self.directory = Path(directory)
         self.directory.mkdir(parents=True, exist_ok=True)
         self.spec = spec
@@ -284,12 +290,12 @@ class Recorder:
             self.write_exodus(state)
         if self.pvd is None:
             return
-        data = {"displacement": state.u[:, : self.body.dim], "velocity": state.v[:, : self.body.dim]}
-        if self.damage is not None:
-            data["damage"] = self.damage()
-        for key, value in self._tensor_fields(state.u).items():
-            data[key] = _padded_tensor(value)
-        name = f"snapshots/step_{state.step:08d}.vtu"
+        if self.vtu_pieces:  # written by the ranks (peridyn.io.vtu_pieces)
+            self.pvd.add(state.time, snapshot_name(state.step, ".pvtu"))
+            return
+        damage = self.damage() if self.damage is not None else None
+        data = snapshot_fields(state.u, state.v, self.body.dim, damage, self._tensor_fields(state.u))
+        name = snapshot_name(state.step, ".vtu")
         write_vtu(self.directory / name, self.body.points[:, : self.body.dim], data)
         self.pvd.add(state.time, name)
 
@@ -323,6 +329,23 @@ class Recorder:
         if status is not None:
             self.h5.set_status(status)
         self.h5.close()
+
+
+def snapshot_name(step: int, suffix: str) -> str:
+    """The VTU snapshot of ``step`` in the output folder: ``snapshots/step_NNNNNNNN`` + ``suffix``."""
+    return f"snapshots/step_{step:08d}{suffix}"
+
+
+def snapshot_fields(u: np.ndarray, v: np.ndarray, dim: int, damage, tensors: dict) -> dict:
+    """The point data of a VTU snapshot: displacement and velocity ((n, 3) m, m/s, first ``dim``
+    columns), the ``damage`` index ((n,) or None) and the ``tensors`` (``Recorder``'s
+    ``tensors``: (n, dim, dim) as 9 components, others as they are)."""
+    data = {"displacement": u[:, :dim], "velocity": v[:, :dim]}
+    if damage is not None:
+        data["damage"] = damage
+    for key, value in tensors.items():
+        data[key] = _padded_tensor(value)
+    return data
 
 
 def _padded_tensor(values: np.ndarray) -> np.ndarray:

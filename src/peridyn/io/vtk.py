@@ -1,4 +1,5 @@
-"""VTK output for ParaView: point clouds as .vtu files and .pvd time collections."""
+"""VTK output for ParaView: point clouds as .vtu files (one, or per-rank pieces joined by a .pvtu
+file) and .pvd time collections."""
 
 from __future__ import annotations
 
@@ -40,6 +41,48 @@ def write_vtu(path: str | os.PathLike, points, point_data: dict) -> None:
     fields = {name: _vtk_field(name, values, n) for name, values in point_data.items()}
     cells = [("vertex", np.arange(n, dtype=np.int64).reshape(-1, 1))]
     meshio.Mesh(points, cells, point_data=fields).write(os.fspath(path), file_format="vtu")
+
+
+#: VTK's names of the numpy types that ``write_vtu`` writes.
+VTK_TYPES = {"float64": "Float64", "float32": "Float32", "uint8": "UInt8", "int64": "Int64", "int32": "Int32"}
+
+
+def write_pvtu(path: str | os.PathLike, pieces: list, point_data: dict) -> None:
+    """Write a ParaView parallel unstructured grid (.pvtu): the .vtu ``pieces`` (paths relative to
+    the folder of ``path``, each written by ``write_vtu``) as one data set.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The .pvtu file (written atomically).
+    pieces : list of str
+    point_data : dict of str to array_like
+        The fields of one of the pieces (as given to ``write_vtu``): their names, types and
+        numbers of components are declared.
+    """
+    root = ET.Element("VTKFile", type="PUnstructuredGrid", version="0.1", byte_order="LittleEndian")
+    grid = ET.SubElement(root, "PUnstructuredGrid", GhostLevel="0")
+    fields = ET.SubElement(grid, "PPointData")
+    for name, values in point_data.items():
+        values = _vtk_field(name, values, len(values))
+        ET.SubElement(
+            fields,
+            "PDataArray",
+            type=VTK_TYPES[values.dtype.name],
+            Name=name,
+            NumberOfComponents=str(1 if values.ndim == 1 else values.shape[1]),
+        )
+    points = ET.SubElement(grid, "PPoints")
+    ET.SubElement(points, "PDataArray", type="Float64", NumberOfComponents="3")
+    for piece in pieces:
+        ET.SubElement(grid, "Piece", Source=Path(piece).as_posix())
+    _write_xml(root, Path(path))
+
+
+def read_pvtu_pieces(path: str | os.PathLike) -> list[Path]:
+    """The piece files (absolute paths) that a .pvtu file lists."""
+    path = Path(path)
+    return [path.parent / piece.attrib["Source"] for piece in ET.parse(path).getroot().iter("Piece")]
 
 
 class PVDCollection:
@@ -107,10 +150,15 @@ class PVDCollection:
         collection = ET.SubElement(root, "Collection")
         for time, file in self._entries:
             ET.SubElement(collection, "DataSet", timestep=repr(time), group="", part="0", file=file)
-        ET.indent(root)
-        tmp = self.path.with_name(self.path.name + ".tmp")
-        ET.ElementTree(root).write(tmp, encoding="utf-8", xml_declaration=True)
-        os.replace(tmp, self.path)
+        _write_xml(root, self.path)
+
+
+def _write_xml(root: ET.Element, path: Path) -> None:
+    """Write the XML tree ``root`` to ``path`` atomically (a temporary file renamed)."""
+    ET.indent(root)
+    tmp = path.with_name(path.name + ".tmp")
+    ET.ElementTree(root).write(tmp, encoding="utf-8", xml_declaration=True)
+    os.replace(tmp, path)
 
 
 def _read_pvd(path: Path) -> list[tuple[float, str]]:

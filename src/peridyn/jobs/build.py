@@ -25,6 +25,7 @@ from peridyn.discretization.bonds import (
 from peridyn.errors import CaseFileError, InputError
 from peridyn.io import exodus, mesh_text
 from peridyn.io.case import Case, Geometry, Region
+from peridyn.parallel.contact import RankContact
 from peridyn.parallel.domain import Domain, agree
 from peridyn.parallel.halo import Halo, ghost_layers, plan_halo
 from peridyn.parallel.partition import rcb
@@ -382,16 +383,13 @@ def build_part(case: Case, comm, base_dir=".") -> Setup:
     local_ids = np.concatenate([owned, ghosts])
     n_points = setup.whole_body.n_points
     setup.domain = Domain(comm, local_ids, len(owned), n_points, halo, "recursive coordinate bisection")
+    setup.contact = agree(comm, build_contact, case, setup.model, setup.domain, setup.whole_body)
     return setup
 
 
 def _build_part(case: Case, comm, base_dir):
     """``build_part`` up to the halo plan: the part's Setup (its domain set after), the owned
     and ghost global indices (local order) and the ghosts' ranks."""
-    if case.contact is not None:
-        raise CaseFileError(
-            case.name, "contact", case.contact.model_dump(exclude_none=True), "no contact in an MPI run (yet)"
-        )
     if case.blocks:
         raise CaseFileError(
             case.name,
@@ -531,13 +529,19 @@ def check_loading(case: Case, loading: Loading) -> None:
         )
 
 
-def build_contact(case: Case, model: Model) -> Contact | None:
-    """The case's short-range contact forces, or None without a ``contact`` block."""
+def build_contact(
+    case: Case, model: Model, domain: Domain | None = None, whole_body: Body | None = None
+) -> Contact | None:
+    """The case's short-range contact forces, or None without a ``contact`` block; with the
+    ``domain`` of a rank's part (several ranks) and the case's ``whole_body``, the rank's
+    (``peridyn.parallel.contact``)."""
     c = case.contact
     if c is None:
         return None
     radius = c.radius_m if c.radius_m is not None else c.radius * model.body.spacing
     try:
+        if domain is not None and domain.size > 1:
+            return RankContact(model, domain, whole_body, radius, c.stiffness_factor)
         return Contact(model, radius, c.stiffness_factor)
     except InputError as exc:
         raise CaseFileError(case.name, "contact", c.model_dump(exclude_none=True), str(exc)) from None

@@ -24,6 +24,7 @@ from peridyn.io.hdf5 import HDF5Writer
 from peridyn.io.outdir import end_status, prepare_output
 from peridyn.io.provenance import package_version, provenance
 from peridyn.io.recorder import LineProbe, Recorder, RecorderSpec
+from peridyn.io.vtu_pieces import VtuPieces
 from peridyn.jobs.build import Setup, build, pad3
 from peridyn.jobs.exodus_variables import check_variables, variable_values
 from peridyn.jobs.figures import draw_crack_figures, draw_run_figures, final_crack_paths
@@ -123,9 +124,9 @@ def run_case(
     comm : communicator or None
         ``peridyn.parallel.comm.world()`` under ``mpiexec -n N`` (N > 1): each rank runs its
         part of the body (``peridyn.parallel``), rank 0 writes the one results.h5 with every
-        record equal to a serial run's, and every rank returns the summary. An explicit run
-        without contact, for now; checkpoints hold the whole body, so a run may restart on
-        another number of ranks. None: one process.
+        record equal to a serial run's, and every rank returns the summary. An explicit run,
+        for now; checkpoints hold the whole body, so a run may restart on another number of
+        ranks. None: one process.
 
     Raises
     ------
@@ -187,15 +188,13 @@ def _check_parallel(case: Case) -> None:
         raise CaseFileError(
             case.name, "output.exodus", case.output.exodus.model_dump(), "true or false in an MPI run"
         )
-    for key in ("stress", "strain"):
-        if getattr(case.output, key):
-            raise CaseFileError(case.name, f"output.{key}", True, "false in an MPI run (not written yet)")
 
 
 def point_tensors(setup: Setup, spec: RecorderSpec):
     """The recorder's ``tensors``: u (n_points, 3) m -> the per-point ``stress`` (Pa) and
     ``strain`` (with ``strain_valid``) that ``output.stress`` and ``output.strain`` ask for,
-    (n_points, dim, dim); None when neither is asked. Serial runs (the whole model)."""
+    (n_points, dim, dim); None when neither is asked. Under MPI, of the rank's part (its owned
+    rows are the serial ones: ``RootObservers`` gathers them)."""
     if not (spec.stress or spec.strain):
         return None
     dim = setup.body.dim
@@ -371,7 +370,9 @@ def _run_explicit(case, setup, solver, out, case_path, checkpoint_every, restart
     ckpt_path = out / "checkpoint.h5"
     case_json, digest = case_identity(case)
     meta = {"case_hash": digest, "case": case_json, "dt": float(solver.dt), "version": package_version()}
-    gathered = RootObservers(d, setup.model)
+    spec = recorder_spec(case, setup.whole_body, solver.dt)
+    tensors = point_tensors(setup, spec)
+    gathered = RootObservers(d, setup.model, tensors)
     cracks = crack_observer(case, setup, n_steps, gathered.damage)
     parts = {
         name: part
@@ -387,41 +388,55 @@ def _run_explicit(case, setup, solver, out, case_path, checkpoint_every, restart
         )
     else:
         state, resume = solver.initial_state(), None
-    spec = recorder_spec(case, setup.whole_body, solver.dt)
     info = provenance(case_path, case=case)
     if d.size > 1:
         info.update(d.provenance())
-    tensors = point_tensors(setup, spec)
+    pieces = None  # under MPI, each rank writes its piece of the VTU snapshots
+    if d.size > 1 and spec.vtu:
+        pieces = VtuPieces(d, setup.body, out, lambda: damage_field(setup.model), tensors)
+    if d.size > 1 and tensors is not None:
+        tensors = gathered.tensor_fields
     fields = exodus_values(case, setup, spec)
     recorder = d.on_root(
-        Recorder, setup.whole_body, out, spec, info, gathered.damage, resume, tensors, fields
+        Recorder, setup.whole_body, out, spec, info, gathered.damage, resume, tensors, fields, d.size > 1
     )
-    checkpointer, prepare = _checkpointer(
+    checkpointer, gather_checkpoint = _checkpointer(
         ckpt_path, checkpoint_every or n_steps + 1, setup, meta, parts, whole_bonds
     )
     watched = [recorder, *([cracks] if cracks is not None else [])]
     due = [spec.due, *([cracks.due] if cracks is not None else [])]
     if d.size > 1 and checkpoint_every:  # saved on rank 0 from the gathered state
         watched, due = [*watched, checkpointer], [*due, checkpointer.due]
+    prepare = gather_checkpoint
+    if pieces is not None:
+        prepare = [*prepare, (spec.snapshot_due, pieces.write)]
     gathered.attach(watched, due, prepare)
     try:
         if resume is None:
+            if pieces is not None:
+                pieces.write(state)
             gathered.call(state, lambda whole: (recorder.record_series(whole), recorder.snapshot(whole)))
         observers = [gathered]
         if checkpoint_every and d.size == 1:
             observers.append(checkpointer)
         remaining = n_steps - state.step
         bar = progress(remaining) if progress is not None else None
+        loop_start = time.perf_counter()
         try:
             solver.run(state, remaining, observers, bar)
         finally:
             if bar is not None:
                 bar.close()
-    except Interrupted as exc:
+        step_seconds = d.max(time.perf_counter() - loop_start)
+    except Interrupted as exc:  # under MPI: on every rank after the same step
         saved = bool(checkpoint_every) or time.perf_counter() - start > CHECKPOINT_AFTER_S
-        saved = saved and d.size == 1  # the ranks of an MPI run may stop at different steps
-        if saved:
+        saved = bool(d.max(int(saved)))  # the ranks' clocks differ: all save if one would
+        if saved and d.size == 1:
             checkpointer.save(state)
+        elif saved:
+            for _, gather in gather_checkpoint:
+                gather(state)
+            gathered.call(state, checkpointer.save)
         if recorder is not None:
             recorder.close(f"interrupted at step {exc.step}")
         raise Interrupted(exc.signal_name, exc.step, "resume" if saved else "") from None
@@ -430,6 +445,8 @@ def _run_explicit(case, setup, solver, out, case_path, checkpoint_every, restart
             recorder.close(end_status(exc))
         raise
     if not spec.snapshot_due(state.step):
+        if pieces is not None:
+            pieces.write(state)
         gathered.call(state, lambda whole: recorder.snapshot(whole))
     n = d.n_owned
     summary = _base_summary(setup)
@@ -441,13 +458,14 @@ def _run_explicit(case, setup, solver, out, case_path, checkpoint_every, restart
             "stable_dt_s": solver.stable_dt,
             "kinetic_energy_j": solver.kinetic_energy(state),
             "strain_energy_j": float(d.dot(setup.model.energy_density(state.u)[:n], setup.body.volumes[:n])),
+            "step_seconds": step_seconds,
         }
     )
     if setup.contact is not None:
         summary["contact_rebuilds"] = setup.contact.rebuilds
     if cracks is not None:
         summary["crack_length_history"] = cracks.history()  # rank 0's is the one returned
-    gathered.call(state, lambda whole: recorder.finish(whole))
+    gathered.call(state, lambda whole: recorder.finish(whole), True)
     return summary
 
 
@@ -479,7 +497,8 @@ def _restart(path, setup: Setup, meta: dict, parts: dict, whole_bonds: np.ndarra
 def _checkpointer(path, every: int, setup: Setup, meta: dict, parts: dict, whole_bonds: np.ndarray):
     """The run's ``Checkpointer`` and what must be gathered before it saves (``RootObservers``):
     under MPI it writes, on rank 0, the whole body's state and intact mask in serial numbering
-    and the parts that hold whole-body state (not a rank's damage skin)."""
+    and the parts that hold whole-body state (the contact list's build displacement, gathered;
+    not a rank's damage skin)."""
     d = setup.domain
     if d.size == 1:
         return Checkpointer(path, every, setup.bonds.intact, meta, parts), []
@@ -488,12 +507,14 @@ def _checkpointer(path, every: int, setup: Setup, meta: dict, parts: dict, whole
         path, every, whole_intact, meta, {k: v for k, v in parts.items() if k != "damage"}
     )
 
-    def gather_intact():
+    def gather_whole(state):  # the state itself is gathered by RootObservers.call
         intact = d.gather_bonds(setup.bonds.intact, setup.bonds.offsets, whole_bonds)
         if d.is_root:
             whole_intact[:] = intact
+        if setup.contact is not None:
+            setup.contact.gather_built()
 
-    return checkpointer, [(checkpointer.due, gather_intact)]
+    return checkpointer, [(checkpointer.due, gather_whole)]
 
 
 def explicit_damping(case: Case, body: Body):

@@ -43,7 +43,15 @@ DATASET = "dataset.nc"
 #: at the end; every finished run is kept in its folder meanwhile).
 REWRITE_INTERVAL = 5.0
 #: Summary keys that are not results of the physics (paths, timings, schema).
-NOT_RESULTS = {"output_dir", "plots", "schema_version", "kind", "seconds", "peak_memory_bytes"}
+NOT_RESULTS = {
+    "output_dir",
+    "plots",
+    "schema_version",
+    "kind",
+    "seconds",
+    "step_seconds",
+    "peak_memory_bytes",
+}
 #: The most results drawn against a parameter when ``outputs.scalars`` does not choose them.
 MAX_FIGURES = 12
 

@@ -8,8 +8,11 @@ numpy call as in serial, then broadcast. Max and min are exact and reduced acros
 
 Errors: a step that only some ranks may fail (a check, a file on rank 0) runs through
 ``agree`` or ``on_root``; every rank then raises the same error at the same point, so no rank
-waits for a message that never comes. ``Domain.serial(n)`` is the one-process stand-in: every
-method reduces to the plain numpy call.
+waits for a message that never comes (such an error is marked ``every_rank``). Any other error
+raised inside a time step is one rank's alone (``failed_alone`` marks it with ``failed_rank``):
+the other ranks may then be blocked in a halo wait or a collective that it will never join,
+which only ``MPI_Abort`` ends (``peridyn.cli`` reports the error on that rank, then aborts).
+``Domain.serial(n)`` is the one-process stand-in: every method reduces to the plain numpy call.
 """
 
 from __future__ import annotations
@@ -253,12 +256,23 @@ def agree(comm, fn, *args):
 
 
 def _raise_any(errors: list, own: BaseException | None) -> None:
-    """Raise ``own``, else the first error of ``errors`` (pickled), if any."""
+    """Raise ``own``, else the first error of ``errors`` (pickled), if any, marked ``every_rank``."""
     if own is not None:
+        own.every_rank = True
         raise own
     for err in errors:
         if err is not None:
-            raise pickle.loads(err)
+            error = pickle.loads(err)
+            error.every_rank = True
+            raise error
+
+
+def failed_alone(error: BaseException, comm) -> None:
+    """Mark ``error``, raised inside a time step on this rank of ``comm`` (several ranks), with
+    ``failed_rank`` (this rank) unless every rank raised it (``every_rank``): no other rank
+    knows of it."""
+    if not getattr(error, "every_rank", False):
+        error.failed_rank = comm.rank
 
 
 def _portable(error: BaseException) -> bytes:

@@ -2,8 +2,12 @@
 
 ``RootObservers`` is the one observer every rank attaches. At a step where one of its observers
 is due, the ranks gather the state (and the damage index) in global point order on rank 0,
-which calls the observers with it; their errors reach every rank (``Domain.on_root``). In one
-process the observers get the run's own state, and the damage is computed when asked.
+which calls the observers with it; their errors reach every rank (``Domain.on_root``). Per-point
+tensors (``output.stress``, ``output.strain``) are computed by each rank on its owned points
+(their families and the neighbours' displacements are on the rank) and gathered likewise for
+the final state (the VTU snapshots are written per rank: ``peridyn.io.vtu_pieces``). In one
+process the observers get the run's own state, and the damage and tensors are computed when
+asked.
 """
 
 from __future__ import annotations
@@ -26,22 +30,30 @@ class RootObservers:
     model : Model
         The rank's part of the model (its ``bonds.intact`` gives the damage index).
 
-    The observers are given by ``attach`` (they may take ``damage`` as their damage index).
+    tensors : callable (u) -> dict of str to array, or None
+        The rank's per-point tensor fields at its local displacement ``u`` (n_local, 3), m
+        (``peridyn.jobs.run.point_tensors``); None: none asked.
+
+    The observers are given by ``attach`` (they may take ``damage`` as their damage index and
+    ``tensor_fields`` as their tensors).
     """
 
-    def __init__(self, domain: Domain, model):
+    def __init__(self, domain: Domain, model, tensors=None):
         self.domain = domain
         self.model = model
+        self.tensors = tensors
         self.observers: list = []
         self.due: list = []
         self.prepare: list = []
         self._damage: np.ndarray | None = None
+        self._tensors: dict = {}
 
     def attach(self, observers: Sequence, due: Sequence[Callable[[int], bool]], prepare=()) -> None:
         """Watch with ``observers`` (objects with ``observe(state, solver)``, used on rank 0 only:
         None elsewhere) at the steps where one of ``due`` (callables step -> bool, known on every
-        rank) is True; ``prepare``: (due, collective callable) pairs run on every rank first at
-        their steps (e.g. gathering the bonds' intact mask for a checkpoint)."""
+        rank) is True; ``prepare``: (due, collective callable(state)) pairs run on every rank
+        first at their steps, with the rank's state (e.g. gathering the bonds' intact mask for a
+        checkpoint, writing the pieces of a VTU snapshot)."""
         self.observers = list(observers) if self.domain.is_root else []
         self.due = list(due)
         self.prepare = list(prepare)
@@ -52,19 +64,28 @@ class RootObservers:
             return damage_field(self.model)
         return self._damage
 
+    def tensor_fields(self, u: np.ndarray) -> dict:
+        """The whole body's tensor fields gathered by the last ``call`` with ``tensors`` (rank 0,
+        several ranks; ``u`` is that call's gathered displacement): the ``tensors`` of a
+        ``Recorder`` on rank 0."""
+        return self._tensors
+
     def observe(self, state: State, solver) -> None:
         """Gather and call the observers when one is due (every rank calls it); in one process,
         call them at every step (nothing to gather)."""
         if self.domain.size == 1 or any(due(state.step) for due in self.due):
-            for due, gather in self.prepare:
+            for due, prepare in self.prepare:
                 if due(state.step):
-                    gather()
+                    prepare(state)
             self.call(state, lambda whole: [obs.observe(whole, solver) for obs in self.observers])
 
-    def call(self, state: State, fn):
+    def call(self, state: State, fn, tensors: bool = False):
         """``fn(state of the whole body)`` on rank 0 after gathering (collective); its result on
-        rank 0, None elsewhere."""
+        rank 0, None elsewhere. ``tensors``: gather the tensor fields too (for ``fn`` to read
+        through ``tensor_fields``)."""
         whole = self.domain.gather_state(state)
         if self.domain.size > 1:
             self._damage = self.domain.gather(damage_field(self.model))
+            if tensors and self.tensors is not None:
+                self._tensors = {k: self.domain.gather(v) for k, v in self.tensors(state.u).items()}
         return self.domain.on_root(fn, whole)

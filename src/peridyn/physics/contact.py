@@ -167,9 +167,17 @@ class Contact:
         from farther away (a closing gap, an impact) nor the transverse stiffness of pairs
         pressed closer than d_c / 2, so such runs may need a smaller ``safety``.
         """
-        tree = cKDTree(self.x)
-        pairs = tree.query_pairs(self.radius * (1 + 1e-9), output_type="ndarray")
-        per_point = np.zeros(len(self.x))
-        np.add.at(per_point, pairs[:, 0], self.volumes[pairs[:, 1]])
-        np.add.at(per_point, pairs[:, 1], self.volumes[pairs[:, 0]])
-        return 2.0 * self.stiffness * per_point
+        return contact_stiffness_bound(self.x, self.volumes, self.radius, self.stiffness)
+
+
+def contact_stiffness_bound(
+    x: np.ndarray, volumes: np.ndarray, radius: float, stiffness: float
+) -> np.ndarray:
+    """(n_points,) N/m^4: ``Contact.stiffness_bound`` of the points ``x`` (n_points, 3), m, with
+    ``volumes`` (n_points,) m^3, contact distance ``radius`` (m) and ``stiffness`` c_sr / delta."""
+    tree = cKDTree(x)
+    pairs = tree.query_pairs(radius * (1 + 1e-9), output_type="ndarray")
+    per_point = np.zeros(len(x))
+    np.add.at(per_point, pairs[:, 0], volumes[pairs[:, 1]])
+    np.add.at(per_point, pairs[:, 1], volumes[pairs[:, 0]])
+    return 2.0 * stiffness * per_point

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from peridyn.errors import InputError
-from peridyn.io.vtk import PVDCollection, write_vtu
+from peridyn.io.vtk import PVDCollection, read_pvtu_pieces, write_pvtu, write_vtu
 
 
 def test_vtu_round_trip_3d(tmp_path):
@@ -99,3 +99,33 @@ def test_pvd_append_mode_rejects_a_broken_file(tmp_path):
     path.write_text("<VTKFile><Collection><DataSet file='a.vtu'/>")
     with pytest.raises(InputError, match="run.pvd: not a valid .pvd collection"):
         PVDCollection(path, mode="a")
+
+
+def test_pvtu_declares_the_pieces_fields_as_write_vtu_writes_them(tmp_path):
+    """A .pvtu (VTK's parallel unstructured grid, the format ParaView reads as one data set)
+    lists its pieces relative to its folder and declares each point field with the VTK type and
+    component count of the pieces' own arrays (as meshio reads them back): 2D vectors padded to 3,
+    booleans as UInt8."""
+    rng = np.random.default_rng(3)
+    data = {
+        "displacement": rng.standard_normal((4, 2)),
+        "valid": np.array([True, False, True, True]),
+        "damage": rng.random(4).astype(np.float32),
+    }
+    (tmp_path / "step").mkdir()
+    pieces = ["step/piece_0000.vtu", "step/piece_0001.vtu"]
+    for piece in pieces:
+        write_vtu(tmp_path / piece, rng.random((4, 2)), data)
+    write_pvtu(tmp_path / "step.pvtu", pieces, data)
+    assert read_pvtu_pieces(tmp_path / "step.pvtu") == [tmp_path / p for p in pieces]
+    declared = {
+        a.attrib["Name"]: (a.attrib["type"], int(a.attrib["NumberOfComponents"]))
+        for a in ET.parse(tmp_path / "step.pvtu").getroot().find("PUnstructuredGrid/PPointData")
+    }
+    written = meshio.read(tmp_path / pieces[0]).point_data
+    vtk_type = {"float64": "Float64", "float32": "Float32", "uint8": "UInt8"}
+    assert declared == {
+        name: (vtk_type[value.dtype.name], 1 if value.ndim == 1 else value.shape[1])
+        for name, value in written.items()
+    }
+    assert declared["displacement"] == ("Float64", 3) and declared["valid"] == ("UInt8", 1)
