@@ -14,6 +14,15 @@ When asked (``stress``, ``strain``), the final fields ``final/stress`` (partial 
 ``final/strain`` (Green-Lagrange strain) with ``final/strain_valid``, (n_points, dim, dim)
 and (n_points,) bool (``peridyn.physics.deformation``), and the same point data in every VTU
 snapshot (9 components, row-major, padded with zeros in 2D: a tensor for ParaView).
+
+The series records are held in memory and written in blocks (``peridyn.io.series_buffer``:
+at most ``SeriesBuffer``'s 8 MiB or 256 records per series), not one HDF5 append and flush
+per record. ``Recorder.flush`` writes them: the owner of the run calls it before every
+checkpoint (``peridyn.io.checkpoint.Checkpointer``'s ``before_save``), and ``finish`` and
+``close`` (the end of the run, an error, an interruption) write them first, so a restart
+from a checkpoint finds every record up to it. A process killed outright (SIGKILL) loses the
+records held since the last flush, which all come after the last checkpoint when
+checkpointing; the file itself stays readable (nothing is written to it between flushes).
 """
 
 from __future__ import annotations
@@ -29,6 +38,7 @@ from peridyn.discretization.state import State, check_state, runaway_limit
 from peridyn.errors import InputError
 from peridyn.io.exodus_write import ExodusWriter
 from peridyn.io.hdf5 import HDF5Writer
+from peridyn.io.series_buffer import SeriesBuffer
 from peridyn.io.vtk import PVDCollection, write_vtu
 
 
@@ -175,8 +185,9 @@ class Recorder:
             body.volumes,
             provenance,
             mode=mode,
-            flush_every=1,
+            flush_every=None,
         )
+        self.series = SeriesBuffer(self.h5)
         self.h5.set_status("running")
         self._create_series()
         self.max_displacement = runaway_limit(body.points)
@@ -228,7 +239,7 @@ class Recorder:
             The state is not finite or runs away (``check_state``): nothing is written.
         """
         check_state(state, self.max_displacement)
-        h5, step, t = self.h5, state.step, state.time
+        h5, step, t = self.series, state.step, state.time
         if self.sensor_names:
             h5.append("sensor_u", step, t, state.u[self.sensor_index])
             h5.append("sensor_v", step, t, state.v[self.sensor_index])
@@ -244,7 +255,7 @@ class Recorder:
         """Write the whole displacement field (HDF5, and VTU when enabled); raises
         InstabilityError, writing nothing, for a non-finite or runaway state."""
         check_state(state, self.max_displacement)
-        self.h5.append("field_u", state.step, state.time, state.u)
+        self.series.append("field_u", state.step, state.time, state.u)
         if self.exodus is not None:
             self.exodus.append(state.time, **exodus_fields(self.body, state, self.damage))
         if self.pvd is None:
@@ -258,8 +269,13 @@ class Recorder:
         write_vtu(self.directory / name, self.body.points[:, : self.body.dim], data)
         self.pvd.add(state.time, name)
 
+    def flush(self) -> None:
+        """Write the series records held in memory and flush the file (before a checkpoint)."""
+        self.series.flush()
+
     def finish(self, state: State) -> None:
-        """Write the final state, then close the file."""
+        """Write the held records and the final state, then close the file."""
+        self.flush()
         self.h5.write_array("final/u", state.u)
         self.h5.write_array("final/v", state.v)
         if self.damage is not None:
@@ -273,10 +289,15 @@ class Recorder:
         return self.tensors(u) if self.tensors is not None else {}
 
     def close(self, status: str | None = None) -> None:
-        """Close the file early (failure, interruption), setting its ``status`` when given."""
-        if status is not None:
-            self.h5.set_status(status)
-        self.h5.close()
+        """Close the file early (failure, interruption), setting its ``status`` when given,
+        after writing the records held (a failing write, e.g. a full disk, does not keep the
+        status from being set)."""
+        try:
+            self.flush()
+        finally:
+            if status is not None:
+                self.h5.set_status(status)
+            self.h5.close()
 
 
 def _padded_tensor(values: np.ndarray) -> np.ndarray:

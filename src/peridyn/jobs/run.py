@@ -364,7 +364,13 @@ def _run_explicit(case, setup, solver, out, case_path, checkpoint_every, restart
     tensors = point_tensors(setup, spec)
     recorder = d.on_root(Recorder, setup.whole_body, out, spec, info, gathered.damage, resume, tensors)
     checkpointer, prepare = _checkpointer(
-        ckpt_path, checkpoint_every or n_steps + 1, setup, meta, parts, whole_bonds
+        ckpt_path,
+        checkpoint_every or n_steps + 1,
+        setup,
+        meta,
+        parts,
+        whole_bonds,
+        [recorder.flush] if recorder is not None else [],
     )
     watched = [recorder, *([cracks] if cracks is not None else [])]
     due = [spec.due, *([cracks.due] if cracks is not None else [])]
@@ -443,16 +449,19 @@ def _restart(path, setup: Setup, meta: dict, parts: dict, whole_bonds: np.ndarra
     return state
 
 
-def _checkpointer(path, every: int, setup: Setup, meta: dict, parts: dict, whole_bonds: np.ndarray):
+def _checkpointer(
+    path, every: int, setup: Setup, meta: dict, parts: dict, whole_bonds: np.ndarray, before_save=()
+):
     """The run's ``Checkpointer`` and what must be gathered before it saves (``RootObservers``):
     under MPI it writes, on rank 0, the whole body's state and intact mask in serial numbering
-    and the parts that hold whole-body state (not a rank's damage skin)."""
+    and the parts that hold whole-body state (not a rank's damage skin). ``before_save``: the
+    calls made before every save (the recorder's ``flush``, on rank 0)."""
     d = setup.domain
     if d.size == 1:
-        return Checkpointer(path, every, setup.bonds.intact, meta, parts), []
+        return Checkpointer(path, every, setup.bonds.intact, meta, parts, before_save), []
     whole_intact = np.ones(int(whole_bonds[-1]), dtype=bool) if d.is_root else None
     checkpointer = Checkpointer(
-        path, every, whole_intact, meta, {k: v for k, v in parts.items() if k != "damage"}
+        path, every, whole_intact, meta, {k: v for k, v in parts.items() if k != "damage"}, before_save
     )
 
     def gather_intact():
