@@ -178,6 +178,7 @@ class Recorder:
             name: tree.query(np.linspace(p.start, p.end, p.points))[1] for name, p in spec.lines.items()
         }
         self.plane_index = {name: np.asarray(idx) for name, idx in spec.planes.items()}
+        self._plane_rows = {name: rows_of(idx) for name, idx in self.plane_index.items()}
         mode = "a" if resume is not None else "w"
         self.h5 = HDF5Writer(
             self.directory / "results.h5",
@@ -245,8 +246,8 @@ class Recorder:
             h5.append("sensor_v", step, t, state.v[self.sensor_index])
         for name, idx in self.line_index.items():
             h5.append(f"line_{name}", step, t, state.u[idx])
-        for name, idx in self.plane_index.items():
-            h5.append(f"plane_{name}", step, t, state.u[idx])
+        for name, rows in self._plane_rows.items():
+            h5.append(f"plane_{name}", step, t, state.u[rows])
         if self.spec.pzt_sensors:
             signals = [np.sum(w * state.u[idx, :2]) for idx, w in self.spec.pzt_sensors.values()]
             h5.append("pzt_signal", step, t, np.array(signals))
@@ -298,6 +299,19 @@ class Recorder:
             if status is not None:
                 self.h5.set_status(status)
             self.h5.close()
+
+
+def rows_of(index: np.ndarray) -> np.ndarray | slice:
+    """``index`` (k,) of rows as a slice when it is an increasing arithmetic progression (the
+    layer of a plate: every ``layers``-th point), so that ``u[rows]`` is a view, copied once;
+    else ``index`` itself. ``u[rows_of(index)]`` has the values of ``u[index]``."""
+    index = np.asarray(index)
+    if len(index) < 2:
+        return index
+    step = int(index[1] - index[0])
+    if step < 1 or np.any(np.diff(index) != step):
+        return index
+    return slice(int(index[0]), int(index[-1]) + 1, step)
 
 
 def _padded_tensor(values: np.ndarray) -> np.ndarray:

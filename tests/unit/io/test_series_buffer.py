@@ -16,6 +16,7 @@ import pytest
 import peridyn
 from peridyn.errors import InputError
 from peridyn.io.hdf5 import HDF5Writer
+from peridyn.io.recorder import rows_of
 from peridyn.io.results import Results
 from peridyn.io.series_buffer import SeriesBuffer
 
@@ -135,3 +136,22 @@ def test_a_killed_process_keeps_the_flushed_blocks_only(tmp_path):
     steps, _, data = Results(path).series("u")
     assert steps.tolist() == list(range(6))  # two blocks of three; steps 6 and 7 were held
     np.testing.assert_array_equal(data[5], np.full((4, 3), 5.0))
+
+
+@pytest.mark.parametrize(
+    "index, is_slice",
+    [
+        ([2, 5, 8, 11], True),
+        ([4, 5, 6], True),
+        ([7], False),
+        ([], False),
+        ([1, 3, 4], False),
+        ([5, 3, 1], False),
+    ],
+)
+def test_rows_of_gives_the_rows_of_the_index(index, is_slice):
+    """The recorder's plane rows: a slice for a layer's arithmetic progression, the same rows."""
+    u = np.arange(36.0).reshape(12, 3)
+    rows = rows_of(np.array(index, dtype=np.int64))
+    assert isinstance(rows, slice) is is_slice
+    np.testing.assert_array_equal(u[rows], u[np.array(index, dtype=np.int64)])
