@@ -1,7 +1,8 @@
 """Velocity-Verlet updates and the state check, fused: one pass over the points each.
 
-Compiled without fast-math: every value is rounded exactly as the NumPy expressions in the
-docstrings round it (no fused multiply-add, signed zeros kept), so a step gives the same
+Serial loops (memory-bound: a second thread gains little, and waits at a barrier on a loaded
+machine), compiled without fast-math: every value is rounded exactly as the NumPy
+expressions in the docstrings round it (no fused multiply-add, signed zeros kept), so a step gives the same
 bits as those expressions (``peridyn.kernels.reference.verlet``; tests/kernels). Arrays are
 (n_points, 3) C-contiguous float64 unless said otherwise.
 """
@@ -10,17 +11,17 @@ import numba
 import numpy as np
 
 
-@numba.njit(parallel=True, cache=True)
+@numba.njit(cache=True)
 def kick_drift(u, v, a, half_dt, dt):
     """``v += half_dt * a`` then ``u += dt * v`` (IN/OUT ``u``, ``v``; ``half_dt``, ``dt`` s)."""
-    for i in numba.prange(u.shape[0]):
+    for i in range(u.shape[0]):
         for k in range(3):
             vk = v[i, k] + half_dt * a[i, k]
             v[i, k] = vk
             u[i, k] = u[i, k] + dt * vk
 
 
-@numba.njit(parallel=True, cache=True)
+@numba.njit(cache=True)
 def acceleration(f, b, inv_rho, damping, v, constrained, a, kick, half_dt):
     """``a = (f + b) * inv_rho``, then ``a -= damping * v``, then ``a[constrained] = 0``, and
     with ``kick`` ``v += half_dt * a`` (OUT ``a``, IN/OUT ``v``).
@@ -31,7 +32,7 @@ def acceleration(f, b, inv_rho, damping, v, constrained, a, kick, half_dt):
     per point; ``constrained`` (n_points, 3) bool.
     """
     n_damping = damping.shape[0]
-    for i in numba.prange(f.shape[0]):
+    for i in range(f.shape[0]):
         r = inv_rho[i]
         c = 0.0
         if n_damping == 1:
@@ -49,13 +50,12 @@ def acceleration(f, b, inv_rho, damping, v, constrained, a, kick, half_dt):
                 v[i, k] = v[i, k] + half_dt * ak
 
 
-@numba.njit(parallel=True, cache=True)
+@numba.njit(cache=True)
 def state_is_sound(u, v, max_displacement):
     """True when every component of ``u`` has ``|u| <= max_displacement`` (m; false for NaN)
     and every component of ``v`` is finite (``u``, ``v`` (n_points, dim) of one shape)."""
-    bad = 0
-    for i in numba.prange(u.shape[0]):
+    for i in range(u.shape[0]):
         for k in range(u.shape[1]):
             if not (abs(u[i, k]) <= max_displacement) or not np.isfinite(v[i, k]):
-                bad += 1
-    return bad == 0
+                return False
+    return True
