@@ -124,8 +124,8 @@ def test_instability_stops_before_a_nan_is_written(monkeypatch, tmp_path, every,
     rarer records, at the solver's check (every 10 steps): status failed, no NaN stored."""
     original = ExplicitSolver._acceleration
 
-    def poisoned(self, state):
-        original(self, state)
+    def poisoned(self, state, **kwargs):
+        original(self, state, **kwargs)
         if state.step >= 23:
             state.a[5, 1] = np.nan
 

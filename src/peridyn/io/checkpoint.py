@@ -139,9 +139,14 @@ class Checkpointer:
     meta : dict
         ``META_KEYS`` and ``case`` of the run.
     parts : dict of name -> object with ``checkpoint_state()``
+    before_save : sequence of callables () -> None
+        Called before every save, e.g. ``Recorder.flush``: the records held in memory up to the
+        checkpoint's step are on disk before the checkpoint is.
     """
 
-    def __init__(self, path, every: int, intact: np.ndarray, meta: dict, parts: dict | None = None):
+    def __init__(
+        self, path, every: int, intact: np.ndarray, meta: dict, parts: dict | None = None, before_save=()
+    ):
         if every < 1:
             raise InputError(f"checkpoint interval must be at least 1 step, got {every}")
         self.path = Path(path)
@@ -149,6 +154,7 @@ class Checkpointer:
         self.intact = intact
         self.meta = meta
         self.parts = parts or {}
+        self.before_save = list(before_save)
 
     def due(self, step: int) -> bool:
         """True when a checkpoint is saved at ``step``."""
@@ -160,5 +166,7 @@ class Checkpointer:
             self.save(state)
 
     def save(self, state: State) -> None:
-        """Save a checkpoint of ``state`` now."""
+        """Save a checkpoint of ``state`` now (after the ``before_save`` calls)."""
+        for call in self.before_save:
+            call()
         save_checkpoint(self.path, state, self.intact, self.meta, self.parts)

@@ -13,7 +13,8 @@ Layout of a results file::
     /<any>/<name>           one-off arrays, e.g. /final/damage
 
 The writer flushes after every ``flush_every`` appends, so a process that
-crashes loses at most the records appended since the last flush.
+crashes loses at most the records appended since the last flush (with ``flush_every=None``
+the caller flushes, e.g. ``peridyn.io.series_buffer.SeriesBuffer`` after each block).
 """
 
 from __future__ import annotations
@@ -77,8 +78,9 @@ class HDF5Writer:
         existing file, e.g. on restart from a checkpoint; its geometry must
         equal ``points`` and ``volumes``, and ``provenance`` updates the root
         attributes. A missing file is created.
-    flush_every : int
-        Flush the file to the operating system after this many appends.
+    flush_every : int or None
+        Flush the file to the operating system after this many appends; None: only
+        when asked (``flush``) and by the methods other than the appends.
 
     Raises
     ------
@@ -110,11 +112,11 @@ class HDF5Writer:
         volumes,
         provenance: dict,
         mode: str = "w",
-        flush_every: int = 1,
+        flush_every: int | None = 1,
     ):
         if mode not in ("w", "a"):
             raise InputError(f"mode must be 'w' or 'a', got {mode!r}")
-        if not is_integer(flush_every) or flush_every < 1:
+        if flush_every is not None and (not is_integer(flush_every) or flush_every < 1):
             raise InputError(f"flush_every must be a positive integer, got {flush_every!r}")
         points, volumes = _check_geometry(points, volumes)
         self.path = os.fspath(path)
@@ -211,16 +213,51 @@ class HDF5Writer:
             Unknown series, non-increasing step, non-finite time or a record
             of the wrong shape.
         """
-        series = self._get_series(name)
-        step, time = _check_step_time(name, series.last_step, step, time)
         values = np.asarray(values)
-        if values.shape != series.data.shape[1:]:
+        self._check_record_shape(name, values.shape)
+        self.append_block(name, [step], [time], values[np.newaxis])
+
+    def append_block(self, name: str, steps, times, values) -> None:
+        """Append ``k`` records to a series at once (one write per dataset), counted as one
+        append by ``flush_every``.
+
+        Parameters
+        ----------
+        name : str
+            A series made by :meth:`create_series`.
+        steps : sequence of int, length k
+            Strictly increasing time step numbers above the last step of the series.
+        times : sequence of float, length k
+            Simulated times in s.
+        values : array_like, shape (k, *record shape)
+            The records, cast to the series' dtype as in :meth:`append`.
+
+        Raises
+        ------
+        InputError
+            As :meth:`append`, for any of the records (nothing is written then).
+        """
+        series = self._get_series(name)
+        values = np.asarray(values)
+        if values.ndim == 0 or len(values) != len(steps) or len(times) != len(steps):
             raise InputError(
-                f"series {name!r}: record has shape {values.shape}, expected {series.data.shape[1:]}"
+                f"series {name!r}: a block of {len(steps)} steps needs as many times and records, "
+                f"got {len(times)} times and values of shape {values.shape}"
             )
-        series.append(step, time, values)
+        self._check_record_shape(name, values.shape[1:])
+        last = series.last_step
+        checked = []
+        for step, time in zip(steps, times, strict=True):
+            step, time = _check_step_time(name, last, step, time)
+            checked.append((step, time))
+            last = step
+        if not checked:
+            return
+        series.append(
+            np.array([s for s, _ in checked], dtype=np.int64), np.array([t for _, t in checked]), values
+        )
         self._pending += 1
-        if self._pending >= self.flush_every:
+        if self.flush_every is not None and self._pending >= self.flush_every:
             self.flush()
 
     def write_array(self, name: str, array, attrs: dict | None = None) -> None:
@@ -304,6 +341,11 @@ class HDF5Writer:
                 f"{data.shape[1:]} and dtype {data.dtype}, not {shape} and {dtype}"
             )
 
+    def _check_record_shape(self, name: str, shape: tuple) -> None:
+        expected = self._get_series(name).data.shape[1:]
+        if shape != expected:
+            raise InputError(f"series {name!r}: record has shape {shape}, expected {expected}")
+
     def _get_series(self, name: str) -> _Series:
         if name not in self._series:
             raise InputError(
@@ -340,13 +382,14 @@ class _Series:
         series.resize(n_records(group))
         return series
 
-    def append(self, step: int, time: float, values: np.ndarray) -> None:
-        """Write one record: data, then time, then step (the step marks it complete)."""
-        n = self.data.shape[0]
-        for dataset, value in ((self.data, values), (self.time, time), (self.step, step)):
-            dataset.resize(n + 1, axis=0)
-            dataset[n] = value
-        self.last_step = step
+    def append(self, steps: np.ndarray, times: np.ndarray, values: np.ndarray) -> None:
+        """Write ``k`` records ((k,) steps and times, (k, *shape) values): data, then time,
+        then step (the step marks them complete)."""
+        n, k = self.data.shape[0], len(steps)
+        for dataset, value in ((self.data, values), (self.time, times), (self.step, steps)):
+            dataset.resize(n + k, axis=0)
+            dataset[n : n + k] = value
+        self.last_step = int(steps[-1])
 
     def resize(self, n: int) -> None:
         """Keep the first ``n`` records."""

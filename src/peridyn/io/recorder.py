@@ -15,6 +15,15 @@ When asked (``stress``, ``strain``), the final fields ``final/stress`` (partial 
 ``final/strain`` (Green-Lagrange strain) with ``final/strain_valid``, (n_points, dim, dim)
 and (n_points,) bool (``peridyn.physics.deformation``), and the same point data in every VTU
 snapshot (9 components, row-major, padded with zeros in 2D: a tensor for ParaView).
+
+The series records are held in memory and written in blocks (``peridyn.io.series_buffer``:
+at most ``SeriesBuffer``'s 8 MiB or 256 records per series), not one HDF5 append and flush
+per record. ``Recorder.flush`` writes them: the owner of the run calls it before every
+checkpoint (``peridyn.io.checkpoint.Checkpointer``'s ``before_save``), and ``finish`` and
+``close`` (the end of the run, an error, an interruption) write them first, so a restart
+from a checkpoint finds every record up to it. A process killed outright (SIGKILL) loses the
+records held since the last flush, which all come after the last checkpoint when
+checkpointing; the file itself stays readable (nothing is written to it between flushes).
 """
 
 from __future__ import annotations
@@ -30,6 +39,7 @@ from peridyn.discretization.state import State, check_state, runaway_limit
 from peridyn.errors import InputError
 from peridyn.io.exodus_write import PERIDIGM_VARIABLES, ExodusWriter
 from peridyn.io.hdf5 import HDF5Writer
+from peridyn.io.series_buffer import SeriesBuffer
 from peridyn.io.vtk import PVDCollection, write_vtu
 
 
@@ -199,6 +209,7 @@ class Recorder:
             name: tree.query(np.linspace(p.start, p.end, p.points))[1] for name, p in spec.lines.items()
         }
         self.plane_index = {name: np.asarray(idx) for name, idx in spec.planes.items()}
+        self._plane_rows = {name: rows_of(idx) for name, idx in self.plane_index.items()}
         mode = "a" if resume is not None else "w"
         self.h5 = HDF5Writer(
             self.directory / "results.h5",
@@ -206,8 +217,9 @@ class Recorder:
             body.volumes,
             provenance,
             mode=mode,
-            flush_every=1,
+            flush_every=None,
         )
+        self.series = SeriesBuffer(self.h5)
         self.h5.set_status("running")
         self._create_series()
         self.max_displacement = runaway_limit(body.points)
@@ -269,14 +281,14 @@ class Recorder:
             The state is not finite or runs away (``check_state``): nothing is written.
         """
         check_state(state, self.max_displacement)
-        h5, step, t = self.h5, state.step, state.time
+        h5, step, t = self.series, state.step, state.time
         if self.sensor_names:
             h5.append("sensor_u", step, t, state.u[self.sensor_index])
             h5.append("sensor_v", step, t, state.v[self.sensor_index])
         for name, idx in self.line_index.items():
             h5.append(f"line_{name}", step, t, state.u[idx])
-        for name, idx in self.plane_index.items():
-            h5.append(f"plane_{name}", step, t, state.u[idx])
+        for name, rows in self._plane_rows.items():
+            h5.append(f"plane_{name}", step, t, state.u[rows])
         if self.spec.pzt_sensors:
             signals = [np.sum(w * state.u[idx, :2]) for idx, w in self.spec.pzt_sensors.values()]
             h5.append("pzt_signal", step, t, np.array(signals))
@@ -285,7 +297,7 @@ class Recorder:
         """Write the whole displacement field (HDF5, and VTU when enabled); raises
         InstabilityError, writing nothing, for a non-finite or runaway state."""
         check_state(state, self.max_displacement)
-        self.h5.append("field_u", state.step, state.time, state.u)
+        self.series.append("field_u", state.step, state.time, state.u)
         if self.exodus is not None and (self.spec.exodus_every is None or self.spec.exodus_due(state.step)):
             self.write_exodus(state)
         if self.pvd is None:
@@ -310,8 +322,13 @@ class Recorder:
         else:
             self.exodus.append(state.time, **exodus_fields(self.body, state, self.damage))
 
+    def flush(self) -> None:
+        """Write the series records held in memory and flush the file (before a checkpoint)."""
+        self.series.flush()
+
     def finish(self, state: State) -> None:
-        """Write the final state, then close the file."""
+        """Write the held records and the final state, then close the file."""
+        self.flush()
         self.h5.write_array("final/u", state.u)
         self.h5.write_array("final/v", state.v)
         if self.damage is not None:
@@ -325,10 +342,28 @@ class Recorder:
         return self.tensors(u) if self.tensors is not None else {}
 
     def close(self, status: str | None = None) -> None:
-        """Close the file early (failure, interruption), setting its ``status`` when given."""
-        if status is not None:
-            self.h5.set_status(status)
-        self.h5.close()
+        """Close the file early (failure, interruption), setting its ``status`` when given,
+        after writing the records held (a failing write, e.g. a full disk, does not keep the
+        status from being set)."""
+        try:
+            self.flush()
+        finally:
+            if status is not None:
+                self.h5.set_status(status)
+            self.h5.close()
+
+
+def rows_of(index: np.ndarray) -> np.ndarray | slice:
+    """``index`` (k,) of rows as a slice when it is an increasing arithmetic progression (the
+    layer of a plate: every ``layers``-th point), so that ``u[rows]`` is a view, copied once;
+    else ``index`` itself. ``u[rows_of(index)]`` has the values of ``u[index]``."""
+    index = np.asarray(index)
+    if len(index) < 2:
+        return index
+    step = int(index[1] - index[0])
+    if step < 1 or np.any(np.diff(index) != step):
+        return index
+    return slice(int(index[0]), int(index[-1]) + 1, step)
 
 
 def snapshot_name(step: int, suffix: str) -> str:

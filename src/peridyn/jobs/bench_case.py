@@ -146,7 +146,7 @@ def run_case_benchmark(
     clock = _Clock()
     with tempfile.TemporaryDirectory(prefix="peridyn-bench-") as tmp:
         out = Path(tmp)
-        check_output_fits(case, setup.whole_body, n_steps + 1, solver.dt, out)
+        check_output_fits(spec, setup.whole_body, n_steps + 1, solver.dt, out)
         gathered = RootObservers(setup.domain, setup.model)
         cracks = crack_observer(case, setup, case_steps, gathered.damage)
         recorder = Recorder(

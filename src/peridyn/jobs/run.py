@@ -153,13 +153,14 @@ def run_case(
     domain = setup.domain
     solver = time_stepper(case, setup) if stepping else None
     out = output_directory(case, output_dir)
+    spec = recorder_spec(case, setup.whole_body, solver.dt) if stepping else None
     if stepping:
-        domain.on_root(check_output_fits, case, setup.whole_body, step_count(case, solver), solver.dt, out)
+        domain.on_root(check_output_fits, spec, setup.whole_body, step_count(case, solver), solver.dt, out)
     domain.on_root(prepare_output, out, RESULTS, overwrite, restart)
     written = not restart  # a restart writes once its checkpoint is accepted (the recorder's part)
     try:
         summary, plots = _solve(
-            case, setup, solver, out, case_path, checkpoint_every, restart, progress, start
+            case, setup, solver, spec, out, case_path, checkpoint_every, restart, progress, start
         )
         written = True
         _finish(case, setup, out, summary, plots, start)
@@ -225,16 +226,16 @@ def step_count(case: Case, solver) -> int:
     return s.steps if s.steps is not None else int(np.ceil(s.time / solver.dt - 1e-9))
 
 
-def check_output_fits(case: Case, body: Body, n_steps: int, dt: float, out: Path) -> None:
-    """Refuse a run whose records (``RecorderSpec.output_bytes``) would not fit in the free space
-    of the disk of its output folder, before anything is written.
+def check_output_fits(spec: RecorderSpec, body: Body, n_steps: int, dt: float, out: Path) -> None:
+    """Refuse a run whose records (``spec.output_bytes``, ``spec`` from ``recorder_spec``) would
+    not fit in the free space of the disk of its output folder, before anything is written.
 
     Raises
     ------
     InputError
         Naming the steps, the bytes and the free space.
     """
-    need = recorder_spec(case, body, dt).output_bytes(body.n_points, n_steps)
+    need = spec.output_bytes(body.n_points, n_steps)
     folder = out.resolve()
     while not folder.exists():
         folder = folder.parent
@@ -259,8 +260,9 @@ def _resume_hint(command: str | None) -> str:
     return command if "--restart" in command.split() else f"{command} --restart"
 
 
-def _solve(case, setup, solver, out, case_path, checkpoint_every, restart, progress, start):
-    """The solver's part of ``run_case``: its summary and the figures it drew."""
+def _solve(case, setup, solver, spec, out, case_path, checkpoint_every, restart, progress, start):
+    """The solver's part of ``run_case``: its summary and the figures it drew (``spec``: the
+    recorder's, for a time-stepping run)."""
     if case.solver.type == "static":
         return _run_static(case, setup, out, case_path), []
     if case.solver.type == "newton":
@@ -269,7 +271,9 @@ def _solve(case, setup, solver, out, case_path, checkpoint_every, restart, progr
         from peridyn.jobs.modal import run_modal
 
         return run_modal(case, setup, out, case_path)
-    summary = _run_explicit(case, setup, solver, out, case_path, checkpoint_every, restart, progress, start)
+    summary = _run_explicit(
+        case, setup, solver, spec, out, case_path, checkpoint_every, restart, progress, start
+    )
     return summary, []
 
 
@@ -363,8 +367,11 @@ def time_stepper(case, setup):
 CHECKPOINT_AFTER_S = 60.0
 
 
-def _run_explicit(case, setup, solver, out, case_path, checkpoint_every, restart, progress, start) -> dict:
-    """Time integration by ``solver`` with recording, checkpoints and the status."""
+def _run_explicit(
+    case, setup, solver, spec, out, case_path, checkpoint_every, restart, progress, start
+) -> dict:
+    """Time integration by ``solver`` with recording by ``spec`` (``recorder_spec``),
+    checkpoints and the status."""
     d = setup.domain
     n_steps = step_count(case, solver)
     ckpt_path = out / "checkpoint.h5"
@@ -401,7 +408,13 @@ def _run_explicit(case, setup, solver, out, case_path, checkpoint_every, restart
         Recorder, setup.whole_body, out, spec, info, gathered.damage, resume, tensors, fields, d.size > 1
     )
     checkpointer, gather_checkpoint = _checkpointer(
-        ckpt_path, checkpoint_every or n_steps + 1, setup, meta, parts, whole_bonds
+        ckpt_path,
+        checkpoint_every or n_steps + 1,
+        setup,
+        meta,
+        parts,
+        whole_bonds,
+        [recorder.flush] if recorder is not None else [],
     )
     watched = [recorder, *([cracks] if cracks is not None else [])]
     due = [spec.due, *([cracks.due] if cracks is not None else [])]
@@ -494,17 +507,20 @@ def _restart(path, setup: Setup, meta: dict, parts: dict, whole_bonds: np.ndarra
     return state
 
 
-def _checkpointer(path, every: int, setup: Setup, meta: dict, parts: dict, whole_bonds: np.ndarray):
+def _checkpointer(
+    path, every: int, setup: Setup, meta: dict, parts: dict, whole_bonds: np.ndarray, before_save=()
+):
     """The run's ``Checkpointer`` and what must be gathered before it saves (``RootObservers``):
     under MPI it writes, on rank 0, the whole body's state and intact mask in serial numbering
     and the parts that hold whole-body state (the contact list's build displacement, gathered;
-    not a rank's damage skin)."""
+    not a rank's damage skin). ``before_save``: the calls made before every save (the
+    recorder's ``flush``, on rank 0)."""
     d = setup.domain
     if d.size == 1:
-        return Checkpointer(path, every, setup.bonds.intact, meta, parts), []
+        return Checkpointer(path, every, setup.bonds.intact, meta, parts, before_save), []
     whole_intact = np.ones(int(whole_bonds[-1]), dtype=bool) if d.is_root else None
     checkpointer = Checkpointer(
-        path, every, whole_intact, meta, {k: v for k, v in parts.items() if k != "damage"}
+        path, every, whole_intact, meta, {k: v for k, v in parts.items() if k != "damage"}, before_save
     )
 
     def gather_whole(state):  # the state itself is gathered by RootObservers.call

@@ -20,6 +20,7 @@ import numpy as np
 
 from peridyn.discretization.state import State
 from peridyn.errors import InputError
+from peridyn.kernels.verlet import acceleration, kick_drift
 from peridyn.parallel.domain import Domain
 from peridyn.physics.contact import Contact
 from peridyn.physics.damage import BondDamage
@@ -97,7 +98,7 @@ class ExplicitSolver:
             )
         self.dt = float(dt)
         self.damping = float(damping[0]) if damping.size == 1 else damping
-        self._damping = (damping if damping.size == 1 else damping[:, None]) if damping.any() else None
+        self._damping = damping if damping.any() else np.zeros(0)  # (0,): undamped
         self.damage = damage
         self.check_every = int(check_every)
         #: largest believable displacement, m (``runaway_limit``)
@@ -105,7 +106,7 @@ class ExplicitSolver:
         n = model.body.n_points
         self._force = np.zeros((n, 3), dtype=model.dtype)
         self._body_force = np.zeros((n, 3))
-        self._inv_rho = (1.0 / model.density)[:, None]
+        self._inv_rho = 1.0 / model.density
         #: the DOFs whose velocity is Peridigm's difference, and their force acceleration
         self._differenced = self.loading.displaced if prescribed_velocity == "difference" else None
         self._free = None
@@ -122,19 +123,39 @@ class ExplicitSolver:
         self._acceleration(state)
         return state
 
-    def _acceleration(self, state: State) -> None:
+    def _acceleration(self, state: State, kick: bool = False) -> None:
+        """``state.a`` from the forces at ``state.u`` (one fused pass: ``kernels.verlet``), with
+        ``kick`` followed by the closing half step of the velocity, ``v += dt/2 a``."""
         f = self.model.force(state.u, out=self._force)
         if self.contact is not None:
             self.contact.add_force(state.u, f)
-        b = self.loading.body_force_density(state.time, self._body_force)
-        a = state.a
-        np.add(f, b, out=a)
-        a *= self._inv_rho
-        if self._damping is not None:
-            a -= self._damping * state.v
+        b = self._body_force
+        if self.loading.body_force:  # else b stays zero
+            self.loading.body_force_density(state.time, b)
+        acceleration(
+            f,
+            b,
+            self._inv_rho,
+            self._damping,
+            state.v,
+            self.loading.constrained,
+            state.a,
+            kick,
+            0.5 * self.dt,
+        )
         if self._differenced is not None:
-            self._free = a[self._differenced]
-        a[self.loading.constrained] = 0.0
+            self._free = self._free_acceleration(f, b, state.v)
+
+    def _free_acceleration(self, f: np.ndarray, b: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """The acceleration (m/s^2) of the DOFs with Peridigm's differenced velocity, as
+        ``kernels.verlet.acceleration`` computes it before their constraint zeroes it; (k,) in
+        the order of ``v[self._differenced]``."""
+        mask = self._differenced
+        rows = np.nonzero(mask)[0]
+        a = (f[mask].astype(np.float64) + b[mask]) * self._inv_rho[rows]
+        if self._damping.size:
+            a -= (self._damping if self._damping.size == 1 else self._damping[rows]) * v[mask]
+        return a
 
     def step(self, state: State) -> int:
         """Advance ``state`` by one step in place; returns the number of bonds broken."""
@@ -142,15 +163,13 @@ class ExplicitSolver:
         differenced = self._differenced
         if differenced is not None:
             u_before = state.u[differenced]
-        state.v += 0.5 * dt * state.a
-        state.u += dt * state.v
+        kick_drift(state.u, state.v, state.a, 0.5 * dt, dt)
         state.time += dt
         state.step += 1
         self.loading.apply_kinematics(state.time, dt, state.u, state.v, rates=differenced is None)
         self.domain.exchange(state.u)
         broken = self.damage.update(state.u) if self.damage is not None else 0
-        self._acceleration(state)
-        state.v += 0.5 * dt * state.a
+        self._acceleration(state, kick=True)
         self.loading.apply_velocities(state.time, state.v)
         if differenced is not None:
             state.v[differenced] = (state.u[differenced] - u_before) / dt + 0.5 * dt * self._free
