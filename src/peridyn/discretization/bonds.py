@@ -170,7 +170,7 @@ def find_bonds(
         see none of its neighbours.
     box : (3,) float or None, m
         Half-widths of a box neighbourhood instead of the sphere: the neighbours are the points
-        with |x_j - x_i| <= box along every axis (Peridigm's PdQuickGrid families); no partial
+        with ``|x_j - x_i| <= box`` along every axis (Peridigm's PdQuickGrid families); no partial
         volumes, one horizon. The influence function still takes ``horizon``.
     point_horizon : (n_points,) float or None, m
         Each point's horizon (blocks of different horizons, docs/blocks.md); ``horizon`` must
