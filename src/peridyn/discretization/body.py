@@ -154,20 +154,9 @@ class Body:
         mask = np.asarray(mask, dtype=bool)
         if mask.shape != (self.n_points,):
             raise InputError(f"removal mask must have shape ({self.n_points},), got {mask.shape}")
-        keep = ~mask
-        if not keep.any():
+        if mask.all():
             raise InputError("the removal takes away every point of the body")
-        new_index = np.cumsum(keep) - 1
-        sets = {k: new_index[v[keep[v]]] for k, v in self.node_sets.items()}
-        layers = None if self.layer_index is None else self.layer_index[keep]
-        return replace(
-            self,
-            points=self.points[keep],
-            volumes=self.volumes[keep],
-            cells=self.cells[keep],
-            node_sets=sets,
-            layer_index=layers,
-        )
+        return self.subset(np.flatnonzero(~mask))
 
 
 def _as_index_array(name: str, selection, n: int) -> np.ndarray:

@@ -51,7 +51,7 @@ import numba
 #: run in a process that compiled the kernels differed in the last bits from one in a process
 #: that loaded them (a sweep's serial and process-pool datasets, a run and its restart). The
 #: per-point sums keep their written order; the force throughput is unchanged (``peridyn bench``,
-#: 50k points: within 1%).
+#: 50k points: within 1%). numba's cache does not notice a change here (see ``bond_differences``).
 FASTMATH = {"contract", "nsz", "arcp"}
 
 
@@ -78,8 +78,9 @@ def bond_differences(xj, xi, uj, ui):
     (Newton's third law to the last bit) and ``du`` keeps its full precision next to
     the much larger coordinates.
 
-    numba's on-disk cache of a kernel does not notice edits to this function (it is
-    keyed on the kernel's own file): after changing it, touch ``pmb.py`` and ``lps.py``.
+    numba's on-disk cache of a kernel does not notice edits to this function, nor to
+    ``FASTMATH``: it is keyed on a hash of the kernel's own file. After changing either,
+    delete the cached kernels (``find src/peridyn -name '*.nb[ic]' -delete``).
     """
     d = xj - xi
     du = uj - ui
