@@ -8,13 +8,14 @@ floor((final - initial) / dt), and Exodus output of the deck's variables, under 
 names, in ``<Output Filename>.e`` at the deck's output frequency (docs/peridigm.md).
 
 Anything a deck asks that peridyn cannot do is a ``CaseFileError`` naming the deck parameter
-(``Blocks`` with several blocks, ``Solver.Verlet`` without ``Fixed dt``, an unknown material
-model, a contact section, ...).
+(``Solver.Verlet`` without ``Fixed dt``, an unknown material model, a contact section, ...).
+Several block groups become ``materials`` and ``blocks`` (docs/blocks.md).
 """
 
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -98,17 +99,25 @@ def deck_case(params: dict, name: str, source: str = "<deck>", deck_dir=".") -> 
     for key in params:
         if key not in SECTIONS and not key.startswith("Output"):
             raise deck.error(key, None, f"one of the sections peridyn reads: {sorted(SECTIONS)}", False)
-    horizon, material_name = _block(deck)
-    group = next(iter(deck.get("Blocks", dict)))
+    groups = _groups(deck)
+    horizon = max(g.horizon for g in groups)
     geometry, discretization, grid = _discretization(deck, deck_dir, horizon)
     case = {
         "name": name,
         "description": f"Peridigm deck {Path(source).name}, translated by peridyn",
         "geometry": geometry,
         "discretization": discretization,
-        "material": _material(deck, material_name) | _damage(deck, f"Blocks.{group}.Damage Model"),
-        "solver": _solver(deck),
     }
+    if len(groups) == 1:
+        (group,) = groups
+        case["material"] = _material(deck, group.material) | _damage(deck, group.damage_key)
+    else:
+        if grid is not None:
+            raise deck.error(
+                "Blocks", [g.name for g in groups], "one block group on a PdQuickGrid (its one block)"
+            )
+        case["materials"], case["blocks"] = _block_materials(deck, groups, horizon)
+    case["solver"] = _solver(deck)
     sets, bcs, ics = _conditions(deck, deck_dir, grid, geometry["type"] == "exodus")
     if sets:
         case["node_sets"] = sets
@@ -116,7 +125,8 @@ def deck_case(params: dict, name: str, source: str = "<deck>", deck_dir=".") -> 
         case["boundary_conditions"] = bcs
     if ics:
         case["initial_conditions"] = ics
-    case["output"] = _output(deck, case["material"]["model"], _compute_classes(deck))
+    model = (case.get("material") or next(iter(case["materials"].values())))["model"]
+    case["output"] = _output(deck, model, _compute_classes(deck))
     return case
 
 
@@ -139,23 +149,71 @@ def _compute_classes(deck: _Deck) -> dict:
     return out
 
 
-def _block(deck: _Deck) -> tuple[float, str]:
-    """The one block's horizon (m) and material name."""
-    blocks = deck.get("Blocks", dict)
-    if len(blocks) != 1:
-        raise deck.error("Blocks", sorted(blocks), "one block group (several blocks are not supported yet)")
-    (group,) = blocks
-    where = f"Blocks.{group}"
-    deck.get(f"{where}.Block Names", str)  # one group of one material and horizon: any blocks
-    for key in deck.get(where, dict):
-        if key not in ("Block Names", "Material", "Horizon", "Damage Model"):
+@dataclass(frozen=True)
+class _Group:
+    """One block group of the deck's ``Blocks``: its mesh blocks, material, horizon (m) and the
+    deck key of its damage model."""
+
+    name: str
+    block_names: tuple[str, ...]
+    material: str
+    horizon: float
+    damage_key: str
+
+
+def _groups(deck: _Deck) -> list[_Group]:
+    """The block groups of ``Blocks``, in deck order."""
+    groups = []
+    for name in deck.get("Blocks", dict):
+        where = f"Blocks.{name}"
+        for key in deck.get(where, dict):
+            if key not in ("Block Names", "Material", "Horizon", "Damage Model"):
+                raise deck.error(
+                    f"{where}.{key}", None, "Block Names, Material, Horizon and Damage Model only", False
+                )
+        horizon = deck.get(f"{where}.Horizon", float)
+        if not horizon > 0:
+            raise deck.error(f"{where}.Horizon", horizon, "a positive horizon (m)")
+        blocks = tuple(deck.get(f"{where}.Block Names", str).split())
+        if not blocks:
+            raise deck.error(f"{where}.Block Names", "", "the names of the group's blocks")
+        groups.append(
+            _Group(name, blocks, deck.get(f"{where}.Material", str), horizon, f"{where}.Damage Model")
+        )
+    if not groups:
+        raise deck.error("Blocks", {}, "at least one block group")
+    return groups
+
+
+def _block_materials(deck: _Deck, groups: list[_Group], horizon: float) -> tuple[dict, dict]:
+    """``materials`` and ``blocks`` of a deck of several block groups (docs/blocks.md): a block
+    per mesh block named in ``Block Names`` (its points are the mesh's node set of that name,
+    e.g. ``block_2`` of a text mesh), made of its group's material with its group's damage
+    model, with the group's horizon when the groups' horizons differ (``horizon`` is the
+    largest: the discretisation's)."""
+    materials, blocks, first = {}, {}, None
+    for group in groups:
+        where = f"Blocks.{group.name}"
+        material = _material(deck, group.material) | _damage(deck, group.damage_key)
+        key = (material["model"], material.get("surface_correction", "none"))
+        if first is None:
+            first = (key, group.material)
+        elif key != first[0]:
             raise deck.error(
-                f"{where}.{key}", None, "Block Names, Material, Horizon and Damage Model only", False
+                f"Materials.{group.material}.Material Model",
+                deck.get(f"Materials.{group.material}.Material Model", str),
+                f"the model and shear correction of Materials.{first[1]} (the blocks of a body share them)",
             )
-    horizon = deck.get(f"{where}.Horizon", float)
-    if not horizon > 0:
-        raise deck.error(f"{where}.Horizon", horizon, "a positive horizon (m)")
-    return horizon, deck.get(f"{where}.Material", str)
+        damage = deck.get(group.damage_key, str, None)
+        name = group.material if damage is None else f"{group.material} with {damage}"
+        materials[name] = material
+        for block in group.block_names:
+            if block in blocks:
+                raise deck.error(f"{where}.Block Names", block, "a block in one group only")
+            blocks[block] = {"set": block, "material": name}
+            if any(g.horizon != horizon for g in groups):
+                blocks[block]["horizon_m"] = group.horizon
+    return materials, blocks
 
 
 def _discretization(deck: _Deck, deck_dir: Path, horizon: float) -> tuple[dict, dict, np.ndarray | None]:
