@@ -467,6 +467,10 @@ class Solver(Strict):
     #: explicit: the reported velocity of a DOF with a prescribed displacement, ``rate`` (its
     #: time function's derivative) or ``difference`` (Peridigm's, see ``ExplicitSolver``)
     prescribed_velocity: Literal["rate", "difference"] = "rate"
+    #: explicit: ``peridigm`` takes Peridigm's time step conventions: without ``dt``, ``safety``
+    #: times Peridigm's bond-based stable step (``peridyn.jobs.peridigm_step``), and ``time`` in
+    #: floor(time / dt) steps (``peridyn``: the model's stable step, ceil(time / dt) steps)
+    step_rule: Literal["peridyn", "peridigm"] = "peridyn"
     #: modal: ``shift-invert`` (factorised), ``lobpcg`` (matrix-free) or ``auto`` (by the
     #: estimated factor size, ``jobs.modal.choose_eigensolver``).
     eigensolver: Literal["auto", "shift-invert", "lobpcg"] = "auto"

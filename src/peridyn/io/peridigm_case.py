@@ -8,7 +8,7 @@ floor((final - initial) / dt), and Exodus output of the deck's variables, under 
 names, in ``<Output Filename>.e`` at the deck's output frequency (docs/peridigm.md).
 
 Anything a deck asks that peridyn cannot do is a ``CaseFileError`` naming the deck parameter
-(``Solver.Verlet`` without ``Fixed dt``, an unknown material model, a contact section, ...).
+(an unknown material model, a contact section, ...).
 Several block groups become ``materials`` and ``blocks`` (docs/blocks.md).
 """
 
@@ -313,17 +313,37 @@ def _solver(deck: _Deck) -> dict:
         raise deck.error(
             "Solver", kinds, "one 'Verlet' or 'QuasiStatic' solver list (others are not supported yet)"
         )
-    if "Fixed dt" not in solver["Verlet"]:
+    return _verlet(deck, final)
+
+
+def _verlet(deck: _Deck, final: float) -> dict:
+    """Peridigm's Verlet solver: its step is ``Fixed dt``, or its bond-based stable step
+    (``peridyn.jobs.peridigm_step``), times ``Safety Factor`` (default 1); floor(final / dt)
+    steps; the velocity of prescribed points as Peridigm reports it."""
+    where = "Solver.Verlet"
+    for key in deck.get(where, dict):
+        if key not in ("Fixed dt", "Safety Factor"):
+            raise deck.error(f"{where}.{key}", None, "only the parameters Fixed dt and Safety Factor", False)
+    safety = deck.get(f"{where}.Safety Factor", float, 1.0)
+    if not 0 < safety <= 1:
         raise deck.error(
-            "Solver.Verlet.Fixed dt",
-            None,
-            "a fixed time step (Peridigm's default step, the bond-based stable step, is not supported yet)",
-            has_value=False,
+            f"{where}.Safety Factor", safety, "a factor in (0, 1] (above 1 the step is unstable)"
         )
-    dt = deck.get("Solver.Verlet.Fixed dt", float)
-    if not dt > 0:
-        raise deck.error("Solver.Verlet.Fixed dt", dt, "a positive time step (s)")
-    steps = math.floor((final - initial) / dt)  # Peridigm's step count
+    fixed = deck.get(f"{where}.Fixed dt", float, None)
+    if fixed is None:  # Peridigm's stable step times the safety factor, found once the bonds are
+        if not final > 0:
+            raise deck.error("Solver.Final Time", final, "a positive time (s)")
+        return {
+            "type": "explicit",
+            "time": final,
+            "safety": safety,
+            "step_rule": "peridigm",
+            "prescribed_velocity": "difference",
+        }
+    if not fixed > 0:
+        raise deck.error(f"{where}.Fixed dt", fixed, "a positive time step (s)")
+    dt = fixed * safety  # Peridigm multiplies a fixed step by the factor too
+    steps = math.floor(final / dt)  # Peridigm's step count (the initial time is 0)
     if steps < 1:
         raise deck.error("Solver.Final Time", final, f"at least one step of {dt:g} s after the initial time")
     return {"type": "explicit", "dt": dt, "steps": steps, "prescribed_velocity": "difference"}

@@ -29,6 +29,7 @@ from peridyn.jobs.build import Setup, build, pad3
 from peridyn.jobs.exodus_variables import check_variables, variable_values
 from peridyn.jobs.figures import draw_crack_figures, draw_run_figures, final_crack_paths
 from peridyn.jobs.lamb_analysis import analyse
+from peridyn.jobs.peridigm_step import peridigm_stable_step
 from peridyn.jobs.summary import finish_summary
 from peridyn.parallel.observers import RootObservers
 from peridyn.physics.absorbing import layer_damping
@@ -221,9 +222,19 @@ def exodus_values(case: Case, setup: Setup, spec: RecorderSpec):
 
 
 def step_count(case: Case, solver) -> int:
-    """Time steps of a time-stepping run: ``solver.steps``, or ``solver.time`` in steps of dt."""
+    """Time steps of a time-stepping run: ``solver.steps``, or ``solver.time`` in steps of dt
+    (ceil(time / dt), or floor(time / dt) with ``solver.step_rule: peridigm``)."""
     s = case.solver
-    return s.steps if s.steps is not None else int(np.ceil(s.time / solver.dt - 1e-9))
+    if s.steps is not None:
+        return s.steps
+    if s.step_rule == "peridigm":  # Peridigm's floor((final - initial) / dt)
+        steps = int(np.floor(s.time / solver.dt))
+        if steps < 1:
+            raise CaseFileError(
+                case.name, "solver.time", s.time, f"at least one step of dt = {solver.dt:.4g} s"
+            )
+        return steps
+    return int(np.ceil(s.time / solver.dt - 1e-9))
 
 
 def check_output_fits(spec: RecorderSpec, body: Body, n_steps: int, dt: float, out: Path) -> None:
@@ -350,17 +361,27 @@ def time_stepper(case, setup):
     damping = explicit_damping(case, setup.whole_body)
     if np.ndim(damping):  # per point: the rank's points
         damping = damping[setup.domain.global_ids]
-    return ExplicitSolver(
-        setup.model,
-        setup.loading,
-        dt=s.dt,
-        safety=s.safety,
-        damping=damping,
-        damage=setup.damage,
-        contact=setup.contact,
-        domain=setup.domain,
-        prescribed_velocity=s.prescribed_velocity,
-    )
+    peridigm_dt = s.dt is None and s.step_rule == "peridigm"
+    try:
+        return ExplicitSolver(
+            setup.model,
+            setup.loading,
+            dt=s.safety * peridigm_stable_step(case, setup) if peridigm_dt else s.dt,
+            safety=s.safety,
+            damping=damping,
+            damage=setup.damage,
+            contact=setup.contact,
+            domain=setup.domain,
+            prescribed_velocity=s.prescribed_velocity,
+        )
+    except InputError as exc:
+        if not peridigm_dt:
+            raise
+        raise InputError(
+            f"Peridigm's time step (its bond-based stable step times solver.safety, a deck's "
+            f"Safety Factor) is too long for this model: {exc}; give a deck's Solver.Verlet "
+            "'Fixed dt' or a smaller 'Safety Factor' (solver.dt or solver.safety)"
+        ) from None
 
 
 #: Seconds of running after which an interrupted run writes a checkpoint even unasked.

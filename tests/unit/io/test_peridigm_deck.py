@@ -107,8 +107,11 @@ def test_refusals_name_the_deck_parameter():
     deck["Solver"]["Implicit"] = deck["Solver"].pop("Verlet")
     _refusal(deck, "Solver")
     deck = copy.deepcopy(base)
-    del deck["Solver"]["Verlet"]["Fixed dt"]
-    _refusal(deck, "Solver.Verlet.Fixed dt")
+    deck["Solver"]["Verlet"]["Safety Factor"] = 1.5
+    _refusal(deck, "Solver.Verlet.Safety Factor")
+    deck = copy.deepcopy(base)
+    deck["Solver"]["Verlet"]["Number of Steps"] = 10
+    _refusal(deck, "Solver.Verlet.Number of Steps")
     deck = copy.deepcopy(base)
     deck["Output"]["Output Variables"]["Partial_Stress"] = True
     _refusal(deck, "Output.Output Variables.Partial_Stress")
