@@ -1,6 +1,7 @@
 """peridyn convert DECK: write the peridyn case file that a Peridigm input deck (.xml or .yaml)
 translates to; peridyn run of that case gives the same results as peridyn run DECK
-(docs/peridigm.md lists the deck features read and those refused)."""
+(docs/peridigm.md lists the deck features read and those refused). Written to a file (-o),
+the case names its mesh relative to the file's folder; printed, by its absolute path."""
 
 from __future__ import annotations
 
@@ -12,7 +13,7 @@ import yaml
 from peridyn.cli.errors import writing
 from peridyn.cli.options import add_common_flags, add_output_flag
 from peridyn.errors import CaseFileError
-from peridyn.io.peridigm_case import convert_deck
+from peridyn.io.peridigm_case import convert_deck, relative_mesh
 from peridyn.io.peridigm_deck import is_peridigm_deck
 
 
@@ -35,6 +36,8 @@ def run(args) -> dict:
         )
     raw = convert_deck(args.deck)
     validate_case(raw, args.deck)
+    if args.output is not None:  # the mesh relative to the case file: they move together
+        relative_mesh(raw, Path(args.output).parent)
     text = yaml.safe_dump(raw, sort_keys=False)
     if args.output is None:
         if not args.json:

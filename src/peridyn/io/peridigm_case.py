@@ -15,6 +15,7 @@ Several block groups become ``materials`` and ``blocks`` (docs/blocks.md).
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -87,7 +88,8 @@ def deck_case(params: dict, name: str, source: str = "<deck>", deck_dir=".") -> 
         The deck's path, for error messages.
     deck_dir : path
         The folder that the deck's mesh and node-set files are relative to; the case refers to
-        the mesh by its absolute path.
+        the mesh by its absolute path (``relative_mesh`` makes it relative to a case file's
+        folder).
 
     Raises
     ------
@@ -491,6 +493,20 @@ def convert_deck(path) -> dict:
     """The case dict of the Peridigm deck at ``path`` (named after the file's stem)."""
     path = Path(path)
     return deck_case(read_deck(path), path.stem, str(path), path.parent)
+
+
+def relative_mesh(raw: dict, folder) -> dict:
+    """``raw`` (a ``deck_case`` dict) with its mesh file relative to ``folder``, the folder of
+    the case file it is written to, so that the case and its mesh move together (node sets are
+    written out as point indices: no other file is named). On another drive (Windows), the
+    absolute path stays."""
+    geometry = raw["geometry"]
+    if "file" in geometry:
+        try:
+            geometry["file"] = Path(os.path.relpath(geometry["file"], Path(folder).resolve())).as_posix()
+        except ValueError:
+            pass
+    return raw
 
 
 def load_deck(path, overrides=()) -> Case:

@@ -3,14 +3,17 @@ translation to peridyn cases (``peridyn.io.peridigm_case``), with the refusals t
 deck parameter. Decks from tests/data/peridigm (Peridigm's test suite)."""
 
 import copy
+import shutil
 from pathlib import Path
 
 import numpy as np
 import pytest
+import yaml
 
 from peridyn.cli import main
 from peridyn.errors import CaseFileError
 from peridyn.io.case import load_case, validate_case
+from peridyn.io.exodus import read_exodus
 from peridyn.io.peridigm_case import convert_deck, deck_case, load_deck
 from peridyn.io.peridigm_deck import is_peridigm_deck, read_deck
 from peridyn.jobs.build import build
@@ -152,9 +155,27 @@ def test_convert_writes_a_case_that_loads_as_the_deck(tmp_path):
     """``peridyn convert DECK -o case.yaml`` writes the case that ``peridyn run DECK`` runs."""
     out = tmp_path / "case.yaml"
     assert main(["convert", str(WAVE), "-o", str(out)]) == 0
-    assert load_case(out) == load_deck(WAVE)
+    written, deck = load_case(out), load_deck(WAVE)
+    assert (tmp_path / written.geometry.file).resolve() == Path(deck.geometry.file)
+    written.geometry.file = deck.geometry.file
+    assert written == deck
     assert main(["validate", str(WAVE), "--json"]) == 0  # validate reads decks as run does
     assert convert_deck(WAVE)["geometry"]["file"] == str((DATA / "WaveInBar.g").resolve())
+
+
+def test_converted_case_moves_with_its_mesh(tmp_path):
+    """The case that ``convert -o`` writes names its mesh relative to its own folder: a folder
+    holding the deck, its mesh and the case, moved elsewhere, still runs (the mesh of 1000
+    points is found)."""
+    first = tmp_path / "first"
+    (first / "cases").mkdir(parents=True)
+    for name in ("WaveInBar.xml", "WaveInBar.g"):
+        shutil.copy(DATA / name, first / name)
+    assert main(["convert", str(first / "WaveInBar.xml"), "-o", str(first / "cases/case.yaml")]) == 0
+    assert yaml.safe_load((first / "cases/case.yaml").read_text())["geometry"]["file"] == "../WaveInBar.g"
+    moved = shutil.move(first, tmp_path / "moved")
+    setup = build(load_case(Path(moved) / "cases/case.yaml"), Path(moved) / "cases")
+    assert setup.body.n_points == read_exodus(DATA / "WaveInBar.g").n_elements
 
 
 def test_translation_of_expressions_and_compute_classes():
