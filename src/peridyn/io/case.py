@@ -277,7 +277,7 @@ class Damage(Strict):
 class Material(Strict):
     """Material model, elastic constants (Pa, kg/m^3) and optional damage."""
 
-    model: Literal["pmb", "lps"]
+    model: Literal["pmb", "lps", "linear_lps"]
     E: Positive
     nu: Annotated[float, NotBool, Field(gt=-1, lt=0.5)] | None = None
     density: Positive
@@ -636,7 +636,7 @@ class Case(Strict):
                         f"{getattr(first, key)!r}: the blocks of a body share one model and surface "
                         "correction (docs/blocks.md)"
                     )
-            if mat.model == "lps" and mat.nu is None:
+            if mat.model in ("lps", "linear_lps") and mat.nu is None:
                 raise ValueError(f"materials.{name}.nu: an LPS material needs Poisson's ratio nu")
         for name, block in self.blocks.items():
             try:

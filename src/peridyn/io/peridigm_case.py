@@ -27,9 +27,9 @@ from peridyn.io.exodus_write import PERIDIGM_VARIABLES
 from peridyn.io.peridigm_deck import is_peridigm_deck, read_deck
 from peridyn.physics.expressions import SpaceTime
 
-#: Peridigm's material models that peridyn runs: name -> peridyn model. ("Linear LPS", the
-#: small-displacement LPS, is refused: peridyn's LPS keeps the exact bond extension.)
-MATERIALS = {"Elastic": "lps", "Elastic Bond Based": "pmb"}
+#: Peridigm's material models that peridyn runs: name -> peridyn model ("Linear LPS": LPS
+#: linearised about the reference configuration, ``peridyn.physics.materials.linear_lps``).
+MATERIALS = {"Elastic": "lps", "Elastic Bond Based": "pmb", "Linear LPS": "linear_lps"}
 #: Peridigm's influence functions that peridyn has: name -> peridyn name.
 INFLUENCE = {"One": "constant"}
 #: Top-level deck sections read (others are refused by name).
@@ -276,8 +276,12 @@ def _material(deck: _Deck, name: str) -> dict:
     # E and nu of the bulk and shear moduli (LPS turns them back into K and mu)
     E = 9.0 * bulk * shear / (3.0 * bulk + shear)
     nu = (3.0 * bulk - 2.0 * shear) / (2.0 * (3.0 * bulk + shear))
-    material = {"model": "lps", "E": E, "nu": nu, "density": density}
+    material = {"model": MATERIALS[model], "E": E, "nu": nu, "density": density}
     if deck.get(f"{where}.Apply Shear Correction Factor", bool, False):
+        if model != "Elastic":
+            raise deck.error(
+                f"{where}.Apply Shear Correction Factor", True, "false for a Linear LPS material"
+            )
         material["surface_correction"] = "shear-factor"
     return material
 

@@ -237,7 +237,7 @@ def modal_factor_bytes(case: Case, base_dir, points: float, horizon: float) -> f
         warnings.simplefilter("ignore")
         body = build_points(case, base_dir)
     models = {m.model for m in case.block_materials().values()}  # one model, blocks or not
-    unknowns = 4 if "lps" in models else 3
+    unknowns = 4 if models & {"lps", "linear_lps"} else 3  # state-based: theta too
     needed = FACTOR_ENTRY_BYTES * estimated_factor_entries(body.points, horizon, unknowns)
     if method == "auto" and needed > min(FACTOR_BUDGET, MEMORY_SHARE * geometry.memory_limit()):
         return 0.0

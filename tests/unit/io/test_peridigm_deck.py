@@ -103,9 +103,12 @@ def test_refusals_name_the_deck_parameter():
     deck["Blocks"]["Other"] = dict(deck["Blocks"]["My Group of Blocks"])
     _refusal(deck, "Blocks")
     deck = copy.deepcopy(base)
-    for model in ("Viscoplastic", "Linear LPS"):
-        deck["Materials"]["My Elastic Material"]["Material Model"] = model
-        _refusal(deck, "Materials.My Elastic Material.Material Model")
+    deck["Materials"]["My Elastic Material"]["Material Model"] = "Viscoplastic"
+    _refusal(deck, "Materials.My Elastic Material.Material Model")
+    deck["Materials"]["My Elastic Material"].update(
+        {"Material Model": "Linear LPS", "Apply Shear Correction Factor": True}
+    )
+    _refusal(deck, "Materials.My Elastic Material.Apply Shear Correction Factor")
     deck = copy.deepcopy(base)
     deck["Solver"]["Implicit"] = deck["Solver"].pop("Verlet")
     _refusal(deck, "Solver")
