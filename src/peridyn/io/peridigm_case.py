@@ -103,23 +103,25 @@ def deck_case(params: dict, name: str, source: str = "<deck>", deck_dir=".") -> 
             raise deck.error(key, None, f"one of the sections peridyn reads: {sorted(SECTIONS)}", False)
     groups = _groups(deck)
     horizon = max(g.horizon for g in groups)
+    if len(groups) == 1:  # materials and solver first: their refusals before a missing mesh's
+        (group,) = groups
+        materials = {"material": _material(deck, group.material) | _damage(deck, group.damage_key)}
+    else:
+        if deck.get("Discretization.Type", str) == "PdQuickGrid":
+            raise deck.error(
+                "Blocks", [g.name for g in groups], "one block group on a PdQuickGrid (its one block)"
+            )
+        materials = dict(zip(("materials", "blocks"), _block_materials(deck, groups, horizon), strict=True))
+    solver = _solver(deck)
     geometry, discretization, grid = _discretization(deck, deck_dir, horizon)
     case = {
         "name": name,
         "description": f"Peridigm deck {Path(source).name}, translated by peridyn",
         "geometry": geometry,
         "discretization": discretization,
+        **materials,
+        "solver": solver,
     }
-    if len(groups) == 1:
-        (group,) = groups
-        case["material"] = _material(deck, group.material) | _damage(deck, group.damage_key)
-    else:
-        if grid is not None:
-            raise deck.error(
-                "Blocks", [g.name for g in groups], "one block group on a PdQuickGrid (its one block)"
-            )
-        case["materials"], case["blocks"] = _block_materials(deck, groups, horizon)
-    case["solver"] = _solver(deck)
     sets, bcs, ics = _conditions(deck, deck_dir, grid, geometry["type"] == "exodus")
     if sets:
         case["node_sets"] = sets
