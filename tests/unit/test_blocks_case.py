@@ -10,7 +10,7 @@ from peridyn.analysis.bloch import Discretisation
 from peridyn.errors import CaseFileError, InputError
 from peridyn.io.case import validate_case
 from peridyn.io.mesh_text import to_text_mesh
-from peridyn.jobs.build import _build_part, build
+from peridyn.jobs.build import build
 from peridyn.jobs.stable_step import STEP_MARGIN, estimated_stable_step
 from peridyn.physics.materials.blocks import assign_blocks
 from peridyn.physics.materials.elastic import check_elastic
@@ -198,10 +198,9 @@ def test_missing_material_and_blocks_is_refused():
 
 
 def test_features_without_blocks_refuse_them():
-    """MPI runs and Bloch analyses take one material (yet): a clear error, not a wrong answer."""
+    """Bloch analyses take one material (yet): a clear error, not a wrong answer (MPI runs take
+    blocks: tests/mpi/test_mpi_decks.py)."""
     case = validate_case(_raw())
-    with pytest.raises(CaseFileError, match="one material in an MPI run"):
-        _build_part(case, None, ".")
     with pytest.raises(InputError, match="body of one material"):
         Discretisation.from_case(case)
 

@@ -14,6 +14,7 @@ from peridyn import interrupts
 from peridyn.discretization import geometry
 from peridyn.discretization.body import Body, in_box, in_cylinder, in_sphere
 from peridyn.discretization.bonds import (
+    HORIZON_RTOL,
     Bonds,
     crossing_rectangle,
     crossing_segment,
@@ -181,9 +182,10 @@ def case_horizon(case: Case, body: Body) -> float:
     return d.horizon_m if d.horizon_m is not None else d.horizon * body.spacing
 
 
-def block_horizons(case: Case, body: Body) -> np.ndarray | None:
+def block_horizons(case: Case, body: Body, of_block=None) -> np.ndarray | None:
     """(n_points,) each point's horizon (m) when the case's blocks have horizons of their own
-    that differ (docs/blocks.md); None when every point's is ``case_horizon``."""
+    that differ (docs/blocks.md); None when every point's is ``case_horizon``. ``of_block``:
+    the points' block indices (``block_index``), given by a rank's part of the body."""
     default = case_horizon(case, body)
     values = np.array(
         [
@@ -197,19 +199,18 @@ def block_horizons(case: Case, body: Body) -> np.ndarray | None:
     )
     if np.all(values == default):
         return None
-    return values[block_index(case, body)]
+    return values[block_index(case, body) if of_block is None else of_block]
 
 
-def build_bonds(case: Case, body: Body, required=None) -> Bonds:
+def build_bonds(case: Case, body: Body, required=None, of_block=None) -> Bonds:
     """Families of the case's discretisation, with its pre-cracks cut (``required``: the
     points that must have a neighbour, default all; see ``find_bonds``); with blocks of their
-    own horizons, each bond within the smaller of its ends' (``block_horizons``)."""
+    own horizons, each bond within the smaller of its ends' (``block_horizons``, ``of_block``
+    as there)."""
     d = case.discretization
-    point_horizon = block_horizons(case, body)
+    point_horizon = block_horizons(case, body, of_block)
     horizon = case_horizon(case, body) if point_horizon is None else float(np.max(point_horizon))
-    box = None
-    if d.neighbourhood == "box":  # round(horizon / spacing) cells along each axis, halves up
-        box = np.floor(horizon / body.cells[0] + 0.5) * body.cells[0]
+    box = neighbourhood_box(case, body, horizon)
     bonds = find_bonds(
         body, horizon, d.influence, d.partial_volumes, required=required, box=box, point_horizon=point_horizon
     )
@@ -390,13 +391,6 @@ def build_part(case: Case, comm, base_dir=".") -> Setup:
 def _build_part(case: Case, comm, base_dir):
     """``build_part`` up to the halo plan: the part's Setup (its domain set after), the owned
     and ghost global indices (local order) and the ghosts' ranks."""
-    if case.blocks:
-        raise CaseFileError(
-            case.name,
-            "blocks",
-            sorted(case.blocks),
-            "one material in an MPI run (several blocks: yet to come)",
-        )
     body = build_body(case, base_dir)
     check_placements(case, body)
     body, actuation = add_actuators(case, body)
@@ -404,23 +398,48 @@ def _build_part(case: Case, comm, base_dir):
     check_loading(case, loading)
     owner = rcb(body.points, comm.size)
     owned = np.flatnonzero(owner == comm.rank)
-    reach = search_reach(body, case_horizon(case, body), case.discretization.partial_volumes)
-    ghosts = ghost_layers(body.points, owned, reach, GHOST_LAYERS)
+    of_block = block_index(case, body) if case.blocks else None  # of the whole body's points
+    ghosts = ghost_layers(body.points, owned, bond_reach(case, body), GHOST_LAYERS)
     near = np.union1d(owned, ghosts)
-    bonds = build_bonds(case, body.subset(near), required=np.searchsorted(near, owned))
+    bonds = build_bonds(
+        case,
+        body.subset(near),
+        required=np.searchsorted(near, owned),
+        of_block=None if of_block is None else of_block[near],
+    )
     # ghosts without a neighbour on the rank (an outer ghost whose cells all miss) are dropped
     ghosts = ghosts[np.diff(bonds.offsets)[np.searchsorted(near, ghosts)] > 0]
     ghosts = ghosts[np.lexsort((ghosts, owner[ghosts]))]
     local_ids = np.concatenate([owned, ghosts])
     bonds = reorder_bonds(bonds, np.searchsorted(near, local_ids), len(near))
     part = body.subset(local_ids)
-    model = build_model(case, part, bonds)
-    damage = None
-    if case.material.damage is not None:
-        protected = protected_points(body, case.material.damage.no_damage_sets)[local_ids]
-        damage = build_damage(case, model, protected)
+    part_blocks = None if of_block is None else of_block[local_ids]
+    model = build_model(case, part, bonds, part_blocks)
+    materials = case.block_materials().values()
+    no_damage = sorted({name for m in materials if m.damage is not None for name in m.damage.no_damage_sets})
+    protected = protected_points(body, no_damage)[local_ids]
+    damage = build_damage(case, model, protected, part_blocks)
     setup = Setup(part, bonds, model, loading.restricted(part, local_ids), damage, None, None, body)
     return setup, owned, ghosts, owner[ghosts]
+
+
+def neighbourhood_box(case: Case, body: Body, horizon: float) -> np.ndarray | None:
+    """(3,) half-widths (m) of the box families of ``discretization.neighbourhood: box``:
+    round(horizon / spacing) cells along each axis, halves up; None for spheres."""
+    if case.discretization.neighbourhood != "box":
+        return None
+    return np.floor(horizon / body.cells[0] + 0.5) * body.cells[0]
+
+
+def bond_reach(case: Case, body: Body) -> float:
+    """Distance (m) within which ``build_bonds`` finds a point's neighbours: the largest
+    horizon's search reach (``search_reach``), or a box family's half-diagonal."""
+    point_horizon = block_horizons(case, body)
+    horizon = case_horizon(case, body) if point_horizon is None else float(np.max(point_horizon))
+    box = neighbourhood_box(case, body, horizon)
+    if box is not None:
+        return float(np.linalg.norm(box * (1 + HORIZON_RTOL)))
+    return search_reach(body, horizon, case.discretization.partial_volumes)
 
 
 def block_index(case: Case, body: Body) -> np.ndarray:
@@ -443,16 +462,17 @@ def block_index(case: Case, body: Body) -> np.ndarray:
         raise CaseFileError(case.name, "blocks", None, str(exc), has_value=False) from None
 
 
-def build_model(case: Case, body: Body, bonds: Bonds) -> Model:
+def build_model(case: Case, body: Body, bonds: Bonds, of_block=None) -> Model:
     """The case's material bound to ``body`` and ``bonds``: one material, or the materials of
-    its blocks (``peridyn.physics.materials.blocks``)."""
+    its blocks (``peridyn.physics.materials.blocks``; ``of_block``: the points' block indices,
+    given by a rank's part of the body)."""
     if case.blocks:
         mats = [case.materials[b.material] for b in case.blocks.values()]
         return make_block_model(
             mats[0].model,
             body,
             bonds,
-            block_index(case, body),
+            block_index(case, body) if of_block is None else of_block,
             [BlockMaterial(m.E, m.density, m.nu) for m in mats],
             surface_correction=mats[0].surface_correction,
             dtype=case.solver.dtype,
@@ -470,12 +490,12 @@ def build_model(case: Case, body: Body, bonds: Bonds) -> Model:
     )
 
 
-def build_damage(case: Case, model: Model, protected=None) -> BondDamage | None:
+def build_damage(case: Case, model: Model, protected=None, of_block=None) -> BondDamage | None:
     """The case's bond breaking on ``model`` (None without ``material.damage``, or with blocks
     none of whose materials has damage); ``protected`` ((n_points,) bool or None): the points of
-    the no-damage sets, given by a rank's part instead of the set names."""
+    the no-damage sets, and ``of_block`` the points' block indices, given by a rank's part."""
     if case.blocks:
-        return block_damage(case, model)
+        return block_damage(case, model, protected, of_block)
     d = case.material.damage
     if d is None:
         return None
@@ -489,15 +509,16 @@ def build_damage(case: Case, model: Model, protected=None) -> BondDamage | None:
     )
 
 
-def block_damage(case: Case, model: Model) -> BondDamage | None:
+def block_damage(case: Case, model: Model, protected=None, of_block=None) -> BondDamage | None:
     """Bond breaking of a body of several blocks (docs/blocks.md): each point's critical stretch
     from its block's material damage (inf, never, where it has none), a bond breaking at the
-    smaller of its ends' (``BondDamage``); the no-damage sets of every material's damage."""
+    smaller of its ends' (``BondDamage``); the no-damage sets of every material's damage
+    (``protected`` and ``of_block`` as ``build_damage``'s)."""
     blocks = list(case.blocks.values())
     specs = [case.materials[b.material].damage for b in blocks]
     if all(d is None for d in specs):
         return None
-    of_point = block_index(case, model.body)
+    of_point = block_index(case, model.body) if of_block is None else of_block
     stretch = np.full(model.body.n_points, np.inf)
     for k, (block, d) in enumerate(zip(blocks, specs, strict=True)):
         if d is None:
@@ -510,6 +531,8 @@ def block_damage(case: Case, model: Model) -> BondDamage | None:
         else:
             stretch[mine] = d.critical_bond_stress / case.materials[block.material].E
     no_damage = sorted({name for d in specs if d is not None for name in d.no_damage_sets})
+    if protected is not None:
+        return BondDamage(model, critical_stretch=stretch, protected=protected)
     return BondDamage(model, critical_stretch=stretch, no_damage_sets=no_damage)
 
 

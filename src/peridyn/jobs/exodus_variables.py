@@ -61,3 +61,61 @@ def variable_values(model: Model, variables, sums=None):
         return out
 
     return values
+
+
+class GatheredVariables:
+    """The named variables of an MPI run (``output.exodus`` as a mapping), gathered on rank 0.
+
+    ``collect`` (collective: every rank calls it at a state) computes each rank's values on its
+    owned points (``variable_values`` of its part: its ghosts' displacements are current, so
+    force densities and dilatations are the serial ones) and gathers them in global point order
+    on rank 0, where the object, called with the gathered state, gives them as
+    ``variable_values`` does: ``Element_Id`` the global 1-based ids, ``Proc_Num`` each point's
+    rank (as Peridigm writes it), and each of ``sums`` summed over its set of the whole body.
+
+    Parameters
+    ----------
+    domain : Domain
+    model : Model
+        The rank's part of the model.
+    variables : sequence of str
+    sums : dict or None
+        Name -> (nodal variable, node set name), as ``variable_values``.
+    whole_body : Body
+        The case's body (its node sets name the sums' points).
+    """
+
+    def __init__(self, domain, model: Model, variables, sums, whole_body):
+        self.domain, self.whole_body = domain, whole_body
+        self.variables, self.sums = list(variables), dict(sums or {})
+        needed = self.variables + [v for v, _ in self.sums.values() if v not in self.variables]
+        self._local = variable_values(model, needed)
+        self._values: dict | None = None
+        self._step: int | None = None
+
+    def collect(self, state: State) -> None:
+        """Gather the values at the rank's ``state`` on rank 0 (collective)."""
+        local = self._local(state)
+        rank = float(self.domain.comm.rank)
+        whole = {}
+        for placement in ("nodal", "element"):
+            for name, values in local[placement].items():
+                if name == "Proc_Num":
+                    values = np.full(len(values), rank)
+                whole[name] = self.domain.gather(np.ascontiguousarray(values))
+        self._step = state.step
+        if not self.domain.is_root:
+            return
+        whole["Element_Id"] = np.arange(1.0, self.whole_body.n_points + 1.0)
+        out = {"nodal": {}, "element": {}, "global_": {}}
+        for name in self.variables:
+            out[PERIDIGM_VARIABLES[name][0]][name] = whole[name]
+        for name, (variable, set_name) in self.sums.items():
+            out["global_"][name] = whole[variable][self.whole_body.node_set(set_name)].sum(axis=0)
+        self._values = out
+
+    def __call__(self, state: State) -> dict:
+        """The values gathered by the last ``collect``, which must be of ``state``'s step."""
+        if self._step != state.step:
+            raise RuntimeError(f"Exodus variables collected at step {self._step}, asked at step {state.step}")
+        return self._values

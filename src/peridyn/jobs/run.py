@@ -26,7 +26,7 @@ from peridyn.io.provenance import package_version, provenance
 from peridyn.io.recorder import LineProbe, Recorder, RecorderSpec
 from peridyn.io.vtu_pieces import VtuPieces
 from peridyn.jobs.build import Setup, build, pad3
-from peridyn.jobs.exodus_variables import check_variables, variable_values
+from peridyn.jobs.exodus_variables import GatheredVariables, check_variables, variable_values
 from peridyn.jobs.figures import draw_crack_figures, draw_run_figures, final_crack_paths
 from peridyn.jobs.lamb_analysis import analyse
 from peridyn.jobs.peridigm_step import peridigm_stable_step
@@ -184,12 +184,6 @@ def _check_parallel(case: Case) -> None:
         raise InputError(
             f"an MPI run (mpiexec -n N) is an explicit run for now, not a {case.solver.type} run"
         )
-    if case.discretization.neighbourhood != "sphere":
-        raise CaseFileError(case.name, "discretization.neighbourhood", "box", "sphere in an MPI run")
-    if not isinstance(case.output.exodus, bool):
-        raise CaseFileError(
-            case.name, "output.exodus", case.output.exodus.model_dump(), "true or false in an MPI run"
-        )
 
 
 def point_tensors(setup: Setup, spec: RecorderSpec):
@@ -214,10 +208,15 @@ def point_tensors(setup: Setup, spec: RecorderSpec):
 
 def exodus_values(case: Case, setup: Setup, spec: RecorderSpec):
     """The recorder's ``fields``: the values of the named Exodus variables (``output.exodus``
-    as a mapping) at a state, or None without them. Serial runs (the whole model)."""
+    as a mapping) at a state, or None without them; under MPI a ``GatheredVariables``, whose
+    ``collect`` every rank calls at the states recorded."""
     if not spec.exodus_variables:
         return None
     check_variables(case.name, setup.model, spec.exodus_variables)
+    if setup.domain.size > 1:  # each rank's owned values, gathered on rank 0 (``collect``)
+        return GatheredVariables(
+            setup.domain, setup.model, spec.exodus_variables, spec.exodus_sums, setup.whole_body
+        )
     return variable_values(setup.model, spec.exodus_variables, spec.exodus_sums)
 
 
@@ -444,11 +443,15 @@ def _run_explicit(
     prepare = gather_checkpoint
     if pieces is not None:
         prepare = [*prepare, (spec.snapshot_due, pieces.write)]
+    collect = fields.collect if isinstance(fields, GatheredVariables) else lambda state: None
+    if isinstance(fields, GatheredVariables):
+        prepare = [*prepare, (spec.exodus_due, collect)]
     gathered.attach(watched, due, prepare)
     try:
         if resume is None:
             if pieces is not None:
                 pieces.write(state)
+            collect(state)
             gathered.call(state, lambda whole: (recorder.record_series(whole), recorder.snapshot(whole)))
         observers = [gathered]
         if checkpoint_every and d.size == 1:
@@ -478,6 +481,7 @@ def _run_explicit(
         if recorder is not None:
             recorder.close(end_status(exc))
         raise
+    collect(state)  # the end-of-run snapshot's Exodus record
     if not spec.snapshot_due(state.step):
         if pieces is not None:
             pieces.write(state)

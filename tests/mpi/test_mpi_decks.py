@@ -1,0 +1,106 @@
+"""Peridigm decks and bodies of several blocks under ``mpiexec -n 2`` and ``-n 3 peridyn run``
+(docs/peridigm.md): the serial run's Exodus values (``output.exodus`` as a mapping, gathered on
+rank 0) and results.h5 bit for bit. WaveInBar (Exodus mesh, named variables every 20 steps),
+Compression_3x1x1 (PdQuickGrid box families, ``discretization.neighbourhood: box``) and the
+shipped steel-aluminium bar of two blocks (cases/bimaterial_bar.yaml, shortened).
+
+Run with ``PYTHONPATH=src python -m pytest -m mpi -q -p no:cacheprovider`` (NUMBA_NUM_THREADS=1
+per rank; each serial run fills numba's cache before the MPI runs).
+"""
+
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+
+import peridyn
+from peridyn.io.exodus import read_exodus
+
+pytestmark = pytest.mark.mpi
+
+ROOT = Path(__file__).resolve().parents[2]
+SRC = str(Path(peridyn.__file__).parents[1])
+DECKS = ROOT / "tests" / "data" / "peridigm"
+
+RUNS = {
+    "WaveInBar": (DECKS / "WaveInBar.xml", []),
+    "Compression_3x1x1": (DECKS / "Compression_3x1x1.yaml", []),
+    "bimaterial_bar": (ROOT / "cases" / "bimaterial_bar.yaml", ["solver.time=6e-6", "output.plots=false"]),
+}
+
+
+def _run(name: str, out: Path, ranks: int) -> subprocess.CompletedProcess:
+    path, sets = RUNS[name]
+    command = [sys.executable, "-m", "peridyn", "run", str(path), "-o", str(out), "--no-progress", "--json"]
+    for s in sets:
+        command += ["--set", s]
+    if ranks > 1:
+        command = ["mpiexec", "-n", str(ranks), *command]
+    env = dict(os.environ, PYTHONPATH=SRC, NUMBA_NUM_THREADS="1")
+    return subprocess.run(command, capture_output=True, text=True, timeout=600, env=env)
+
+
+@pytest.fixture(scope="module")
+def serial(tmp_path_factory):
+    """The serial run of each deck or case."""
+    if shutil.which("mpiexec") is None:
+        pytest.skip("mpiexec not installed (pip install 'peridyn[mpi]')")
+    pytest.importorskip("mpi4py")
+    base = tmp_path_factory.mktemp("serial")
+    for name in RUNS:
+        done = _run(name, base / name, 1)
+        assert done.returncode == 0, done.stderr
+    return base
+
+
+def _exodus(folder: Path):
+    (path,) = folder.glob("*.e")
+    return read_exodus(path)
+
+
+@pytest.mark.parametrize("ranks", [2, 3])
+@pytest.mark.parametrize("name", ["WaveInBar", "Compression_3x1x1"])
+def test_deck_exodus_output_is_the_serial_one(serial, tmp_path, name, ranks):
+    """Every record's time and every nodal, element and global variable as in the serial run,
+    bit for bit, but ``Proc_Num``: each point's rank (Peridigm's meaning), 0 in one process,
+    here the ranks 0 to n - 1, each owning points."""
+    done = _run(name, tmp_path, ranks)
+    assert done.returncode == 0, done.stderr
+    one, many = _exodus(serial / name), _exodus(tmp_path)
+    assert np.array_equal(one.times, many.times) and len(one.times) > 1
+    for kind in ("nodal_variables", "element_variables", "global_variables"):
+        a, b = getattr(one, kind), getattr(many, kind)
+        assert a.keys() == b.keys()
+        assert [k for k in a if k != "Proc_Num" and not np.array_equal(a[k], b[k])] == []
+    if "Proc_Num" in one.element_variables:
+        assert np.all(one.element_variables["Proc_Num"] == 0)
+        assert set(np.unique(many.element_variables["Proc_Num"])) == set(range(ranks))
+
+
+def _datasets(path: Path) -> dict:
+    """Every dataset under final/ and series/ of a results file."""
+    found = {}
+    with h5py.File(path) as f:
+        for group in ("final", "series"):
+            if group in f:
+                f[group].visititems(
+                    lambda name, obj, g=group: (
+                        found.__setitem__(f"{g}/{name}", obj[()]) if isinstance(obj, h5py.Dataset) else None
+                    )
+                )
+    return found
+
+
+def test_body_of_two_blocks_is_the_serial_one(serial, tmp_path):
+    """cases/bimaterial_bar.yaml (steel and aluminium LPS blocks) on 2 ranks: every dataset of
+    results.h5 under final/ and series/ as in the serial run, bit for bit."""
+    done = _run("bimaterial_bar", tmp_path, 2)
+    assert done.returncode == 0, done.stderr
+    one, many = _datasets(serial / "bimaterial_bar/results.h5"), _datasets(tmp_path / "results.h5")
+    assert one.keys() == many.keys() and len(one) > 5
+    assert [k for k in one if not np.array_equal(one[k], many[k])] == []
