@@ -20,6 +20,7 @@ from peridyn.errors import InputError
 from peridyn.io.case import Case
 from peridyn.jobs.build import Setup, block_index
 from peridyn.physics.materials.elastic import bulk_modulus
+from peridyn.physics.materials.registry import model_class
 
 #: pi as Peridigm's estimate writes it.
 PERIDIGM_PI = 3.14159265
@@ -36,7 +37,8 @@ def peridigm_stable_step(case: Case, setup: Setup) -> float:
         of_point = block_index(case, setup.whole_body)[domain.global_ids]
     else:
         materials, of_point = [case.material], np.zeros(body.n_points, dtype=np.int64)
-    bulk = np.array([bulk_modulus(m.E, 0.25 if m.model == "pmb" else m.nu) for m in materials])[of_point]
+    nus = [model_class(m.model).implied_poisson_ratio(3) or m.nu for m in materials]  # PMB: 1/4
+    bulk = np.array([bulk_modulus(m.E, nu) for m, nu in zip(materials, nus, strict=True)])[of_point]
     density = np.array([m.density for m in materials])[of_point]
     horizon = bonds.horizon if bonds.point_horizon is None else bonds.point_horizon
     spring = 18.0 * bulk / (PERIDIGM_PI * horizon * horizon * horizon * horizon)

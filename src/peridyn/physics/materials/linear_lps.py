@@ -66,6 +66,20 @@ class LinearLPSModel(LPSModel):
         out[:] = f
         return out
 
+    def partial_stress(self, u):
+        """Partial stress (n_points, 3, 3), Pa: sigma_i = sum_j t_ij n_ij (x) xi_ij over the
+        intact bonds with the linear force state t_ij = w_ij |xi_ij| P_i + (pair_ij / 2) e_ij
+        along the reference direction n (the derivative of W_i; ``Model.partial_stress``
+        takes the deformed direction of the nonlinear law)."""
+        b, lin = self.bonds, self.linearisation()
+        e, theta = self._extension_and_dilatation(u)
+        owners = b.owners()
+        t = np.where(b.intact, lin.weight * b.length * (lin.p_coef * theta)[owners] + 0.5 * lin.pair * e, 0.0)
+        xi = self.body.points[b.neighbours] - self.body.points[owners]
+        sigma = np.zeros((self.body.n_points, 3, 3))
+        np.add.at(sigma, owners, (t / b.length)[:, None, None] * xi[:, :, None] * xi[:, None, :])
+        return sigma
+
     def energy_density(self, u):
         """Quadratic energy density (n_points,), J/m^3: W_i of the module docstring."""
         lin = self.linearisation()
