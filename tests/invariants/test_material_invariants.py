@@ -1,4 +1,4 @@
-"""Invariants every material model must satisfy: run on every registered material (PMB, LPS
+"""Invariants every material model must satisfy: run on every registered material (PMB, LPS, linear LPS
 and the test-only conical bond material of tests/materials), in 3D and 2D."""
 
 import numpy as np
