@@ -126,7 +126,7 @@ def test_wrong_column_count_in_mesh(tmp_path):
 
 
 def test_unknown_material_model():
-    with pytest.raises(CaseFileError, match=r"material\.model.*'pmb' or 'lps'"):
+    with pytest.raises(CaseFileError, match=r"material\.model.*'pmb', 'lps' or 'linear_lps'"):
         validate_case(_case(**{"material.model": "neo-hooke"}))
 
 

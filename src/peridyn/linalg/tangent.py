@@ -37,7 +37,10 @@ from peridyn.physics.materials.linearisation import BondLinearisation
 
 
 def tangent_stiffness(model: Model, u: np.ndarray) -> sp.csr_matrix:
-    """Consistent tangent K(u) = -d(V f)/du (3 n, 3 n), N/m, at displacement ``u`` (n, 3), m."""
+    """Consistent tangent K(u) = -d(V f)/du (3 n, 3 n), N/m, at displacement ``u`` (n, 3), m;
+    of a material linear in u (``Model.is_linear``) its one tangent, the one at rest."""
+    if model.is_linear:
+        u = np.zeros_like(u, dtype=np.float64)
     b = model.bonds
     owners = b.owners()
     nbr = b.neighbours.astype(np.int64)

@@ -44,6 +44,8 @@ class Model:
     ----------
     name : str
         The case-file name the class is registered under (``material.model``).
+    is_linear : bool
+        True when the force is linear in u (its tangent is its stiffness at rest).
     body : Body
     bonds : Bonds
         ``bonds.intact`` is shared and updated in place when bonds break.
@@ -60,6 +62,9 @@ class Model:
     """
 
     name = "model"
+    #: True for a material whose force is linear in u (``linear_lps``): its tangent stiffness is
+    #: the same at every state (``linalg.tangent`` takes it at rest).
+    is_linear = False
 
     def __init__(self, body: Body, bonds: Bonds, E, density, dtype=np.float64):
         self.body = body

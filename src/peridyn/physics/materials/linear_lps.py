@@ -31,6 +31,8 @@ class LinearLPSModel(LPSModel):
     ``LPSModel`` (E, nu, density, surface correction). Forces and energies are computed in
     float64 whatever ``dtype``."""
 
+    is_linear = True
+
     def _extension_and_dilatation(self, u) -> tuple[np.ndarray, np.ndarray]:
         """Linearised extension e (n_bonds,), m, and dilatation theta (n_points,) of u."""
         b, lin = self.bonds, self.linearisation()
