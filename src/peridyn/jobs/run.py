@@ -179,10 +179,12 @@ def run_case(
 
 def _check_parallel(case: Case) -> None:
     """Refuse what an MPI run cannot do yet."""
-    if case.solver.type != "explicit":
+    if case.solver.type not in ("explicit", "modal"):
         raise InputError(
-            f"an MPI run (mpiexec -n N) is an explicit run for now, not a {case.solver.type} run"
+            f"an MPI run (mpiexec -n N) is an explicit or modal run for now, not a {case.solver.type} run"
         )
+    if case.solver.type == "modal" and case.solver.eigensolver == "shift-invert":
+        raise CaseFileError(case.name, "solver.eigensolver", "shift-invert", "lobpcg or auto in an MPI run")
     if case.discretization.neighbourhood != "sphere":
         raise CaseFileError(case.name, "discretization.neighbourhood", "box", "sphere in an MPI run")
     if not isinstance(case.output.exodus, bool):
