@@ -116,7 +116,7 @@ def _dispatch(parser: ArgumentParser, args) -> int:
 
 
 #: The commands that run over MPI ranks (``mpiexec -n N peridyn ...``, N > 1).
-MPI_COMMANDS = ("run",)
+MPI_COMMANDS = ("run", "modal")
 
 
 def _refuse_under_mpi(command: str) -> None:
@@ -125,7 +125,7 @@ def _refuse_under_mpi(command: str) -> None:
 
     if command not in MPI_COMMANDS and launched_by_mpi() and world().size > 1:
         raise InputError(
-            f"'peridyn {command}' does not run over MPI ranks (only {', '.join(MPI_COMMANDS)} does): "
+            f"'peridyn {command}' does not run over MPI ranks (only {', '.join(MPI_COMMANDS)} do): "
             "run it without mpiexec"
         )
 

@@ -36,16 +36,23 @@ def run(args) -> dict:
     """Solve and print the frequency table unless --json."""
     from peridyn.jobs.estimate import check_memory
     from peridyn.jobs.run import run_case
+    from peridyn.parallel.comm import world
 
     overrides = [*args.overrides, "solver.type=modal"]
     if args.modes is not None:
         overrides.append(f"solver.modes={args.modes}")
     case = load_case(args.case, overrides)
     check_memory(case, args.max_memory, Path(args.case).parent)
+    comm = world()  # under mpiexec -n N: the distributed LOBPCG, rank 0 writes
     summary = run_case(
-        case, args.output, case_path=args.case, base_dir=Path(args.case).parent, overwrite=args.overwrite
+        case,
+        args.output,
+        case_path=args.case,
+        base_dir=Path(args.case).parent,
+        overwrite=args.overwrite,
+        comm=comm,
     )
-    if args.compare:
+    if args.compare and comm.rank == 0:
         from peridyn.jobs.modal import compare_with_run
 
         summary["comparison"] = compare_with_run(Path(summary["output_dir"]), Path(args.compare))

@@ -30,13 +30,39 @@ FACTOR_BUDGET = 2**30
 
 def run_modal(case, setup, out: Path, case_path=None) -> tuple[dict, list[Path]]:
     """Modal analysis of a built case; returns the summary's own keys (docs/user-guide.md,
-    "Summaries and results files") and the figures drawn."""
+    "Summaries and results files") and the figures drawn. Under MPI (``setup.domain`` of
+    several ranks) the modes are found by the distributed LOBPCG (``solvers.distributed_eigen``)
+    and rank 0 writes the same files as a serial run (collective)."""
     fixed = setup.loading.constrained if setup.loading.has_loads else None
-    result, types, modes = modal_table(
-        setup.model, case.solver.modes, fixed=fixed, eigensolver=case.solver.eigensolver
-    )
+    d = setup.domain
+    if d.size == 1:
+        result, types, modes = modal_table(
+            setup.model, case.solver.modes, fixed=fixed, eigensolver=case.solver.eigensolver
+        )
+        return _write_modal(case, setup.body, setup.bonds.n_bonds, result, types, modes, out, case_path)
+    from peridyn.linalg.distributed import RankDofs
+    from peridyn.solvers.distributed_eigen import distributed_modes
+
+    result, stats = distributed_modes(RankDofs(setup.model, d, fixed), case.solver.modes)
+    masses = d.gather(setup.model.density * setup.model.body.volumes)
+    n_bonds = d.count(setup.bonds.offsets[d.n_owned])  # the owned points' families come first
+    written = d.on_root(_write_classified, case, setup.whole_body, masses, n_bonds, result, out, case_path)
+    summary, plots = written if d.is_root else (None, [])
+    summary = d.comm.bcast(summary)
+    summary["iterations"] = stats["iterations"]
+    return summary, plots
+
+
+def _write_classified(case, body, masses, n_bonds, result, out, case_path):
+    """``_write_modal`` of a ModalResult of the whole ``body`` (rank 0), classified first."""
+    types, modes = mode_rows(body, masses, result)
+    return _write_modal(case, body, n_bonds, result, types, modes, out, case_path)
+
+
+def _write_modal(case, body, n_bonds, result, types, modes, out, case_path) -> tuple[dict, list[Path]]:
+    """Write the tables, results.h5, the mode-shape VTUs and figure of the modes ``result`` of
+    ``body``; the summary's own keys and the figures."""
     _write_tables(out, modes)
-    body = setup.body
     with HDF5Writer(
         out / "results.h5", body.points[:, : body.dim], body.volumes, provenance(case_path, case=case)
     ) as h5:
@@ -55,7 +81,7 @@ def run_modal(case, setup, out: Path, case_path=None) -> tuple[dict, list[Path]]
         "rigid_modes": result.n_rigid,
         "modes": modes,
         "points": body.n_points,
-        "bonds": setup.bonds.n_bonds,
+        "bonds": n_bonds,
     }
     plots = []
     if case.output.plots:
@@ -71,8 +97,14 @@ def modal_table(model, n_modes: int, fixed=None, eigensolver: str = "auto"):
     order, label ("1st bending", ``mode_label``), residual."""
     method = choose_eigensolver(model, eigensolver)
     result = modal_analysis(model, n_modes, fixed=fixed, method=method)
-    masses = model.density * model.body.volumes
-    types = classify_modes(model.body.points, result.shapes, masses, result.rigid)
+    types, rows = mode_rows(model.body, model.density * model.body.volumes, result)
+    return result, types, rows
+
+
+def mode_rows(body, masses, result):
+    """Types (``analysis.modes.classify_modes``) and JSON/CSV rows of the modes ``result`` of
+    ``body`` whose points weigh ``masses`` (n_points,) kg."""
+    types = classify_modes(body.points, result.shapes, masses, result.rigid)
     rows = [
         {
             "index": i,
@@ -84,7 +116,7 @@ def modal_table(model, n_modes: int, fixed=None, eigensolver: str = "auto"):
         }
         for i, (f, t, r) in enumerate(zip(result.frequencies, types, result.residuals, strict=True))
     ]
-    return result, types, rows
+    return types, rows
 
 
 def match_modes(before, after, masses) -> tuple[np.ndarray, list[dict]]:

@@ -180,10 +180,15 @@ def run_case(
 
 def _check_parallel(case: Case) -> None:
     """Refuse what an MPI run cannot do yet."""
-    if case.solver.type != "explicit":
+    if case.solver.type not in ("explicit", "modal", "static"):
         raise InputError(
-            f"an MPI run (mpiexec -n N) is an explicit run for now, not a {case.solver.type} run"
+            "an MPI run (mpiexec -n N) is an explicit, static or modal run for now, not a "
+            f"{case.solver.type} run"
         )
+    if case.solver.type == "static" and (case.material.damage is not None or case.contact is not None):
+        raise InputError("a static MPI run (mpiexec -n N) has neither bond breaking nor contact for now")
+    if case.solver.type == "modal" and case.solver.eigensolver == "shift-invert":
+        raise CaseFileError(case.name, "solver.eigensolver", "shift-invert", "lobpcg or auto in an MPI run")
 
 
 def point_tensors(setup: Setup, spec: RecorderSpec):
@@ -585,8 +590,9 @@ def _run_static(case, setup, out, case_path) -> dict:
     s = case.solver
     u = None
     iterations = 0
+    solve = relax if setup.domain.size == 1 else _distributed_static(setup)
     for k in range(1, s.load_steps + 1):
-        result = relax(
+        result = solve(
             setup.model,
             setup.loading,
             time=k / s.load_steps,
@@ -613,6 +619,22 @@ def _run_static(case, setup, out, case_path) -> dict:
     )
 
 
+def _distributed_static(setup: Setup):
+    """``relax``'s stand-in under MPI: modified Newton with CG (``solvers.distributed_static``) on
+    the rank's dofs, its preconditioner built once for every load step (no damage, no contact:
+    ``_check_parallel``)."""
+    from peridyn.linalg.distributed import RankDofs, rank_preconditioner
+    from peridyn.solvers.distributed_static import distributed_equilibrium
+
+    dofs = RankDofs(setup.model, setup.domain, setup.loading.constrained)
+    precond = rank_preconditioner(dofs)
+
+    def solve(model, loading, time, u0, tolerance, max_iterations, damage, contact):
+        return distributed_equilibrium(dofs, precond, loading, time, u0, tolerance, max_iterations)
+
+    return solve
+
+
 def _equilibrium_recorder(case, setup, out, case_path) -> Recorder:
     """The recorder of a quasi-static run."""
     spec = recorder_spec(case, setup.body, 1.0)
@@ -631,6 +653,8 @@ def _record_equilibrium(case, setup, out, case_path, u, results: dict, recorder=
     """Record a quasi-static solution ``u`` as one state at ``time`` (s; ``recorder``: the
     run's, else a new one); the run's summary."""
     state = State(u, np.zeros_like(u), np.zeros_like(u), time, results["steps"])
+    if setup.domain.size > 1:
+        return _record_distributed_equilibrium(case, setup, out, case_path, state, results)
     if recorder is None:
         recorder = _equilibrium_recorder(case, setup, out, case_path)
     recorder.record_series(state)
@@ -639,6 +663,31 @@ def _record_equilibrium(case, setup, out, case_path, u, results: dict, recorder=
     summary.update(results)
     summary["strain_energy_j"] = setup.model.strain_energy(u)
     recorder.finish(state)
+    return summary
+
+
+def _record_distributed_equilibrium(case, setup, out, case_path, state: State, results: dict) -> dict:
+    """``_record_equilibrium`` under MPI: ``state`` of the rank's part (ghost rows filled), gathered
+    on rank 0, which records it as a serial run would (VTU snapshots in per-rank pieces); the
+    summary (collective)."""
+    d = setup.domain
+    spec = recorder_spec(case, setup.whole_body, 1.0)
+    tensors = point_tensors(setup, spec)
+    gathered = RootObservers(d, setup.model, tensors)
+    info = provenance(case_path, case=case)
+    info.update(d.provenance())
+    if spec.vtu:
+        VtuPieces(d, setup.body, out, lambda: damage_field(setup.model), tensors).write(state)
+    whole_tensors = gathered.tensor_fields if tensors is not None else None
+    recorder = d.on_root(
+        Recorder, setup.whole_body, out, spec, info, gathered.damage, None, whole_tensors, None, True
+    )
+    gathered.call(state, lambda whole: (recorder.record_series(whole), recorder.snapshot(whole)), True)
+    summary = _base_summary(setup)
+    summary.update(results)
+    n = d.n_owned
+    summary["strain_energy_j"] = float(d.dot(setup.model.energy_density(state.u)[:n], setup.body.volumes[:n]))
+    gathered.call(state, lambda whole: recorder.finish(whole), True)
     return summary
 
 

@@ -25,17 +25,24 @@ from peridyn.physics.materials.base import Model
 PROXY_REACH = 1.5
 
 
-def rigid_fields(points: np.ndarray) -> np.ndarray:
+def rigid_fields(
+    points: np.ndarray, centroid: np.ndarray | None = None, scale: float | None = None
+) -> np.ndarray:
     """The six rigid motions of the points (3 n, 6): translations x, y, z, then rotations about
-    the x, y, z axes through the centroid (scaled to unit largest entry)."""
+    the x, y, z axes through the centroid (scaled to unit largest entry).
+
+    ``centroid`` (3,), m, and ``scale``, m (the largest |coordinate - centroid|): those of a
+    larger body of which ``points`` are a part (one rank's, ``linalg.distributed``); None: of
+    ``points``."""
     n = len(points)
-    r = points - points.mean(axis=0)
+    r = points - (points.mean(axis=0) if centroid is None else centroid)
+    scale = np.abs(r).max() if scale is None else scale
     fields = np.zeros((n, 3, 6))
     for a in range(3):
         fields[:, a, a] = 1.0
         axis = np.zeros(3)
         axis[a] = 1.0
-        fields[:, :, 3 + a] = np.cross(axis, r) / max(np.abs(r).max(), 1e-300)
+        fields[:, :, 3 + a] = np.cross(axis, r) / max(scale, 1e-300)
     return fields.reshape(3 * n, 6)
 
 

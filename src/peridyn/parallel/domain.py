@@ -127,6 +127,13 @@ class Domain:
         """``np.dot`` of two per-point arrays over the whole body, as in serial, on every rank."""
         return self._on_root_value(np.dot, self.gather(a), self.gather(b))
 
+    def allsum(self, value):
+        """The sum of every rank's ``value`` (a number or an array, element by element) by one
+        allreduce: rounded in rank order, not as a serial sum over the points. For the global
+        dot products of Krylov solvers (``peridyn.linalg.distributed``), whose answers must
+        equal a serial run's to the solver tolerance only, at the cost of one message round."""
+        return self.comm.allreduce(value, "sum")
+
     def _on_root_value(self, fn, *args):
         value = fn(*args) if self.is_root else None
         return self.comm.bcast(value)

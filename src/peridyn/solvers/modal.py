@@ -136,11 +136,26 @@ def _result(lam, vecs, K, m, dofs, n_points, k_max, known_rigid) -> ModalResult:
     lam, vecs, known_rigid = lam[order], vecs[:, order], known_rigid[order]
     kx = K @ vecs
     mx = m[:, None] * vecs
-    freqs = np.sign(lam) * np.sqrt(np.abs(lam)) / (2 * np.pi)
-    rigid = known_rigid | (np.abs(freqs) < RIGID_FRACTION * np.abs(freqs).max())
     resid = np.linalg.norm(kx - mx * lam, axis=0)
-    # elastic modes: relative to ||K x||; rigid ones (K x ~ 0): relative to max K_ii ||x||
-    scale = np.where(rigid, k_max * np.linalg.norm(vecs, axis=0), np.linalg.norm(kx, axis=0))
     shapes = np.zeros((len(lam), n_points * 3))
     shapes[:, dofs] = vecs.T
-    return ModalResult(freqs, shapes.reshape(len(lam), -1, 3), resid / np.maximum(scale, 1e-300), rigid)
+    return classify_result(
+        lam,
+        shapes.reshape(len(lam), -1, 3),
+        resid,
+        k_max * np.linalg.norm(vecs, axis=0),
+        np.linalg.norm(kx, axis=0),
+        known_rigid,
+    )
+
+
+def classify_result(lam, shapes, resid, scale_rigid, scale_elastic, known_rigid) -> ModalResult:
+    """ModalResult of sorted eigenpairs: ``lam`` (n_modes,) 1/s^2, ``shapes`` (n_modes,
+    n_points, 3), the residual norms ||K x - lambda M x|| ``resid`` (n_modes,) N, and the
+    scales they are relative to, (n_modes,) N: ``scale_elastic`` ||K x||, ``scale_rigid``
+    max K_ii ||x|| (K x ~ 0 for a rigid mode). Rigid modes: ``known_rigid`` and those below
+    RIGID_FRACTION of the highest frequency."""
+    freqs = np.sign(lam) * np.sqrt(np.abs(lam)) / (2 * np.pi)
+    rigid = known_rigid | (np.abs(freqs) < RIGID_FRACTION * np.abs(freqs).max())
+    scale = np.where(rigid, scale_rigid, scale_elastic)
+    return ModalResult(freqs, shapes, resid / np.maximum(scale, 1e-300), rigid)
