@@ -12,7 +12,11 @@ and after each run (a shared machine: say what the load was).
     PYTHONPATH=src python benchmarks/bench_mpi.py --quick            # bar_pulse, a short check
     PYTHONPATH=src python benchmarks/bench_mpi.py --repeat 2 -o benchmarks/bench_mpi.json
 
-A short serial run first fills numba's cache, so that no run compiles. Plots are off
+Beside the runs it records what the scaling model (``docs/figures/mpi_scaling.py``) reads: the
+serial step's parts on one thread (``peridyn bench --case CASE --steps 100``: force, observers,
+rest, ms per step) and the point-to-point latency and bandwidth of two ranks
+(``benchmarks/mpi_pingpong.py``). A short serial run first fills numba's cache, so that no run
+compiles. Plots are off
 (``output.plots=false``): figures are drawn by rank 0 alone after the loop and are no part of
 the scaling; ``--set`` passes more overrides to every run.
 """
@@ -44,13 +48,7 @@ def run_once(case: Path, sets: list[str], ranks: int, threads: int, out: Path) -
         command += ["--set", s]
     if ranks > 1:
         command = ["mpiexec", "-n", str(ranks), *command]
-    env = dict(
-        os.environ,
-        PYTHONPATH=str(ROOT / "src"),
-        NUMBA_NUM_THREADS=str(threads),
-        OMP_NUM_THREADS="1",
-        OPENBLAS_NUM_THREADS="1",
-    )
+    env = _env(threads)
     load_before = os.getloadavg()[0]
     start = time.perf_counter()
     done = subprocess.run(command, capture_output=True, text=True, env=env, check=False)
@@ -83,6 +81,35 @@ def run_once(case: Path, sets: list[str], ranks: int, threads: int, out: Path) -
     return row
 
 
+def _env(threads: int) -> dict:
+    return dict(
+        os.environ,
+        PYTHONPATH=str(ROOT / "src"),
+        NUMBA_NUM_THREADS=str(threads),
+        OMP_NUM_THREADS="1",
+        OPENBLAS_NUM_THREADS="1",
+    )
+
+
+def serial_parts(case: Path, sets: list[str], steps: int = 100) -> dict:
+    """``peridyn bench --case`` on one thread: the step's parts, s per step, and the load."""
+    command = [sys.executable, "-m", "peridyn", "bench", "--case", str(case), "--steps", str(steps)]
+    command += ["--repeat", "3", "--json"]
+    for s in ["output.plots=false", *sets]:
+        command += ["--set", s]
+    done = subprocess.run(command, capture_output=True, text=True, env=_env(1), check=True)
+    bench = json.loads(done.stdout)
+    per_step = {name: seconds / bench["steps"] for name, seconds in bench["parts"].items()}
+    return {"steps": bench["steps"], "seconds_per_step": per_step, "load_average": bench["load_average"]}
+
+
+def pingpong() -> dict:
+    """Latency (s) and bandwidth (bytes/s) of two ranks (``benchmarks/mpi_pingpong.py``)."""
+    command = ["mpiexec", "-n", "2", sys.executable, str(ROOT / "benchmarks" / "mpi_pingpong.py")]
+    done = subprocess.run(command, capture_output=True, text=True, env=_env(1), check=True)
+    return {**json.loads(done.stdout), "load_before": os.getloadavg()[0]}
+
+
 def table(rows: list[dict]) -> str:
     """The runs as a Markdown table."""
     lines = [
@@ -112,6 +139,7 @@ def main(argv=None) -> int:
         default=",".join(f"{r}x{t}" for r, t in CONFIGURATIONS),
         help="ranks x threads, comma-separated (default %(default)s)",
     )
+    parser.add_argument("--no-model-inputs", action="store_true", help="skip the parts and the ping-pong")
     parser.add_argument("-o", "--output", type=Path, help="write the runs as JSON here")
     args = parser.parse_args(argv)
     case, sets = CASES["quick" if args.quick else "lamb"]
@@ -127,8 +155,12 @@ def main(argv=None) -> int:
                 rows.append(row)
                 print(table([row]).splitlines()[-1], file=sys.stderr, flush=True)
     print(table(rows))
+    record = {"case": str(case.relative_to(ROOT)), "sets": sets, "cpus": os.cpu_count(), "runs": rows}
+    if not args.no_model_inputs:
+        record["serial_parts"] = serial_parts(case, sets)
+        record["pingpong"] = pingpong()
+        print(json.dumps({k: record[k] for k in ("serial_parts", "pingpong")}, indent=1))
     if args.output is not None:
-        record = {"case": str(case.relative_to(ROOT)), "sets": sets, "cpus": os.cpu_count(), "runs": rows}
         args.output.write_text(json.dumps(record, indent=1) + "\n")
     return 0
 
