@@ -18,8 +18,8 @@ One explicit step on P ranks of one thread each takes
 - ``t_root``: the recorder's time per step (observers), on rank 0 alone, not divided;
 - ``t_halo = m alpha + s / beta``: the largest rank's counted messages m and bytes s per step,
   with the latency alpha and bandwidth beta of ``benchmarks/mpi_pingpong.py``;
-- ``t_gather``: a recording step gathers the state (u, v, a: 72 B) and the damage index (8 B) of
-  every point on rank 0: ``(P - 1) alpha + 80 (N - N_0) / beta``.
+- ``t_gather``: a recording step gathers the state (u, v, a: 72 B per point) on rank 0 (the
+  damage index only at snapshots): ``(P - 1) alpha + 72 (N - N_0) / beta``.
 
 Projections (no recording of whole fields per step: sensors only, so no ``t_root`` nor
 ``t_gather``): a cube of N points, horizon 3.015 spacings (122 bonds per point), LPS, parts
@@ -88,7 +88,7 @@ def predicted_step(c: dict, run: dict) -> dict:
     n_r = max(owned)
     ranks = run["ranks"]
     halo = max(r["messages_per_step"] * c["alpha"] + r["bytes_per_step"] / c["beta"] for r in per_rank)
-    gather = (ranks - 1) * c["alpha"] + 80.0 * (c["points"] - owned[0]) / c["beta"]
+    gather = (ranks - 1) * c["alpha"] + 72.0 * (c["points"] - owned[0]) / c["beta"]
     shared = max(1.0, ranks / c["cpus"])  # more ranks than cores: each gets cpus / ranks of one
     terms = {
         "compute": shared * (c["t_bond"] * c["bonds"] * n_r / c["points"] + c["t_point"] * n_r),

@@ -423,7 +423,8 @@ def _run_explicit(
     prepare = gather_checkpoint
     if pieces is not None:
         prepare = [*prepare, (spec.snapshot_due, pieces.write)]
-    gathered.attach(watched, due, prepare)
+    damage_due = [spec.snapshot_due, spec.exodus_due, *([cracks.due] if cracks is not None else [])]
+    gathered.attach(watched, due, prepare, damage_due)
     try:
         if resume is None:
             if pieces is not None:
