@@ -137,12 +137,21 @@ class Domain:
         (None elsewhere); in one process ``a`` itself."""
         if self.size == 1:
             return a
-        parts = self.comm.gather(np.ascontiguousarray(a[: self.n_owned]))
+        whole = self.gather_many(a)
+        return None if whole is None else whole[0]
+
+    def gather_many(self, *arrays: np.ndarray) -> list | None:
+        """``gather`` of several per-point arrays in one message per rank (one collective: its
+        latency paid once), on rank 0 (None elsewhere); in one process the arrays themselves."""
+        if self.size == 1:
+            return list(arrays)
+        parts = self.comm.gather(tuple(np.ascontiguousarray(a[: self.n_owned]) for a in arrays))
         if not self.is_root:
             return None
-        out = np.empty((self.n_global, *a.shape[1:]), dtype=a.dtype)
-        for ids, part in zip(self._rank_ids, parts, strict=True):
-            out[ids] = part
+        out = [np.empty((self.n_global, *a.shape[1:]), dtype=a.dtype) for a in arrays]
+        for ids, rank_parts in zip(self._rank_ids, parts, strict=True):
+            for whole, part in zip(out, rank_parts, strict=True):
+                whole[ids] = part
         return out
 
     def sum(self, a: np.ndarray) -> float:
@@ -202,8 +211,8 @@ class Domain:
         process ``state`` itself."""
         if self.size == 1:
             return state
-        u, v, a = (self.gather(x) for x in (state.u, state.v, state.a))
-        return State(u, v, a, state.time, state.step) if self.is_root else None
+        whole = self.gather_many(state.u, state.v, state.a)
+        return State(*whole, state.time, state.step) if self.is_root else None
 
     # -- per-bond arrays (checkpoints) ------------------------------------------------------
 
