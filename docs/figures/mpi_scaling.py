@@ -24,12 +24,14 @@ One explicit step on P ranks of one thread each takes
 Projections (no recording of whole fields per step: sensors only, so no ``t_root`` nor
 ``t_gather``): a cube of N points, horizon 3.015 spacings (122 bonds per point), LPS, parts
 that are cubes of n = N / P points with a ghost shell two search reaches thick (6 spacings):
-g = (n^(1/3) + 12)^3 - n ghosts, 26 neighbour ranks, 24 bytes per ghost per step; the latency
+g = (n^(1/3) + 12)^3 - n ghosts, 26 neighbour ranks, 24 bytes per ghost per step, and the LPS
+dilatation of every ghost at half the force's cost per bond (an estimate); the latency
 and bandwidth of a cluster interconnect (``CLUSTER``, stated, not measured here) and this
-machine's t_bond and t_point per core; plus the state check's allgather every 10 steps
-(2 log2(P) alpha / 10). Memory per rank: ``peridyn.jobs.estimate``'s explicit costs (300 MB
-base, 350 B per point, 100 B per directed bond) on the rank's owned and ghost points, plus the
-whole body that every rank builds today (``WHOLE_BODY_BYTES`` per point of the whole body).
+machine's t_bond and t_point per core measured quietly (``QUIET``); plus the state check's
+allgather every 10 steps (2 log2(P) alpha / 10). Memory per rank: ``peridyn.jobs.estimate``'s
+explicit costs (300 MB base, 350 B per point, 100 B per directed bond) on the rank's owned and
+ghost points, plus the whole body that every rank builds today (``WHOLE_BODY_BYTES`` per point
+of the whole body).
 """
 
 from __future__ import annotations
@@ -57,6 +59,11 @@ BASE_BYTES, POINT_BYTES, BOND_BYTES = 300e6, 350.0, 100.0
 #: the ghost search's k-d tree on every point (a copy of the points and an index: 32 B), and the
 #: whole loading's per-point flags (about 6 B)
 WHOLE_BODY_BYTES = 110.0
+#: compute coefficients of the projections, per thread, from the quiet-machine measurement of
+#: the seed Lamb case (benchmarks/RESULTS.md, "Whole explicit steps against the force kernel",
+#: load 5: force 54.9 ms and rest 4.1 ms per step on 2 threads, 9 322 368 bonds, 125 250
+#: points): the runs of bench_mpi.py so far met loads of 12-25, which inflate them 2-4x
+QUIET = {"t_bond": 54.9e-3 * 2 / 9_322_368, "t_point": 4.1e-3 * 2 / 125_250}
 RANKS = (16, 64, 256, 1024)
 SIZES = (1e7, 1e8, 1e9)
 
@@ -123,7 +130,10 @@ def projected(c: dict, points: float, ranks: int, cluster=CLUSTER) -> dict:
     side = n ** (1.0 / 3.0)
     ghosts = (side + 2 * SHELL) ** 3 - n
     alpha, beta = cluster["latency_s"], cluster["bandwidth_bytes_per_s"]
-    compute = c["t_bond"] * BONDS_PER_POINT * n + c["t_point"] * n
+    # the owned points' force, and the LPS dilatation of the ghosts (read by the boundary
+    # points' force; estimated at half the force's cost per bond, an upper bound: the outer
+    # ghosts' families are partial)
+    compute = c["t_bond"] * BONDS_PER_POINT * (n + 0.5 * ghosts) + c["t_point"] * n
     halo = 26 * alpha + 24.0 * ghosts / beta
     collectives = 2 * math.log2(ranks) * alpha / 10
     part = part_bytes(n + ghosts, BONDS_PER_POINT)
@@ -222,8 +232,8 @@ def main(argv: list[str]) -> int:
     )
     print(check_table(record, c))
     print()
-    print(projection_table(c))
-    draw(c, HERE / "mpi_scaling.png")
+    print(projection_table(QUIET))
+    draw(QUIET, HERE / "mpi_scaling.png")
     return 0
 
 
