@@ -152,6 +152,31 @@ def test_mpi_run_equals_the_serial_run_bit_for_bit(case, ranks, serial, tmp_path
     with h5py.File(tmp_path / case / "results.h5") as f:
         assert f.attrs["mpi_ranks"] == ranks
         assert sum(int(n) for n in f.attrs["points_per_rank"][1:-1].split(",")) == len(want["final/u"])
+    _assert_halo_traffic(summary, case, ranks)
+
+
+def _assert_halo_traffic(summary: dict, case: str, ranks: int) -> None:
+    """The counted halo traffic is what the halo plans imply: one exchange of u per step, so the
+    bytes all ranks send per step are 3 float64 (24 bytes) per ghost point of all ranks (each
+    ghost row is received once per step from its owner); contact adds its own halo, so only
+    a lower bound holds with it. The times are parts of the rank's time loop."""
+    mpi = summary["mpi"]
+    per_rank = mpi["per_rank"]
+    assert [r["rank"] for r in per_rank] == list(range(ranks)) and mpi["mpi_ranks"] == ranks
+    assert [r["owned"] for r in per_rank] == mpi["points_per_rank"]
+    assert [r["ghosts"] for r in per_rank] == mpi["ghosts_per_rank"]
+    sent = sum(r["bytes_per_step"] for r in per_rank)
+    if case.endswith("contact"):
+        assert sent >= 24 * sum(mpi["ghosts_per_rank"])
+    else:
+        assert sent == pytest.approx(24 * sum(mpi["ghosts_per_rank"]), rel=1e-12)
+        for r in per_rank:
+            assert r["messages_per_step"] == pytest.approx(r["halo_neighbours"], rel=1e-12)
+    for r in per_rank:
+        assert 0.0 < r["halo_wait_seconds"] <= r["halo_seconds"] < r["step_seconds"]
+        assert 0.0 < r["collective_seconds"] < r["step_seconds"] <= summary["step_seconds"]
+        assert r["halo_share"] == pytest.approx(r["halo_seconds"] / r["step_seconds"], rel=1e-12)
+        assert r["peak_memory_bytes"] > 100e6  # the interpreter with numpy, scipy and numba alone
 
 
 def test_contact_acts_and_its_list_is_rebuilt_during_the_mpi_run(serial):

@@ -28,7 +28,7 @@ from peridyn.io import exodus, mesh_text
 from peridyn.io.case import Case, Geometry, Region
 from peridyn.parallel.contact import RankContact
 from peridyn.parallel.domain import Domain, agree
-from peridyn.parallel.halo import Halo, ghost_layers, plan_halo
+from peridyn.parallel.halo import Halo, clearance, ghost_layers, plan_halo
 from peridyn.parallel.partition import rcb
 from peridyn.physics.contact import Contact
 from peridyn.physics.damage import BondDamage, protected_points
@@ -375,22 +375,25 @@ def build_part(case: Case, comm, base_dir=".") -> Setup:
     """This rank's part of the case: the points that recursive coordinate bisection gives it and
     two layers of ghosts (``peridyn.parallel``), their bonds only, the model, damage and loading
     on them. Each owned point's family keeps the serial order (the search runs on the part's
-    points in global order, then the owned points are moved first and the ghosts after), so
-    that the kernels sum every force in the serial order. Collective: every rank calls it, and
-    an error on one rank is raised on all.
+    points in global order, then the owned points are moved first, farthest from the ghosts
+    first, and the ghosts after), so that the kernels sum every force in the serial order.
+    Collective: every rank calls it, and an error on one rank is raised on all.
     """
-    setup, owned, ghosts, ghost_owner = agree(comm, _build_part, case, comm, base_dir)
+    setup, owned, ghosts, ghost_owner, clear_rows = agree(comm, _build_part, case, comm, base_dir)
     halo = Halo(comm, plan_halo(comm, owned, ghosts, ghost_owner))
     local_ids = np.concatenate([owned, ghosts])
     n_points = setup.whole_body.n_points
-    setup.domain = Domain(comm, local_ids, len(owned), n_points, halo, "recursive coordinate bisection")
+    setup.domain = Domain(
+        comm, local_ids, len(owned), n_points, halo, "recursive coordinate bisection", clear_rows
+    )
     setup.contact = agree(comm, build_contact, case, setup.model, setup.domain, setup.whole_body)
     return setup
 
 
 def _build_part(case: Case, comm, base_dir):
     """``build_part`` up to the halo plan: the part's Setup (its domain set after), the owned
-    and ghost global indices (local order) and the ghosts' ranks."""
+    and ghost global indices (local order), the ghosts' ranks and the numbers of leading owned
+    rows of clearance 1 and 2 (``Domain.clear_rows``)."""
     body = build_body(case, base_dir)
     check_placements(case, body)
     body, actuation = add_actuators(case, body)
@@ -410,6 +413,9 @@ def _build_part(case: Case, comm, base_dir):
     # ghosts without a neighbour on the rank (an outer ghost whose cells all miss) are dropped
     ghosts = ghosts[np.diff(bonds.offsets)[np.searchsorted(near, ghosts)] > 0]
     ghosts = ghosts[np.lexsort((ghosts, owner[ghosts]))]
+    clear = clearance(bonds.offsets, bonds.neighbours, np.searchsorted(near, owned), GHOST_LAYERS)
+    owned = owned[np.argsort(-clear, kind="stable")]  # farthest from the ghosts first
+    clear_rows = tuple(int(np.count_nonzero(clear >= c)) for c in range(1, GHOST_LAYERS + 1))
     local_ids = np.concatenate([owned, ghosts])
     bonds = reorder_bonds(bonds, np.searchsorted(near, local_ids), len(near))
     part = body.subset(local_ids)
@@ -420,7 +426,7 @@ def _build_part(case: Case, comm, base_dir):
     protected = protected_points(body, no_damage)[local_ids]
     damage = build_damage(case, model, protected, part_blocks)
     setup = Setup(part, bonds, model, loading.restricted(part, local_ids), damage, None, None, body)
-    return setup, owned, ghosts, owner[ghosts]
+    return setup, owned, ghosts, owner[ghosts], clear_rows
 
 
 def neighbourhood_box(case: Case, body: Body, horizon: float) -> np.ndarray | None:

@@ -30,7 +30,7 @@ from peridyn.jobs.exodus_variables import GatheredVariables, check_variables, va
 from peridyn.jobs.figures import draw_crack_figures, draw_run_figures, final_crack_paths
 from peridyn.jobs.lamb_analysis import analyse
 from peridyn.jobs.peridigm_step import peridigm_stable_step
-from peridyn.jobs.summary import finish_summary
+from peridyn.jobs.summary import finish_summary, peak_memory_bytes
 from peridyn.parallel.observers import RootObservers
 from peridyn.physics.absorbing import layer_damping
 from peridyn.physics.damage import damage_field
@@ -451,7 +451,8 @@ def _run_explicit(
     collect = fields.collect if isinstance(fields, GatheredVariables) else lambda state: None
     if isinstance(fields, GatheredVariables):
         prepare = [*prepare, (spec.exodus_due, collect)]
-    gathered.attach(watched, due, prepare)
+    damage_due = [spec.snapshot_due, spec.exodus_due, *([cracks.due] if cracks is not None else [])]
+    gathered.attach(watched, due, prepare, damage_due)
     try:
         if resume is None:
             if pieces is not None:
@@ -463,13 +464,15 @@ def _run_explicit(
             observers.append(checkpointer)
         remaining = n_steps - state.step
         bar = progress(remaining) if progress is not None else None
+        traffic = d.comm.traffic.copy()
         loop_start = time.perf_counter()
         try:
             solver.run(state, remaining, observers, bar)
         finally:
             if bar is not None:
                 bar.close()
-        step_seconds = d.max(time.perf_counter() - loop_start)
+        loop_seconds = time.perf_counter() - loop_start
+        step_seconds = d.max(loop_seconds)
     except Interrupted as exc:  # under MPI: on every rank after the same step
         saved = bool(checkpoint_every) or time.perf_counter() - start > CHECKPOINT_AFTER_S
         saved = bool(d.max(int(saved)))  # the ranks' clocks differ: all save if one would
@@ -504,6 +507,14 @@ def _run_explicit(
             "step_seconds": step_seconds,
         }
     )
+    if d.size > 1:
+        summary["mpi"] = {
+            **{key: info[key] for key in d.provenance_keys},
+            "per_rank": d.traffic_per_rank(traffic, remaining, loop_seconds),
+        }
+        peaks = d.comm.allgather(peak_memory_bytes())  # so far: the build and the time loop
+        for rank, peak in zip(summary["mpi"]["per_rank"], peaks, strict=True):
+            rank["peak_memory_bytes"] = peak
     if setup.contact is not None:
         summary["contact_rebuilds"] = setup.contact.rebuilds
     if cracks is not None:

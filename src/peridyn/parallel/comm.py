@@ -4,14 +4,17 @@ otherwise.
 Both expose the same small set of methods (rank, size, barrier, bcast, gather, allgather,
 alltoall, allreduce of numbers and arrays, and the non-blocking point-to-point messages of the
 halo exchange), so that code written for ranks runs unchanged in one process; a serial run
-never imports mpi4py. ``world()`` picks one: MPI only when mpi4py imports and the environment
-shows an MPI launch (``PMI_SIZE``, ``OMPI_COMM_WORLD_SIZE``, ``MPI_LOCALNRANKS`` ...).
+never imports mpi4py. Each keeps a ``Traffic`` count of what it did (messages, bytes, seconds
+waiting), which a run reports per rank. ``world()`` picks one: MPI only when mpi4py imports and
+the environment shows an MPI launch (``PMI_SIZE``, ``OMPI_COMM_WORLD_SIZE``, ``MPI_LOCALNRANKS`` ...).
 """
 
 from __future__ import annotations
 
 import functools
 import os
+import time
+from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
@@ -20,11 +23,48 @@ import numpy as np
 LAUNCH_VARIABLES = ("PMI_SIZE", "OMPI_COMM_WORLD_SIZE", "MPI_LOCALNRANKS", "SLURM_NTASKS")
 
 
+@dataclass
+class Traffic:
+    """What one rank's communicator has done so far.
+
+    Attributes
+    ----------
+    messages : int
+        Point-to-point messages sent (halo exchanges of the bonds and of contact).
+    bytes : int
+        Their payload, bytes.
+    halo_seconds : float
+        Wall time, s, in the halo exchanges' ``start`` (packing and posting) and ``finish``.
+    wait_seconds : float
+        The part of ``halo_seconds`` spent in ``finish``, waiting for the messages, s.
+    collective_seconds : float
+        Wall time, s, in collectives (barrier, bcast, gather, allgather, alltoall, allreduce):
+        their transfer and the wait for the slowest rank.
+    """
+
+    messages: int = 0
+    bytes: int = 0
+    halo_seconds: float = 0.0
+    wait_seconds: float = 0.0
+    collective_seconds: float = 0.0
+
+    def since(self, earlier: Traffic) -> Traffic:
+        """The traffic between ``earlier`` (a copy taken before) and now."""
+        return Traffic(*(getattr(self, f.name) - getattr(earlier, f.name) for f in fields(self)))
+
+    def copy(self) -> Traffic:
+        return replace(self)
+
+
 class SerialComm:
     """One process: every collective returns its own contribution."""
 
     rank = 0
     size = 1
+
+    def __init__(self):
+        #: nothing is ever sent: stays zero
+        self.traffic = Traffic()
 
     def barrier(self) -> None:
         """Nothing to wait for."""
@@ -69,22 +109,32 @@ class MPIComm:
         self.rank = comm.Get_rank()
         self.size = comm.Get_size()
         self._ops = {"sum": MPI.SUM, "max": MPI.MAX, "min": MPI.MIN}
+        #: messages, bytes and seconds of this rank (``Traffic``)
+        self.traffic = Traffic()
+
+    def _timed(self, call, *args, **kwargs):
+        """``call(*args, **kwargs)``, its wall time added to ``traffic.collective_seconds``."""
+        start = time.perf_counter()
+        try:
+            return call(*args, **kwargs)
+        finally:
+            self.traffic.collective_seconds += time.perf_counter() - start
 
     def barrier(self) -> None:
-        self._comm.Barrier()
+        self._timed(self._comm.Barrier)
 
     def bcast(self, obj, root: int = 0):
-        return self._comm.bcast(obj, root=root)
+        return self._timed(self._comm.bcast, obj, root=root)
 
     def gather(self, obj, root: int = 0):
         """A list of every rank's ``obj`` on ``root``, None elsewhere."""
-        return self._comm.gather(obj, root=root)
+        return self._timed(self._comm.gather, obj, root=root)
 
     def allgather(self, obj) -> list:
-        return self._comm.allgather(obj)
+        return self._timed(self._comm.allgather, obj)
 
     def alltoall(self, objs: list) -> list:
-        return self._comm.alltoall(objs)
+        return self._timed(self._comm.alltoall, objs)
 
     def allreduce(self, value, op: str = "sum"):
         """The reduction of a number or of a numpy array (element by element) over all ranks.
@@ -93,11 +143,14 @@ class MPIComm:
         that must equal a serial run's are gathered and summed in point order instead."""
         if isinstance(value, np.ndarray):
             out = np.empty_like(value)
-            self._comm.Allreduce(np.ascontiguousarray(value), out, op=self._ops[op])
+            self._timed(self._comm.Allreduce, np.ascontiguousarray(value), out, op=self._ops[op])
             return out
-        return self._comm.allreduce(value, op=self._ops[op])
+        return self._timed(self._comm.allreduce, value, op=self._ops[op])
 
     def isend(self, buf: np.ndarray, dest: int, tag: int):
+        """Post the send of ``buf``, counted in ``traffic`` (messages, bytes)."""
+        self.traffic.messages += 1
+        self.traffic.bytes += buf.nbytes
         return self._comm.Isend(buf, dest=dest, tag=tag)
 
     def irecv(self, buf: np.ndarray, source: int, tag: int):

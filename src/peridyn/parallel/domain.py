@@ -1,8 +1,9 @@
 """A rank's part of a body (``Domain``): which points it owns, its ghosts and their exchange, and
 the collective operations a run needs, written so that results equal a serial run's bit for bit.
 
-Local arrays hold the owned points first (``owned`` rows, in global order), then the ghosts
-(``peridyn.parallel.halo``). Reductions that round (sums, dot products) are never summed per rank:
+Local arrays hold the owned points first (``owned`` rows: the farthest from the ghosts first,
+``clear_rows``), then the ghosts (``peridyn.parallel.halo``); ``global_ids`` maps them to the
+serial numbering. Reductions that round (sums, dot products) are never summed per rank:
 the owned values are gathered on rank 0 in global point order and reduced there with the same
 numpy call as in serial, then broadcast. Max and min are exact and reduced across ranks.
 
@@ -23,7 +24,7 @@ import numpy as np
 
 from peridyn.discretization.state import State, check_state, runaway_limit_of_extent
 from peridyn.errors import InstabilityError, PeridynError
-from peridyn.parallel.comm import SerialComm
+from peridyn.parallel.comm import SerialComm, Traffic
 from peridyn.parallel.halo import Halo
 
 
@@ -38,17 +39,32 @@ class Domain:
     ----------
     comm : SerialComm or MPIComm
     global_ids : (n_local,) int64
-        Global index of each local point: the owned ones (ascending) first, then the ghosts.
+        Global index of each local point: the owned ones first, then the ghosts.
     n_owned : int
     n_global : int
     halo : Halo or None
         The ghost exchange (None: no ghosts, one rank).
     partition : str
         How the points were split, for the provenance.
+    clear_rows : tuple of int
+        ``clear_rows[c - 1]``: the number of leading owned rows of clearance c or more
+        (``peridyn.parallel.halo.clearance``: no ghost within c - 1 bonds of their families),
+        whose forces need no ghost value (c = 1 bond-based, c = 2 state-based). Default: none
+        known (every force waits for the ghosts).
     """
 
-    def __init__(self, comm, global_ids, n_owned: int, n_global: int, halo: Halo | None, partition: str):
+    def __init__(
+        self,
+        comm,
+        global_ids,
+        n_owned: int,
+        n_global: int,
+        halo: Halo | None,
+        partition: str,
+        clear_rows: tuple = (0, 0),
+    ):
         self.comm = comm
+        self.clear_rows = tuple(int(c) for c in clear_rows)
         self.global_ids = np.asarray(global_ids, dtype=np.int64)
         self.n_owned = int(n_owned)
         self.n_global = int(n_global)
@@ -61,7 +77,7 @@ class Domain:
     @classmethod
     def serial(cls, n_points: int) -> Domain:
         """The whole body in one process."""
-        return cls(SerialComm(), np.arange(n_points), n_points, n_points, None, "none")
+        return cls(SerialComm(), np.arange(n_points), n_points, n_points, None, "none", (n_points, n_points))
 
     @property
     def size(self) -> int:
@@ -91,6 +107,17 @@ class Domain:
         if self.halo is not None:
             self.halo.exchange(a)
 
+    def start_exchange(self, a: np.ndarray) -> None:
+        """Post the exchange of ``exchange``; the ghost rows of ``a`` are filled at
+        ``finish_exchange``, and meanwhile neither they nor ``a``'s owned rows may change."""
+        if self.halo is not None:
+            self.halo.start(a)
+
+    def finish_exchange(self) -> None:
+        """Wait for the exchange posted by ``start_exchange``."""
+        if self.halo is not None:
+            self.halo.finish()
+
     # -- reductions ----------------------------------------------------------------------
 
     def max(self, value):
@@ -110,12 +137,21 @@ class Domain:
         (None elsewhere); in one process ``a`` itself."""
         if self.size == 1:
             return a
-        parts = self.comm.gather(np.ascontiguousarray(a[: self.n_owned]))
+        whole = self.gather_many(a)
+        return None if whole is None else whole[0]
+
+    def gather_many(self, *arrays: np.ndarray) -> list | None:
+        """``gather`` of several per-point arrays in one message per rank (one collective: its
+        latency paid once), on rank 0 (None elsewhere); in one process the arrays themselves."""
+        if self.size == 1:
+            return list(arrays)
+        parts = self.comm.gather(tuple(np.ascontiguousarray(a[: self.n_owned]) for a in arrays))
         if not self.is_root:
             return None
-        out = np.empty((self.n_global, *a.shape[1:]), dtype=a.dtype)
-        for ids, part in zip(self._rank_ids, parts, strict=True):
-            out[ids] = part
+        out = [np.empty((self.n_global, *a.shape[1:]), dtype=a.dtype) for a in arrays]
+        for ids, rank_parts in zip(self._rank_ids, parts, strict=True):
+            for whole, part in zip(out, rank_parts, strict=True):
+                whole[ids] = part
         return out
 
     def sum(self, a: np.ndarray) -> float:
@@ -182,8 +218,8 @@ class Domain:
         process ``state`` itself."""
         if self.size == 1:
             return state
-        u, v, a = (self.gather(x) for x in (state.u, state.v, state.a))
-        return State(u, v, a, state.time, state.step) if self.is_root else None
+        whole = self.gather_many(state.u, state.v, state.a)
+        return State(*whole, state.time, state.step) if self.is_root else None
 
     # -- per-bond arrays (checkpoints) ------------------------------------------------------
 
@@ -241,10 +277,43 @@ class Domain:
         out[outer] = out[rev[outer]]
         return out
 
+    #: the keys of ``provenance``
+    provenance_keys = ("mpi_ranks", "partition", "points_per_rank", "ghosts_per_rank")
+
     def provenance(self) -> dict:
-        """Ranks and partition for the results file's provenance (collective)."""
-        counts = self.comm.allgather(self.n_owned)
-        return {"mpi_ranks": self.size, "partition": self.partition, "points_per_rank": counts}
+        """Ranks, partition, and each rank's owned and ghost points, for the results file's
+        provenance (collective)."""
+        counts = self.comm.allgather((self.n_owned, len(self.global_ids) - self.n_owned))
+        owned, ghosts = (list(c) for c in zip(*counts, strict=True))
+        values = (self.size, self.partition, owned, ghosts)
+        return dict(zip(self.provenance_keys, values, strict=True))
+
+    def traffic_per_rank(self, earlier: Traffic, steps: int, seconds: float) -> list[dict]:
+        """Every rank's communication in ``steps`` time steps (collective), one dict per rank.
+
+        ``earlier`` is a copy of ``comm.traffic`` taken before the steps and ``seconds`` the
+        rank's own wall time, s, in them. Keys: ``rank``, ``owned`` and ``ghosts`` (points),
+        ``halo_neighbours`` (ranks it sends to), ``step_seconds`` (``seconds``),
+        ``messages_per_step`` and ``bytes_per_step`` (sent), ``halo_seconds`` (in the halo
+        exchanges), ``halo_wait_seconds`` (its part waiting for messages), ``collective_seconds``
+        and ``halo_share`` (``halo_seconds / seconds``). Counts include the contact halo.
+        """
+        t = self.comm.traffic.since(earlier)
+        per_step = 1.0 / max(int(steps), 1)
+        mine = {
+            "rank": self.comm.rank,
+            "owned": self.n_owned,
+            "ghosts": len(self.global_ids) - self.n_owned,
+            "halo_neighbours": 0 if self.halo is None else len(self.halo.plan.send_ranks),
+            "step_seconds": seconds,
+            "messages_per_step": t.messages * per_step,
+            "bytes_per_step": t.bytes * per_step,
+            "halo_seconds": t.halo_seconds,
+            "halo_wait_seconds": t.wait_seconds,
+            "collective_seconds": t.collective_seconds,
+            "halo_share": t.halo_seconds / seconds if seconds > 0 else 0.0,
+        }
+        return self.comm.allgather(mine)
 
 
 def agree(comm, fn, *args):

@@ -10,13 +10,16 @@ A rank owns some points and keeps copies (ghosts) of the points it needs from ot
   bond, which needs the far end's coefficients) comes out on the rank as in a serial run, with
   a single exchange of u per step.
 
-Local numbering: owned points first (in global order), then the ghosts grouped by the rank
-that owns them (ranks ascending, global order within a rank), so that each rank's ghosts are
-one block of rows that a message fills in place.
+Local numbering: owned points first, then the ghosts grouped by the rank that owns them (ranks
+ascending, global order within a rank), so that each rank's ghosts are one block of rows that a
+message fills in place. The owned points are ordered by their ``clearance`` from the ghosts,
+the farthest first (global order within a clearance), so that the rows a force needs no ghost
+for are leading blocks, computed while the ghosts' values are on their way.
 """
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -45,6 +48,29 @@ def ghost_layers(points: np.ndarray, owned: np.ndarray, reach: float, layers: in
         taken[frontier] = True
     taken[owned] = False
     return np.flatnonzero(taken).astype(np.int64)
+
+
+def clearance(offsets: np.ndarray, neighbours: np.ndarray, owned: np.ndarray, hops: int = 2) -> np.ndarray:
+    """(k,) int64: for each of the ``owned`` rows (k,) of a part's bonds (CSR ``offsets`` and
+    ``neighbours`` over all its rows, the others its ghosts), the bond hops between it and the
+    nearest ghost less one, at most ``hops``: 0 if its family holds a ghost, 1 if not but a
+    neighbour's does, ...
+
+    A row of clearance c has a force computable without ghost values when the force reads the
+    families of points up to c - 1 bonds away: 1 for a bond-based force, 2 for a state-based one
+    (the dilatation of each neighbour).
+    """
+    n_rows = len(offsets) - 1
+    owners = np.repeat(np.arange(n_rows), np.diff(offsets))
+    near_ghost = np.ones(n_rows, dtype=bool)
+    near_ghost[owned] = False  # rows within the current distance of a ghost
+    level = np.full(len(owned), hops, dtype=np.int64)
+    for c in range(hops):
+        touching = np.bincount(owners, weights=near_ghost[neighbours], minlength=n_rows) > 0
+        reached = touching[owned] & (level == hops)
+        level[reached] = c
+        near_ghost |= touching
+    return level
 
 
 @dataclass(frozen=True)
@@ -84,8 +110,8 @@ class HaloPlan:
 def plan_halo(comm, owned_ids: np.ndarray, ghost_ids: np.ndarray, ghost_owner: np.ndarray) -> HaloPlan:
     """The exchange plan of one rank (collective: every rank calls it).
 
-    ``owned_ids`` (global, sorted) are this rank's points, ``ghost_ids`` its ghosts in local order
-    (grouped by owner rank ascending, global order within) and ``ghost_owner`` their ranks.
+    ``owned_ids`` (global) are this rank's points in local order, ``ghost_ids`` its ghosts in local
+    order (grouped by owner rank ascending, global order within) and ``ghost_owner`` their ranks.
     """
     n_owned = len(owned_ids)
     recv_ranks = np.unique(ghost_owner)
@@ -99,7 +125,8 @@ def plan_halo(comm, owned_ids: np.ndarray, ghost_ids: np.ndarray, ghost_owner: n
         requests[int(r)] = ghost_ids[a:b]
     wanted = comm.alltoall(requests)
     send_ranks = np.array([r for r in range(comm.size) if len(wanted[r])], dtype=np.int64)
-    send_rows = [np.searchsorted(owned_ids, wanted[r]).astype(np.int64) for r in send_ranks]
+    order = np.argsort(owned_ids, kind="stable")
+    send_rows = [order[np.searchsorted(owned_ids, wanted[r], sorter=order)] for r in send_ranks]
     return HaloPlan(n_owned, recv_ranks.astype(np.int64), recv_slices, send_ranks, send_rows)
 
 
@@ -108,7 +135,8 @@ class Halo:
 
     ``start(a)`` posts the receives straight into the ghost rows of ``a`` (each sender fills one
     contiguous block) and the sends of the owned rows the others need; ``finish()`` waits for
-    them. Work on the owned rows may go between the two; ``exchange(a)`` does both.
+    them. Work on the owned rows may go between the two; ``exchange(a)`` does both. The
+    communicator's ``traffic`` counts the messages, bytes and the seconds spent in both.
     """
 
     def __init__(self, comm, plan: HaloPlan):
@@ -116,12 +144,10 @@ class Halo:
         self.plan = plan
         self._pending: list = []
         self._buffers: list = []
-        #: messages and bytes sent by this rank so far
-        self.messages_sent = 0
-        self.bytes_sent = 0
 
     def start(self, a: np.ndarray) -> None:
         """Post the exchange of ``a`` (n_local, ...) C-contiguous; ghost rows are OUT."""
+        began = time.perf_counter()
         p = self.plan
         for r, (lo, hi) in zip(p.recv_ranks, p.recv_slices, strict=True):
             self._pending.append(self.comm.irecv(a[lo:hi], int(r), HALO_TAG))
@@ -129,13 +155,16 @@ class Halo:
             buf = np.ascontiguousarray(a[rows])
             self._buffers.append(buf)
             self._pending.append(self.comm.isend(buf, int(r), HALO_TAG))
-            self.messages_sent += 1
-            self.bytes_sent += buf.nbytes
+        self.comm.traffic.halo_seconds += time.perf_counter() - began
 
     def finish(self) -> None:
         """Wait for the messages of ``start``."""
+        began = time.perf_counter()
         self.comm.waitall(self._pending)
         self._pending, self._buffers = [], []
+        waited = time.perf_counter() - began
+        self.comm.traffic.halo_seconds += waited
+        self.comm.traffic.wait_seconds += waited
 
     def exchange(self, a: np.ndarray) -> None:
         """Fill the ghost rows of ``a`` with their owners' values."""

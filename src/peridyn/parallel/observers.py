@@ -45,18 +45,24 @@ class RootObservers:
         self.observers: list = []
         self.due: list = []
         self.prepare: list = []
+        self.damage_due: list | None = None
         self._damage: np.ndarray | None = None
         self._tensors: dict = {}
 
-    def attach(self, observers: Sequence, due: Sequence[Callable[[int], bool]], prepare=()) -> None:
+    def attach(
+        self, observers: Sequence, due: Sequence[Callable[[int], bool]], prepare=(), damage_due=None
+    ) -> None:
         """Watch with ``observers`` (objects with ``observe(state, solver)``, used on rank 0 only:
         None elsewhere) at the steps where one of ``due`` (callables step -> bool, known on every
         rank) is True; ``prepare``: (due, collective callable(state)) pairs run on every rank
         first at their steps, with the rank's state (e.g. gathering the bonds' intact mask for a
-        checkpoint, writing the pieces of a VTU snapshot)."""
+        checkpoint, writing the pieces of a VTU snapshot). ``damage_due``: callables step ->
+        bool, the steps at which an observer reads ``damage`` (the damage index, a pass over
+        every bond, is then computed and gathered); None: at every step observed."""
         self.observers = list(observers) if self.domain.is_root else []
         self.due = list(due)
         self.prepare = list(prepare)
+        self.damage_due = None if damage_due is None else list(damage_due)
 
     def damage(self) -> np.ndarray:
         """The damage index (n_points,) of the whole body at the last gathered state (rank 0)."""
@@ -77,15 +83,19 @@ class RootObservers:
             for due, prepare in self.prepare:
                 if due(state.step):
                     prepare(state)
-            self.call(state, lambda whole: [obs.observe(whole, solver) for obs in self.observers])
+            damage = self.damage_due is None or any(due(state.step) for due in self.damage_due)
+            self.call(
+                state, lambda whole: [obs.observe(whole, solver) for obs in self.observers], damage=damage
+            )
 
-    def call(self, state: State, fn, tensors: bool = False):
+    def call(self, state: State, fn, tensors: bool = False, damage: bool = True):
         """``fn(state of the whole body)`` on rank 0 after gathering (collective); its result on
         rank 0, None elsewhere. ``tensors``: gather the tensor fields too (for ``fn`` to read
-        through ``tensor_fields``)."""
+        through ``tensor_fields``); ``damage``: gather the damage index (else ``damage()`` gives
+        None until the next call that gathers it)."""
         whole = self.domain.gather_state(state)
         if self.domain.size > 1:
-            self._damage = self.domain.gather(damage_field(self.model))
+            self._damage = self.domain.gather(damage_field(self.model)) if damage else None
             if tensors and self.tensors is not None:
                 self._tensors = {k: self.domain.gather(v) for k, v in self.tensors(state.u).items()}
         return self.domain.on_root(fn, whole)

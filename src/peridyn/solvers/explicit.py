@@ -110,6 +110,10 @@ class ExplicitSolver:
         #: the DOFs whose velocity is Peridigm's difference, and their force acceleration
         self._differenced = self.loading.displaced if prescribed_velocity == "difference" else None
         self._free = None
+        #: under MPI without bond breaking, the force of the rows far from the ghosts is computed
+        #: while u's ghost rows are exchanged (``Model.force_overlapped``); bond breaking reads
+        #: every owned family's stretch first, so it waits for the ghosts
+        self.overlap = self.domain.halo is not None and damage is None
 
     def __repr__(self) -> str:
         damping = self.damping if np.isscalar(self.damping) else f"up to {np.max(self.damping):g}"
@@ -123,10 +127,16 @@ class ExplicitSolver:
         self._acceleration(state)
         return state
 
-    def _acceleration(self, state: State, kick: bool = False) -> None:
+    def _acceleration(self, state: State, kick: bool = False, overlapped: bool = False) -> None:
         """``state.a`` from the forces at ``state.u`` (one fused pass: ``kernels.verlet``), with
-        ``kick`` followed by the closing half step of the velocity, ``v += dt/2 a``."""
-        f = self.model.force(state.u, out=self._force)
+        ``kick`` followed by the closing half step of the velocity, ``v += dt/2 a``.
+        ``overlapped``: the exchange of u's ghost rows has been started, and is finished during
+        the force (``Model.force_overlapped``)."""
+        if overlapped:
+            d = self.domain
+            f = self.model.force_overlapped(state.u, self._force, d.clear_rows, d.n_owned, d.finish_exchange)
+        else:
+            f = self.model.force(state.u, out=self._force)
         if self.contact is not None:
             self.contact.add_force(state.u, f)
         b = self._body_force
@@ -167,9 +177,13 @@ class ExplicitSolver:
         state.time += dt
         state.step += 1
         self.loading.apply_kinematics(state.time, dt, state.u, state.v, rates=differenced is None)
-        self.domain.exchange(state.u)
-        broken = self.damage.update(state.u) if self.damage is not None else 0
-        self._acceleration(state, kick=True)
+        if self.overlap:
+            self.domain.start_exchange(state.u)
+            broken = 0
+        else:
+            self.domain.exchange(state.u)
+            broken = self.damage.update(state.u) if self.damage is not None else 0
+        self._acceleration(state, kick=True, overlapped=self.overlap)
         self.loading.apply_velocities(state.time, state.v)
         if differenced is not None:
             state.v[differenced] = (state.u[differenced] - u_before) / dt + 0.5 * dt * self._free

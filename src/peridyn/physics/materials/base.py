@@ -26,7 +26,7 @@ from __future__ import annotations
 import numpy as np
 
 from peridyn.discretization.body import Body
-from peridyn.discretization.bonds import Bonds
+from peridyn.discretization.bonds import Bonds, range_offsets
 from peridyn.errors import InputError
 from peridyn.kernels.lps import lps_dilatation
 from peridyn.kernels.stress import partial_stress
@@ -81,6 +81,8 @@ class Model:
         # neighbour volume times its volume factor, (n_bonds,) m^3
         self.bond_volume = body.volumes[bonds.neighbours] * bonds.volume_factor
         self._linearisation: BondLinearisation | None = None
+        self._row_offsets_cache: dict = {}
+        self._scratch_cache: dict = {}
 
     @classmethod
     def from_parameters(
@@ -122,6 +124,44 @@ class Model:
     def force(self, u: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
         """Internal force density (n_points, 3), N/m^3, at displacement ``u`` (n_points, 3), m."""
         raise NotImplementedError
+
+    def force_overlapped(
+        self, u: np.ndarray, out: np.ndarray, clear_rows, n_owned: int, finish
+    ) -> np.ndarray:
+        """``force(u, out)`` on the rows ``0 .. n_owned - 1`` of a rank's part (``peridyn.parallel``)
+        while the ghost rows of ``u`` (rows ``n_owned ..``) are on their way: ``finish()`` waits
+        for them. The rows that need no ghost value (the first ``clear_rows[0]`` rows for a
+        force that reads the families of a point's neighbours, else ``clear_rows[1]``; see
+        ``Domain.clear_rows``) are computed before ``finish()``, the others after, each row by
+        the same kernel arithmetic as ``force``; the ghost rows of ``out`` are left zero.
+
+        This default waits first, then computes ``force``.
+        """
+        finish()
+        return self.force(u, out)
+
+    def _row_offsets(self, start: int, stop: int) -> np.ndarray:
+        """The bonds' offsets with only the families of rows ``start .. stop - 1`` kept
+        (``range_offsets``), made once per range."""
+        cache = self._row_offsets_cache
+        if (start, stop) not in cache:
+            cache[(start, stop)] = range_offsets(self.bonds.offsets, start, stop)
+        return cache[(start, stop)]
+
+    def _scratch(self, like: np.ndarray) -> np.ndarray:
+        """A work array of ``like``'s shape and dtype, made once (contents undefined)."""
+        cache = self._scratch_cache
+        key = (like.shape, like.dtype.str)
+        if key not in cache:
+            cache[key] = np.empty_like(like)
+        return cache[key]
+
+    def _refresh_ghosts(self, state: np.ndarray, u: np.ndarray, n_owned: int) -> np.ndarray:
+        """``state`` (``_as_state(u)`` taken before the ghost rows of ``u`` arrived) with them:
+        ``u`` itself if it was not copied, else the copy with its ghost rows converted again."""
+        if state is not u:
+            state[n_owned:] = u[n_owned:]
+        return state
 
     def energy_density(self, u: np.ndarray) -> np.ndarray:
         """Strain energy density (n_points,), J/m^3."""

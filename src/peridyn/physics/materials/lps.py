@@ -200,15 +200,27 @@ class LPSModel(Model):
         bulk = 4.0 * gamma**2 * self.weighted_volume / (15.0 if self.dim == 3 else 8.0)
         return bulk / largest
 
-    def _dilatation(self, u: np.ndarray) -> np.ndarray:
-        """theta into ``self._theta``; ``u`` already in the kernel dtype and layout."""
+    def _dilatation(self, u: np.ndarray, offsets=None, theta=None) -> np.ndarray:
+        """theta into ``theta`` (default ``self._theta``) for the families of ``offsets``
+        (default all); ``u`` already in the kernel dtype and layout."""
         b = self.bonds
+        offsets = b.offsets if offsets is None else offsets
+        theta = self._theta if theta is None else theta
         if self.dtype == np.float32:
             return lps_dilatation_cf(
-                self.x, u, b.offsets, b.neighbours, self.w, b.intact, self._theta_coef, self._theta
+                self.x, u, offsets, b.neighbours, self.w, b.intact, self._theta_coef, theta
             )
         return lps_dilatation(
-            self.x, u, b.offsets, b.neighbours, self.length, self.w, b.intact, self._theta_coef, self._theta
+            self.x, u, offsets, b.neighbours, self.length, self.w, b.intact, self._theta_coef, theta
+        )
+
+    def _pair_force(self, u: np.ndarray, offsets, p: np.ndarray, out: np.ndarray) -> np.ndarray:
+        """The pair-force kernel of the dtype into ``out`` for the families of ``offsets``."""
+        b = self.bonds
+        if self.dtype == np.float32:
+            return lps_pair_force_cf(self.x, u, offsets, b.neighbours, self.w, self.dev, b.intact, p, out)
+        return lps_pair_force(
+            self.x, u, offsets, b.neighbours, self.length, self.w, self.dev, b.intact, p, out
         )
 
     def dilatation(self, u) -> np.ndarray:
@@ -223,14 +235,30 @@ class LPSModel(Model):
         on every call, so broken bonds need no notification.
         """
         out = np.empty_like(self.x) if out is None else out
-        b = self.bonds
         u = self._as_state(u)
         p = np.multiply(self._dilatation(u), self._p_coef, out=self._p)
-        if self.dtype == np.float32:
-            return lps_pair_force_cf(self.x, u, b.offsets, b.neighbours, self.w, self.dev, b.intact, p, out)
-        return lps_pair_force(
-            self.x, u, b.offsets, b.neighbours, self.length, self.w, self.dev, b.intact, p, out
-        )
+        return self._pair_force(u, self.bonds.offsets, p, out)
+
+    def force_overlapped(self, u, out, clear_rows, n_owned, finish):
+        """See ``Model.force_overlapped``. The dilatation of the first ``clear_rows[0]`` rows
+        and the force of the first ``clear_rows[1]`` (whose neighbours are all among the
+        former) need no ghost value; after ``finish()`` the dilatation of every other row (the
+        ghosts' included: an owned point's force reads its neighbours') and the other owned
+        rows' force."""
+        clear, clear_force = clear_rows[0], clear_rows[1]
+        theta, p, p_coef = self._theta, self._p, self._p_coef
+        state = self._as_state(u)
+        self._dilatation(state, self._row_offsets(0, clear), theta)
+        np.multiply(theta[:clear], p_coef[:clear], out=p[:clear])
+        self._pair_force(state, self._row_offsets(0, clear_force), p, out)
+        finish()
+        state = self._refresh_ghosts(state, u, n_owned)
+        rest = self._dilatation(state, self._row_offsets(clear, len(theta)), self._scratch(theta))
+        theta[clear:] = rest[clear:]
+        np.multiply(theta[clear:], p_coef[clear:], out=p[clear:])
+        rest = self._pair_force(state, self._row_offsets(clear_force, n_owned), p, self._scratch(out))
+        out[clear_force:n_owned] = rest[clear_force:n_owned]
+        return out
 
     def energy_density(self, u):
         b = self.bonds

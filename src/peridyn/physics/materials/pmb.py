@@ -144,20 +144,27 @@ class PMBModel(Model):
         ``bonds.intact`` on every call, so broken bonds need no notification.
         """
         out = np.empty_like(self.x) if out is None else out
+        return self._kernel_force(self._as_state(u), self.bonds.offsets, out)
+
+    def force_overlapped(self, u, out, clear_rows, n_owned, finish):
+        """See ``Model.force_overlapped``: a bond-based force needs no ghost value on the first
+        ``clear_rows[0]`` rows."""
+        clear = clear_rows[0]
+        state = self._as_state(u)
+        self._kernel_force(state, self._row_offsets(0, clear), out)
+        finish()
+        state = self._refresh_ghosts(state, u, n_owned)
+        rest = self._kernel_force(state, self._row_offsets(clear, n_owned), self._scratch(out))
+        out[clear:n_owned] = rest[clear:n_owned]
+        return out
+
+    def _kernel_force(self, state, offsets, out):
+        """The force kernel of the dtype on ``state`` (``_as_state``) with family ``offsets``."""
         b = self.bonds
         if self.dtype == np.float32:
-            return pmb_force_cf(
-                self.x, self._as_state(u), b.offsets, b.neighbours, self.bond_stiffness, b.intact, out
-            )
+            return pmb_force_cf(self.x, state, offsets, b.neighbours, self.bond_stiffness, b.intact, out)
         return pmb_force(
-            self.x,
-            self._as_state(u),
-            b.offsets,
-            b.neighbours,
-            self.inv_length,
-            self.bond_stiffness,
-            b.intact,
-            out,
+            self.x, state, offsets, b.neighbours, self.inv_length, self.bond_stiffness, b.intact, out
         )
 
     def energy_density(self, u):
