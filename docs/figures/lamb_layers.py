@@ -15,7 +15,10 @@ errors at 150 kHz of the x-axis line, ``fk_error``) and draws
 discretisations, simulation markers where run). The runs not simulated show the estimated
 peak memory (``peridyn validate``, :func:`peridyn.jobs.estimate.estimate_case`).
 
-    PYTHONPATH=src python docs/figures/lamb_layers.py LAYERS BLOCH
+    PYTHONPATH=src python docs/figures/lamb_layers.py LAYERS BLOCH [--doc]
+
+``--doc`` also puts the table in docs/lamb.md in place of the one there (the first table after
+the heading "Simulation against Bloch").
 """
 
 from __future__ import annotations
@@ -37,6 +40,8 @@ from peridyn.jobs.sweep_spec import expand  # noqa: E402
 ROOT = Path(__file__).resolve().parents[2]
 SWEEP = ROOT / "sweeps" / "lamb_layers.yaml"
 FIGURE = Path(__file__).with_name("lamb_layers.png")
+DOC = ROOT / "docs" / "lamb.md"
+HEADING = "### Simulation against Bloch"
 MODES = ("S0", "A0")
 FREQUENCIES = (110e3, 150e3, 185e3, 225e3)
 #: The accuracy the issue asks of a discretisation, |k / k0 - 1|.
@@ -151,13 +156,25 @@ def figure(data: list[dict], path: Path) -> Path:
     return path
 
 
+def write_doc(text: str, path: Path = DOC) -> None:
+    """Replace the first Markdown table after :data:`HEADING` in ``path`` with ``text``."""
+    lines = path.read_text().splitlines(keepends=True)
+    start = next(i for i, line in enumerate(lines) if line.startswith(HEADING))
+    first = next(i for i in range(start, len(lines)) if lines[i].startswith("|"))
+    end = next((i for i in range(first, len(lines)) if not lines[i].startswith("|")), len(lines))
+    path.write_text("".join(lines[:first]) + text + "\n" + "".join(lines[end:]))
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("layers", type=Path, help="output folder of sweeps/lamb_layers.yaml")
     parser.add_argument("bloch", type=Path, help="output folder of sweeps/lamb_layers_bloch.yaml")
+    parser.add_argument("--doc", action="store_true", help="also put the table in docs/lamb.md")
     args = parser.parse_args()
     data = rows(args.layers, args.bloch)
     print(table(data))
+    if args.doc:
+        write_doc(table(data))
     for source in ("bloch", "simulation"):
         hits = [
             f"{r['layers']} layers at {r['spacing'] * 1e3:g} mm"
