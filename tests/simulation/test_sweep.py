@@ -27,14 +27,14 @@ import peridyn
 from peridyn.errors import InputError
 from peridyn.io.dataset import load_sweep
 from peridyn.jobs.sweep import run_sweep
-from peridyn.jobs.sweep_run import CRASH_ONCE_ENV, RECORD, run_tasks
+from peridyn.jobs.sweep_run import CRASH_ONCE_ENV, RECORD, run_tasks, threads_per_worker
 
 xr = pytest.importorskip("xarray", reason="sweeps need the sweep extra (pip install 'peridyn[sweep]')")
 ROOT = Path(__file__).resolve().parents[2]
 SRC = str(Path(peridyn.__file__).parents[1])
 DEMO = ROOT / "sweeps" / "demo.yaml"
 #: Values that depend on the machine or the moment, not on the numbers.
-VOLATILE = ("seconds",)
+VOLATILE = ("seconds", "finished")
 
 
 def tiny_sweep(tmp_path, vary, name="tiny", time_s=5e-6) -> Path:
@@ -196,10 +196,43 @@ def test_bloch_sweep_reports_rayleigh_lamb_theory(tmp_path):
         assert float(ds[f"{key}.error"]) == pytest.approx(k / m.wavenumber_rad_m - 1, rel=1e-12)
 
 
+@pytest.mark.parametrize("executor", ["serial", "processes", "dask"])
+def test_threads_per_run_are_set_before_each_run(tmp_path, executor):
+    """--threads 1: every run's kernels ran with 1 numba thread (its record), whatever the
+    executor's default (cores // workers, or the process's own); the serial sweep gives this
+    process its threads back. The runs end one after the other, at the moments recorded."""
+    import numba
+
+    if executor == "dask":
+        pytest.importorskip("dask.distributed", reason="the dask executor needs the sweep extra")
+    before = numba.get_num_threads()
+    path = tiny_sweep(tmp_path, {"product": {"material.density": [7850, 7000, 6000]}})
+    start = time.time()
+    summary = run_sweep(path, tmp_path / "out", executor=executor, workers=1, threads=1)
+    assert summary["threads"] == 1 and summary["completed"] == 3
+    records = [json.loads(p.read_text()) for p in (tmp_path / "out").glob(f"runs/*/{RECORD}")]
+    assert [r["threads"] for r in records] == [1, 1, 1]
+    ds = load_sweep(summary["dataset"])
+    finished = np.sort(ds["finished"].values)
+    assert start < finished[0] and np.all(np.diff(finished) > 0) and finished[-1] < time.time()
+    assert numba.get_num_threads() == before
+
+
+def test_default_threads_share_the_cores_between_the_workers(tmp_path):
+    path = tiny_sweep(tmp_path, {"product": {"material.density": [7850, 7000]}})
+    summary = run_sweep(path, tmp_path / "out", executor="processes", workers=2)
+    records = [json.loads(p.read_text()) for p in (tmp_path / "out").glob(f"runs/*/{RECORD}")]
+    assert summary["threads"] == threads_per_worker(2) and {r["threads"] for r in records} == {
+        summary["threads"]
+    }
+
+
 def test_bad_executor_arguments_are_refused_before_anything_runs(tmp_path):
     path = tiny_sweep(tmp_path, {"product": {"material.density": [7850]}})
     with pytest.raises(InputError, match="use it with --executor dask"):
         run_sweep(path, tmp_path / "out", executor="processes", scheduler="tcp://127.0.0.1:8786")
     with pytest.raises(InputError, match="executor must be one of"):
         run_sweep(path, tmp_path / "out", executor="threads")
+    with pytest.raises(InputError, match="threads must be a whole number >= 1"):
+        run_sweep(path, tmp_path / "out", executor="processes", threads=0)
     assert not (tmp_path / "out").exists()

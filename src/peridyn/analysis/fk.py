@@ -35,7 +35,6 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy.fft import next_fast_len
-from scipy.signal import get_window
 from scipy.special import hankel1
 
 from peridyn.errors import InputError
@@ -670,6 +669,8 @@ def _refine(axis: np.ndarray, values: np.ndarray, i: int) -> float:
 def _window(window, n: int) -> np.ndarray:
     if window is None:
         return np.ones(n)
+    from scipy.signal import get_window  # here: scipy.signal takes ~0.5 s to import (a run's start)
+
     try:
         return get_window(window, n)
     except (ValueError, TypeError) as exc:

@@ -51,7 +51,7 @@ def add_progress_flags(parser: argparse.ArgumentParser) -> None:
 
 
 def add_executor_flags(parser: argparse.ArgumentParser, what: str = "runs") -> None:
-    """``--executor``, ``--workers`` and ``--scheduler``: where the runs of a sweep run
+    """``--executor``, ``--workers``, ``--threads`` and ``--scheduler``: where the runs of a sweep run
     (``peridyn.jobs.sweep_run``); ``what`` names them in the help."""
     from peridyn.jobs.sweep_run import EXECUTORS
 
@@ -66,7 +66,16 @@ def add_executor_flags(parser: argparse.ArgumentParser, what: str = "runs") -> N
         type=positive_int,
         default=1,
         metavar="N",
-        help="worker processes (processes, local dask cluster); each gets cores // N threads",
+        help="worker processes (processes, local dask cluster)",
+    )
+    parser.add_argument(
+        "--threads",
+        type=positive_int,
+        default=None,
+        metavar="N",
+        help=f"threads per run (numba; BLAS and OpenMP in the workers started here), set before "
+        f"each of the {what} starts (default: cores // workers with processes and a local dask "
+        "cluster, else the process's or the cluster workers' own)",
     )
     parser.add_argument(
         "--scheduler",

@@ -27,7 +27,7 @@ from peridyn.cli.options import (
 from peridyn.errors import InputError
 
 #: The sweep's summary keys the study's summary keeps (under ``sweep``).
-SWEEP_KEYS = ("runs", "completed", "failed", "skipped", "dataset", "executor", "workers")
+SWEEP_KEYS = ("runs", "completed", "failed", "skipped", "dataset", "executor", "workers", "threads")
 
 
 def register(sub) -> None:
@@ -130,6 +130,7 @@ def _study(args, case, out, spacings, factors, series, references, start) -> dic
         args.overrides,
         executor=args.executor,
         workers=args.workers,
+        threads=args.threads,
         scheduler=args.scheduler,
         overwrite=args.overwrite,
         progress=say,

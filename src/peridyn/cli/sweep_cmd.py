@@ -39,6 +39,7 @@ def run(args) -> dict:
         args.output,
         executor=args.executor,
         workers=args.workers,
+        threads=args.threads,
         scheduler=args.scheduler,
         overwrite=args.overwrite,
         progress=None if bar is None else _runs(bar),

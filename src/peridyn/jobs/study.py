@@ -136,6 +136,7 @@ def run_levels(
     overwrite: bool = False,
     progress=None,
     command: str | None = None,
+    threads: int | None = None,
 ) -> tuple[list[StudyRun], dict]:
     """Solve the modal problem of every (spacing, horizon factor) level as a sweep.
 
@@ -157,7 +158,7 @@ def run_levels(
         Modes per run (rigid included); None keeps the case's ``solver.modes``.
     overrides : sequence of "key=value"
         Applied to every run before the spacing and horizon.
-    executor, workers, scheduler, overwrite, command
+    executor, workers, scheduler, overwrite, command, threads
         As for :func:`peridyn.jobs.sweep.run_sweep`.
     progress : callable(str) or None
         Receives one line per level as it ends.
@@ -201,6 +202,7 @@ def run_levels(
         out,
         executor=executor,
         workers=workers,
+        threads=threads,
         scheduler=scheduler,
         overwrite=overwrite,
         command=command,

@@ -33,7 +33,7 @@ from peridyn.jobs.sweep_run import (
     execute,
     read_record,
     run_tasks,
-    threads_per_worker,
+    run_threads,
 )
 from peridyn.jobs.sweep_spec import Sweep, expand
 
@@ -52,6 +52,9 @@ NOT_RESULTS = {
     "step_seconds",
     "peak_memory_bytes",
 }
+#: Dataset variables of every sweep that time its runs, not results: wall time (s) and the
+#: moment each run ended (Unix time, s).
+TIMINGS = ("seconds", "finished")
 #: The most results drawn against a parameter when ``outputs.scalars`` does not choose them.
 MAX_FIGURES = 12
 
@@ -80,6 +83,7 @@ def run_sweep(
     overrides=(),
     first: int | None = None,
     on_record=None,
+    threads: int | None = None,
 ) -> dict:
     """Run the sweep file ``path``; returns its summary.
 
@@ -91,8 +95,7 @@ def run_sweep(
         Default ``peridyn-out/<sweep name>``.
     executor : "serial", "processes" or "dask"
     workers : int
-        Worker processes (``processes`` and a local dask cluster); each runs with
-        ``cores // workers`` numba threads.
+        Worker processes (``processes`` and a local dask cluster).
     scheduler : str or None
         Address of a running dask scheduler (``executor="dask"`` only).
     overwrite : bool
@@ -107,12 +110,17 @@ def run_sweep(
     on_record : callable(record) or None
         Called in this process with each run's record as the run ends
         (:mod:`peridyn.jobs.sweep_run`), in the order the runs end.
+    threads : int or None
+        Threads per run (numba; with processes and a local dask cluster also BLAS and
+        OpenMP). Default: ``cores // workers`` for processes and a local dask cluster, the
+        process's own threads for serial, the workers' own setting on a ``scheduler``
+        cluster (:func:`peridyn.jobs.sweep_run.run_threads`).
 
     Returns
     -------
     dict
         ``runs``, ``completed``, ``failed``, ``skipped``, ``seconds``, ``dataset`` (path),
-        ``output_dir``, ``figures`` and ``executor``, ``workers``.
+        ``output_dir``, ``figures`` and ``executor``, ``workers``, ``threads`` (None: not set).
 
     Raises
     ------
@@ -128,6 +136,7 @@ def run_sweep(
         )
     if not isinstance(workers, int) or workers < 1:
         raise InputError(f"workers must be a whole number >= 1, got {workers!r}")
+    threads = run_threads(threads, executor, workers, scheduler)
     require_xarray()
     sweep = expand(path, overrides, first)
     out = Path(output_dir or Path("peridyn-out") / sweep.name)
@@ -136,7 +145,6 @@ def run_sweep(
     (out / "runs").mkdir(parents=True, exist_ok=True)
     _write_manifest(sweep, out)
     collector = Collector(sweep, out)
-    threads = None if executor == "serial" or scheduler is not None else threads_per_worker(workers)
     reference_dir = _reference(sweep, out, overwrite)
     tasks = []
     for run in sweep.runs:
@@ -205,6 +213,7 @@ def run_sweep(
         "figures": [str(p) for p in figures],
         "executor": executor,
         "workers": 1 if executor == "serial" else workers,
+        "threads": threads,
     }
 
 
@@ -356,6 +365,7 @@ class Collector:
             "status": [rec["status"] if rec else "pending" for rec in records],
             "error": [rec["error"] if rec else "" for rec in records],
             "seconds": [rec["seconds"] if rec else None for rec in records],
+            "finished": [rec.get("finished") if rec else None for rec in records],
         }
         for name in names:
             table[name] = [row.get(name) for row in flat]
@@ -423,7 +433,7 @@ def _draw_figures(sweep: Sweep, ds, out: Path) -> list[Path]:
             n
             for n in ds.data_vars
             if ds[n].dims == ("run",)
-            and n != "seconds"
+            and n not in TIMINGS
             and np.issubdtype(ds[n].dtype, np.number)
             and _varies(ds[n].values)
         ][:MAX_FIGURES]

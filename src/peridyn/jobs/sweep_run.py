@@ -3,7 +3,8 @@ many (``serial``, ``processes``, ``dask``), each reporting every finished run as
 
 A run's record (``run.json`` in its folder, written atomically when the run ends) holds its
 id, index, parameters, case hash, status (``complete``, ``failed: <reason>`` or
-``interrupted ...``), error text, wall time and the job's summary. A run that raises is
+``interrupted ...``), error text, numba threads, wall time, the moment it ended (Unix time, s)
+and the job's summary. A run that raises is
 recorded as failed and never stops the sweep; a worker process that dies is replaced and its
 runs are submitted again (at most :data:`MAX_ATTEMPTS` times each).
 """
@@ -48,7 +49,9 @@ class RunTask:
     base_dir : str
         Folder of the base case (relative paths of the case are read from it).
     threads : int or None
-        numba threads for the run (None: leave the worker's setting).
+        numba threads for the run, set before it starts (None: leave the worker's setting;
+        a worker process started by the sweep also has its BLAS and OpenMP pools sized to it,
+        :func:`worker_environment`).
     reference_dir : str or None
         A modal run's folder to compare this modal run's modes with (``comparison`` in the
         summary: frequency change and MAC of each reference mode).
@@ -76,7 +79,7 @@ def execute(task: RunTask) -> dict:
     if task.threads is not None:
         set_threads(task.threads)
     start = time.perf_counter()
-    record = _identity(task)
+    record = {**_identity(task), "threads": _numba_threads()}
     try:
         summary = _job(task)
         record.update(status="complete", error="", summary=summary)
@@ -85,6 +88,7 @@ def execute(task: RunTask) -> dict:
     except Exception as exc:  # noqa: BLE001 - a failed run is recorded and the sweep goes on
         record.update(status=end_status(exc), error=f"{type(exc).__name__}: {exc}", summary=None)
     record["seconds"] = time.perf_counter() - start
+    record["finished"] = time.time()
     write_record(task.run_dir, record)
     return record
 
@@ -142,6 +146,13 @@ def set_threads(n: int) -> None:
     numba.set_num_threads(max(1, min(n, numba.config.NUMBA_NUM_THREADS)))
 
 
+def _numba_threads() -> int:
+    """The numba threads this process's kernels run with."""
+    import numba
+
+    return numba.get_num_threads()
+
+
 def write_record(run_dir, record: dict) -> None:
     """Write ``<run_dir>/run.json`` atomically."""
     path = Path(run_dir) / RECORD
@@ -168,6 +179,25 @@ def _builtin(obj):
 def threads_per_worker(workers: int) -> int:
     """numba threads for each of ``workers`` workers so that together they use the cores once."""
     return max(1, available_cores() // max(1, workers))
+
+
+def run_threads(threads: int | None, executor: str, workers: int, scheduler: str | None) -> int | None:
+    """Threads per run (``--threads``): ``threads`` when given, else ``cores // workers`` for the
+    workers a sweep starts itself (processes, a local dask cluster) and None (the process's or
+    the cluster workers' own setting) for the serial executor and a ``--scheduler`` cluster.
+
+    Raises
+    ------
+    InputError
+        ``threads`` is not a whole number >= 1.
+    """
+    if threads is not None:
+        if isinstance(threads, bool) or not isinstance(threads, int) or threads < 1:
+            raise InputError(f"threads must be a whole number >= 1, got {threads!r}")
+        return threads
+    if executor == "serial" or scheduler is not None:
+        return None
+    return threads_per_worker(workers)
 
 
 def available_cores() -> int:
@@ -200,9 +230,10 @@ def run_tasks(
     if not tasks and executor != "dask":
         return
     if executor == "serial":
-        for task in tasks:
-            if not on_done(execute(task)):
-                return
+        with numba_threads_kept():
+            for task in tasks:
+                if not on_done(execute(task)):
+                    return
     elif executor == "processes":
         _run_processes(tasks, on_done, workers)
     else:
@@ -280,6 +311,7 @@ def _lost(task: RunTask, reason: str) -> dict:
         "error": reason,
         "summary": None,
         "seconds": 0.0,
+        "finished": time.time(),
     }
     write_record(task.run_dir, record)
     return record
@@ -322,6 +354,18 @@ def _run_dask(tasks, on_done, workers: int, scheduler: str | None) -> None:
         client.close()
         if cluster is not None:
             cluster.close()
+
+
+@contextmanager
+def numba_threads_kept() -> Iterable[None]:
+    """Within the block, runs may set this process's numba threads; they are restored after."""
+    import numba
+
+    before = numba.get_num_threads()
+    try:
+        yield
+    finally:
+        numba.set_num_threads(before)
 
 
 @contextmanager
