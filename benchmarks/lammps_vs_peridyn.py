@@ -133,6 +133,7 @@ def main(argv: list[str] | None = None) -> dict:
         "lammps_runs": lammps,
         "lammps_best": best_l,
         "peridyn_threads": peridyn[0]["threads"],
+        "peridyn_runs": peridyn,  # every round's full ``peridyn bench`` result (roofs included)
         "rows": rows,
     }
     args.output.write_text(json.dumps(record, indent=2) + "\n")
