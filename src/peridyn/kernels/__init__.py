@@ -112,7 +112,8 @@ def stack_array(size, dtype):
     NumPy array, even one allocated inside the kernel, is opaque to it and blocks the
     vectorisation. Allocated once per call of the compiled loop body, whatever the number
     of iterations; it lives until the kernel returns. With the JIT off (``NUMBA_DISABLE_JIT``)
-    this plain function runs instead: a NumPy array.
+    this plain function runs instead: a NumPy array. As with :func:`bond_differences`, numba's
+    on-disk cache of a kernel does not notice edits here: delete the cached kernels after one.
     """
     return np.empty(size, dtype)
 
