@@ -16,15 +16,23 @@ ROW_KEYS = {
     "bonds",
     "bond_updates_per_s",
     "bytes_per_bond",
-    "roofline_fraction",
+    "memory_roof_bond_updates_per_s",
+    "memory_roof_fraction",
+    "sqrt_per_bond",
+    "div_per_bond",
+    "compute_roof_bond_updates_per_s",
+    "compute_roof_fraction",
     "speedup_vs_baseline",
 }
 TINY_TRIAD = 1 << 16
 
 
 def _check(result, points):
-    assert set(result) == {"bandwidth_bytes_per_s", "threads", "results"}
-    assert result["bandwidth_bytes_per_s"] > 0
+    assert set(result) == {"bandwidth_bytes_per_s", "sqrt_per_s", "div_per_s", "threads", "results"}
+    bandwidth = result["bandwidth_bytes_per_s"]
+    assert bandwidth > 0
+    for rates in (result["sqrt_per_s"], result["div_per_s"]):
+        assert set(rates) == {"float64", "float32"} and min(rates.values()) > 0
     assert isinstance(result["threads"], int) and result["threads"] >= 1
     rows = result["results"]
     assert [(r["model"], r["dtype"]) for r in rows] == list(benchmark.ROWS)
@@ -34,7 +42,14 @@ def _check(result, points):
         assert r["bonds"] > 0
         assert r["bond_updates_per_s"] > 0
         assert r["bytes_per_bond"] > 0
-        assert r["roofline_fraction"] > 0
+        # the roofs as the module docstring defines them, from the rates the result reports
+        rate = r["bond_updates_per_s"]
+        assert r["memory_roof_bond_updates_per_s"] == pytest.approx(bandwidth / r["bytes_per_bond"])
+        assert r["memory_roof_fraction"] == pytest.approx(rate / r["memory_roof_bond_updates_per_s"])
+        seconds = r["sqrt_per_bond"] / result["sqrt_per_s"][r["dtype"]]
+        seconds += r["div_per_bond"] / result["div_per_s"][r["dtype"]]
+        assert r["compute_roof_bond_updates_per_s"] == pytest.approx(1 / seconds)
+        assert r["compute_roof_fraction"] == pytest.approx(rate / r["compute_roof_bond_updates_per_s"])
         assert r["speedup_vs_baseline"] > 0
     assert rows[0]["speedup_vs_baseline"] == pytest.approx(1.0)
 
@@ -57,6 +72,18 @@ def test_bytes_per_bond_counts_the_per_bond_arrays():
     assert benchmark.bytes_per_bond("pmb-baseline", "float64") == 4 + 8 + 8 + 1
     assert benchmark.bytes_per_bond("pmb", "float32") == 4 + 4 + 1
     assert benchmark.bytes_per_bond("lps", "float64") == 2 * (4 + 8 + 8 + 1)
+
+
+def test_ops_per_bond_counts_the_kernels_square_roots_and_divisions():
+    """Counted in the kernels' loops (``kernels.pmb``, ``kernels.lps``): the baseline divides
+    twice, the float64 PMB kernel once; float32 recomputes |xi| (a second square root)."""
+    assert benchmark.ops_per_bond("pmb-baseline", "float64") == (1, 2)
+    assert benchmark.ops_per_bond("pmb", "float64") == (1, 1)
+    assert benchmark.ops_per_bond("pmb", "float32") == (2, 1)
+    assert benchmark.ops_per_bond("lps", "float64") == (2, 1)
+    assert benchmark.ops_per_bond("lps", "float32") == (4, 2)
+    with pytest.raises(InputError):
+        benchmark.ops_per_bond("lps", "float16")
 
 
 def test_bad_arguments():

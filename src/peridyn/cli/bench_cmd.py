@@ -3,8 +3,9 @@
 Without --case: times one explicit-step force evaluation of the baseline PMB loop and
 of the PMB and LPS models (float64 and float32, through model.force) on a cube of
 about 100k points (1 mm spacing, horizon 3.015 spacings, no partial volumes unless
---partial-volumes), next to the machine's triad memory bandwidth. Best of --repeat
-interleaved rounds after a warm-up. See peridyn.jobs.bench for what is counted.
+--partial-volumes), next to the machine's triad memory bandwidth and square-root and
+division throughput: each row's share of the memory roof and of the compute roof. Best
+of --repeat interleaved rounds after a warm-up. See peridyn.jobs.bench for what is counted.
 
 With --case CASE.yaml (an explicit case, --set overrides applied): builds the case
 as `peridyn run` does and times --steps whole steps (force, breaking test, contact,

@@ -37,8 +37,19 @@ arrays the kernel reads, summed over its passes (:func:`bytes_per_bond`):
 Not counted: the neighbours' coordinates, displacements and per-point coefficients
 (gathered, but neighbours are close in index on a grid, so they come from cache), the
 CSR offsets and the force written (per point, amortised over ~100 bonds).
-``roofline_fraction`` = bond_updates_per_s x bytes_per_bond / bandwidth: the share of
-the triad bandwidth that this streaming alone uses (1 would be memory bound).
+
+Two roofs, each a bond-update rate that one resource alone would allow:
+
+- memory roof = bandwidth / bytes_per_bond: streaming the per-bond arrays at the triad
+  bandwidth; ``memory_roof_fraction`` = bond_updates_per_s / memory roof (1 would be
+  memory bound);
+- compute roof = 1 / (n_sqrt / sqrt rate + n_div / division rate): issuing the row's
+  square roots and divisions per bond (:func:`ops_per_bond`; they share the divider
+  unit on x86 cores, so their times add) at the packed throughput measured by the
+  probes of ``kernels.roof`` (in-cache arrays, one row per numba thread, the row's
+  dtype; best of ``max(repeat, 5)``); ``compute_roof_fraction`` = bond_updates_per_s /
+  compute roof. The rest of a bond update (gathers, multiplies, adds) is not counted:
+  the larger fraction says which of the two resources is closer to being the limit.
 """
 
 from __future__ import annotations
@@ -53,6 +64,7 @@ from peridyn.discretization import geometry
 from peridyn.discretization.bonds import find_bonds
 from peridyn.errors import InputError
 from peridyn.kernels.pmb import pmb_force_baseline
+from peridyn.kernels.roof import div_probe, sqrt_probe
 from peridyn.kernels.triad import triad
 from peridyn.physics.materials import make_model
 
@@ -71,6 +83,17 @@ ROWS = (
     ("lps", "float64"),
     ("lps", "float32"),
 )
+#: Square roots and divisions per bond update of each row (both passes for LPS).
+OPS_PER_BOND = {
+    ("pmb-baseline", "float64"): (1, 2),  # |Y|; (r - L) / L and c s / r
+    ("pmb", "float64"): (1, 1),  # 1 / |Y|
+    ("pmb", "float32"): (2, 1),  # |Y|, |xi|; one division
+    ("lps", "float64"): (2, 1),  # |Y| in each pass; one division in the force pass
+    ("lps", "float32"): (4, 2),  # |Y|, |xi| and one division in each pass
+}
+#: Compute probes: elements per row (in L1) and in-place iterations per call.
+PROBE_ELEMENTS = 1024
+PROBE_REPS = 4000
 #: Steel-like constants of the benchmark material (do not affect the timings).
 E, NU, DENSITY = 200e9, 0.25, 7850.0
 
@@ -82,6 +105,27 @@ def triad_bandwidth(elements: int = DEFAULT_TRIAD_ELEMENTS, repeat: int = 10) ->
     a = np.zeros(elements)
     triad(a, b, c, 3.0)  # compile (or load) and touch the pages
     return 3 * a.itemsize * elements / best_seconds(lambda: triad(a, b, c, 3.0), repeat)
+
+
+def op_rates(dtype: str, repeat: int = 5) -> tuple[float, float]:
+    """Square roots and divisions per second in ``dtype`` on all numba threads (``kernels.roof``)."""
+    # full-mantissa operands (see kernels.roof): a ramp over [1, 2) and c = 1.7
+    start = np.linspace(1.0, 2.0, PROBE_ELEMENTS, endpoint=False, dtype=dtype)
+    buf = np.tile(start, (numba.get_num_threads(), 1))
+    c = buf.dtype.type(1.7)
+    sqrt_probe(buf, c, 1)  # compile (or load)
+    div_probe(buf, c, 1)
+    count = buf.size * PROBE_REPS
+    sqrt_rate = count / best_seconds(lambda: sqrt_probe(buf, c, PROBE_REPS), repeat)
+    div_rate = count / best_seconds(lambda: div_probe(buf, c, PROBE_REPS), repeat)
+    return sqrt_rate, div_rate
+
+
+def ops_per_bond(model: str, dtype: str) -> tuple[int, int]:
+    """(square roots, divisions) one bond update of the row computes (see the module docstring)."""
+    if (model, dtype) not in OPS_PER_BOND:
+        raise InputError(f"unknown benchmark row {model!r} {dtype}")
+    return OPS_PER_BOND[model, dtype]
 
 
 def best_seconds(call: Callable[[], object], repeat: int) -> float:
@@ -196,11 +240,17 @@ def run_benchmark(
             best[key] = min(best[key], time.perf_counter() - t0)
     say("triad bandwidth")
     bandwidth = triad_bandwidth(triad_elements, max(repeat, 5))
+    say("square-root and division throughput")
+    rates = {dtype: op_rates(dtype, max(repeat, 5)) for dtype in ("float64", "float32")}
     base_rate = bonds.n_bonds / best["pmb-baseline", "float64"]
     results = []
     for name, dtype in ROWS:
         rate = bonds.n_bonds / best[name, dtype]
         nbytes = bytes_per_bond(name, dtype)
+        n_sqrt, n_div = ops_per_bond(name, dtype)
+        sqrt_rate, div_rate = rates[dtype]
+        memory_roof = bandwidth / nbytes
+        compute_roof = 1.0 / (n_sqrt / sqrt_rate + n_div / div_rate)
         results.append(
             {
                 "model": name,
@@ -209,12 +259,19 @@ def run_benchmark(
                 "bonds": int(bonds.n_bonds),
                 "bond_updates_per_s": float(rate),
                 "bytes_per_bond": int(nbytes),
-                "roofline_fraction": float(rate * nbytes / bandwidth),
+                "memory_roof_bond_updates_per_s": float(memory_roof),
+                "memory_roof_fraction": float(rate / memory_roof),
+                "sqrt_per_bond": n_sqrt,
+                "div_per_bond": n_div,
+                "compute_roof_bond_updates_per_s": float(compute_roof),
+                "compute_roof_fraction": float(rate / compute_roof),
                 "speedup_vs_baseline": float(rate / base_rate),
             }
         )
     return {
         "bandwidth_bytes_per_s": float(bandwidth),
+        "sqrt_per_s": {dtype: float(r[0]) for dtype, r in rates.items()},
+        "div_per_s": {dtype: float(r[1]) for dtype, r in rates.items()},
         "threads": int(numba.get_num_threads()),
         "results": results,
     }
@@ -226,17 +283,24 @@ def format_table(result: dict) -> str:
     head = (
         f"{rows[0]['points']} points, {rows[0]['bonds']} directed bonds, "
         f"{result['threads']} numba threads, triad bandwidth "
-        f"{result['bandwidth_bytes_per_s'] / 1e9:.1f} GB/s"
+        f"{result['bandwidth_bytes_per_s'] / 1e9:.1f} GB/s; square roots / divisions per ns: "
+        + ", ".join(
+            f"{dtype} {result['sqrt_per_s'][dtype] / 1e9:.2f} / {result['div_per_s'][dtype] / 1e9:.2f}"
+            for dtype in result["sqrt_per_s"]
+        )
     )
     lines = [
         head,
         "",
-        f"{'model':<13} {'dtype':<8} {'M bond/s':>9} {'x baseline':>10} {'B/bond':>7} {'roofline':>8}",
+        f"{'model':<13} {'dtype':<8} {'M bond/s':>9} {'x baseline':>10} {'B/bond':>7} "
+        f"{'mem roof':>9} {'share':>6} {'sqrt,div':>8} {'cpu roof':>9} {'share':>6}",
     ]
     for r in rows:
         lines.append(
             f"{r['model']:<13} {r['dtype']:<8} {r['bond_updates_per_s'] / 1e6:>9.1f} "
             f"{r['speedup_vs_baseline']:>10.2f} {r['bytes_per_bond']:>7d} "
-            f"{r['roofline_fraction']:>8.2f}"
+            f"{r['memory_roof_bond_updates_per_s'] / 1e6:>9.0f} {r['memory_roof_fraction']:>6.2f} "
+            f"{str(r['sqrt_per_bond']) + ',' + str(r['div_per_bond']):>8} "
+            f"{r['compute_roof_bond_updates_per_s'] / 1e6:>9.0f} {r['compute_roof_fraction']:>6.2f}"
         )
     return "\n".join(lines)

@@ -17,11 +17,19 @@ and a debugger):
 
 How the force kernels are written (what makes them fast, see ``benchmarks/RESULTS.md``):
 
-- the family of point ``i`` is taken as slices ``nbr[lo:hi]``, ``k[lo:hi]``... indexed
-  from 0 and the neighbour index is read as unsigned, so that numba emits no
-  negative-index wraparound code and LLVM sees unit-stride per-bond loads: the inner
-  loop then vectorises (4 bonds per AVX2 register in float64, 8 in float32), the
-  neighbours' coordinates being loaded lane by lane;
+- the family of point ``i`` is taken in chunks of ``CHUNK`` bonds, each as slices
+  ``nbr[c:c + m]``, ``k[c:c + m]``... indexed from 0, and the neighbour index is read as
+  unsigned, so that numba emits no negative-index wraparound code and LLVM sees
+  unit-stride per-bond loads;
+- each chunk takes two loops. The first computes each bond's scalar force (or dilatation
+  term) and its ``Y`` and writes them to a small buffer on the stack
+  (:func:`stack_array`); it has no sum, so LLVM vectorises it (gathers of the
+  neighbours' coordinates, packed square roots and divisions). The second adds the
+  chunk's terms to the point's sums one bond after the other, in the written order. A
+  single loop would not vectorise: without the "reassoc" flag (see ``FASTMATH``) LLVM
+  keeps a sum's order, and it only vectorises a sum it may reorder; the bond loop then
+  ran at the scalar divider's rate. Both loops round exactly as the single loop did
+  (same operations, same order: the same bits);
 - ``x`` and ``u`` are read through flat views (``x.reshape(3 n)``), so the address
   of ``x[j, a]`` is ``3 j + a`` with a compile-time stride;
 - broken bonds are masked by a select on ``intact`` (no branch in the loop);
@@ -43,6 +51,15 @@ Two forms of the stretch are used:
 """
 
 import numba
+import numpy as np
+from numba import types
+from numba.core import cgutils
+from numba.extending import intrinsic, overload
+
+#: Bonds per chunk of the force kernels' two-loop form (see above); the stack buffer of a
+#: kernel holds 4 values per bond of a chunk (``CHUNK_BUFFER``).
+CHUNK = 16
+CHUNK_BUFFER = 4 * CHUNK
 
 #: Fast-math flags used by the force kernels: fused multiply-adds, no signed zeros, reciprocal
 #: divisions; NaN/inf semantics are kept so blow-ups are still detected. Not "reassoc": with it
@@ -85,3 +102,41 @@ def bond_differences(xj, xi, uj, ui):
     d = xj - xi
     du = uj - ui
     return d, du, d + du
+
+
+def stack_array(size, dtype):
+    """A scratch array of ``size`` (a literal int) items of ``dtype``: on the calling kernel's stack.
+
+    LLVM knows that such a buffer (an ``alloca``) shares no memory with the kernel's array
+    arguments, so a loop that gathers from those and writes here still vectorises; a
+    NumPy array, even one allocated inside the kernel, is opaque to it and blocks the
+    vectorisation. Allocated once per call of the compiled loop body, whatever the number
+    of iterations; it lives until the kernel returns. With the JIT off (``NUMBA_DISABLE_JIT``)
+    this plain function runs instead: a NumPy array. As with :func:`bond_differences`, numba's
+    on-disk cache of a kernel does not notice edits here: delete the cached kernels after one.
+    """
+    return np.empty(size, dtype)
+
+
+@intrinsic
+def _stack_pointer(typingctx, size, dtype):
+    """Pointer to ``size`` (literal) items of ``dtype`` in the caller's stack frame."""
+    if not isinstance(size, types.IntegerLiteral):
+        return None
+    n = size.literal_value
+
+    def codegen(context, builder, signature, args):
+        return cgutils.alloca_once(builder, context.get_value_type(dtype.dtype), size=n)
+
+    return types.CPointer(dtype.dtype)(size, dtype), codegen
+
+
+@overload(stack_array, prefer_literal=True)
+def _stack_array_jit(size, dtype):
+    if not isinstance(size, types.IntegerLiteral):
+        return None
+
+    def impl(size, dtype):
+        return numba.carray(_stack_pointer(size, dtype), size)
+
+    return impl

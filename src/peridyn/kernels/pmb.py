@@ -16,7 +16,7 @@ is the straightforward loop kept as the reference row of ``peridyn bench``.
 import numba
 import numpy as np
 
-from peridyn.kernels import FASTMATH, bond_differences
+from peridyn.kernels import CHUNK, CHUNK_BUFFER, FASTMATH, bond_differences, stack_array
 
 
 @numba.njit(parallel=True, fastmath=FASTMATH, cache=True)
@@ -34,25 +34,32 @@ def pmb_force(x, u, offsets, nbr, inv_len, k, intact, f):
     for i in numba.prange(n):
         xi0, xi1, xi2 = xf[3 * i], xf[3 * i + 1], xf[3 * i + 2]
         ui0, ui1, ui2 = uf[3 * i], uf[3 * i + 1], uf[3 * i + 2]
-        lo = offsets[i]
+        buf = stack_array(CHUNK_BUFFER, f.dtype)
         hi = offsets[i + 1]
-        fam = nbr[lo:hi]
-        il = inv_len[lo:hi]
-        kb = k[lo:hi]
-        ok = intact[lo:hi]
         f0 = zero
         f1 = zero
         f2 = zero
-        for q in range(hi - lo):
-            j = 3 * np.uint64(np.uint32(fam[q]))
-            _, _, y0 = bond_differences(xf[j], xi0, uf[j], ui0)
-            _, _, y1 = bond_differences(xf[j + 1], xi1, uf[j + 1], ui1)
-            _, _, y2 = bond_differences(xf[j + 2], xi2, uf[j + 2], ui2)
-            s = kb[q] * (il[q] - one / np.sqrt(y0 * y0 + y1 * y1 + y2 * y2))
-            s = s if ok[q] else zero
-            f0 += s * y0
-            f1 += s * y1
-            f2 += s * y2
+        for c in range(offsets[i], hi, CHUNK):
+            m = min(CHUNK, hi - c)
+            fam = nbr[c : c + m]
+            il = inv_len[c : c + m]
+            kb = k[c : c + m]
+            ok = intact[c : c + m]
+            for q in range(m):
+                j = 3 * np.uint64(np.uint32(fam[q]))
+                _, _, y0 = bond_differences(xf[j], xi0, uf[j], ui0)
+                _, _, y1 = bond_differences(xf[j + 1], xi1, uf[j + 1], ui1)
+                _, _, y2 = bond_differences(xf[j + 2], xi2, uf[j + 2], ui2)
+                s = kb[q] * (il[q] - one / np.sqrt(y0 * y0 + y1 * y1 + y2 * y2))
+                buf[q] = s if ok[q] else zero
+                buf[CHUNK + q] = y0
+                buf[2 * CHUNK + q] = y1
+                buf[3 * CHUNK + q] = y2
+            for q in range(m):
+                s = buf[q]
+                f0 += s * buf[CHUNK + q]
+                f1 += s * buf[2 * CHUNK + q]
+                f2 += s * buf[3 * CHUNK + q]
         f[i, 0] = f0
         f[i, 1] = f1
         f[i, 2] = f2
@@ -75,27 +82,34 @@ def pmb_force_cf(x, u, offsets, nbr, k, intact, f):
     for i in numba.prange(n):
         xi0, xi1, xi2 = xf[3 * i], xf[3 * i + 1], xf[3 * i + 2]
         ui0, ui1, ui2 = uf[3 * i], uf[3 * i + 1], uf[3 * i + 2]
-        lo = offsets[i]
+        buf = stack_array(CHUNK_BUFFER, f.dtype)
         hi = offsets[i + 1]
-        fam = nbr[lo:hi]
-        kb = k[lo:hi]
-        ok = intact[lo:hi]
         f0 = zero
         f1 = zero
         f2 = zero
-        for q in range(hi - lo):
-            j = 3 * np.uint64(np.uint32(fam[q]))
-            d0, e0, y0 = bond_differences(xf[j], xi0, uf[j], ui0)
-            d1, e1, y1 = bond_differences(xf[j + 1], xi1, uf[j + 1], ui1)
-            d2, e2, y2 = bond_differences(xf[j + 2], xi2, uf[j + 2], ui2)
-            r = np.sqrt(y0 * y0 + y1 * y1 + y2 * y2)
-            length = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
-            ext2 = e0 * (y0 + d0) + e1 * (y1 + d1) + e2 * (y2 + d2)
-            s = kb[q] * ext2 / (r * length * (r + length))
-            s = s if ok[q] else zero
-            f0 += s * y0
-            f1 += s * y1
-            f2 += s * y2
+        for c in range(offsets[i], hi, CHUNK):
+            m = min(CHUNK, hi - c)
+            fam = nbr[c : c + m]
+            kb = k[c : c + m]
+            ok = intact[c : c + m]
+            for q in range(m):
+                j = 3 * np.uint64(np.uint32(fam[q]))
+                d0, e0, y0 = bond_differences(xf[j], xi0, uf[j], ui0)
+                d1, e1, y1 = bond_differences(xf[j + 1], xi1, uf[j + 1], ui1)
+                d2, e2, y2 = bond_differences(xf[j + 2], xi2, uf[j + 2], ui2)
+                r = np.sqrt(y0 * y0 + y1 * y1 + y2 * y2)
+                length = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+                ext2 = e0 * (y0 + d0) + e1 * (y1 + d1) + e2 * (y2 + d2)
+                s = kb[q] * ext2 / (r * length * (r + length))
+                buf[q] = s if ok[q] else zero
+                buf[CHUNK + q] = y0
+                buf[2 * CHUNK + q] = y1
+                buf[3 * CHUNK + q] = y2
+            for q in range(m):
+                s = buf[q]
+                f0 += s * buf[CHUNK + q]
+                f1 += s * buf[2 * CHUNK + q]
+                f2 += s * buf[3 * CHUNK + q]
         f[i, 0] = f0
         f[i, 1] = f1
         f[i, 2] = f2

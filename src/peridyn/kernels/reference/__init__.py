@@ -12,7 +12,7 @@ through it.
 Floating-point inputs are evaluated in float64 whatever their dtype, so a float32 kernel
 is compared with the value of its own inputs to double precision. The exceptions are the
 references of the kernels whose roundings are part of their definition
-(:func:`bond_differences`, ``damage.squared_length``, ``triad``): those compute in the
+(:func:`bond_differences`, ``damage.squared_length``, ``triad``, ``roof``): those compute in the
 input dtype, operation by operation.
 
 This module holds the helpers shared by the references of the bond kernels.
