@@ -1,5 +1,6 @@
 """Family search, influence functions, partial volumes and pre-cracks."""
 
+import dataclasses
 import itertools
 
 import numpy as np
@@ -50,6 +51,24 @@ def test_families_are_symmetric_and_sorted():
     for i in range(body.n_points):
         fam = bonds.neighbours[bonds.offsets[i] : bonds.offsets[i + 1]]
         assert np.all(np.diff(fam) > 0)
+
+
+def test_reverse_of_families_in_any_order():
+    """``reverse`` pairs each bond i->j with j->i when the families are not sorted by neighbour
+    (as in a rank's part): the definition checked directly, and it is its own inverse."""
+    body = geometry.plate(0.008, 0.006, 0.002, spacing=1e-3, layers=3)
+    bonds = find_bonds(body, 2.5e-3)
+    order = np.concatenate(
+        [
+            np.random.default_rng(i).permutation(np.arange(bonds.offsets[i], bonds.offsets[i + 1]))
+            for i in range(body.n_points)
+        ]
+    )
+    shuffled = dataclasses.replace(bonds, neighbours=bonds.neighbours[order], length=bonds.length[order])
+    rev, owners = shuffled.reverse(), shuffled.owners()
+    np.testing.assert_array_equal(owners[rev], shuffled.neighbours)
+    np.testing.assert_array_equal(shuffled.neighbours[rev], owners)
+    np.testing.assert_array_equal(rev[rev], np.arange(bonds.n_bonds))
 
 
 @pytest.mark.parametrize("dim", [2, 3])

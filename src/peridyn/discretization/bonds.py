@@ -112,11 +112,16 @@ class Bonds:
     def reverse(self) -> np.ndarray:
         """(n_bonds,) int64: index of the opposite directed bond j->i of each bond i->j."""
         owners = self.owners()
-        # the k-th bond in (i, j) order is the reverse of the k-th bond in (j, i) order; families
-        # are usually sorted by neighbour (then the first order is the storage order), but a
-        # rank's part (``peridyn.parallel``) keeps the global order of its ghosts' indices
+        # the k-th bond in (i, j) order is the reverse of the k-th bond in (j, i) order. Owners
+        # ascend in storage order, so a stable sort by neighbour gives the (j, i) order (one
+        # sort key instead of a lexsort of two). Families are usually sorted by neighbour (then
+        # the (i, j) order is the storage order), but a rank's part (``peridyn.parallel``)
+        # keeps the global order of its ghosts' indices
+        by_neighbour = np.argsort(self.neighbours, kind="stable")
+        same = owners[1:] == owners[:-1]
+        if np.all(self.neighbours[1:][same] >= self.neighbours[:-1][same]):
+            return by_neighbour
         by_owner = np.lexsort((self.neighbours, owners))
-        by_neighbour = np.lexsort((owners, self.neighbours))
         rev = np.empty(self.n_bonds, dtype=np.int64)
         rev[by_owner] = by_neighbour
         return rev

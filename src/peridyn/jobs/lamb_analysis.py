@@ -19,6 +19,9 @@ from peridyn.io.case import Case
 
 #: Modes whose wavenumber is picked by default.
 FUNDAMENTAL_MODES = ("S0", "A0")
+#: Frequencies of the Rayleigh-Lamb curves drawn on an f-k map (one every 1% of its height:
+#: a point every few pixels; each costs a root search per mode family).
+FK_THEORY_POINTS = 100
 
 
 def plate_theory(case: Case) -> tuple[float, float, float, float]:
@@ -118,7 +121,7 @@ def _fk(case: Case, body: Body, results: Path, directory, plots: bool) -> tuple[
     if plots:
         from peridyn.plotting.lamb_wavefield import plot_fk_map
 
-        curves = dispersion_curves(E, nu, rho, thickness, f_max=2 * f0, max_order=1)
+        curves = dispersion_curves(E, nu, rho, thickness, f_max=2 * f0, n=FK_THEORY_POINTS, max_order=1)
         for component, (freq, k, mag) in maps.items():
             marks = {
                 m: (f0, peaks[m]) for m, c in fk.components.items() if c == component and peaks[m] is not None

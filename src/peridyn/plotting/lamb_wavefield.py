@@ -78,13 +78,13 @@ def plot_wavefield_snapshots(
     found, records = _records_near(results, series, times)
     grids = {i: point_grid(points[layer == i], np.flatnonzero(layer == i)) for i in shown}
     rows = [(t, record, i) for t, record in zip(found, records, strict=True) for i in shown]
-    fig, axes = _figure(len(rows), len(columns), (3.6 * len(columns), 2.6 * len(rows)))
+    fig, axes = _panel_figure(len(rows), len(columns))
     for col, c in enumerate(columns):
         limit = float(np.max(np.abs(records[:, :, c]))) or 1.0
         for row, (t, record, i) in enumerate(rows):
             image = _draw_layer(axes[row, col], grids[i], record[:, c], limit)
             axes[row, col].set_title(f"u{COMPONENTS[c]}, layer {i}, t = {t * 1e6:.1f} us", fontsize=9)
-        fig.colorbar(image, ax=axes[:, col].tolist(), label=f"u{COMPONENTS[c]} (m)", shrink=0.6)
+        fig.colorbar(image, cax=_column_colorbar_axes(fig, axes[:, col]), label=f"u{COMPONENTS[c]} (m)")
     return _save(fig, path)
 
 
@@ -325,6 +325,50 @@ def _figure(rows: int, cols: int, size) -> tuple[Figure, np.ndarray]:
     fig = Figure(figsize=size, layout="constrained")
     FigureCanvasAgg(fig)
     return fig, np.asarray(fig.subplots(rows, cols, squeeze=False))
+
+
+#: Panel grid of the wavefield figure, inches: each panel's axes and the margins around it
+#: (left: y tick labels and label; right: the column's colour bar, its ticks and label; top: the
+#: title; bottom: x tick labels and label).
+_PANEL_AXES = (2.18, 1.5)
+_PANEL_MARGINS = {"left": 0.62, "right": 1.0, "top": 0.3, "bottom": 0.5}
+#: Colour bar of a column: gap to the axes and width (inches), share of the column's height.
+_COLORBAR = (0.25, 0.12, 0.45)
+
+
+def _panel_figure(rows: int, cols: int) -> tuple[Figure, np.ndarray]:
+    """A ``rows`` x ``cols`` grid of map panels at fixed positions, with room for a colour bar
+    right of each column: no layout engine (which measures every tick label of every panel
+    twice before drawing)."""
+    (width, height), m = _PANEL_AXES, _PANEL_MARGINS
+    column, row = m["left"] + width + m["right"], m["top"] + height + m["bottom"]
+    fig = Figure(figsize=(column * cols, row * rows))
+    FigureCanvasAgg(fig)
+    axes = fig.subplots(
+        rows,
+        cols,
+        squeeze=False,
+        gridspec_kw={
+            "left": m["left"] / (column * cols),
+            "right": 1.0 - m["right"] / (column * cols),
+            "bottom": m["bottom"] / (row * rows),
+            "top": 1.0 - m["top"] / (row * rows),
+            "wspace": (m["right"] + m["left"]) / width,
+            "hspace": (m["top"] + m["bottom"]) / height,
+        },
+    )
+    return fig, np.asarray(axes)
+
+
+def _column_colorbar_axes(fig: Figure, column_axes) -> object:
+    """Axes of a colour bar right of a column of panels, centred on it (``_COLORBAR``)."""
+    top, bottom = column_axes[0].get_position(original=True), column_axes[-1].get_position(original=True)
+    fig_width, _ = fig.get_size_inches()
+    gap, width, share = _COLORBAR
+    span = top.y1 - bottom.y0
+    return fig.add_axes(
+        (top.x1 + gap / fig_width, bottom.y0 + 0.5 * (1.0 - share) * span, width / fig_width, share * span)
+    )
 
 
 def _save(fig: Figure, path) -> Path:

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 import pytest
 
@@ -12,6 +14,8 @@ from peridyn.errors import InputError
 from peridyn.io.hdf5 import HDF5Writer
 from peridyn.physics.timefunctions import ToneBurst
 from peridyn.plotting.lamb_wavefield import (
+    _column_colorbar_axes,
+    _panel_figure,
     plot_fk_map,
     plot_kxky_maps,
     plot_sensor_signals,
@@ -55,6 +59,23 @@ def test_wavefield_snapshots(results, tmp_path):
         plot_wavefield_snapshots(results, tmp_path / "bad.png", [20e-6], components="w")
     with pytest.raises(InputError, match="out of range"):
         plot_wavefield_snapshots(results, tmp_path / "bad.png", [20e-6], layers=[3])
+
+
+def test_wavefield_panels_and_colour_bars_do_not_overlap():
+    """The fixed panel grid of the wavefield figure: no two panels overlap, and each column's
+    colour bar lies right of its panels and left of the next column's (boxes in figure
+    fractions, as placed before drawing)."""
+    fig, axes = _panel_figure(4, 3)
+    bars = [_column_colorbar_axes(fig, axes[:, col]) for col in range(3)]
+    boxes = [ax.get_position(original=True) for ax in axes.flat]
+    for a, b in itertools.combinations(boxes, 2):
+        assert a.x1 <= b.x0 or b.x1 <= a.x0 or a.y1 <= b.y0 or b.y1 <= a.y0
+    for col, bar in enumerate(bars):
+        box = bar.get_position()
+        assert box.x0 > max(ax.get_position(original=True).x1 for ax in axes[:, col])
+        if col + 1 < 3:
+            assert box.x1 < min(ax.get_position(original=True).x0 for ax in axes[:, col + 1])
+        assert 0.0 < box.y0 < box.y1 < 1.0 and box.x1 < 1.0
 
 
 def test_through_thickness_cut(results, tmp_path):

@@ -144,12 +144,16 @@ class LPSModel(Model):
                     "positivity: use a smaller horizon or another surface_correction",
                     stacklevel=2,
                 )
-        # m~_i = sum_j g_ij w |xi|^2 (= m without correction), m^5
-        self.dev_weighted_volume = family_sums(
-            b.offsets, np.where(b.intact, self.dev_factor * w * b.length**2, 0.0)
-        )
+        # m~_i = sum_j g_ij w |xi|^2, m^5, and alpha_i g_ij; without the energy correction g = 1:
+        # m~ is m and alpha_i g_ij is alpha_i bit for bit (products by 1), not formed again
+        point_dev = self.alpha[b.owners()]
+        self.dev_weighted_volume = m
+        if surface_correction == "energy":
+            self.dev_weighted_volume = family_sums(
+                b.offsets, np.where(b.intact, self.dev_factor * w * b.length**2, 0.0)
+            )
+            point_dev = point_dev * self.dev_factor
         # k_ij = w (alpha_i g_ij + alpha_j g_ji), the bond's deviatoric stiffness (both energies)
-        point_dev = self.alpha[b.owners()] * self.dev_factor
         self.dev = (w * (point_dev + point_dev[b.reverse()])).astype(self.dtype)
         self.length = b.length.astype(self.dtype)
         self.w = w.astype(self.dtype)
