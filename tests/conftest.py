@@ -4,6 +4,7 @@ Importing ``materials.conical_bond`` registers the test-only "conical" material,
 test parametrized with ``MODEL_CASES`` or ``MATERIALS`` (the registered materials) runs on it.
 """
 
+import h5py
 import numpy as np
 import pytest
 from materials import conical_bond  # noqa: F401  (registers the "conical" material)
@@ -73,3 +74,17 @@ MODEL_CASES = [
 def rng():
     """A seeded generator (tests never use global random state)."""
     return np.random.default_rng(20261123)
+
+
+def results_datasets(path) -> dict:
+    """Every dataset under final/ and series/ of a results file, by its path in the file."""
+    found = {}
+    with h5py.File(path) as f:
+        for group in ("final", "series"):
+            if group in f:
+                f[group].visititems(
+                    lambda name, obj, g=group: (
+                        found.__setitem__(f"{g}/{name}", obj[()]) if isinstance(obj, h5py.Dataset) else None
+                    )
+                )
+    return found

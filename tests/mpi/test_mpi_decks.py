@@ -14,9 +14,9 @@ import subprocess
 import sys
 from pathlib import Path
 
-import h5py
 import numpy as np
 import pytest
+from conftest import results_datasets
 
 import peridyn
 from peridyn.io.exodus import read_exodus
@@ -82,25 +82,14 @@ def test_deck_exodus_output_is_the_serial_one(serial, tmp_path, name, ranks):
         assert set(np.unique(many.element_variables["Proc_Num"])) == set(range(ranks))
 
 
-def _datasets(path: Path) -> dict:
-    """Every dataset under final/ and series/ of a results file."""
-    found = {}
-    with h5py.File(path) as f:
-        for group in ("final", "series"):
-            if group in f:
-                f[group].visititems(
-                    lambda name, obj, g=group: (
-                        found.__setitem__(f"{g}/{name}", obj[()]) if isinstance(obj, h5py.Dataset) else None
-                    )
-                )
-    return found
-
-
 def test_body_of_two_blocks_is_the_serial_one(serial, tmp_path):
     """cases/bimaterial_bar.yaml (steel and aluminium LPS blocks) on 2 ranks: every dataset of
     results.h5 under final/ and series/ as in the serial run, bit for bit."""
     done = _run("bimaterial_bar", tmp_path, 2)
     assert done.returncode == 0, done.stderr
-    one, many = _datasets(serial / "bimaterial_bar/results.h5"), _datasets(tmp_path / "results.h5")
+    one, many = (
+        results_datasets(serial / "bimaterial_bar/results.h5"),
+        results_datasets(tmp_path / "results.h5"),
+    )
     assert one.keys() == many.keys() and len(one) > 5
     assert [k for k in one if not np.array_equal(one[k], many[k])] == []

@@ -28,6 +28,7 @@ import h5py
 import meshio
 import numpy as np
 import pytest
+from conftest import results_datasets
 
 import peridyn
 from peridyn.io.vtk import read_pvtu_pieces
@@ -76,20 +77,6 @@ def _run(case: str, out: Path, ranks: int, *extra: str, flags=()) -> subprocess.
     return subprocess.run(command, capture_output=True, text=True, timeout=600, env=env)
 
 
-def _datasets(path: Path) -> dict:
-    """Every dataset under final/ and series/ of a results file."""
-    found = {}
-    with h5py.File(path) as f:
-        for group in ("final", "series"):
-            if group in f:
-                f[group].visititems(
-                    lambda name, obj, g=group: (
-                        found.__setitem__(f"{g}/{name}", obj[()]) if isinstance(obj, h5py.Dataset) else None
-                    )
-                )
-    return found
-
-
 @pytest.fixture(scope="module")
 def serial(tmp_path_factory):
     """The serial run of every case, after a short warm-up run (numba's cache filled)."""
@@ -102,7 +89,7 @@ def serial(tmp_path_factory):
         assert warm.returncode == 0, warm.stderr
         done = _run(case, base / case, 1)
         assert done.returncode == 0, done.stderr
-        refs[case] = _datasets(base / case / "results.h5"), json.loads(done.stdout), base / case
+        refs[case] = results_datasets(base / case / "results.h5"), json.loads(done.stdout), base / case
     return refs
 
 
@@ -136,7 +123,7 @@ def test_mpi_run_equals_the_serial_run_bit_for_bit(case, ranks, serial, tmp_path
     done = _run(case, tmp_path / case, ranks)
     assert done.returncode == 0, done.stderr
     assert done.stderr.count("peridyn 0.1") <= 1  # only rank 0 speaks
-    got, want = _datasets(tmp_path / case / "results.h5"), serial[case][0]
+    got, want = results_datasets(tmp_path / case / "results.h5"), serial[case][0]
     assert got.keys() == want.keys()
     for name, value in want.items():
         assert got[name].dtype == value.dtype and got[name].shape == value.shape, name
@@ -192,7 +179,7 @@ def test_contact_on_four_ranks_equals_the_serial_run_bit_for_bit(serial, tmp_pat
     """Issue 20 asks for 1 to 4 ranks: contact, the case with the most collectives, on four."""
     done = _run("kalthoff_contact", tmp_path / "run", 4)
     assert done.returncode == 0, done.stderr
-    got, want = _datasets(tmp_path / "run" / "results.h5"), serial["kalthoff_contact"][0]
+    got, want = results_datasets(tmp_path / "run" / "results.h5"), serial["kalthoff_contact"][0]
     assert got.keys() == want.keys()
     for name, value in want.items():
         assert got[name].dtype == value.dtype and np.array_equal(got[name], value), name
@@ -297,7 +284,7 @@ def test_ctrl_c_stops_every_rank_at_one_step_with_a_checkpoint_and_restart_is_bi
     done = _run("plate2d_stretch", out, 3, flags=["--restart"])
     assert done.returncode == 0, done.stderr
     want = serial["plate2d_stretch"][0]
-    got = _datasets(out / "results.h5")
+    got = results_datasets(out / "results.h5")
     assert got.keys() == want.keys()
     for name, value in want.items():
         assert got[name].dtype == value.dtype and np.array_equal(got[name], value), name
@@ -316,7 +303,7 @@ def test_restart_on_three_ranks_from_a_two_rank_checkpoint_equals_the_serial_run
     done = _run("plate2d_stretch", out, 3, flags=["--restart"])
     assert done.returncode == 0, done.stderr
     want, summary, folder = serial["plate2d_stretch"]
-    got = _datasets(out / "results.h5")
+    got = results_datasets(out / "results.h5")
     assert got.keys() == want.keys()
     for name, value in want.items():
         assert got[name].dtype == value.dtype and np.array_equal(got[name], value), name

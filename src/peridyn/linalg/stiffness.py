@@ -29,7 +29,6 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import LinearOperator
 
-from peridyn.kernels.linear import bond_extension, lps_linear_force, scatter_along_bonds
 from peridyn.physics.materials.base import Model
 
 
@@ -42,26 +41,7 @@ def mass_matrix(model: Model) -> sp.dia_matrix:
 def linear_force(model: Model, u: np.ndarray) -> np.ndarray:
     """Linearised internal force density (n_points, 3), N/m^3, of ``u`` (n_points, 3), m
     (``kernels.linear``; the coefficients of ``model.linearisation()``)."""
-    b = model.bonds
-    x = model.body.points
-    u = np.ascontiguousarray(u, dtype=np.float64)
-    lin = model.linearisation()
-    if lin.has_dilatation:  # the state-based kernel takes any material's dilatation coefficients
-        return lps_linear_force(
-            x,
-            u,
-            b.offsets,
-            b.neighbours,
-            b.length,
-            lin.weight,
-            lin.extension,
-            b.intact,
-            lin.theta_coef,
-            lin.p_coef,
-        )
-    # bond-based: t = extension e, scattered along the bonds
-    e = bond_extension(x, u, b.offsets, b.neighbours, b.length, b.intact, np.empty(b.n_bonds))
-    return scatter_along_bonds(x, b.offsets, b.neighbours, b.length, lin.extension * e, np.empty_like(x))
+    return model.linearisation().force(model.body.points, model.bonds, u)
 
 
 def stiffness_operator(model: Model) -> LinearOperator:

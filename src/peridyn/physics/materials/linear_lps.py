@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from peridyn.kernels.linear import bond_extension, lps_linear_force
+from peridyn.kernels.linear import bond_extension
 from peridyn.physics.materials.lps import LPSModel
 from peridyn.physics.materials.registry import register_material
 
@@ -49,20 +49,8 @@ class LinearLPSModel(LPSModel):
         return self._extension_and_dilatation(u)[1]
 
     def force(self, u, out=None):
-        """Linear force density (n_points, 3), N/m^3 (``kernels.linear.lps_linear_force``)."""
-        b, lin = self.bonds, self.linearisation()
-        f = lps_linear_force(
-            self.body.points,
-            np.ascontiguousarray(u, dtype=np.float64),
-            b.offsets,
-            b.neighbours,
-            b.length,
-            lin.weight,
-            lin.extension,
-            b.intact,
-            lin.theta_coef,
-            lin.p_coef,
-        )
+        """Linear force density (n_points, 3), N/m^3 (``BondLinearisation.force``)."""
+        f = self.linearisation().force(self.body.points, self.bonds, u)
         if out is None:
             return f.astype(self.dtype, copy=False)
         out[:] = f

@@ -38,6 +38,8 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
+from peridyn.kernels.linear import bond_extension, lps_linear_force, scatter_along_bonds
+
 #: The parts a material without dilatation (bond-based) leaves as None.
 DILATATION_PARTS = ("weight", "theta_coef", "p_coef", "dilatation_energy")
 
@@ -104,3 +106,26 @@ class BondLinearisation:
     def has_dilatation(self) -> bool:
         """True for a state-based material whose bonds couple through a dilatation theta."""
         return self.weight is not None
+
+    def force(self, points: np.ndarray, bonds, u: np.ndarray) -> np.ndarray:
+        """Linear internal force density (n_points, 3), N/m^3, of ``u`` (n_points, 3), m, on the
+        reference ``points`` (n_points, 3), m, and their ``bonds`` (``kernels.linear``)."""
+        u = np.ascontiguousarray(u, dtype=np.float64)
+        b = bonds
+        if self.has_dilatation:  # the state-based kernel takes any material's dilatation coefficients
+            return lps_linear_force(
+                points,
+                u,
+                b.offsets,
+                b.neighbours,
+                b.length,
+                self.weight,
+                self.extension,
+                b.intact,
+                self.theta_coef,
+                self.p_coef,
+            )
+        # bond-based: t = extension e, scattered along the bonds
+        e = bond_extension(points, u, b.offsets, b.neighbours, b.length, b.intact, np.empty(b.n_bonds))
+        t = self.extension * e
+        return scatter_along_bonds(points, b.offsets, b.neighbours, b.length, t, np.empty_like(points))
