@@ -62,8 +62,8 @@ class Model:
     """
 
     name = "model"
-    #: True for a material whose force is linear in u (``linear_lps``): its tangent stiffness is
-    #: the same at every state (``linalg.tangent`` takes it at rest).
+    # a material whose force is linear in u (linear_lps) sets it: its tangent stiffness is the
+    # same at every state (linalg.tangent takes it at rest)
     is_linear = False
 
     def __init__(self, body: Body, bonds: Bonds, E, density, dtype=np.float64):
