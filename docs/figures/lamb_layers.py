@@ -49,9 +49,20 @@ TARGET = 0.015
 
 
 def simulated(record: dict) -> dict:
-    """``{(mode, f): error}`` of a complete run's k-space rings against Rayleigh-Lamb."""
+    """``{(mode, f): error}`` of a complete run's k-space rings against Rayleigh-Lamb; NaN where
+    the run's map shows no ring of that mode (the analysis found none)."""
     rings, theory = record["summary"]["kxky_rings_rad_m"], record["summary"]["kxky_theory_rad_m"]
-    return {(m, f): rings[f"{f:g}"][m] / theory[f"{f:g}"][m] - 1 for m in MODES for f in FREQUENCIES}
+    ring = {(m, f): rings[f"{f:g}"][m] for m in MODES for f in FREQUENCIES}
+    return {
+        (m, f): np.nan if ring[(m, f)] is None else ring[(m, f)] / theory[f"{f:g}"][m] - 1
+        for m in MODES
+        for f in FREQUENCIES
+    }
+
+
+def percent(error) -> str:
+    """An error as a signed percentage, or "n/f" (no ring or peak found)."""
+    return "n/f" if error is None or np.isnan(error) else f"{100 * error:+.1f}"
 
 
 def bloch_errors(ds, layers: int, spacing: float) -> dict:
@@ -100,13 +111,13 @@ def table(data: list[dict]) -> str:
     for r in data:
         sim = r["simulation"]
         cells = [
-            ("-" if sim is None else f"{100 * sim[k]:+.1f}") + f" / {100 * r['bloch'][k]:+.1f}"
+            ("-" if sim is None else percent(sim[k])) + f" / {100 * r['bloch'][k]:+.1f}"
             for k in ((m, f) for m in MODES for f in FREQUENCIES)
         ]
         if sim is None:
             cost = f"- | not run | est. {r['estimated_bytes'] / 1e9:.1f} GB"
         else:
-            fk = ", ".join(f"{100 * r['fk'][m]:+.1f}" for m in MODES)
+            fk = ", ".join(percent(r["fk"][m]) for m in MODES)
             cost = f"{fk} | {r['seconds']:.0f} s | {r['peak_bytes'] / 1e9:.2f} GB"
         lines.append(
             f"| {r['layers']} | {r['spacing'] * 1e3:g} | {r['points']:,} | "
