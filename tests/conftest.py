@@ -4,11 +4,17 @@ Importing ``materials.conical_bond`` registers the test-only "conical" material,
 test parametrized with ``MODEL_CASES`` or ``MATERIALS`` (the registered materials) runs on it.
 """
 
+import os
+import subprocess
+import sys
+from pathlib import Path
+
 import h5py
 import numpy as np
 import pytest
 from materials import conical_bond  # noqa: F401  (registers the "conical" material)
 
+import peridyn
 from peridyn.discretization import geometry
 from peridyn.discretization.bonds import find_bonds
 from peridyn.physics.materials import MODELS, make_model
@@ -88,3 +94,13 @@ def results_datasets(path) -> dict:
                     )
                 )
     return found
+
+
+def peridyn_process(argv: list, ranks: int = 1) -> subprocess.CompletedProcess:
+    """``python -m peridyn ARGV`` in a new process of this checkout, one numba thread, under
+    ``mpiexec -n RANKS`` when ``ranks`` > 1; output captured, 600 s at most."""
+    command = [sys.executable, "-m", "peridyn", *argv]
+    if ranks > 1:
+        command = ["mpiexec", "-n", str(ranks), *command]
+    env = dict(os.environ, PYTHONPATH=str(Path(peridyn.__file__).parents[1]), NUMBA_NUM_THREADS="1")
+    return subprocess.run(command, capture_output=True, text=True, timeout=600, env=env)

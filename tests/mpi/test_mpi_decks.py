@@ -8,23 +8,19 @@ Run with ``PYTHONPATH=src python -m pytest -m mpi -q -p no:cacheprovider`` (NUMB
 per rank; each serial run fills numba's cache before the MPI runs).
 """
 
-import os
 import shutil
 import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import results_datasets
+from conftest import peridyn_process, results_datasets
 
-import peridyn
 from peridyn.io.exodus import read_exodus
 
 pytestmark = pytest.mark.mpi
 
 ROOT = Path(__file__).resolve().parents[2]
-SRC = str(Path(peridyn.__file__).parents[1])
 DECKS = ROOT / "tests" / "data" / "peridigm"
 
 RUNS = {
@@ -36,13 +32,10 @@ RUNS = {
 
 def _run(name: str, out: Path, ranks: int) -> subprocess.CompletedProcess:
     path, sets = RUNS[name]
-    command = [sys.executable, "-m", "peridyn", "run", str(path), "-o", str(out), "--no-progress", "--json"]
+    argv = ["run", str(path), "-o", str(out), "--no-progress", "--json"]
     for s in sets:
-        command += ["--set", s]
-    if ranks > 1:
-        command = ["mpiexec", "-n", str(ranks), *command]
-    env = dict(os.environ, PYTHONPATH=SRC, NUMBA_NUM_THREADS="1")
-    return subprocess.run(command, capture_output=True, text=True, timeout=600, env=env)
+        argv += ["--set", s]
+    return peridyn_process(argv, ranks)
 
 
 @pytest.fixture(scope="module")

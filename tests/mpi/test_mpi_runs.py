@@ -28,7 +28,7 @@ import h5py
 import meshio
 import numpy as np
 import pytest
-from conftest import results_datasets
+from conftest import peridyn_process, results_datasets
 
 import peridyn
 from peridyn.io.vtk import read_pvtu_pieces
@@ -70,11 +70,7 @@ def _run(case: str, out: Path, ranks: int, *extra: str, flags=()) -> subprocess.
     argv = ["run", str(ROOT / "cases" / path), "-o", str(out), "--no-progress", "--json", *flags]
     for s in ["output.plots=false", *sets, *extra]:
         argv += ["--set", s]
-    command = [sys.executable, "-m", "peridyn", *argv]
-    if ranks > 1:
-        command = ["mpiexec", "-n", str(ranks), *command]
-    env = dict(os.environ, PYTHONPATH=SRC, NUMBA_NUM_THREADS="1")
-    return subprocess.run(command, capture_output=True, text=True, timeout=600, env=env)
+    return peridyn_process(argv, ranks)
 
 
 @pytest.fixture(scope="module")

@@ -14,23 +14,19 @@ Run with ``PYTHONPATH=src python -m pytest -m mpi -q -p no:cacheprovider tests/m
 """
 
 import json
-import os
 import shutil
-import subprocess
-import sys
 from pathlib import Path
 
 import h5py
 import numpy as np
 import pytest
+from conftest import peridyn_process
 
-import peridyn
 from peridyn.analysis.modes import mac_matrix
 
 pytestmark = pytest.mark.mpi
 
 ROOT = Path(__file__).resolve().parents[2]
-SRC = str(Path(peridyn.__file__).parents[1])
 
 CASES = {
     "plate": ("pmma_plate.yaml", ["discretization.spacing=4e-3"]),
@@ -43,11 +39,7 @@ def _modal(case: str, out: Path, ranks: int) -> dict:
     argv = ["modal", str(ROOT / "cases" / path), "-o", str(out), "--json"]
     for s in ["output.plots=false", *sets]:
         argv += ["--set", s]
-    command = [sys.executable, "-m", "peridyn", *argv]
-    if ranks > 1:
-        command = ["mpiexec", "-n", str(ranks), *command]
-    env = dict(os.environ, PYTHONPATH=SRC, NUMBA_NUM_THREADS="1")
-    done = subprocess.run(command, capture_output=True, text=True, timeout=600, env=env)
+    done = peridyn_process(argv, ranks)
     assert done.returncode == 0, done.stderr
     return json.loads(done.stdout)
 
@@ -109,11 +101,7 @@ def _static(out: Path, ranks: int, *extra: str) -> dict:
     argv = ["run", str(ROOT / "cases" / STATIC[0]), "-o", str(out), "--json", "--no-progress"]
     for s in [*STATIC[1], *extra]:
         argv += ["--set", s]
-    command = [sys.executable, "-m", "peridyn", *argv]
-    if ranks > 1:
-        command = ["mpiexec", "-n", str(ranks), *command]
-    env = dict(os.environ, PYTHONPATH=SRC, NUMBA_NUM_THREADS="1")
-    done = subprocess.run(command, capture_output=True, text=True, timeout=600, env=env)
+    done = peridyn_process(argv, ranks)
     assert done.returncode == 0, done.stderr
     return json.loads(done.stdout)
 
