@@ -236,3 +236,34 @@ def test_bad_executor_arguments_are_refused_before_anything_runs(tmp_path):
     with pytest.raises(InputError, match="threads must be a whole number >= 1"):
         run_sweep(path, tmp_path / "out", executor="processes", threads=0)
     assert not (tmp_path / "out").exists()
+
+
+def test_run_sweep_keeps_its_reference_series_as_the_baseline(tmp_path):
+    """A run sweep with a ``reference`` (the healthy body) runs it once and its dataset holds
+    the reference's series beside the runs' (``reference_sensor_u``, on the runs' sensor axis):
+    a run whose case is the reference's gives the same signals bit for bit (a run is
+    deterministic), and a bar of another modulus does not."""
+    path = tiny_sweep(tmp_path, {"product": {"material.E": [200.0e9, 150.0e9]}})
+    spec = yaml.safe_load(path.read_text())
+    spec["reference"] = spec["base"]
+    spec["outputs"]["series"] = ["sensor_u"]
+    path.write_text(yaml.safe_dump(spec))
+    summary = run_sweep(path, tmp_path / "out")
+    assert (summary["completed"], summary["failed"]) == (2, 0)
+    ds = load_sweep(summary["dataset"])
+    baseline = ds["reference_sensor_u"]
+    assert baseline.dims == ("reference_sensor_u_record", "sensor_u_axis1", "sensor_u_axis2")
+    np.testing.assert_array_equal(ds["reference_sensor_u_time"].values, ds["sensor_u_time"].values[0])
+    np.testing.assert_array_equal(baseline.values, ds["sensor_u"].values[0])
+    assert not np.array_equal(baseline.values, ds["sensor_u"].values[1])
+
+
+def test_reference_needs_a_modal_or_run_sweep(tmp_path):
+    """A fatigue or Bloch sweep has nothing to compare with a reference: the sweep file is
+    refused, naming ``reference``."""
+    path = tiny_sweep(tmp_path, {"product": {"material.E": [200.0e9]}})
+    spec = yaml.safe_load(path.read_text())
+    spec.update(reference=spec["base"], command="fatigue")
+    path.write_text(yaml.safe_dump(spec))
+    with pytest.raises(InputError, match="reference"):
+        run_sweep(path, tmp_path / "out")

@@ -62,7 +62,7 @@ def require_xarray():
     return xarray
 
 
-def build_dataset(coords: dict, table: dict, series: dict, attrs: dict):
+def build_dataset(coords: dict, table: dict, series: dict, attrs: dict, reference: dict | None = None):
     """The ``xarray.Dataset`` of a sweep.
 
     Parameters
@@ -74,6 +74,10 @@ def build_dataset(coords: dict, table: dict, series: dict, attrs: dict):
     series : dict name -> SeriesColumn
     attrs : dict
         Global attributes (text or numbers).
+    reference : dict name -> (times (k,), values (k, *shape)), or None
+        The series of the sweep's reference run (e.g. the healthy body's sensor signals): each
+        becomes ``reference_<name>`` along ``reference_<name>_record`` and the series' own
+        entry axes, with ``reference_<name>_time`` (s).
     """
     xr = require_xarray()
     n = len(next(iter(coords.values()))) if coords else 0
@@ -88,6 +92,10 @@ def build_dataset(coords: dict, table: dict, series: dict, attrs: dict):
         ds[f"{name}_time"] = (dims[:2], times)
         if column.entry_names is not None and len(dims) > 2:
             ds.coords[dims[2]] = np.asarray(column.entry_names, dtype=str)
+    for name, (times, values) in (reference or {}).items():
+        record = f"reference_{name}_record"
+        ds[f"reference_{name}"] = ((record, *_entry_dims(name, np.ndim(values) - 1)), np.asarray(values))
+        ds[f"reference_{name}_time"] = (record, np.asarray(times))
     return ds
 
 
@@ -147,5 +155,9 @@ def _padded(name: str, column: SeriesColumn, n: int):
         if t is not None:
             times[i, : len(t)] = t
             values[i, : len(t)] = v
-    dims = ("run", f"{name}_record", *(f"{name}_axis{j + 1}" for j in range(len(shape))))
-    return values, times, dims
+    return values, times, ("run", f"{name}_record", *_entry_dims(name, len(shape)))
+
+
+def _entry_dims(name: str, n_axes: int) -> tuple[str, ...]:
+    """The names of a series' ``n_axes`` axes after its record axis."""
+    return tuple(f"{name}_axis{j + 1}" for j in range(n_axes))

@@ -146,6 +146,8 @@ def run_sweep(
     _write_manifest(sweep, out)
     collector = Collector(sweep, out)
     reference_dir = _reference(sweep, out, overwrite)
+    if reference_dir is not None:
+        collector.add_reference(Path(reference_dir))
     tasks = []
     for run in sweep.runs:
         if not overwrite and collector.is_complete(run):
@@ -275,7 +277,9 @@ def _reference(sweep: Sweep, out: Path, overwrite: bool) -> str | None:
     folder = out / "reference"
     record = read_record(folder)
     if overwrite or record is None or record["case_hash"] != ref.case_hash or record["status"] != "complete":
-        task = RunTask(ref.run_id, -1, {}, ref.case, ref.case_hash, "modal", str(folder), str(base), None)
+        task = RunTask(
+            ref.run_id, -1, {}, ref.case, ref.case_hash, sweep.spec.command, str(folder), str(base), None
+        )
         record = execute(task)
     if record["status"] != "complete":
         raise InputError(
@@ -302,6 +306,7 @@ class Collector:
         self.sweep, self.out = sweep, out
         self.records: dict[str, dict] = {}
         self.series: dict[str, dict] = {}
+        self.reference_series: dict[str, tuple] = {}
         self.skipped = 0
         self._written = -np.inf
         self.read_finished()
@@ -327,12 +332,26 @@ class Collector:
         """Take a run's record (and read its series when it is complete)."""
         self.records[record["run_id"]] = record
         self.series[record["run_id"]] = {}
-        if record["status"] == "complete" and self.sweep.spec.outputs.series:
-            results = Results(self.out / "runs" / record["run_id"] / "results.h5")
-            for name in self.sweep.spec.outputs.series:
-                _, times, values = results.series(name)
-                names = results.series_attrs(name).get("names")
-                self.series[record["run_id"]][name] = (times, values, names)
+        if record["status"] == "complete":
+            self.series[record["run_id"]] = self._read_series(self.out / "runs" / record["run_id"])
+
+    def add_reference(self, folder: Path) -> None:
+        """Take the series of the sweep's (complete) reference run in ``folder``."""
+        self.reference_series = {
+            name: (times, values) for name, (times, values, _) in self._read_series(folder).items()
+        }
+
+    def _read_series(self, folder: Path) -> dict:
+        """``{name: (times, values, entry names)}`` of the ``outputs.series`` of the run in
+        ``folder``."""
+        if not self.sweep.spec.outputs.series:
+            return {}
+        results = Results(folder / "results.h5")
+        out = {}
+        for name in self.sweep.spec.outputs.series:
+            _, times, values = results.series(name)
+            out[name] = (times, values, results.series_attrs(name).get("names"))
+        return out
 
     def counts(self) -> dict:
         """``completed`` and ``failed`` runs."""
@@ -385,7 +404,7 @@ class Collector:
             "command": self.sweep.spec.command,
             "parameters": json.dumps(self.sweep.spec.parameter_names()),
         }
-        return build_dataset(coords, table, series, attrs)
+        return build_dataset(coords, table, series, attrs, self.reference_series)
 
 
 def flatten_summary(summary: dict) -> dict:

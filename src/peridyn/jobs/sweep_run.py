@@ -107,7 +107,7 @@ def _job(task: RunTask) -> dict:
         from peridyn.jobs.run import run_case
 
         summary = run_case(task.case, task.run_dir, base_dir=task.base_dir, overwrite=True)
-    if task.reference_dir is not None:
+    if task.reference_dir is not None and task.command == "modal":
         from peridyn.jobs.modal import compare_with_run
 
         summary["comparison"] = compare_with_run(Path(task.run_dir), Path(task.reference_dir))

@@ -2,8 +2,9 @@
 
 A sweep file holds ``base`` (a case file, relative to the sweep file), ``command`` (``run``,
 ``modal``, ``fatigue``, or ``bloch``: the Bloch prediction alone; the job each run is),
-``reference`` (modal only: a case file, e.g. the healthy body, whose modes every run is
-compared with by MAC), ``set`` (overrides for every run), ``vary`` (one block or a list of
+``reference`` (a case file, e.g. the healthy body, run once with the sweep's ``set``: a modal
+sweep compares every run's modes with its modes by MAC; a run sweep's dataset holds its series
+as the baseline, e.g. the healthy plate's sensor signals), ``set`` (overrides for every run), ``vary`` (one block or a list of
 blocks, combined as a product; a block is ``product``,
 ``zip``, ``list`` or ``random``), ``labels`` (varied names that are not case entries, e.g. a
 damage type, usable in expressions), ``derived`` (case entries computed from the others with
@@ -199,9 +200,9 @@ class SweepSpec(_Strict):
                 raise ValueError(f"derived_by.{label}: {clash} are also varied or derived")
         if self.command == "bloch" and not self.outputs.bloch:
             raise ValueError("command bloch needs the frequencies of outputs.bloch")
-        if self.reference is not None and self.command != "modal":
+        if self.reference is not None and self.command not in ("modal", "run"):
             raise ValueError(
-                f"reference (a healthy body to compare modes with) needs command: modal, not {self.command}"
+                f"reference (a healthy body to compare with) needs command: modal or run, not {self.command}"
             )
         unused = sorted(set(self.labels) - set(seen))
         if unused:
