@@ -103,6 +103,20 @@ def serial_parts(case: Path, sets: list[str], steps: int = 100) -> dict:
     return {"steps": bench["steps"], "seconds_per_step": per_step, "load_average": bench["load_average"]}
 
 
+def probe_points(case: Path, sets: list[str]) -> int:
+    """The points whose displacement a series record gathers on rank 0 under MPI (the recorder's
+    ``Probes``: sensors, lines, planes and PZT sensor points, with repeats), for the model's
+    gather term."""
+    from peridyn.io.case import load_case
+    from peridyn.io.recorder import Probes
+    from peridyn.jobs.build import build_body
+    from peridyn.jobs.run import recorder_spec
+
+    loaded = load_case(case, sets)
+    body = build_body(loaded, case.parent)
+    return len(Probes.of(body, recorder_spec(loaded, body, 1.0)).u_points)
+
+
 def pingpong() -> dict:
     """Latency (s) and bandwidth (bytes/s) of two ranks (``benchmarks/mpi_pingpong.py``)."""
     command = ["mpiexec", "-n", "2", sys.executable, str(ROOT / "benchmarks" / "mpi_pingpong.py")]
@@ -156,6 +170,7 @@ def main(argv=None) -> int:
                 print(table([row]).splitlines()[-1], file=sys.stderr, flush=True)
     print(table(rows))
     record = {"case": str(case.relative_to(ROOT)), "sets": sets, "cpus": os.cpu_count(), "runs": rows}
+    record["probe_points"] = probe_points(case, sets)
     if not args.no_model_inputs:
         record["serial_parts"] = serial_parts(case, sets)
         record["pingpong"] = pingpong()
