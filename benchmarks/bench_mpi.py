@@ -15,7 +15,8 @@ and after each run (a shared machine: say what the load was).
 Beside the runs it records what the scaling model (``docs/figures/mpi_scaling.py``) reads: the
 serial step's parts on one thread (``peridyn bench --case CASE --steps 100``: force, observers,
 rest, ms per step) and the point-to-point latency and bandwidth of two ranks
-(``benchmarks/mpi_pingpong.py``). A short serial run first fills numba's cache, so that no run
+(``benchmarks/mpi_pingpong.py``), and the number of probe points a series record gathers (the
+recorder's ``Probes``). A short serial run first fills numba's cache, so that no run
 compiles. Plots are off
 (``output.plots=false``): figures are drawn by rank 0 alone after the loop and are no part of
 the scaling; ``--set`` passes more overrides to every run.

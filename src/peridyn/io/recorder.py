@@ -375,16 +375,16 @@ class Probes:
 
     Attributes
     ----------
-    index : dict of str -> (n,) int64
+    index : dict of str -> (n,) int
         Global point indices of each series' displacement, in this order: ``sensor_u`` (the
         points nearest to the sensors, when there are sensors), ``line_<name>`` (nearest to
         each line's samples), ``plane_<name>`` (each plane's points) and ``pzt_<name>`` (the
         points under each PZT sensor patch, ``RecorderSpec.pzt_sensors``' indices).
-    u_points : (k,) int64
+    u_points : (k,) int
         Their concatenation in that order (a point may appear in several series).
     slices : dict of str -> slice
         Each series' rows of ``u_points``.
-    v_points : (s,) int64
+    v_points : (s,) int
         The sensors' points, whose velocity ``sensor_v`` records.
     """
 
@@ -406,7 +406,6 @@ class Probes:
             index[f"plane_{name}"] = np.asarray(idx)
         for name, (idx, _) in spec.pzt_sensors.items():
             index[f"pzt_{name}"] = np.asarray(idx)
-        index = {key: idx.astype(np.int64, copy=False) for key, idx in index.items()}
         ends = np.cumsum([0, *(len(idx) for idx in index.values())])
         slices = {key: slice(int(a), int(b)) for key, a, b in zip(index, ends[:-1], ends[1:], strict=True)}
         u_points = np.concatenate([np.zeros(0, dtype=np.int64), *index.values()])
