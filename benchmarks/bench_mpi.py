@@ -15,7 +15,8 @@ and after each run (a shared machine: say what the load was).
 Beside the runs it records what the scaling model (``docs/figures/mpi_scaling.py``) reads: the
 serial step's parts on one thread (``peridyn bench --case CASE --steps 100``: force, observers,
 rest, ms per step) and the point-to-point latency and bandwidth of two ranks
-(``benchmarks/mpi_pingpong.py``). A short serial run first fills numba's cache, so that no run
+(``benchmarks/mpi_pingpong.py``), and the number of probe points a series record gathers (the
+recorder's ``Probes``). A short serial run first fills numba's cache, so that no run
 compiles. Plots are off
 (``output.plots=false``): figures are drawn by rank 0 alone after the loop and are no part of
 the scaling; ``--set`` passes more overrides to every run.
@@ -103,6 +104,20 @@ def serial_parts(case: Path, sets: list[str], steps: int = 100) -> dict:
     return {"steps": bench["steps"], "seconds_per_step": per_step, "load_average": bench["load_average"]}
 
 
+def probe_points(case: Path, sets: list[str]) -> int:
+    """The points whose displacement a series record gathers on rank 0 under MPI (the recorder's
+    ``Probes``: sensors, lines, planes and PZT sensor points, with repeats), for the model's
+    gather term."""
+    from peridyn.io.case import load_case
+    from peridyn.io.recorder import Probes
+    from peridyn.jobs.build import build_body
+    from peridyn.jobs.run import recorder_spec
+
+    loaded = load_case(case, sets)
+    body = build_body(loaded, case.parent)
+    return len(Probes.of(body, recorder_spec(loaded, body, 1.0)).u_points)
+
+
 def pingpong() -> dict:
     """Latency (s) and bandwidth (bytes/s) of two ranks (``benchmarks/mpi_pingpong.py``)."""
     command = ["mpiexec", "-n", "2", sys.executable, str(ROOT / "benchmarks" / "mpi_pingpong.py")]
@@ -156,6 +171,7 @@ def main(argv=None) -> int:
                 print(table([row]).splitlines()[-1], file=sys.stderr, flush=True)
     print(table(rows))
     record = {"case": str(case.relative_to(ROOT)), "sets": sets, "cpus": os.cpu_count(), "runs": rows}
+    record["probe_points"] = probe_points(case, sets)
     if not args.no_model_inputs:
         record["serial_parts"] = serial_parts(case, sets)
         record["pingpong"] = pingpong()

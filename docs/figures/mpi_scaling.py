@@ -18,8 +18,11 @@ One explicit step on P ranks of one thread each takes
 - ``t_root``: the recorder's time per step (observers), on rank 0 alone, not divided;
 - ``t_halo = m alpha + s / beta``: the largest rank's counted messages m and bytes s per step,
   with the latency alpha and bandwidth beta of ``benchmarks/mpi_pingpong.py``;
-- ``t_gather``: a recording step gathers the state (u, v, a: 72 B per point) on rank 0 (the
-  damage index only at snapshots): ``(P - 1) alpha + 72 (N - N_0) / beta``.
+- ``t_gather``: a series record checks the state (an allgather: ``2 log2(P) alpha``), gathers
+  u at the recorder's k probe points (24 B each, ``probe_points`` of the record; the other
+  ranks own ``k (N - N_0) / N`` of them) on rank 0 and broadcasts rank 0's outcome
+  (``log2(P) alpha``): ``(P - 1 + 3 log2(P)) alpha + 24 k (N - N_0) / (N beta)``; the
+  sensors' velocities and the whole state at the few snapshots are left out.
 
 Projections (no recording of whole fields per step: sensors only, so no ``t_root`` nor
 ``t_gather``): a cube of N points, horizon 3.015 spacings (122 bonds per point), LPS, parts
@@ -85,6 +88,7 @@ def coefficients(record: dict) -> dict:
         "points": base["points"],
         "cpus": record["cpus"],
         "bonds": base["bonds"],
+        "probe_points": record["probe_points"],
     }
 
 
@@ -95,7 +99,9 @@ def predicted_step(c: dict, run: dict) -> dict:
     n_r = max(owned)
     ranks = run["ranks"]
     halo = max(r["messages_per_step"] * c["alpha"] + r["bytes_per_step"] / c["beta"] for r in per_rank)
-    gather = (ranks - 1) * c["alpha"] + 72.0 * (c["points"] - owned[0]) / c["beta"]
+    messages = ranks - 1 + 3 * math.log2(ranks)
+    others = c["probe_points"] * (c["points"] - owned[0]) / c["points"]
+    gather = messages * c["alpha"] + 24.0 * others / c["beta"]
     shared = max(1.0, ranks / c["cpus"])  # more ranks than cores: each gets cpus / ranks of one
     terms = {
         "compute": shared * (c["t_bond"] * c["bonds"] * n_r / c["points"] + c["t_point"] * n_r),

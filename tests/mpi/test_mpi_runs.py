@@ -6,7 +6,8 @@ the stress and strain tensors (``output.stress``, ``output.strain``) and VTU sna
 pieces under MPI, compared with the serial snapshots point by point), and the
 Kalthoff-Winkler plate (notches, pre-cracks, fracture energy, velocity loading) at 1 mm, also with
 contact (radius one spacing: the impacted notch flank moves 1 mm in 30 us, so the contact list is
-rebuilt, with new contact ghosts, during the run).
+rebuilt, with new contact ghosts, during the run), and a cut of the seed Lamb plate that records
+every kind of probe (sensors, a line, a plane, a PZT sensor) at every step.
 
 Run with ``PYTHONPATH=src python -m pytest -m mpi -q -p no:cacheprovider`` (NUMBA_NUM_THREADS=1
 per rank; the runs start after a serial warm-up run that fills numba's cache).
@@ -51,6 +52,23 @@ CASES = {
     "kalthoff_contact": (
         "kalthoff_winkler.yaml",
         ["discretization.spacing=1e-3", "solver.time=30e-6", "contact.radius=1.0"],
+    ),
+    # the seed Lamb plate cut to 60 x 39.6 mm: every kind of probe (sensors, a line, the top
+    # plane, a PZT sensor) recorded at every step, gathered as probe values only under MPI
+    "lamb_probes": (
+        "lamb_plate.yaml",
+        [
+            "geometry.size=[0.06, 0.0396, 0.002]",
+            "actuators.pzt.center=[0.0306, 0.0198]",
+            "output.sensors={top: [0.0426, 0.0198, 0.002], mid: [0.0426, 0.0198, 0.001], "
+            "centre: [0.0306, 0.0198, 0.002]}",
+            "output.lines={x_axis: {start: [0.0006, 0.0198, 0.002], end: [0.0594, 0.0198, 0.002], "
+            "points: 50}}",
+            "output.pzt_sensors={p: {center: [0.0426, 0.0198], size: 2.4e-3}}",
+            "output.snapshot_times=[2.0e-6]",
+            "analysis={}",
+            "solver.time=4e-6",
+        ],
     ),
 }
 
@@ -124,8 +142,14 @@ def test_mpi_run_equals_the_serial_run_bit_for_bit(case, ranks, serial, tmp_path
     for name, value in want.items():
         assert got[name].dtype == value.dtype and got[name].shape == value.shape, name
         assert np.array_equal(got[name], value), name
-    if case != "bar_pulse":  # the damage cases broke bonds: the comparison covers breaking
+    if case not in (
+        "bar_pulse",
+        "lamb_probes",
+    ):  # the damage cases broke bonds: the comparison covers breaking
         assert want["final/damage"].max() > 0
+    if case == "lamb_probes":  # every kind of probe series is compared
+        kinds = ("sensor_u", "sensor_v", "line_x_axis", "plane_top", "pzt_signal")
+        assert {f"series/{k}/data" for k in kinds} <= want.keys()
     if TENSORS[0] in CASES[case][1]:  # the tensors are compared too
         assert {"final/stress", "final/strain", "final/strain_valid"} <= want.keys()
     summary = json.loads(done.stdout)  # the time loop is part of the run (docs/user-guide.md)

@@ -36,6 +36,28 @@ class State:
         return cls(np.zeros((n_points, 3)), np.zeros((n_points, 3)), np.zeros((n_points, 3)))
 
 
+@dataclass
+class ProbeState:
+    """A state's values at a recorder's probe points only (``peridyn.io.recorder.Probes``): what an
+    MPI run gathers on rank 0 at a series record instead of the whole body. The ranks have
+    already checked the whole state (``check_state``, ``peridyn.parallel.domain.Domain``).
+
+    Attributes
+    ----------
+    u : (k, 3) float64
+        Displacement (m) at the probes' ``u_points``, in their order.
+    v : (s, 3) float64
+        Velocity (m/s) at the probes' ``v_points``, in their order.
+    time : float, s
+    step : int
+    """
+
+    u: np.ndarray
+    v: np.ndarray
+    time: float = 0.0
+    step: int = 0
+
+
 def runaway_limit(points: np.ndarray) -> float:
     """Largest believable displacement component, m: ``RUNAWAY_FACTOR`` times the largest
     extent of the body's reference points (n_points, dim)."""
@@ -52,17 +74,32 @@ def check_state(state: State, max_displacement: float = np.inf) -> None:
     not finite, or when a displacement component exceeds ``max_displacement`` (m).
 
     One pass over both fields when all is well (``kernels.verlet.state_is_sound``)."""
+    found = first_unsound(state, max_displacement)
+    if found is not None:
+        raise InstabilityError(state.step, state.time, found[1], found[2])
+
+
+def first_unsound(
+    state: State, max_displacement: float = np.inf, point_ids: np.ndarray | None = None
+) -> tuple[int, int, str] | None:
+    """What ``check_state`` reports: None when u and v are finite and no component of u exceeds
+    ``max_displacement`` (m); else ``(field, point, detail)``: ``field`` 0 (u) or 1 (v), the
+    first field out of bounds; ``point`` its first bad row or, with ``point_ids`` ((n,) int, the
+    rows' global indices, e.g. a rank's owned points), the smallest global index of its bad
+    rows; ``detail`` what is wrong."""
     if state_is_sound(state.u, state.v, float(max_displacement)):
-        return
+        return None
     fields = (("displacement u", state.u, max_displacement), ("velocity v", state.v, np.inf))
-    for name, values, limit in fields:
+    for field, (name, values, limit) in enumerate(fields):
         bad = ~(np.abs(values) <= limit).all(axis=1)
         if bad.any():
-            point = int(np.flatnonzero(bad)[0])
-            what = "not finite" if not np.isfinite(values[point]).all() else f"above {limit:.3g} m (runaway)"
-            raise InstabilityError(
-                state.step,
-                state.time,
+            rows = np.flatnonzero(bad)
+            row = int(rows[0] if point_ids is None else rows[np.argmin(point_ids[rows])])
+            what = "not finite" if not np.isfinite(values[row]).all() else f"above {limit:.3g} m (runaway)"
+            point = row if point_ids is None else int(point_ids[row])
+            return (
+                field,
                 point,
                 f"{name} {what} (time step too large, or a load too violent for the discretisation?)",
             )
+    return None

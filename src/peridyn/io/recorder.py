@@ -35,7 +35,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from peridyn.discretization.body import Body
-from peridyn.discretization.state import State, check_state, runaway_limit
+from peridyn.discretization.state import ProbeState, State, check_state, runaway_limit
 from peridyn.errors import InputError
 from peridyn.io.exodus_write import PERIDIGM_VARIABLES, ExodusWriter
 from peridyn.io.hdf5 import HDF5Writer
@@ -126,9 +126,14 @@ class RecorderSpec:
             return False
         return self.snapshot_due(step) if self.exodus_every is None else step % self.exodus_every == 0
 
+    def whole_due(self, step: int) -> bool:
+        """True when something that reads the whole body (a snapshot, an Exodus record) is
+        written at ``step``."""
+        return self.snapshot_due(step) or self.exodus_due(step)
+
     def due(self, step: int) -> bool:
         """True when anything is recorded at ``step``."""
-        return self.series_due(step) or self.snapshot_due(step) or self.exodus_due(step)
+        return self.series_due(step) or self.whole_due(step)
 
     def output_bytes(self, n_points: int, n_steps: int) -> float:
         """Bytes a run of ``n_steps`` steps on ``n_points`` points writes, about: the probe
@@ -173,6 +178,9 @@ class Recorder:
     vtu_pieces : bool
         The VTU snapshots are per-rank pieces that the ranks of an MPI run write with their
         ``.pvtu`` (``peridyn.io.vtu_pieces``): ``snapshots.pvd`` lists the ``.pvtu`` files.
+    probes : Probes or None
+        The points the series read (``Probes.of(body, spec)``, computed when None): an MPI run
+        gathers these only at a series record and passes a ``ProbeState`` to ``record_series``.
     """
 
     def __init__(
@@ -186,6 +194,7 @@ class Recorder:
         tensors=None,
         fields=None,
         vtu_pieces: bool = False,
+        probes: Probes | None = None,
     ):
         self.body = body
         self.vtu_pieces = vtu_pieces
@@ -198,18 +207,17 @@ class Recorder:
             raise InputError(f"output.every must be at least 1, got {spec.every}")
         if (spec.stress or spec.strain) and tensors is None:
             raise InputError("output.stress and output.strain need a tensors function: the recorder has none")
-        tree = cKDTree(body.points)
+        self.probes = probes if probes is not None else Probes.of(body, spec)
+        index = self.probes.index
         self.sensor_names = list(spec.sensors)
-        self.sensor_index = (
-            tree.query(np.array([spec.sensors[k] for k in self.sensor_names]))[1]
-            if spec.sensors
-            else np.zeros(0, dtype=int)
-        )
-        self.line_index = {
-            name: tree.query(np.linspace(p.start, p.end, p.points))[1] for name, p in spec.lines.items()
+        self.sensor_index = self.probes.v_points
+        self.line_index = {name: index[f"line_{name}"] for name in spec.lines}
+        self.plane_index = {name: index[f"plane_{name}"] for name in spec.planes}
+        #: where ``record_series`` reads each series in a whole state's u: global rows (a
+        #: plate layer's as a slice, ``rows_of``)
+        self._point_rows = {
+            key: rows_of(idx) if key.startswith("plane_") else idx for key, idx in index.items()
         }
-        self.plane_index = {name: np.asarray(idx) for name, idx in spec.planes.items()}
-        self._plane_rows = {name: rows_of(idx) for name, idx in self.plane_index.items()}
         mode = "a" if resume is not None else "w"
         self.h5 = HDF5Writer(
             self.directory / "results.h5",
@@ -272,25 +280,33 @@ class Recorder:
         elif self.spec.exodus_every is not None and self.spec.exodus_due(state.step):
             self.write_exodus(state)
 
-    def record_series(self, state: State) -> None:
-        """Append one record to every probe series.
+    def record_series(self, state: State | ProbeState) -> None:
+        """Append one record to every probe series, from the whole body's ``state`` or from the
+        values at the probe points only (a ``ProbeState`` in ``probes``' order, checked by
+        whoever gathered it).
 
         Raises
         ------
         InstabilityError
-            The state is not finite or runs away (``check_state``): nothing is written.
+            The whole ``state`` is not finite or runs away (``check_state``): nothing is written.
         """
-        check_state(state, self.max_displacement)
+        if isinstance(state, ProbeState):
+            rows, sensor_rows = self.probes.slices, slice(None)
+        else:
+            check_state(state, self.max_displacement)
+            rows, sensor_rows = self._point_rows, self.sensor_index
         h5, step, t = self.series, state.step, state.time
         if self.sensor_names:
-            h5.append("sensor_u", step, t, state.u[self.sensor_index])
-            h5.append("sensor_v", step, t, state.v[self.sensor_index])
-        for name, idx in self.line_index.items():
-            h5.append(f"line_{name}", step, t, state.u[idx])
-        for name, rows in self._plane_rows.items():
-            h5.append(f"plane_{name}", step, t, state.u[rows])
+            h5.append("sensor_u", step, t, state.u[rows["sensor_u"]])
+            h5.append("sensor_v", step, t, state.v[sensor_rows])
+        for name in self.line_index:
+            h5.append(f"line_{name}", step, t, state.u[rows[f"line_{name}"]])
+        for name in self.plane_index:
+            h5.append(f"plane_{name}", step, t, state.u[rows[f"plane_{name}"]])
         if self.spec.pzt_sensors:
-            signals = [np.sum(w * state.u[idx, :2]) for idx, w in self.spec.pzt_sensors.values()]
+            signals = [
+                np.sum(w * state.u[rows[f"pzt_{k}"], :2]) for k, (_, w) in self.spec.pzt_sensors.items()
+            ]
             h5.append("pzt_signal", step, t, np.array(signals))
 
     def snapshot(self, state: State) -> None:
@@ -351,6 +367,49 @@ class Recorder:
             if status is not None:
                 self.h5.set_status(status)
             self.h5.close()
+
+
+@dataclass(frozen=True)
+class Probes:
+    """The points whose values a recorder's series read (``Recorder.record_series``).
+
+    Attributes
+    ----------
+    index : dict of str -> (n,) int
+        Global point indices of each series' displacement, in this order: ``sensor_u`` (the
+        points nearest to the sensors, when there are sensors), ``line_<name>`` (nearest to
+        each line's samples), ``plane_<name>`` (each plane's points) and ``pzt_<name>`` (the
+        points under each PZT sensor patch, ``RecorderSpec.pzt_sensors``' indices).
+    u_points : (k,) int
+        Their concatenation in that order (a point may appear in several series).
+    slices : dict of str -> slice
+        Each series' rows of ``u_points``.
+    v_points : (s,) int
+        The sensors' points, whose velocity ``sensor_v`` records.
+    """
+
+    index: dict
+    u_points: np.ndarray
+    slices: dict
+    v_points: np.ndarray
+
+    @classmethod
+    def of(cls, body: Body, spec: RecorderSpec) -> Probes:
+        """The probes of ``spec`` in ``body`` (the whole body's points)."""
+        tree = cKDTree(body.points)
+        index = {}
+        if spec.sensors:
+            index["sensor_u"] = tree.query(np.array(list(spec.sensors.values())))[1]
+        for name, p in spec.lines.items():
+            index[f"line_{name}"] = tree.query(np.linspace(p.start, p.end, p.points))[1]
+        for name, idx in spec.planes.items():
+            index[f"plane_{name}"] = np.asarray(idx)
+        for name, (idx, _) in spec.pzt_sensors.items():
+            index[f"pzt_{name}"] = np.asarray(idx)
+        ends = np.cumsum([0, *(len(idx) for idx in index.values())])
+        slices = {key: slice(int(a), int(b)) for key, a, b in zip(index, ends[:-1], ends[1:], strict=True)}
+        u_points = np.concatenate([np.zeros(0, dtype=np.int64), *index.values()])
+        return cls(index, u_points, slices, index.get("sensor_u", np.zeros(0, dtype=np.int64)))
 
 
 def rows_of(index: np.ndarray) -> np.ndarray | slice:

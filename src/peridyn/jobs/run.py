@@ -23,7 +23,7 @@ from peridyn.io.checkpoint import Checkpointer, load_checkpoint
 from peridyn.io.hdf5 import HDF5Writer
 from peridyn.io.outdir import end_status, prepare_output
 from peridyn.io.provenance import package_version, provenance
-from peridyn.io.recorder import LineProbe, Recorder, RecorderSpec
+from peridyn.io.recorder import LineProbe, Probes, Recorder, RecorderSpec
 from peridyn.io.vtu_pieces import VtuPieces
 from peridyn.jobs.build import Setup, build, pad3
 from peridyn.jobs.exodus_variables import GatheredVariables, check_variables, variable_values
@@ -429,8 +429,19 @@ def _run_explicit(
     if d.size > 1 and tensors is not None:
         tensors = gathered.tensor_fields
     fields = exodus_values(case, setup, spec)
+    probes = Probes.of(setup.whole_body, spec)  # every rank: under MPI, gathered at a series record
     recorder = d.on_root(
-        Recorder, setup.whole_body, out, spec, info, gathered.damage, resume, tensors, fields, d.size > 1
+        Recorder,
+        setup.whole_body,
+        out,
+        spec,
+        info,
+        gathered.damage,
+        resume,
+        tensors,
+        fields,
+        d.size > 1,
+        probes,
     )
     checkpointer, gather_checkpoint = _checkpointer(
         ckpt_path,
@@ -442,7 +453,7 @@ def _run_explicit(
         [recorder.flush] if recorder is not None else [],
     )
     watched = [recorder, *([cracks] if cracks is not None else [])]
-    due = [spec.due, *([cracks.due] if cracks is not None else [])]
+    due = [spec.whole_due, *([cracks.due] if cracks is not None else [])]  # the series: ``series``
     if d.size > 1 and checkpoint_every:  # saved on rank 0 from the gathered state
         watched, due = [*watched, checkpointer], [*due, checkpointer.due]
     prepare = gather_checkpoint
@@ -452,7 +463,10 @@ def _run_explicit(
     if isinstance(fields, GatheredVariables):
         prepare = [*prepare, (spec.exodus_due, collect)]
     damage_due = [spec.snapshot_due, spec.exodus_due, *([cracks.due] if cracks is not None else [])]
-    gathered.attach(watched, due, prepare, damage_due)
+    record = recorder.record_series if recorder is not None else None
+    gathered.attach(
+        watched, due, prepare, damage_due, (spec.series_due, probes.u_points, probes.v_points, record)
+    )
     try:
         if resume is None:
             if pieces is not None:

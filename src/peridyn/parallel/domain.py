@@ -22,7 +22,7 @@ import pickle
 
 import numpy as np
 
-from peridyn.discretization.state import State, check_state, runaway_limit_of_extent
+from peridyn.discretization.state import State, check_state, first_unsound, runaway_limit_of_extent
 from peridyn.errors import InstabilityError, PeridynError
 from peridyn.parallel.comm import SerialComm, Traffic
 from peridyn.parallel.halo import Halo
@@ -201,17 +201,21 @@ class Domain:
         return result
 
     def check_state(self, state: State, max_displacement: float) -> None:
-        """``check_state`` of the owned points, on every rank together; the point named is the
-        global index."""
+        """``check_state`` of the whole body, each rank checking its owned points, then one
+        allgather: every rank raises the error of the serial check (the first field out of
+        bounds, u before v, at its smallest global point)."""
         n = self.n_owned
         owned = State(state.u[:n], state.v[:n], state.a[:n], state.time, state.step)
-        self.agree(self._check_owned, owned, max_displacement)
-
-    def _check_owned(self, owned: State, max_displacement: float) -> None:
-        try:
+        if self.size == 1:
             check_state(owned, max_displacement)
-        except InstabilityError as exc:
-            raise InstabilityError(exc.step, exc.time, int(self.global_ids[exc.point]), exc.detail) from None
+            return
+        found = first_unsound(owned, max_displacement, self.global_ids[:n])
+        every = [f for f in self.comm.allgather(found) if f is not None]
+        if every:
+            _, point, detail = min(every)
+            error = InstabilityError(state.step, state.time, point, detail)
+            error.every_rank = True
+            raise error
 
     def gather_state(self, state: State) -> State | None:
         """The state of the whole body in global order on rank 0 (None elsewhere); in one

@@ -2,7 +2,10 @@
 
 ``RootObservers`` is the one observer every rank attaches. At a step where one of its observers
 is due, the ranks gather the state (and the damage index) in global point order on rank 0,
-which calls the observers with it; their errors reach every rank (``Domain.on_root``). Per-point
+which calls the observers with it; their errors reach every rank (``Domain.on_root``). At a step
+where only a recorder's series are due (``attach``'s ``series``; the seed Lamb case records them at
+every step) the ranks check the state together (``Domain.check_state``) and gather only the
+values at the probe points (``peridyn.parallel.points.PointGather``). Per-point
 tensors (``output.stress``, ``output.strain``) are computed by each rank on its owned points
 (their families and the neighbours' displacements are on the rank) and gathered likewise for
 the final state (the VTU snapshots are written per rank: ``peridyn.io.vtu_pieces``). In one
@@ -16,8 +19,9 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from peridyn.discretization.state import State
+from peridyn.discretization.state import ProbeState, State
 from peridyn.parallel.domain import Domain
+from peridyn.parallel.points import PointGather
 from peridyn.physics.damage import damage_field
 
 
@@ -48,9 +52,15 @@ class RootObservers:
         self.damage_due: list | None = None
         self._damage: np.ndarray | None = None
         self._tensors: dict = {}
+        self._series = None  # (due, PointGather, record, runaway limit) under MPI
 
     def attach(
-        self, observers: Sequence, due: Sequence[Callable[[int], bool]], prepare=(), damage_due=None
+        self,
+        observers: Sequence,
+        due: Sequence[Callable[[int], bool]],
+        prepare=(),
+        damage_due=None,
+        series=None,
     ) -> None:
         """Watch with ``observers`` (objects with ``observe(state, solver)``, used on rank 0 only:
         None elsewhere) at the steps where one of ``due`` (callables step -> bool, known on every
@@ -58,11 +68,24 @@ class RootObservers:
         first at their steps, with the rank's state (e.g. gathering the bonds' intact mask for a
         checkpoint, writing the pieces of a VTU snapshot). ``damage_due``: callables step ->
         bool, the steps at which an observer reads ``damage`` (the damage index, a pass over
-        every bond, is then computed and gathered); None: at every step observed."""
+        every bond, is then computed and gathered); None: at every step observed.
+
+        ``series``: None, or ``(due, u_points, v_points, record)``: at a step where ``due``
+        (step -> bool) is True and none of ``due`` is, the ranks check the whole state
+        (``Domain.check_state``: an unsound one raises InstabilityError on every rank), gather
+        u at the global points ``u_points`` (k,) and v at ``v_points`` (s,) only, and rank 0
+        calls ``record`` (a callable, None elsewhere) with that ``ProbeState``: a recorder's
+        ``record_series`` with its ``Probes``. Collective; several ranks only (in one process
+        the observers see the state itself)."""
         self.observers = list(observers) if self.domain.is_root else []
         self.due = list(due)
         self.prepare = list(prepare)
         self.damage_due = None if damage_due is None else list(damage_due)
+        self._series = None
+        if series is not None and self.domain.size > 1:
+            series_due, u_points, v_points, record = series
+            limit = self.domain.runaway_limit(self.model.body.points)
+            self._series = series_due, PointGather(self.domain, u_points, v_points), record, limit
 
     def damage(self) -> np.ndarray:
         """The damage index (n_points,) of the whole body at the last gathered state (rank 0)."""
@@ -78,7 +101,8 @@ class RootObservers:
 
     def observe(self, state: State, solver) -> None:
         """Gather and call the observers when one is due (every rank calls it); in one process,
-        call them at every step (nothing to gather)."""
+        call them at every step (nothing to gather). At a step with only the series due, gather
+        the probe points' values and record them (``attach``'s ``series``)."""
         if self.domain.size == 1 or any(due(state.step) for due in self.due):
             for due, prepare in self.prepare:
                 if due(state.step):
@@ -87,6 +111,16 @@ class RootObservers:
             self.call(
                 state, lambda whole: [obs.observe(whole, solver) for obs in self.observers], damage=damage
             )
+        elif self._series is not None and self._series[0](state.step):
+            self.record_probes(state)
+
+    def record_probes(self, state: State) -> None:
+        """The series record of ``attach``'s ``series`` at ``state`` (collective)."""
+        _, gather, record, limit = self._series
+        self.domain.check_state(state, limit)
+        values = gather(state.u, state.v)
+        probe = None if values is None else ProbeState(*values, state.time, state.step)
+        self.domain.on_root(record, probe)
 
     def call(self, state: State, fn, tensors: bool = False, damage: bool = True):
         """``fn(state of the whole body)`` on rank 0 after gathering (collective); its result on
