@@ -36,8 +36,9 @@ MAX_NAME = 255
 COMPONENTS = "XYZ"
 #: Peridigm's output variables that peridyn writes: name -> (placement, vector). Nodal vectors:
 #: displacement (m), velocity (m/s), force (N), force density (N/m^3), acceleration (m/s^2);
-#: element scalars: 1-based id, rank, volume (m^3), dilatation, weighted volume (m^5), stored
-#: elastic energy (J, energy density times volume), number of neighbours and damage.
+#: element scalars: 1-based id, 0-based id (``ID``, the older decks' name), rank, volume (m^3),
+#: dilatation, weighted volume (m^5), stored elastic energy (J, energy density times volume),
+#: number of neighbours and damage.
 PERIDIGM_VARIABLES = {
     "Displacement": ("nodal", True),
     "Velocity": ("nodal", True),
@@ -45,6 +46,7 @@ PERIDIGM_VARIABLES = {
     "Force_Density": ("nodal", True),
     "Acceleration": ("nodal", True),
     "Element_Id": ("element", False),
+    "ID": ("element", False),
     "Proc_Num": ("element", False),
     "Volume": ("element", False),
     "Dilatation": ("element", False),

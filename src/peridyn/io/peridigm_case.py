@@ -28,8 +28,15 @@ from peridyn.io.peridigm_deck import is_peridigm_deck, read_deck
 from peridyn.physics.expressions import SpaceTime
 
 #: Peridigm's material models that peridyn runs: name -> peridyn model ("Linear LPS": LPS
-#: linearised about the reference configuration, ``peridyn.physics.materials.linear_lps``).
-MATERIALS = {"Elastic": "lps", "Elastic Bond Based": "pmb", "Linear LPS": "linear_lps"}
+#: linearised about the reference configuration, ``peridyn.physics.materials.linear_lps``;
+#: "Linear Elastic": the older decks' name of "Elastic", Peridigm's
+#: ``LinearElasticIsotropicMaterial``, the same force state ``computeInternalForceLinearElastic``).
+MATERIALS = {
+    "Elastic": "lps",
+    "Elastic Bond Based": "pmb",
+    "Linear LPS": "linear_lps",
+    "Linear Elastic": "lps",
+}
 #: Peridigm's influence functions that peridyn has: name -> peridyn name.
 INFLUENCE = {"One": "constant"}
 #: Top-level deck sections read (others are refused by name).
@@ -122,7 +129,8 @@ def deck_case(params: dict, name: str, source: str = "<deck>", deck_dir=".") -> 
         **materials,
         "solver": solver,
     }
-    sets, bcs, ics = _conditions(deck, deck_dir, grid, geometry["type"] == "exodus")
+    first_id = 0 if older_form(deck) else 1
+    sets, bcs, ics = _conditions(deck, deck_dir, grid, geometry["type"] == "exodus", first_id)
     if sets:
         case["node_sets"] = sets
     if bcs:
@@ -165,9 +173,17 @@ class _Group:
     damage_key: str
 
 
+def older_form(deck: _Deck) -> bool:
+    """True for Peridigm's older deck form: one horizon under ``Discretization`` (not per
+    block), and node sets as 0-based node ids (docs/peridigm.md)."""
+    return "Horizon" in deck.get("Discretization", dict)
+
+
 def _groups(deck: _Deck) -> list[_Group]:
-    """The block groups of ``Blocks``, in deck order."""
+    """The block groups of ``Blocks``, in deck order; in the older form (``older_form``) each
+    takes ``Discretization.Horizon``."""
     groups = []
+    shared = older_form(deck)
     for name in deck.get("Blocks", dict):
         where = f"Blocks.{name}"
         for key in deck.get(where, dict):
@@ -175,9 +191,14 @@ def _groups(deck: _Deck) -> list[_Group]:
                 raise deck.error(
                     f"{where}.{key}", None, "Block Names, Material, Horizon and Damage Model only", False
                 )
-        horizon = deck.get(f"{where}.Horizon", float)
+        if shared and "Horizon" in deck.get(where, dict):
+            raise deck.error(
+                f"{where}.Horizon", deck.get(f"{where}.Horizon"), "no block horizon: Discretization.Horizon"
+            )
+        key = "Discretization.Horizon" if shared else f"{where}.Horizon"
+        horizon = deck.get(key, float)
         if not horizon > 0:
-            raise deck.error(f"{where}.Horizon", horizon, "a positive horizon (m)")
+            raise deck.error(key, horizon, "a positive horizon (m)")
         blocks = tuple(deck.get(f"{where}.Block Names", str).split())
         if not blocks:
             raise deck.error(f"{where}.Block Names", "", "the names of the group's blocks")
@@ -391,8 +412,9 @@ def _quasi_static(deck: _Deck, final: float) -> dict:
     }
 
 
-def _conditions(deck: _Deck, deck_dir: Path, grid, mesh_sets: bool) -> tuple[dict, list, list]:
-    """Node sets, boundary conditions and initial conditions of ``Boundary Conditions``."""
+def _conditions(deck: _Deck, deck_dir: Path, grid, mesh_sets: bool, first_id: int) -> tuple[dict, list, list]:
+    """Node sets, boundary conditions and initial conditions of ``Boundary Conditions``; node
+    ids count from ``first_id`` (1, or 0 in the older deck form)."""
     section = deck.get("Boundary Conditions", dict, {})
     definitions = {k: v for k, v in section.items() if not isinstance(v, dict)}
     sets, bcs, ics = {}, [], []
@@ -406,7 +428,9 @@ def _conditions(deck: _Deck, deck_dir: Path, grid, mesh_sets: bool) -> tuple[dic
             if set_name not in sets:
                 sets[set_name] = {
                     "type": "points",
-                    "indices": _set_indices(deck, f"Boundary Conditions.{set_name}", deck_dir, grid),
+                    "indices": _set_indices(
+                        deck, f"Boundary Conditions.{set_name}", deck_dir, grid, first_id
+                    ),
                 }
         elif not mesh_sets:
             raise deck.error(f"{where}.Node Set", set_name, f"a node set of the deck: {sorted(definitions)}")
@@ -437,25 +461,28 @@ def _value(deck: _Deck, key: str):
     return {"type": "expression", "text": text}
 
 
-def _set_indices(deck: _Deck, key: str, deck_dir: Path, grid) -> list[int]:
-    """0-based peridyn point indices of a node set given as 1-based ids inline or in a file."""
+def _set_indices(deck: _Deck, key: str, deck_dir: Path, grid, first_id: int) -> list[int]:
+    """0-based peridyn point indices of a node set given as ids counted from ``first_id``
+    (1, or 0 in the older deck form), inline or in a file."""
+    counted = f"{first_id}-based node ids"
     text = deck.get(key, str)
     path = deck_dir / text
     if not text.split()[0].isdigit() or path.is_file():
         if not path.is_file():
-            raise deck.error(key, text, "1-based node ids, or a file of them")
+            raise deck.error(key, text, f"{counted}, or a file of them")
         text = path.read_text(encoding="utf-8")
     try:
         ids = np.array([int(t) for t in text.split()], dtype=np.int64)
     except ValueError:
-        raise deck.error(key, text[:80], "whitespace-separated 1-based node ids") from None
-    if len(ids) == 0 or ids.min() < 1:
-        raise deck.error(key, text[:80], "1-based node ids (at least one)")
-    index = ids - 1
+        raise deck.error(key, text[:80], f"whitespace-separated {counted}") from None
+    if len(ids) == 0 or ids.min() < first_id:
+        raise deck.error(key, text[:80], f"{counted} (at least one)")
+    index = ids - first_id
     if grid is not None:
         nx, ny, nz = (int(n) for n in grid)
         if index.max() >= nx * ny * nz:
-            raise deck.error(key, int(ids.max()), f"node ids up to {nx * ny * nz} (the grid's points)")
+            last = nx * ny * nz - 1 + first_id
+            raise deck.error(key, int(ids.max()), f"node ids up to {last} (the grid's points)")
         # PdQuickGrid numbers x fastest, peridyn's box z fastest
         i, j, k = index % nx, (index // nx) % ny, index // (nx * ny)
         index = (i * ny + j) * nz + k

@@ -90,6 +90,30 @@ def test_pdquickgrid_ids_are_x_fastest():
     assert case["node_sets"]["Max X Node Set"]["indices"] == [2, 4]
 
 
+def test_older_deck_form():
+    """Peridigm's older form (BondBreakingInitialVelocity.xml, tests/data/peridigm_other): the
+    horizon under Discretization for every block, "Linear Elastic" the LPS model of "Elastic",
+    node ids 0-based (id 1 of its 2 x 2 x 1 grid is (i, j) = (1, 0), peridyn's point 2), and
+    its box families of horizon 0.51 m on spacings (1.05, 1, 1) m: one cell along y only."""
+    older = read_deck(DATA.parent / "peridigm_other" / "BondBreakingInitialVelocity.xml")
+    case = deck_case(older, "older")
+    assert case["discretization"]["horizon_m"] == 0.51
+    assert case["material"]["model"] == "lps"
+    assert case["node_sets"]["Node Set 1"]["indices"] == [2]
+    bonds = build(validate_case(case)).bonds
+    assert np.diff(bonds.offsets).tolist() == [1, 1, 1, 1]
+    assert bonds.neighbours.tolist() == [1, 0, 3, 2]  # (0, 0)-(0, 1) and (1, 0)-(1, 1)
+    deck = copy.deepcopy(older)
+    deck["Blocks"]["My Group of Blocks"]["Horizon"] = 0.51
+    _refusal(deck, "Blocks.My Group of Blocks.Horizon")
+    deck = copy.deepcopy(older)
+    deck["Boundary Conditions"]["Node Set 0"] = "4"
+    assert _refusal(deck, "Boundary Conditions.Node Set 0").value == 4
+    deck["Discretization"]["Horizon"] = 0.4  # round(0.4 / 1.0) = 0 cells along every axis
+    with pytest.raises(CaseFileError, match="reaches no cell"):
+        validate_case(deck_case(older | {"Discretization": deck["Discretization"]}, "older"))
+
+
 def _refusal(deck: dict, key_start: str, folder=DATA):
     with pytest.raises(CaseFileError) as err:
         deck_case(deck, "x", "deck.yaml", folder)
