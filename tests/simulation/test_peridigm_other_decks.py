@@ -3,12 +3,14 @@ those peridyn runs, each checked against an independent fact of the physics it w
 verify; the others refused with a CaseFileError naming the deck parameter that peridyn cannot
 run, before any mesh is looked for (docs/peridigm.md lists them)."""
 
+import dataclasses
 import math
 from pathlib import Path
 
 import numpy as np
 import pytest
-from test_peridigm_decks import run_deck
+from exodiff_comp import compare_meshes
+from test_peridigm_decks import DATA, run_deck
 
 from peridyn.errors import CaseFileError
 from peridyn.io.exodus import read_exodus
@@ -71,6 +73,72 @@ def test_bond_breaking_initial_velocity(tmp_path):
         assert not intact[-1] and np.all(damage[~intact][:, points] == 1)
         v_free = math.sqrt(v**2 - v_c**2)
         np.testing.assert_allclose(vy[~intact][:, points] * sign, v_free, rtol=0, atol=omega * v_c * dt)
+
+
+def test_compression_init_disp_2x1x1(tmp_path):
+    """Peridigm's CompressionInitDisp_2x1x1 (older deck form): two points L = 2 m apart (x),
+    displaced by +-1e-5 m towards each other and let go. Velocity Verlet on the pair's stretch
+    e'' = -omega^2 e (``pair_frequency``) gives exactly e_n = e_0 cos(n phi) with cos phi =
+    1 - (omega dt)^2 / 2 (from e_0 at rest, e_1 = e_0 (1 - (omega dt)^2 / 2), then the central
+    difference), and the rates by the trapezoidal sums of a_n = -omega^2 e_n; the force
+    density is rho a / 2 on each point, the dilatation 3 e / L and the weighted volume L^2 V,
+    V = 2 m^3. The whole run is linear in e (the bond stays on the x axis), so only round-off
+    separates the run from these: the extension |y| - |xi| of the 2 m bond shortened by 2e-5 m
+    carries one rounding of |y| (eps |xi| = 4.4e-16 m), 2.2e-11 of itself (rtol 1e-10)."""
+    deck = read_deck(OTHER / "CompressionInitDisp_2x1x1.xml")
+    material = deck["Materials"]["My Elastic Material"]
+    dt, density, length, volume = deck["Solver"]["Verlet"]["Fixed dt"], material["Density"], 2.0, 2.0
+    omega = pair_frequency(material["Bulk Modulus"], density, length)
+    out = read_exodus(run_deck(OTHER / "CompressionInitDisp_2x1x1.xml", tmp_path))
+    steps = np.arange(len(out.times))
+    np.testing.assert_allclose(out.times, steps * dt, rtol=1e-12)
+    phi = math.acos(1 - (omega * dt) ** 2 / 2)
+    e = -2e-5 * np.cos(steps * phi)  # the deck's +-1e-5 m: the pair starts 2e-5 m short
+    a = -(omega**2) * e
+    rate = np.concatenate([[0.0], np.cumsum(dt / 2 * (a[:-1] + a[1:]))])
+    right = np.argmax(out.coordinates[:, 0])  # the point at x = +1 m moves with +e/2
+    sign = np.where(np.arange(2) == right, 1.0, -1.0)
+    for name, expected in (("Displacement", e / 2), ("Velocity", rate / 2), ("Acceleration", a / 2)):
+        got = out.nodal_variables[f"{name}X"]
+        np.testing.assert_allclose(
+            got * sign, np.outer(expected, [1, 1]), rtol=1e-10, atol=1e-25, err_msg=name
+        )
+    np.testing.assert_allclose(
+        out.nodal_variables["Force_DensityX"] * sign, np.outer(density * a / 2, [1, 1]), rtol=1e-10
+    )
+    np.testing.assert_allclose(
+        out.element_variables["Dilatation"], np.outer(3 * e / length, [1, 1]), rtol=1e-10
+    )
+    np.testing.assert_allclose(out.element_variables["Weighted_Volume"], length**2 * volume, rtol=1e-14)
+    assert out.element_variables["ID"].tolist() == [[0.0, 1.0]] * len(steps)
+
+
+def reordered(mesh, order: np.ndarray):
+    """An Exodus file read (``read_exodus``, one element per point) with its points in ``order``."""
+    return dataclasses.replace(
+        mesh,
+        coordinates=mesh.coordinates[order],
+        nodal_variables={k: v[:, order] for k, v in mesh.nodal_variables.items()},
+        element_variables={k: v[:, order] for k, v in mesh.element_variables.items()},
+    )
+
+
+def test_compression_qs_3x2x2_matches_its_text_file_twin(tmp_path):
+    """Peridigm's Compression_QS_3x2x2 (older deck form: PdQuickGrid, 0-based node ids) is the
+    problem of its twin Compression_QS_3x2x2_TextFile (the same 12 points, unit volumes,
+    horizon, spherical families, material, node sets and quasi-static load steps, on a text
+    mesh): its result matches the twin's gold file (Peridigm's, tests/data/peridigm), point by
+    point once the points are matched by their coordinates, within the twin's exodiff
+    tolerances (Compression_QS_3x2x2_TextFile.comp)."""
+    twin = DATA / "Compression_QS_3x2x2_TextFile"
+    gold = read_exodus(twin / "Compression_QS_3x2x2_TextFile_gold.e")
+    mine = read_exodus(run_deck(OTHER / "Compression_QS_3x2x2.xml", tmp_path))
+    distance = np.linalg.norm(gold.coordinates[:, None, :] - mine.coordinates[None, :, :], axis=2)
+    order = np.argmin(distance, axis=1)
+    assert sorted(order.tolist()) == list(range(12)) and np.all(distance.min(axis=1) < 1e-12)
+    excess = compare_meshes(gold, reordered(mine, order), twin / "Compression_QS_3x2x2_TextFile.comp")
+    assert set(excess) >= {"DisplacementX", "VelocityX", "Force_DensityX", "Dilatation", "Weighted_Volume"}
+    assert {k: v for k, v in excess.items() if v > 0} == {}
 
 
 @pytest.mark.parametrize(
