@@ -205,8 +205,8 @@ class Geometry(Strict):
             raise ValueError("a rectangle (2D) needs its thickness (m)")
         if self.is_mesh and not self.file:
             raise ValueError(f"a {self.type} geometry needs the mesh file")
-        if self.type == "exodus" and self.dimension != 3:
-            raise ValueError("an exodus geometry is 3D (dimension 3)")
+        if self.is_mesh and self.dimension == 2 and self.thickness is None:
+            raise ValueError(f"a 2D {self.type} geometry needs its thickness (m)")
         return self
 
     @property

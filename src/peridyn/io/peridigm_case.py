@@ -37,6 +37,13 @@ MATERIALS = {
     "Linear LPS": "linear_lps",
     "Linear Elastic": "lps",
 }
+#: Peridigm's partial-volume models, refused with ``PARTIAL_VOLUME_DIFFERS``.
+PARTIAL_VOLUME = ("Elastic Partial Volume", "Linear LPS Partial Volume")
+PARTIAL_VOLUME_DIFFERS = (
+    "a model without Peridigm's partial volumes (there a bond's volumes are the parts of the "
+    "two mesh elements inside each other's horizon spheres, one for each direction of the bond; "
+    "peridyn's are the part of a cube of the point's volume, centred on it, inside the sphere)"
+)
 #: Peridigm's influence functions that peridyn has: name -> peridyn name.
 INFLUENCE = {"One": "constant"}
 #: Top-level deck sections read (others are refused by name).
@@ -120,7 +127,15 @@ def deck_case(params: dict, name: str, source: str = "<deck>", deck_dir=".") -> 
             )
         materials = dict(zip(("materials", "blocks"), _block_materials(deck, groups, horizon), strict=True))
     solver = _solver(deck)
+    planes = {_plane(deck, g.material) for g in groups}
+    if len(planes) > 1:
+        raise deck.error("Materials", sorted(g.material for g in groups), "materials of one dimension")
+    (plane,) = planes
+    if plane is not None and deck.get("Discretization.Type", str) == "PdQuickGrid":
+        raise deck.error("Discretization.Type", "PdQuickGrid", "a mesh for a 2D material (a 3D grid)")
     geometry, discretization, grid = _discretization(deck, deck_dir, horizon)
+    if plane is not None:
+        geometry |= {"dimension": 2, "plane": plane[0], "thickness": plane[1]}
     case = {
         "name": name,
         "description": f"Peridigm deck {Path(source).name}, translated by peridyn",
@@ -280,21 +295,30 @@ def _material(deck: _Deck, name: str) -> dict:
     where = f"Materials.{name}"
     deck.get(where, dict)
     model = deck.get(f"{where}.Material Model", str)
+    if model in PARTIAL_VOLUME:
+        raise deck.error(f"{where}.Material Model", model, PARTIAL_VOLUME_DIFFERS)
     if model not in MATERIALS:
         raise deck.error(f"{where}.Material Model", model, f"one of {sorted(MATERIALS)}")
     density = deck.get(f"{where}.Density", float)
     bulk = deck.get(f"{where}.Bulk Modulus", float)
     known = {"Material Model", "Density", "Bulk Modulus", "Shear Modulus", "Apply Shear Correction Factor"}
-    known |= {"Influence Function"}
+    known |= {"Influence Function", "Plane Stress", "Plane Strain", "Height"}
     for key in deck.get(where, dict):
         if key not in known:
             raise deck.error(f"{where}.{key}", None, f"only the parameters {sorted(known)}", False)
     influence = deck.get(f"{where}.Influence Function", str, "One")
     if influence not in INFLUENCE:
         raise deck.error(f"{where}.Influence Function", influence, f"one of {sorted(INFLUENCE)}")
+    plane = _plane(deck, name)
     if MATERIALS[model] == "pmb":
-        # c = 18 K / (pi delta^4) from K alone: peridyn's PMB has nu = 1/4, so K = E / 1.5
-        return {"model": "pmb", "E": 1.5 * bulk, "density": density}
+        # c = 18 K / (pi delta^4) from K alone: peridyn's PMB has nu = 1/4, so K = E / 1.5; in
+        # 2D Peridigm's c = 12 K / (pi h delta^3) is peridyn's 12 kappa / (pi t delta^3) of
+        # the plane bulk modulus kappa = K (``PLANE_E``)
+        return {"model": "pmb", "E": (PLANE_E[plane[0]] if plane else 1.5) * bulk, "density": density}
+    if plane is not None:
+        raise deck.error(
+            f"{where}.Plane {plane[0].capitalize()}", True, "3D, or the Elastic Bond Based model in 2D"
+        )
     shear = deck.get(f"{where}.Shear Modulus", float)
     # E and nu of the bulk and shear moduli (LPS turns them back into K and mu)
     E = 9.0 * bulk * shear / (3.0 * bulk + shear)
@@ -307,6 +331,30 @@ def _material(deck: _Deck, name: str) -> dict:
             )
         material["surface_correction"] = "shear-factor"
     return material
+
+
+#: E / K of peridyn's 2D bond-based model whose plane bulk modulus is K: kappa = E / (2 (1 - nu))
+#: with nu = 1/3 in plane stress, E / (2 (1 + nu) (1 - 2 nu)) with nu = 1/4 in plane strain.
+PLANE_E = {"stress": 4.0 / 3.0, "strain": 1.25}
+
+
+def _plane(deck: _Deck, name: str) -> tuple[str, float] | None:
+    """("stress" or "strain", Height in m) of a 2D material (``Plane Stress`` or ``Plane
+    Strain`` true, as Peridigm's ``ElasticBondBasedMaterial``), or None in 3D."""
+    where = f"Materials.{name}"
+    on = [p for p in ("stress", "strain") if deck.get(f"{where}.Plane {p.capitalize()}", bool, False)]
+    if len(on) > 1:
+        raise deck.error(f"{where}.Plane Strain", True, "one of Plane Stress and Plane Strain")
+    if not on:
+        if deck.get(f"{where}.Height", float, None) is not None:
+            raise deck.error(
+                f"{where}.Height", deck.get(f"{where}.Height"), "a height with Plane Stress/Strain"
+            )
+        return None
+    height = deck.get(f"{where}.Height", float)
+    if not height > 0:
+        raise deck.error(f"{where}.Height", height, "a positive height (m): the thickness")
+    return on[0], height
 
 
 def _damage(deck: _Deck, key: str) -> dict:

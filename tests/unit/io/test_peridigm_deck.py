@@ -114,6 +114,39 @@ def test_older_deck_form():
         validate_case(deck_case(older | {"Discretization": deck["Discretization"]}, "older"))
 
 
+def test_2d_deck_translation_and_refusals():
+    """A 2D bond-based deck (ElasticBondBased2DPlaneStress.yaml): a 2D Exodus geometry of the
+    deck's Height and plane, E = 4 K / 3 in plane stress (1.25 K in plane strain), so that
+    peridyn's 12 kappa / (pi t delta^3) with the plane bulk modulus kappa is Peridigm's
+    12 K / (pi h delta^3); a plane flag on another model, Height alone and a 2D material on a
+    (3D) PdQuickGrid are refused by name."""
+    other = DATA.parent / "peridigm_other"
+    deck = read_deck(other / "ElasticBondBased2DPlaneStress.yaml")
+    material = deck["Materials"]["My Elastic Bond Based Material"]
+    with pytest.raises(CaseFileError) as err:
+        deck_case(deck, "2d", "deck.yaml", other)
+    assert err.value.key == "Discretization.Input Mesh File"
+    deck["Discretization"]["Input Mesh File"] = "ElasticBondBased3D.g"  # a mesh that exists here
+    case = deck_case(deck, "2d", "deck.yaml", DATA)
+    assert case["geometry"] | {"file": None} == {"type": "exodus", "file": None, "dimension": 2} | {
+        "plane": "stress",
+        "thickness": 0.25,
+    }
+    assert case["material"]["E"] == 4.0 / 3.0 * material["Bulk Modulus"]
+    strain = copy.deepcopy(deck)
+    strain["Materials"]["My Elastic Bond Based Material"] |= {"Plane Stress": False, "Plane Strain": True}
+    assert deck_case(strain, "2d", "deck.yaml", DATA)["material"]["E"] == 1.25 * material["Bulk Modulus"]
+    lps = copy.deepcopy(deck)
+    lps["Materials"]["My Elastic Bond Based Material"] |= {"Material Model": "Elastic", "Shear Modulus": 1e11}
+    _refusal(lps, "Materials.My Elastic Bond Based Material.Plane Stress")
+    height_only = copy.deepcopy(deck)
+    height_only["Materials"]["My Elastic Bond Based Material"]["Plane Stress"] = False
+    _refusal(height_only, "Materials.My Elastic Bond Based Material.Height")
+    grid = read_deck(COMPRESSION)
+    grid["Materials"]["My Elastic Material"] = dict(material)
+    _refusal(grid, "Discretization.Type")
+
+
 def _refusal(deck: dict, key_start: str, folder=DATA):
     with pytest.raises(CaseFileError) as err:
         deck_case(deck, "x", "deck.yaml", folder)
