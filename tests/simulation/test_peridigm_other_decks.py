@@ -208,6 +208,8 @@ def test_elastic_bond_based_2d(tmp_path, plane):
             "Materials.Linearized LPS Material.Material Model",
             "Linear LPS Partial Volume",
         ),
+        ("Compression_3x1x1.xml", "Output.Output Variables.Strain_Energy", True),
+        ("Compression_2x1x1.xml", "Problem", None),
     ],
 )
 def test_other_peridigm_decks_are_refused_by_parameter(deck, key, value):
