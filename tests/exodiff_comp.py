@@ -68,8 +68,12 @@ def compare(gold_path, result_path, comp_path) -> dict:
     """Excess over tolerance (<= 0 passes) of each compared item of the result against the
     gold: ``coordinates``, ``times`` and every variable the comp file lists. A variable that
     the result lacks, or time steps that differ in number, count as +inf."""
+    return compare_meshes(read_exodus(gold_path), read_exodus(result_path), comp_path)
+
+
+def compare_meshes(gold, mine, comp_path) -> dict:
+    """``compare`` of two Exodus files read (``read_exodus``)."""
     comp = read_comp(comp_path)
-    gold, mine = read_exodus(gold_path), read_exodus(result_path)
     out = {}
     same_shape = gold.coordinates.shape == mine.coordinates.shape
     out["coordinates"] = (

@@ -8,6 +8,7 @@ was expected (with "did you mean" for misspelt keys).
 
 from __future__ import annotations
 
+import math
 import re
 from pathlib import Path
 from typing import Annotated, Literal
@@ -204,8 +205,8 @@ class Geometry(Strict):
             raise ValueError("a rectangle (2D) needs its thickness (m)")
         if self.is_mesh and not self.file:
             raise ValueError(f"a {self.type} geometry needs the mesh file")
-        if self.type == "exodus" and self.dimension != 3:
-            raise ValueError("an exodus geometry is 3D (dimension 3)")
+        if self.is_mesh and self.dimension == 2 and self.thickness is None:
+            raise ValueError(f"a 2D {self.type} geometry needs its thickness (m)")
         return self
 
     @property
@@ -236,7 +237,10 @@ class Discretization(Strict):
     def _one_horizon(self):
         if (self.horizon is None) == (self.horizon_m is None):
             raise ValueError("give exactly one of horizon (multiple of the spacing) or horizon_m")
-        check_horizon(self.horizon, self.horizon_m, self.spacing)
+        if self.neighbourhood == "box" and self.horizon_m is not None:
+            check_box_horizon(self.horizon_m, self.spacing)
+        else:
+            check_horizon(self.horizon, self.horizon_m, self.spacing)
         return self
 
 
@@ -253,6 +257,18 @@ def check_horizon(horizon: float | None, horizon_m: float | None, spacing) -> No
         raise ValueError(
             f"horizon_m = {horizon_m:g} m is below the spacing {spacing:g} m: "
             "at least the spacing (else a point has no neighbours along the axes)"
+        )
+
+
+def check_box_horizon(horizon_m: float, spacing) -> None:
+    """Refuse the horizon (m) of a box neighbourhood (round(horizon / spacing) cells along each
+    axis) that reaches no cell along any axis of the ``spacing`` (m, one value or a list;
+    Peridigm's older BondBreakingInitialVelocity deck reaches along y only) (ValueError)."""
+    spacing = min(spacing) if isinstance(spacing, list) else spacing
+    if spacing is not None and math.floor(horizon_m / spacing + 0.5) < 1:
+        raise ValueError(
+            f"horizon_m = {horizon_m:g} m reaches no cell of a box neighbourhood: at least half "
+            f"the smallest spacing {spacing:g} m"
         )
 
 

@@ -40,6 +40,7 @@ import scipy.io
 
 from peridyn.discretization.body import Body
 from peridyn.errors import InputError
+from peridyn.io.mesh_text import volume_cells
 
 #: HEX8 faces, nodes in cyclic order with outward normals (Exodus node numbering, 0-based).
 HEX_FACES = np.array([[0, 1, 5, 4], [1, 2, 6, 5], [2, 3, 7, 6], [3, 0, 4, 7], [0, 3, 2, 1], [4, 5, 6, 7]])
@@ -404,16 +405,33 @@ def hex_centroid_volume(nodes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return moment / volume[:, None], volume
 
 
-def body_from_exodus(path: str | os.PathLike) -> Body:
-    """A 3-D body from an Exodus mesh: a point per element (:func:`mesh_points`), cells taken as
-    cubes of the point's volume, node sets of each block (by name), node set and side set."""
+def body_from_exodus(
+    path: str | os.PathLike, dim: int = 3, thickness: float | None = None, plane: str | None = None
+) -> Body:
+    """A body from an Exodus mesh: a point per element (:func:`mesh_points`) with the element's
+    volume (m^3), node sets of each block (by name), node set and side set. 3D: cells taken as
+    cubes of the volume. 2D (``dim`` 2, a body of ``thickness`` m in ``plane`` "stress" or
+    "strain"): one layer of elements, every point at the same z (else an InputError), placed
+    at z = 0; cells squares of area volume / thickness, as Peridigm's 2D decks read a one-layer
+    hex mesh."""
     pts = mesh_points(read_exodus(path))
-    side = np.cbrt(pts.volumes)
+    points = pts.points
+    if dim == 2:
+        z = points[:, 2]
+        if np.ptp(z) > 1e-12 * max(1.0, float(np.max(np.abs(points)))):
+            raise InputError(
+                f"{path}: a 2D body needs one layer of elements (its points at z from {z.min():g} "
+                f"to {z.max():g} m)"
+            )
+        points = points * [1.0, 1.0, 0.0]  # the layer in the plane z = 0 of a 2D body
+    cells, side = volume_cells(pts.volumes, dim, thickness, "Exodus mesh")
     return Body(
-        points=pts.points,
+        points=points,
         volumes=pts.volumes,
-        cells=np.stack([side, side, side], axis=1),
-        dim=3,
+        cells=cells,
+        dim=dim,
         spacing=float(np.median(side)),
         node_sets=pts.point_sets,
+        thickness=thickness if dim == 2 else None,
+        plane=plane if dim == 2 else None,
     )

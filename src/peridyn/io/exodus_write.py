@@ -36,8 +36,9 @@ MAX_NAME = 255
 COMPONENTS = "XYZ"
 #: Peridigm's output variables that peridyn writes: name -> (placement, vector). Nodal vectors:
 #: displacement (m), velocity (m/s), force (N), force density (N/m^3), acceleration (m/s^2);
-#: element scalars: 1-based id, rank, volume (m^3), dilatation, weighted volume (m^5), stored
-#: elastic energy (J, energy density times volume), number of neighbours and damage.
+#: element scalars: 1-based id, 0-based id (``ID``, the older decks' name), rank, volume (m^3),
+#: dilatation, weighted volume (m^5), stored elastic energy (J, energy density times volume),
+#: number of neighbours and damage.
 PERIDIGM_VARIABLES = {
     "Displacement": ("nodal", True),
     "Velocity": ("nodal", True),
@@ -45,6 +46,7 @@ PERIDIGM_VARIABLES = {
     "Force_Density": ("nodal", True),
     "Acceleration": ("nodal", True),
     "Element_Id": ("element", False),
+    "ID": ("element", False),
     "Proc_Num": ("element", False),
     "Volume": ("element", False),
     "Dilatation": ("element", False),
@@ -88,6 +90,10 @@ class ExodusWriter:
         The fields given to :meth:`append`: 1 for a scalar, ``dim`` for a vector. Nodal and
         element fields have a value per point, global fields one value (or vector).
     title : str
+    volumes : (n,) float64 or None, m^3
+        Each point's volume, written as its SPHERE element's attributes (radius of the sphere
+        of that volume, volume), Peridigm's sphere-mesh convention: the file then reads back as
+        a mesh (``peridyn.io.exodus.mesh_points``). None: no attributes.
     """
 
     def __init__(
@@ -100,6 +106,7 @@ class ExodusWriter:
         element=None,
         global_=None,
         title: str = "peridyn",
+        volumes=None,
     ):
         self.path = Path(path)
         self.points = np.asarray(points, dtype=np.float64)
@@ -118,6 +125,9 @@ class ExodusWriter:
         }
         self.names = {kind: component_names(f, self.dim) for kind, f in self.fields.items()}
         self.title = title
+        self.volumes = None if volumes is None else np.asarray(volumes, dtype=np.float64)
+        if self.volumes is not None and self.volumes.shape != (n,):
+            raise InputError(f"Exodus volumes must have shape ({n},), got {self.volumes.shape}")
         self.n_steps = 0
         self._begin = None  # file offset of the first record
 
@@ -249,6 +259,12 @@ class ExodusWriter:
             f.createDimension(f"num_nod_per_el{j}", 1)
             conn = _int_var(f, f"connect{j}", (f"num_el_in_blk{j}", f"num_nod_per_el{j}"), idx[:, None] + 1)
             conn.elem_type = "SPHERE"
+            if self.volumes is not None:
+                f.createDimension(f"num_att_in_blk{j}", 2)
+                volume = self.volumes[idx]
+                radius = np.cbrt(3.0 * volume / (4.0 * np.pi))
+                attrib = f.createVariable(f"attrib{j}", "d", (f"num_el_in_blk{j}", f"num_att_in_blk{j}"))
+                attrib[:] = np.column_stack([radius, volume])
         if self.names["element"]:
             tab = np.ones((len(self.blocks), len(self.names["element"])))
             _int_var(f, "elem_var_tab", ("num_el_blk", "num_elem_var"), tab)

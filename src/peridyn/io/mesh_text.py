@@ -189,6 +189,18 @@ def _check_volumes(path: str, volumes: np.ndarray) -> None:
         raise InputError(f"{path}, line {line}: volume must be positive and finite, got {float(value)!r}")
 
 
+def volume_cells(volumes: np.ndarray, dim: int, thickness: float | None, what: str):
+    """Cells (n_points, 3) of points of ``volumes`` (m^3) read from a mesh, and their in-plane
+    sides (n_points,), m: cubes of the volume in 3D, squares times ``thickness`` (m) in 2D."""
+    if dim == 2:
+        if thickness is None:
+            raise InputError(f"a 2D {what} needs the thickness of the body")
+        side = np.sqrt(volumes / thickness)
+        return np.stack([side, side, np.full_like(side, thickness)], axis=1), side
+    side = np.cbrt(volumes)
+    return np.stack([side, side, side], axis=1), side
+
+
 def from_text_mesh(path, dim: int = 3, thickness: float | None = None, plane: str | None = None) -> Body:
     """A body from a Peridigm-style text mesh (``x y z block_id volume`` per line).
 
@@ -196,14 +208,7 @@ def from_text_mesh(path, dim: int = 3, thickness: float | None = None, plane: st
     in 2D); node sets ``block_<id>`` hold the points of each block.
     """
     points, blocks, volumes = read_text_mesh(path)
-    if dim == 2:
-        if thickness is None:
-            raise InputError("a 2D text mesh needs the thickness of the body")
-        side = np.sqrt(volumes / thickness)
-        cells = np.stack([side, side, np.full_like(side, thickness)], axis=1)
-    else:
-        side = np.cbrt(volumes)
-        cells = np.stack([side, side, side], axis=1)
+    cells, side = volume_cells(volumes, dim, thickness, "text mesh")
     sets = {f"block_{b}": np.flatnonzero(blocks == b) for b in np.unique(blocks)}
     return Body(
         points=points,

@@ -28,8 +28,22 @@ from peridyn.io.peridigm_deck import is_peridigm_deck, read_deck
 from peridyn.physics.expressions import SpaceTime
 
 #: Peridigm's material models that peridyn runs: name -> peridyn model ("Linear LPS": LPS
-#: linearised about the reference configuration, ``peridyn.physics.materials.linear_lps``).
-MATERIALS = {"Elastic": "lps", "Elastic Bond Based": "pmb", "Linear LPS": "linear_lps"}
+#: linearised about the reference configuration, ``peridyn.physics.materials.linear_lps``;
+#: "Linear Elastic": the older decks' name of "Elastic", Peridigm's
+#: ``LinearElasticIsotropicMaterial``, the same force state ``computeInternalForceLinearElastic``).
+MATERIALS = {
+    "Elastic": "lps",
+    "Elastic Bond Based": "pmb",
+    "Linear LPS": "linear_lps",
+    "Linear Elastic": "lps",
+}
+#: Peridigm's partial-volume models, refused with ``PARTIAL_VOLUME_DIFFERS``.
+PARTIAL_VOLUME = ("Elastic Partial Volume", "Linear LPS Partial Volume")
+PARTIAL_VOLUME_DIFFERS = (
+    "a model without Peridigm's partial volumes (there a bond's volumes are the parts of the "
+    "two mesh elements inside each other's horizon spheres, one for each direction of the bond; "
+    "peridyn's are the part of a cube of the point's volume, centred on it, inside the sphere)"
+)
 #: Peridigm's influence functions that peridyn has: name -> peridyn name.
 INFLUENCE = {"One": "constant"}
 #: Top-level deck sections read (others are refused by name).
@@ -113,7 +127,15 @@ def deck_case(params: dict, name: str, source: str = "<deck>", deck_dir=".") -> 
             )
         materials = dict(zip(("materials", "blocks"), _block_materials(deck, groups, horizon), strict=True))
     solver = _solver(deck)
+    planes = {_plane(deck, g.material) for g in groups}
+    if len(planes) > 1:
+        raise deck.error("Materials", sorted(g.material for g in groups), "materials of one dimension")
+    (plane,) = planes
+    if plane is not None and deck.get("Discretization.Type", str) == "PdQuickGrid":
+        raise deck.error("Discretization.Type", "PdQuickGrid", "a mesh for a 2D material (a 3D grid)")
     geometry, discretization, grid = _discretization(deck, deck_dir, horizon)
+    if plane is not None:
+        geometry |= {"dimension": 2, "plane": plane[0], "thickness": plane[1]}
     case = {
         "name": name,
         "description": f"Peridigm deck {Path(source).name}, translated by peridyn",
@@ -122,7 +144,8 @@ def deck_case(params: dict, name: str, source: str = "<deck>", deck_dir=".") -> 
         **materials,
         "solver": solver,
     }
-    sets, bcs, ics = _conditions(deck, deck_dir, grid, geometry["type"] == "exodus")
+    first_id = 0 if older_form(deck) else 1
+    sets, bcs, ics = _conditions(deck, deck_dir, grid, geometry["type"] == "exodus", first_id)
     if sets:
         case["node_sets"] = sets
     if bcs:
@@ -165,9 +188,17 @@ class _Group:
     damage_key: str
 
 
+def older_form(deck: _Deck) -> bool:
+    """True for Peridigm's older deck form: one horizon under ``Discretization`` (not per
+    block), and node sets as 0-based node ids (docs/peridigm.md)."""
+    return "Horizon" in deck.get("Discretization", dict)
+
+
 def _groups(deck: _Deck) -> list[_Group]:
-    """The block groups of ``Blocks``, in deck order."""
+    """The block groups of ``Blocks``, in deck order; in the older form (``older_form``) each
+    takes ``Discretization.Horizon``."""
     groups = []
+    shared = older_form(deck)
     for name in deck.get("Blocks", dict):
         where = f"Blocks.{name}"
         for key in deck.get(where, dict):
@@ -175,9 +206,14 @@ def _groups(deck: _Deck) -> list[_Group]:
                 raise deck.error(
                     f"{where}.{key}", None, "Block Names, Material, Horizon and Damage Model only", False
                 )
-        horizon = deck.get(f"{where}.Horizon", float)
+        if shared and "Horizon" in deck.get(where, dict):
+            raise deck.error(
+                f"{where}.Horizon", deck.get(f"{where}.Horizon"), "no block horizon: Discretization.Horizon"
+            )
+        key = "Discretization.Horizon" if shared else f"{where}.Horizon"
+        horizon = deck.get(key, float)
         if not horizon > 0:
-            raise deck.error(f"{where}.Horizon", horizon, "a positive horizon (m)")
+            raise deck.error(key, horizon, "a positive horizon (m)")
         blocks = tuple(deck.get(f"{where}.Block Names", str).split())
         if not blocks:
             raise deck.error(f"{where}.Block Names", "", "the names of the group's blocks")
@@ -259,21 +295,30 @@ def _material(deck: _Deck, name: str) -> dict:
     where = f"Materials.{name}"
     deck.get(where, dict)
     model = deck.get(f"{where}.Material Model", str)
+    if model in PARTIAL_VOLUME:
+        raise deck.error(f"{where}.Material Model", model, PARTIAL_VOLUME_DIFFERS)
     if model not in MATERIALS:
         raise deck.error(f"{where}.Material Model", model, f"one of {sorted(MATERIALS)}")
     density = deck.get(f"{where}.Density", float)
     bulk = deck.get(f"{where}.Bulk Modulus", float)
     known = {"Material Model", "Density", "Bulk Modulus", "Shear Modulus", "Apply Shear Correction Factor"}
-    known |= {"Influence Function"}
+    known |= {"Influence Function", "Plane Stress", "Plane Strain", "Height"}
     for key in deck.get(where, dict):
         if key not in known:
             raise deck.error(f"{where}.{key}", None, f"only the parameters {sorted(known)}", False)
     influence = deck.get(f"{where}.Influence Function", str, "One")
     if influence not in INFLUENCE:
         raise deck.error(f"{where}.Influence Function", influence, f"one of {sorted(INFLUENCE)}")
+    plane = _plane(deck, name)
     if MATERIALS[model] == "pmb":
-        # c = 18 K / (pi delta^4) from K alone: peridyn's PMB has nu = 1/4, so K = E / 1.5
-        return {"model": "pmb", "E": 1.5 * bulk, "density": density}
+        # c = 18 K / (pi delta^4) from K alone: peridyn's PMB has nu = 1/4, so K = E / 1.5; in
+        # 2D Peridigm's c = 12 K / (pi h delta^3) is peridyn's 12 kappa / (pi t delta^3) of
+        # the plane bulk modulus kappa = K (``PLANE_E``)
+        return {"model": "pmb", "E": (PLANE_E[plane[0]] if plane else 1.5) * bulk, "density": density}
+    if plane is not None:
+        raise deck.error(
+            f"{where}.Plane {plane[0].capitalize()}", True, "3D, or the Elastic Bond Based model in 2D"
+        )
     shear = deck.get(f"{where}.Shear Modulus", float)
     # E and nu of the bulk and shear moduli (LPS turns them back into K and mu)
     E = 9.0 * bulk * shear / (3.0 * bulk + shear)
@@ -286,6 +331,30 @@ def _material(deck: _Deck, name: str) -> dict:
             )
         material["surface_correction"] = "shear-factor"
     return material
+
+
+#: E / K of peridyn's 2D bond-based model whose plane bulk modulus is K: kappa = E / (2 (1 - nu))
+#: with nu = 1/3 in plane stress, E / (2 (1 + nu) (1 - 2 nu)) with nu = 1/4 in plane strain.
+PLANE_E = {"stress": 4.0 / 3.0, "strain": 1.25}
+
+
+def _plane(deck: _Deck, name: str) -> tuple[str, float] | None:
+    """("stress" or "strain", Height in m) of a 2D material (``Plane Stress`` or ``Plane
+    Strain`` true, as Peridigm's ``ElasticBondBasedMaterial``), or None in 3D."""
+    where = f"Materials.{name}"
+    on = [p for p in ("stress", "strain") if deck.get(f"{where}.Plane {p.capitalize()}", bool, False)]
+    if len(on) > 1:
+        raise deck.error(f"{where}.Plane Strain", True, "one of Plane Stress and Plane Strain")
+    if not on:
+        if deck.get(f"{where}.Height", float, None) is not None:
+            raise deck.error(
+                f"{where}.Height", deck.get(f"{where}.Height"), "a height with Plane Stress/Strain"
+            )
+        return None
+    height = deck.get(f"{where}.Height", float)
+    if not height > 0:
+        raise deck.error(f"{where}.Height", height, "a positive height (m): the thickness")
+    return on[0], height
 
 
 def _damage(deck: _Deck, key: str) -> dict:
@@ -391,8 +460,9 @@ def _quasi_static(deck: _Deck, final: float) -> dict:
     }
 
 
-def _conditions(deck: _Deck, deck_dir: Path, grid, mesh_sets: bool) -> tuple[dict, list, list]:
-    """Node sets, boundary conditions and initial conditions of ``Boundary Conditions``."""
+def _conditions(deck: _Deck, deck_dir: Path, grid, mesh_sets: bool, first_id: int) -> tuple[dict, list, list]:
+    """Node sets, boundary conditions and initial conditions of ``Boundary Conditions``; node
+    ids count from ``first_id`` (1, or 0 in the older deck form)."""
     section = deck.get("Boundary Conditions", dict, {})
     definitions = {k: v for k, v in section.items() if not isinstance(v, dict)}
     sets, bcs, ics = {}, [], []
@@ -406,7 +476,9 @@ def _conditions(deck: _Deck, deck_dir: Path, grid, mesh_sets: bool) -> tuple[dic
             if set_name not in sets:
                 sets[set_name] = {
                     "type": "points",
-                    "indices": _set_indices(deck, f"Boundary Conditions.{set_name}", deck_dir, grid),
+                    "indices": _set_indices(
+                        deck, f"Boundary Conditions.{set_name}", deck_dir, grid, first_id
+                    ),
                 }
         elif not mesh_sets:
             raise deck.error(f"{where}.Node Set", set_name, f"a node set of the deck: {sorted(definitions)}")
@@ -437,25 +509,28 @@ def _value(deck: _Deck, key: str):
     return {"type": "expression", "text": text}
 
 
-def _set_indices(deck: _Deck, key: str, deck_dir: Path, grid) -> list[int]:
-    """0-based peridyn point indices of a node set given as 1-based ids inline or in a file."""
+def _set_indices(deck: _Deck, key: str, deck_dir: Path, grid, first_id: int) -> list[int]:
+    """0-based peridyn point indices of a node set given as ids counted from ``first_id``
+    (1, or 0 in the older deck form), inline or in a file."""
+    counted = f"{first_id}-based node ids"
     text = deck.get(key, str)
     path = deck_dir / text
     if not text.split()[0].isdigit() or path.is_file():
         if not path.is_file():
-            raise deck.error(key, text, "1-based node ids, or a file of them")
+            raise deck.error(key, text, f"{counted}, or a file of them")
         text = path.read_text(encoding="utf-8")
     try:
         ids = np.array([int(t) for t in text.split()], dtype=np.int64)
     except ValueError:
-        raise deck.error(key, text[:80], "whitespace-separated 1-based node ids") from None
-    if len(ids) == 0 or ids.min() < 1:
-        raise deck.error(key, text[:80], "1-based node ids (at least one)")
-    index = ids - 1
+        raise deck.error(key, text[:80], f"whitespace-separated {counted}") from None
+    if len(ids) == 0 or ids.min() < first_id:
+        raise deck.error(key, text[:80], f"{counted} (at least one)")
+    index = ids - first_id
     if grid is not None:
         nx, ny, nz = (int(n) for n in grid)
         if index.max() >= nx * ny * nz:
-            raise deck.error(key, int(ids.max()), f"node ids up to {nx * ny * nz} (the grid's points)")
+            last = nx * ny * nz - 1 + first_id
+            raise deck.error(key, int(ids.max()), f"node ids up to {last} (the grid's points)")
         # PdQuickGrid numbers x fastest, peridyn's box z fastest
         i, j, k = index % nx, (index // nx) % ny, index // (nx * ny)
         index = (i * ny + j) * nz + k

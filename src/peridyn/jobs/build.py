@@ -131,11 +131,8 @@ def build_points(case: Case, base_dir=".", removals: bool = True) -> Body:
 def mesh_body(g: Geometry, base_dir=".") -> Body:
     """The body of a text-mesh or Exodus geometry, its file relative to ``base_dir``."""
     mesh = Path(g.file) if Path(g.file).is_absolute() else Path(base_dir) / g.file
-    if g.type == "exodus":
-        return exodus.body_from_exodus(mesh)
-    return mesh_text.from_text_mesh(
-        mesh, dim=g.dimension, thickness=g.thickness, plane=g.plane if g.dimension == 2 else None
-    )
+    read = exodus.body_from_exodus if g.type == "exodus" else mesh_text.from_text_mesh
+    return read(mesh, dim=g.dimension, thickness=g.thickness, plane=g.plane if g.dimension == 2 else None)
 
 
 def region_mask(body: Body, region: Region, where: str) -> np.ndarray:

@@ -45,6 +45,7 @@ def variable_values(model: Model, variables, sums=None):
             "Force_Density": lambda: force_density,
             "Force": lambda: force_density * body.volumes[:, None],
             "Element_Id": lambda: np.arange(1.0, body.n_points + 1.0),
+            "ID": lambda: np.arange(0.0, body.n_points),
             "Proc_Num": lambda: np.zeros(body.n_points),
             "Volume": lambda: body.volumes,
             "Dilatation": lambda: model.dilatation(state.u),
@@ -70,8 +71,9 @@ class GatheredVariables:
     owned points (``variable_values`` of its part: its ghosts' displacements are current, so
     force densities and dilatations are the serial ones) and gathers them in global point order
     on rank 0, where the object, called with the gathered state, gives them as
-    ``variable_values`` does: ``Element_Id`` the global 1-based ids, ``Proc_Num`` each point's
-    rank (as Peridigm writes it), and each of ``sums`` summed over its set of the whole body.
+    ``variable_values`` does: ``Element_Id`` the global 1-based ids (``ID`` 0-based),
+    ``Proc_Num`` each point's rank (as Peridigm writes it), and each of ``sums`` summed over its
+    set of the whole body.
 
     Parameters
     ----------
@@ -107,6 +109,7 @@ class GatheredVariables:
         if not self.domain.is_root:
             return
         whole["Element_Id"] = np.arange(1.0, self.whole_body.n_points + 1.0)
+        whole["ID"] = np.arange(0.0, self.whole_body.n_points)
         out = {"nodal": {}, "element": {}, "global_": {}}
         for name in self.variables:
             out[PERIDIGM_VARIABLES[name][0]][name] = whole[name]

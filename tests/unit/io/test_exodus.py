@@ -15,11 +15,13 @@ from peridyn.errors import InputError
 from peridyn.io.exodus import (
     ElementBlock,
     ExodusMesh,
+    body_from_exodus,
     hex_centroid_volume,
     mesh_points,
     read_exodus,
     tet_centroid_volume,
 )
+from peridyn.io.exodus_write import ExodusWriter
 
 DATA = Path(__file__).parents[2] / "data" / "peridigm"
 
@@ -279,3 +281,23 @@ def test_bad_meshes_are_refused(tmp_path):
         f.createDimension("x", 1)
     with pytest.raises(InputError, match="num_dim"):
         read_exodus(tmp_path / "plain.nc")
+
+
+def test_sphere_volumes_written_read_back_and_one_layer_2d(tmp_path):
+    """``ExodusWriter(volumes=...)`` writes Peridigm's sphere attributes (radius, volume) that
+    ``body_from_exodus`` reads back as the points' volumes; a 2D body (Peridigm's 2D decks on a
+    one-layer mesh) takes cells of area volume / thickness and refuses points at two z."""
+    points = np.array([[0.0, 0.0, 0.1], [0.5, 0.0, 0.1], [0.0, 0.5, 0.1]])
+    volumes = np.array([0.02, 0.03, 0.05])
+    ExodusWriter(tmp_path / "flat.e", points, volumes=volumes).append(0.0)
+    body = body_from_exodus(tmp_path / "flat.e", dim=2, thickness=0.2, plane="strain")
+    np.testing.assert_array_equal(body.volumes, volumes)
+    assert (body.dim, body.thickness, body.plane) == (2, 0.2, "strain")
+    np.testing.assert_allclose(body.cells[:, 0] ** 2 * 0.2, volumes, rtol=1e-15)
+    radius = read_exodus(tmp_path / "flat.e").blocks[0].attributes[:, 0]
+    np.testing.assert_allclose(4 / 3 * np.pi * radius**3, volumes, rtol=1e-15)
+    points[2, 2] = 0.3
+    ExodusWriter(tmp_path / "two.e", points, volumes=volumes).append(0.0)
+    assert body_from_exodus(tmp_path / "two.e").dim == 3
+    with pytest.raises(InputError, match="one layer"):
+        body_from_exodus(tmp_path / "two.e", dim=2, thickness=0.2)

@@ -90,6 +90,63 @@ def test_pdquickgrid_ids_are_x_fastest():
     assert case["node_sets"]["Max X Node Set"]["indices"] == [2, 4]
 
 
+def test_older_deck_form():
+    """Peridigm's older form (BondBreakingInitialVelocity.xml, tests/data/peridigm_other): the
+    horizon under Discretization for every block, "Linear Elastic" the LPS model of "Elastic",
+    node ids 0-based (id 1 of its 2 x 2 x 1 grid is (i, j) = (1, 0), peridyn's point 2), and
+    its box families of horizon 0.51 m on spacings (1.05, 1, 1) m: one cell along y only."""
+    older = read_deck(DATA.parent / "peridigm_other" / "BondBreakingInitialVelocity.xml")
+    case = deck_case(older, "older")
+    assert case["discretization"]["horizon_m"] == 0.51
+    assert case["material"]["model"] == "lps"
+    assert case["node_sets"]["Node Set 1"]["indices"] == [2]
+    bonds = build(validate_case(case)).bonds
+    assert np.diff(bonds.offsets).tolist() == [1, 1, 1, 1]
+    assert bonds.neighbours.tolist() == [1, 0, 3, 2]  # (0, 0)-(0, 1) and (1, 0)-(1, 1)
+    deck = copy.deepcopy(older)
+    deck["Blocks"]["My Group of Blocks"]["Horizon"] = 0.51
+    _refusal(deck, "Blocks.My Group of Blocks.Horizon")
+    deck = copy.deepcopy(older)
+    deck["Boundary Conditions"]["Node Set 0"] = "4"
+    assert _refusal(deck, "Boundary Conditions.Node Set 0").value == 4
+    deck["Discretization"]["Horizon"] = 0.4  # round(0.4 / 1.0) = 0 cells along every axis
+    with pytest.raises(CaseFileError, match="reaches no cell"):
+        validate_case(deck_case(older | {"Discretization": deck["Discretization"]}, "older"))
+
+
+def test_2d_deck_translation_and_refusals():
+    """A 2D bond-based deck (ElasticBondBased2DPlaneStress.yaml): a 2D Exodus geometry of the
+    deck's Height and plane, E = 4 K / 3 in plane stress (1.25 K in plane strain), so that
+    peridyn's 12 kappa / (pi t delta^3) with the plane bulk modulus kappa is Peridigm's
+    12 K / (pi h delta^3); a plane flag on another model, Height alone and a 2D material on a
+    (3D) PdQuickGrid are refused by name."""
+    other = DATA.parent / "peridigm_other"
+    deck = read_deck(other / "ElasticBondBased2DPlaneStress.yaml")
+    material = deck["Materials"]["My Elastic Bond Based Material"]
+    with pytest.raises(CaseFileError) as err:
+        deck_case(deck, "2d", "deck.yaml", other)
+    assert err.value.key == "Discretization.Input Mesh File"
+    deck["Discretization"]["Input Mesh File"] = "ElasticBondBased3D.g"  # a mesh that exists here
+    case = deck_case(deck, "2d", "deck.yaml", DATA)
+    assert case["geometry"] | {"file": None} == {"type": "exodus", "file": None, "dimension": 2} | {
+        "plane": "stress",
+        "thickness": 0.25,
+    }
+    assert case["material"]["E"] == 4.0 / 3.0 * material["Bulk Modulus"]
+    strain = copy.deepcopy(deck)
+    strain["Materials"]["My Elastic Bond Based Material"] |= {"Plane Stress": False, "Plane Strain": True}
+    assert deck_case(strain, "2d", "deck.yaml", DATA)["material"]["E"] == 1.25 * material["Bulk Modulus"]
+    lps = copy.deepcopy(deck)
+    lps["Materials"]["My Elastic Bond Based Material"] |= {"Material Model": "Elastic", "Shear Modulus": 1e11}
+    _refusal(lps, "Materials.My Elastic Bond Based Material.Plane Stress")
+    height_only = copy.deepcopy(deck)
+    height_only["Materials"]["My Elastic Bond Based Material"]["Plane Stress"] = False
+    _refusal(height_only, "Materials.My Elastic Bond Based Material.Height")
+    grid = read_deck(COMPRESSION)
+    grid["Materials"]["My Elastic Material"] = dict(material)
+    _refusal(grid, "Discretization.Type")
+
+
 def _refusal(deck: dict, key_start: str, folder=DATA):
     with pytest.raises(CaseFileError) as err:
         deck_case(deck, "x", "deck.yaml", folder)
