@@ -119,13 +119,14 @@ class RankStatics:
         if factorised:
             self._preconditioner = rank_preconditioner(self.dofs)
         iterations, converged = self._cg(rhs, x, target, FRESH_ITERATIONS if factorised else None)
+        fresh = iterations  # with the preconditioner built for this solve
         if not converged and not factorised:  # the old preconditioner is too far off now
             self._preconditioner = rank_preconditioner(self.dofs)
             factorised = True
-            more, converged = self._cg(rhs, x, target, FRESH_ITERATIONS)
-            iterations += more
+            fresh, converged = self._cg(rhs, x, target, FRESH_ITERATIONS)
+            iterations += fresh
         if factorised and self.refactor_iterations is None:
-            self._stale_limit = max(REFACTOR_ITERATIONS, STALE_FACTOR * iterations)
+            self._stale_limit = max(REFACTOR_ITERATIONS, STALE_FACTOR * fresh)
         if not converged:
             raise InputError(
                 f"fatigue static solve: CG did not converge in {iterations} "
