@@ -334,7 +334,7 @@ def test_restart_on_three_ranks_from_a_two_rank_checkpoint_equals_the_serial_run
 
 
 def test_commands_that_do_not_run_over_ranks_are_refused_once():
-    """``mpiexec -n 2 peridyn fatigue`` would run the same job twice into one folder: refused."""
+    """``mpiexec -n 2 peridyn demo`` would run the same job twice into one folder: refused."""
     if not _have_mpi():
         pytest.skip("mpiexec or mpi4py not installed")
     env = dict(os.environ, PYTHONPATH=SRC)
@@ -345,8 +345,7 @@ def test_commands_that_do_not_run_over_ranks_are_refused_once():
         sys.executable,
         "-m",
         "peridyn",
-        "fatigue",
-        str(ROOT / "cases" / "sen_fatigue_2d.yaml"),
+        "demo",
     ]
     done = subprocess.run(command, capture_output=True, text=True, timeout=300, env=env)
     assert done.returncode == 1

@@ -116,7 +116,7 @@ def _dispatch(parser: ArgumentParser, args) -> int:
 
 
 #: The commands that run over MPI ranks (``mpiexec -n N peridyn ...``, N > 1).
-MPI_COMMANDS = ("run", "modal")
+MPI_COMMANDS = ("run", "modal", "fatigue")
 
 
 def _refuse_under_mpi(command: str) -> None:

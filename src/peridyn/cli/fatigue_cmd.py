@@ -67,8 +67,15 @@ def _raw():
 
 
 def run(args) -> dict:
-    """Run a fatigue case, or calibrate when the case argument is ``calibrate``."""
+    """Run a fatigue case (over the MPI ranks under ``mpiexec -n N``), or calibrate when the case
+    argument is ``calibrate`` (one process)."""
+    from peridyn.parallel.comm import world
+
     if args.case == "calibrate":
+        if world().size > 1:
+            raise InputError(
+                "'peridyn fatigue calibrate' does not run over MPI ranks: run it without mpiexec"
+            )
         return calibrate(args)
     from peridyn.io.case import load_case
     from peridyn.jobs.estimate import check_memory
@@ -83,6 +90,7 @@ def run(args) -> dict:
         modal=True if args.modal else None,
         progress=progress_bar(args.progress, f"{case.name} fatigue steps"),
         overwrite=args.overwrite,
+        comm=world(),
     )
     if not args.json:
         print(

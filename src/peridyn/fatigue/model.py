@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from peridyn.errors import InputError
+from peridyn.parallel.domain import Domain
 from peridyn.physics.materials.base import Model
 
 
@@ -90,11 +91,26 @@ class RemainingLife:
     params : FatigueParameters
     breakable : (n_bonds,) bool or None
         Bonds allowed to break (False for bonds touching no-damage node sets).
+    domain : Domain or None
+        Under MPI, the rank's place in the body (``model`` is its part: owned points, then
+        ghosts): the ghosts' phase comes from their owners (``update_phase``). None: one process.
+
+    Every bond on a rank is a copy of a bond of an owned family of some rank (its owner's), and
+    its life is computed from the same values there and here (the strain from the exchanged
+    displacement, the phase of its owner), so the copies stay equal and a bond and its reverse,
+    owned by two ranks, break at the same step on both, as in serial.
     """
 
-    def __init__(self, model: Model, params: FatigueParameters, breakable: np.ndarray | None = None):
+    def __init__(
+        self,
+        model: Model,
+        params: FatigueParameters,
+        breakable: np.ndarray | None = None,
+        domain: Domain | None = None,
+    ):
         b = model.bonds
         self.model = model
+        self.domain = domain
         self.params = params
         self.life = np.ones(b.n_bonds)
         self.phase_two = np.zeros(model.body.n_points, dtype=bool)
@@ -129,7 +145,8 @@ class RemainingLife:
         return int(dead.sum())
 
     def update_phase(self, phi: np.ndarray) -> int:
-        """Switch points with a family member at phi >= phi_c to phase II (eq. 7.6); returns how many.
+        """Switch points with a family member at phi >= phi_c to phase II (eq. 7.6); returns how many
+        (of the owned points, under MPI; the ghosts take their owners' switch).
 
         Phase and restart are per directed bond half, by its owner: the halves owned by a
         switched point restart at life 1 with the phase-II rate, the reverse halves keep
@@ -139,6 +156,11 @@ class RemainingLife:
         hit = (phi[b.neighbours] >= self.params.phi_c).astype(np.float64)
         near = np.bincount(self._owners, weights=hit, minlength=len(phi)) > 0
         new = (near | (phi >= self.params.phi_c)) & ~self.phase_two
+        if self.domain is not None and self.domain.size > 1:  # the ghosts' switch is their owners'
+            switched = new.astype(np.float64)
+            self.domain.exchange(switched)
+            new = switched > 0.0
         self.phase_two |= new
         self.life[new[self._owners]] = 1.0
-        return int(new.sum())
+        n_owned = len(phi) if self.domain is None else self.domain.n_owned
+        return int(new[:n_owned].sum())

@@ -5,6 +5,12 @@ broke bonds: otherwise it has not changed), take the cyclic bond
 strain from the load ratio, spend the step's cycles (``CycleMapping``) on every bond's remaining
 life, break the bonds whose life ran out, switch families to phase II where the damage reached
 phi_c, and track the crack tip.
+
+Under MPI (a ``Domain`` of several ranks) each rank runs the loop on its part of the body (owned
+points, ghosts filled by the halo exchange): the equilibrium by the distributed CG
+(``fatigue.distributed.RankStatics``), strains, lives and breaking on the part's bonds
+(``RemainingLife``), the adaptive step as the minimum over the ranks, the crack tip on the damage
+gathered on rank 0 (its length broadcast), the bonds broken counted over the owned families.
 """
 
 from __future__ import annotations
@@ -15,12 +21,14 @@ import numpy as np
 
 from peridyn import interrupts
 from peridyn.errors import InputError
+from peridyn.fatigue.distributed import RankStatics
 from peridyn.fatigue.mapping import CycleMapping
 from peridyn.fatigue.model import FatigueParameters, RemainingLife, cyclic_bond_strain
 from peridyn.fatigue.statics import LinearStatics
 from peridyn.fatigue.tip import crack_tip
 from peridyn.io.case import FatigueTip
-from peridyn.physics.damage import damage_field
+from peridyn.parallel.domain import Domain
+from peridyn.physics.damage import damage_field, protected_points
 from peridyn.physics.loads import Loading
 from peridyn.physics.materials.base import Model
 
@@ -38,21 +46,31 @@ class FatigueResult:
     u_max : (n_points, 3) float64, m, displacement at the maximum load after the last step
     damage : (n_points,) float64, final damage index
     first_break : (n_points,) float64, cycle at which each point first lost a bond (inf if none)
+
+    Under MPI every rank holds the history (``cycles``, ``crack_length``, ``broken``); the
+    per-point arrays are the whole body's in global point order on rank 0, None on the others.
     """
 
     cycles: np.ndarray
     crack_length: np.ndarray
     broken: np.ndarray
-    u_max: np.ndarray
-    damage: np.ndarray
-    first_break: np.ndarray = field(repr=False)
+    u_max: np.ndarray | None
+    damage: np.ndarray | None
+    first_break: np.ndarray | None = field(repr=False)
 
 
-def breakable_bonds(model: Model, no_damage_sets=()) -> np.ndarray:
-    """(n_bonds,) bool: bonds with neither end in a no-damage node set."""
-    protected = np.zeros(model.body.n_points, dtype=bool)
-    for name in no_damage_sets:
-        protected[model.body.node_set(name)] = True
+def breakable_bonds(model: Model, no_damage_sets=(), domain: Domain | None = None) -> np.ndarray:
+    """(n_bonds,) bool: bonds with neither end in a no-damage node set.
+
+    Under MPI (``domain`` of several ranks) ``model`` is a rank's part, which may hold none of a
+    set's points: each set must be known and hold points somewhere in the body (collective)."""
+    body = model.body
+    if domain is not None and domain.size > 1:
+        for name in no_damage_sets:
+            if domain.count(len(body.node_sets.get(name, ()))) == 0:
+                raise InputError(f"no-damage node set {name!r} is unknown or holds no point")
+        no_damage_sets = [name for name in no_damage_sets if len(body.node_sets[name])]
+    protected = protected_points(body, no_damage_sets)
     b = model.bonds
     return ~(protected[b.owners()] | protected[b.neighbours])
 
@@ -70,6 +88,7 @@ def run_fatigue(
     solver: str = "auto",
     stop_length: float = np.inf,
     progress=None,
+    domain: Domain | None = None,
 ) -> FatigueResult:
     """Run the fatigue loop on ``model`` (its ``bonds.intact`` is updated in place).
 
@@ -87,38 +106,56 @@ def run_fatigue(
     solver : linear solver of the equilibrium (``fatigue.statics.LinearStatics``)
     stop_length : m, the run ends after the step at which the crack length reaches it
     progress : object with update(n) (e.g. a tqdm bar) or None
+    domain : the rank's place in the body under MPI (``model`` and ``loading`` are its part; the
+        solver is then the distributed CG: ``solver`` "auto" or "amg"); None: one process.
+        Collective: every rank calls it.
     """
     if not -1.0 <= load_ratio < 1.0:
         raise InputError(f"load ratio R must be in [-1, 1), got {load_ratio!r}")
     tip = FatigueTip() if tip is None else tip
-    statics = LinearStatics(model, loading, max_load_time, solver)
-    life = RemainingLife(model, params, breakable_bonds(model, no_damage_sets))
-    points, spacing = model.body.points, model.body.spacing
+    domain = Domain.serial(model.body.n_points) if domain is None else domain
+    if domain.size == 1:
+        statics = LinearStatics(model, loading, max_load_time, solver)
+    elif solver in ("auto", "amg"):
+        statics = RankStatics(model, loading, domain, max_load_time)
+    else:
+        raise InputError(f"an MPI fatigue run solves by CG with AMG (solver auto or amg), not {solver!r}")
+    life = RemainingLife(model, params, breakable_bonds(model, no_damage_sets, domain), domain)
+    points, spacing = domain.gather(model.body.points), model.body.spacing
     owners = model.bonds.owners()
-    n_broken0 = int((~model.bonds.intact).sum())
+    owned_bonds = slice(0, model.bonds.offsets[domain.n_owned])  # the owned points' families
+
+    def n_broken():
+        return domain.count(int((~model.bonds.intact[owned_bonds]).sum()))
+
+    n_broken0 = n_broken()
     first_break = np.full(model.body.n_points, np.inf)
     life.update_phase(damage_field(model))  # pre-cracks may start families in phase II
     cycles, lengths, broken = [0.0], [], [0]
 
     def crack_length(phi):
-        return crack_tip(points, phi, spacing, tip.axis, tip.depth_axis, tip.damage, tip.start, tip.sense)
+        whole = domain.gather(phi)
+        length = domain.on_root(
+            crack_tip, points, whole, spacing, tip.axis, tip.depth_axis, tip.damage, tip.start, tip.sense
+        )
+        return domain.comm.bcast(length)
 
     lengths.append(crack_length(damage_field(model)))
     n_cycles = 0.0
     u = None
     changed = True
     for dn in mapping.cycles_per_step():
-        interrupts.check(where=f"cycling (at {n_cycles:.6g} cycles)")
+        interrupts.check(where=f"cycling (at {n_cycles:.6g} cycles)", agree=domain.max)
         if changed:  # equilibrium only moves when bonds broke
             u = statics.solve()
             eps = cyclic_bond_strain(model, u, load_ratio)
         if mapping.adaptive:
-            dn = min(dn, life.cycles_to_next_break(eps) * (1.0 + 1e-12))
+            dn = min(dn, domain.min(life.cycles_to_next_break(eps)) * (1.0 + 1e-12))
         before = model.bonds.intact.copy()
         life.advance(eps, dn)
         n_cycles += dn
         lost = before & ~model.bonds.intact
-        changed = bool(lost.any())
+        changed = bool(domain.max(bool(lost.any())))
         hit = np.zeros(model.body.n_points, dtype=bool)
         hit[owners[lost]] = True
         first_break[hit & np.isinf(first_break)] = n_cycles
@@ -126,16 +163,15 @@ def run_fatigue(
         life.update_phase(phi)
         cycles.append(n_cycles)
         lengths.append(crack_length(phi))
-        broken.append(int((~model.bonds.intact).sum()) - n_broken0)
+        broken.append(n_broken() - n_broken0)
         if progress is not None:
             progress.update(1)
         if lengths[-1] >= stop_length:
             break
+    u_max = (statics.solve() if changed else u) if u is not None else np.zeros_like(model.body.points)
     return FatigueResult(
         np.array(cycles),
         np.array(lengths),
         np.array(broken, dtype=np.int64),
-        (statics.solve() if changed else u) if u is not None else np.zeros_like(points),
-        damage_field(model),
-        first_break,
+        *domain.gather_many(u_max, damage_field(model), first_break) or (None, None, None),
     )

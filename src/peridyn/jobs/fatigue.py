@@ -5,6 +5,11 @@ the cycles),
 ``crack_length.png``, ``damage.vtu`` (final damage and first-break cycle), ``modal.json``
 (frequency tables before/after, MAC matrix, matched types) when ``modal_after`` is set,
 and ``fatigue.json`` (the summary).
+
+Under ``mpiexec -n N`` (N > 1) each rank builds its part of the body and runs the fatigue loop on
+it (``fatigue.run``: the distributed CG for the equilibrium); rank 0 writes the same files as a
+serial run. The modal analyses and the compliance K of the Paris fit are not distributed: they
+are refused by their case keys (``check_parallel_fatigue``).
 """
 
 from __future__ import annotations
@@ -12,12 +17,13 @@ from __future__ import annotations
 import csv
 import json
 import time
+from contextlib import nullcontext
 from pathlib import Path
 
 import numpy as np
 
 from peridyn import interrupts
-from peridyn.errors import CaseFileError, did_you_mean
+from peridyn.errors import CaseFileError, InputError, did_you_mean
 from peridyn.fatigue.calibration import growth_rates, paris_fit, stress_intensity
 from peridyn.fatigue.mapping import CycleMapping
 from peridyn.fatigue.model import FatigueParameters, scale_A_II
@@ -50,6 +56,29 @@ def check_fatigue_case(case: Case) -> None:
                 name,
                 f"a defined node set{did_you_mean(name, known)}: {sorted(known)}",
             )
+
+
+def check_parallel_fatigue(case: Case, modal: bool | None = None) -> None:
+    """Refuse what an MPI fatigue run (mpiexec -n N, N > 1) cannot do: the modal analyses before
+    and after (``fatigue.modal_after`` or ``--modal``), the compliance K of the Paris fit
+    (``fatigue.paris.k: compliance``), and the serial linear solvers (``fatigue.solver``)."""
+    f = case.fatigue
+    if modal or (modal is None and f.modal_after is not None):
+        if modal is None:
+            raise CaseFileError(
+                case.name, "fatigue.modal_after", "set", "no modal analyses in an MPI run (mpiexec -n N)"
+            )
+        raise InputError(
+            "--modal: an MPI fatigue run (mpiexec -n N) has no modal analyses; run without mpiexec"
+        )
+    if f.paris is not None and f.paris.k == "compliance":
+        raise CaseFileError(
+            case.name, "fatigue.paris.k", f.paris.k, "eq. 7.12 (not compliance) in an MPI run"
+        )
+    if f.solver not in ("auto", "amg"):
+        raise CaseFileError(
+            case.name, "fatigue.solver", f.solver, "auto or amg in an MPI run (distributed CG)"
+        )
 
 
 def fatigue_parameters(case: Case, horizon: float) -> FatigueParameters:
@@ -129,17 +158,23 @@ def run_fatigue_case(
     modal: bool | None = None,
     progress=None,
     overwrite: bool = False,
+    comm=None,
 ) -> dict:
     """Run a fatigue case; returns the summary (JSON keys of ``peridyn fatigue --json``, also in
     ``fatigue.json``; docs/user-guide.md, "Summaries and results files"). A folder holding an
     earlier ``fatigue.json`` is refused unless ``overwrite``; the job's status goes to
-    ``status.json`` (``peridyn.io.outdir``)."""
+    ``status.json`` (``peridyn.io.outdir``). ``comm``: ``peridyn.parallel.comm.world()`` under
+    ``mpiexec -n N`` (N > 1; see the module docstring), every rank returning the summary; None:
+    one process."""
     start = time.perf_counter()
     check_fatigue_case(case)
-    setup = build(case, base_dir)
-    out = prepare_output(output_directory(case, output_dir), "fatigue.json", overwrite)
-    with json_job_status(out):
-        return _run_fatigue(case, setup, out, modal, progress, start)
+    if comm is not None and comm.size > 1:
+        check_parallel_fatigue(case, modal)
+    setup = build(case, base_dir, comm)
+    d = setup.domain
+    out = d.on_root(prepare_output, output_directory(case, output_dir), "fatigue.json", overwrite)
+    with json_job_status(out) if d.is_root else nullcontext():
+        return d.comm.bcast(_run_fatigue(case, setup, out, modal, progress, start))
 
 
 def _run_fatigue(case, setup, out, modal, progress, start) -> dict:
@@ -152,8 +187,11 @@ def _run_fatigue(case, setup, out, modal, progress, start) -> dict:
         before, _, setup_rows = modal_table(setup.model, n_modes)
     k_curve = specimen_k(case, setup)
     mapping = CycleMapping(tuple((b.steps, b.tau) for b in f.mapping), f.adaptive)
-    if progress is not None:
+    d = setup.domain
+    if progress is not None and d.is_root:
         progress = progress(mapping.n_steps)
+    else:
+        progress = None
     result = run_fatigue(
         setup.model,
         setup.loading,
@@ -166,19 +204,28 @@ def _run_fatigue(case, setup, out, modal, progress, start) -> dict:
         solver=f.solver,
         stop_length=_stop_length(f),
         progress=progress,
+        domain=d,
     )
     if progress is not None:
         progress.close()
+    owned = slice(0, setup.bonds.offsets[d.n_owned])  # the owned points' families: every bond once
     summary = {
         "cycles": float(result.cycles[-1]),
         "crack_length_m": float(result.crack_length[-1]),
         "paris_slope": paris_slope(case, result, k_curve),
         "paris_rates": int(paris_rates(case, result)[1].size) if f.paris is not None else 0,
-        "points": setup.body.n_points,
-        "bonds": setup.bonds.n_bonds,
-        "broken_bonds": int((~setup.bonds.intact).sum()),
+        "points": setup.whole_body.n_points,
+        "bonds": d.count(owned.stop),
+        "broken_bonds": d.count(int((~setup.bonds.intact[owned]).sum())),
         "fatigue_broken_bonds": int(result.broken[-1]),
     }
+    return d.on_root(_write_fatigue, case, setup, out, summary, result, do_modal, before, setup_rows, start)
+
+
+def _write_fatigue(case, setup, out, summary, result, do_modal, before, setup_rows, start) -> dict:
+    """The modal analysis after (one process), the files of the run and its summary (rank 0)."""
+    f = case.fatigue
+    n_modes = f.modal_after.modes if f.modal_after is not None else 12
     if do_modal:
         after, _, after_rows = modal_table(setup.model, n_modes)
         masses = setup.model.density * setup.body.volumes
@@ -186,7 +233,7 @@ def _run_fatigue(case, setup, out, modal, progress, start) -> dict:
         summary["modal"] = {"before": setup_rows, "after": after_rows, "mac": mac.tolist(), "matches": pairs}
         (out / "modal.json").write_text(json.dumps(summary["modal"], indent=1))
     _write_history(out / "crack_length.csv", result)
-    body = setup.body
+    body = setup.whole_body
     write_vtu(
         out / "damage.vtu",
         body.points[:, : body.dim],

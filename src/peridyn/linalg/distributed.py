@@ -148,13 +148,20 @@ class RankStiffness:
         full[self.rank_dofs.dofs] = block
         full = full.reshape(self._n_local, 3, k)
         self.rank_dofs.domain.exchange(full)
+        return self.field_rows(full).reshape(v.shape)
+
+    def field_rows(self, full: np.ndarray) -> np.ndarray:
+        """The owned free rows (n_free, k), N, of K applied to ``full`` (n_local, 3, k), m: k
+        displacement fields given on every local point, ghost rows filled (e.g. prescribed
+        displacements, held dofs included)."""
+        k = full.shape[2]
         wanted = self._model.bonds.n_bonds * k
         if len(self._work) < wanted:
             self._work = np.empty(wanted)
         extension = self._work[:wanted].reshape(self._model.bonds.n_bonds, k)
         f = block_linear_force(self._model, full, extension).reshape(3 * self._n_local, k)
         self.columns += k
-        return (-self._volumes[:, None] * f[self.rank_dofs.dofs]).reshape(v.shape)
+        return -self._volumes[:, None] * f[self.rank_dofs.dofs]
 
 
 def rank_preconditioner(dofs: RankDofs) -> LinearOperator:
