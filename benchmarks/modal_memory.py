@@ -12,7 +12,12 @@ the block V-cycle's arrays, every LOBPCG call and the residuals. The peak of eac
 the kernel's high-water mark (VmHWM), reset before the phase (``/proc/self/clear_refs``).
 
 Prints one row per phase: MiB resident before, the phase's peak above that, and what the
-phase leaves resident (after - before); then the whole run's peak.
+phase leaves resident (after - before); then the whole run's peak (the resets make
+``/usr/bin/time``'s maximum resident size that of the last phase only: read this one).
+
+With ``--cli OUTPUT`` the phases are those of ``peridyn modal CASE --set
+discretization.spacing=... --set discretization.horizon=... --modes N --json --output OUTPUT``
+run in this process (the case's eigensolver choice, then the output files).
 """
 
 from __future__ import annotations
@@ -24,6 +29,7 @@ import time
 from pathlib import Path
 
 import peridyn.linalg.amg as amg
+import peridyn.linalg.block_amg as block_amg
 import peridyn.solvers.eigen_iterative as eigen_iterative
 import peridyn.solvers.modal as modal
 from peridyn.io.case import load_case
@@ -85,6 +91,20 @@ class PhaseLog:
         setattr(module, attribute, measured)
 
 
+def _count_calls(cls) -> list[int]:
+    """A one-item list counting the calls of ``cls`` instances (the preconditioner's
+    applications: one per LOBPCG iteration)."""
+    count = [0]
+    original = cls.__call__
+
+    def counted(self, *args, **kwargs):
+        count[0] += 1
+        return original(self, *args, **kwargs)
+
+    cls.__call__ = counted
+    return count
+
+
 def main(argv=None) -> dict:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("case", nargs="?", default="cases/pmma_plate.yaml")
@@ -92,6 +112,7 @@ def main(argv=None) -> dict:
     parser.add_argument("--horizon", type=float, default=1.4143, help="horizon / spacing")
     parser.add_argument("--modes", type=int, default=12)
     parser.add_argument("--json", action="store_true", help="one JSON object instead of the table")
+    parser.add_argument("--cli", metavar="OUTPUT", help="run `peridyn modal` itself, writing to OUTPUT")
     args = parser.parse_args(argv)
     log = PhaseLog()
     log.wrap(eigen_iterative, "block_stiffness_operator", "matrix-free operator")
@@ -101,31 +122,41 @@ def main(argv=None) -> dict:
     log.wrap(amg, "BlockVCycle", "V-cycle arrays")
     log.wrap(eigen_iterative, "_quiet_lobpcg", "LOBPCG")
     log.wrap(modal, "_result", "residuals and shapes")
+    v_cycles = _count_calls(block_amg.BlockVCycle)
     overrides = [f"discretization.spacing={args.spacing}", f"discretization.horizon={args.horizon}"]
-    case = load_case(args.case, overrides)
-    setup = log.measure("body, bonds, model", build, case, Path(args.case).parent)
     start = time.perf_counter()
-    result = modal.modal_analysis(setup.model, args.modes, method="lobpcg")
-    summary = {
-        "points": setup.body.n_points,
-        "bonds": setup.bonds.n_bonds,
-        "solve_s": round(time.perf_counter() - start, 1),
-        "peak_mib": round(log.whole_peak),
-        "lobpcg_calls": sum(row["phase"] == "LOBPCG" for row in log.rows),
-        "elastic_hz": [round(float(f), 3) for f in result.elastic().frequencies],
-        "phases": log.rows,
-    }
+    if args.cli:
+        from peridyn.cli import main as peridyn_main
+
+        sets = [word for item in overrides for word in ("--set", item)]
+        peridyn_main(["modal", args.case, *sets, "--modes", str(args.modes), "--json", "--output", args.cli])
+        summary = {}
+    else:
+        case = load_case(args.case, overrides)
+        setup = log.measure("body, bonds, model", build, case, Path(args.case).parent)
+        result = modal.modal_analysis(setup.model, args.modes, method="lobpcg")
+        summary = {
+            "points": setup.body.n_points,
+            "bonds": setup.bonds.n_bonds,
+            "elastic_hz": [round(float(f), 3) for f in result.elastic().frequencies],
+        }
+    summary.update(
+        seconds=round(time.perf_counter() - start, 1),
+        peak_mib=round(max(log.whole_peak, _status("VmHWM"))),
+        lobpcg_calls=sum(row["phase"] == "LOBPCG" for row in log.rows),
+        v_cycles=v_cycles[0],
+        phases=log.rows,
+    )
     if args.json:
         print(json.dumps(summary))
     else:
-        print(f"{summary['points']} points, {summary['bonds']} bonds, solve {summary['solve_s']} s")
+        print(json.dumps({key: value for key, value in summary.items() if key != "phases"}))
         print(f"{'phase':<24} {'before':>8} {'peak+':>8} {'kept':>8} {'s':>8}   (MiB)")
         for row in log.rows:
             print(
                 f"{row['phase']:<24} {row['before_mib']:>8} {row['peak_above_mib']:>8} "
                 f"{row['retained_mib']:>8} {row['seconds']:>8}"
             )
-        print(f"whole run peak {summary['peak_mib']} MiB; elastic modes {summary['elastic_hz']} Hz")
     return summary
 
 
