@@ -74,6 +74,7 @@ def lobpcg_modes(model: Model, n_modes: int, dofs: np.ndarray, max_iterations: i
     # near-null space: the local rigid motions, whatever the constraints (Vanek et al. 1996)
     near_null = orthonormal(rigid_fields(model.body.points)[dofs])
     precond = _interruptible(amg_preconditioner(proxy, m, near_null, shift, proxy_aggregates(model, dofs)))
+    del proxy  # the V-cycle keeps its own copy (shifted, in blocks)
     block = min(n_elastic + GUARD_VECTORS, len(dofs) // 5)
     if block < n_elastic:
         raise InputError(
