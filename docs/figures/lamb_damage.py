@@ -19,7 +19,8 @@ record. Each arrival is given to the mode whose line of the discrete plate is ne
 script fits c_g of each mode through t0 and prints it beside the group velocities of
 Rayleigh-Lamb theory and of the discrete plate (Bloch, the case's own discretisation: dω/dk from
 the wavenumbers at the frequency ± ``DF``), at the burst's centre frequency. Prints the
-Markdown tables (runs, DI median and maximum by damage type and size; the group velocities) and
+Markdown tables (runs, DI median and maximum by damage type and size; how the scattered energy
+grows with the size at each position; the group velocities) and
 draws ``docs/figures/lamb_damage.png``.
 
     PYTHONPATH=src python docs/figures/lamb_damage.py OUT
@@ -146,6 +147,32 @@ def table(ds, runs: np.ndarray, di: np.ndarray) -> str:
     return "\n".join(lines)
 
 
+def size_growth(ds, runs: np.ndarray, di: np.ndarray) -> str:
+    """For each damage type, over the positions run at every size: the share of positions whose
+    scattered energy (DI summed over the four sensors) grows from each size to the next, and the
+    median ratio."""
+    lines = [
+        "| damage | sizes (mm) | positions | energy grows at | median ratio |",
+        "|---|---|---:|---:|---:|",
+    ]
+    total = di.sum(axis=1)
+    kinds, sizes = ds["damage"].values[runs], ds["size"].values[runs]
+    for kind in sorted(set(kinds)):
+        at = {}
+        for i in np.flatnonzero(kinds == kind):
+            key = (float(ds["x"].values[runs[i]]), float(ds["y"].values[runs[i]]))
+            at.setdefault(key, {})[float(sizes[i])] = total[i]
+        steps = sorted(set(sizes[kinds == kind]))
+        full = np.array([[row[s] for s in steps] for row in at.values() if len(row) == len(steps)])
+        for a in range(len(steps) - 1):
+            ratio = full[:, a + 1] / full[:, a]
+            lines.append(
+                f"| {kind} | {1e3 * steps[a]:g} -> {1e3 * steps[a + 1]:g} | {len(full)} | "
+                f"{np.mean(ratio > 1):.0%} | {np.median(ratio):.2f} |"
+            )
+    return "\n".join(lines)
+
+
 def figure(ds, runs, times, r, di, path_m, arrival, geometry, speeds, fit, out: Path) -> Path:
     """Damage map (marker area by DI), the strongest run's residuals, arrivals against paths."""
     fig, axes = plt.subplots(1, 3, figsize=(15, 4.4), constrained_layout=True)
@@ -209,6 +236,8 @@ def main(argv=None) -> None:
     speeds = group_velocities(geometry)
     fit = fitted_speeds(path_m.ravel(), arrival.ravel(), geometry["centre_time"], speeds)
     print(table(ds, runs, di))
+    print()
+    print(size_growth(ds, runs, di))
     print(
         f"\n{len(runs)} of {ds.sizes['run']} runs complete; "
         f"group velocity at {geometry['frequency'] / 1e3:g} kHz (m/s):"

@@ -4,8 +4,8 @@ A sweep file holds ``base`` (a case file, relative to the sweep file), ``command
 ``modal``, ``fatigue``, or ``bloch``: the Bloch prediction alone; the job each run is),
 ``reference`` (a case file, e.g. the healthy body, run once with the sweep's ``set``: a modal
 sweep compares every run's modes with its modes by MAC; a run sweep's dataset holds its series
-as the baseline, e.g. the healthy plate's sensor signals), ``set`` (overrides for every run), ``vary`` (one block or a list of
-blocks, combined as a product; a block is ``product``,
+as the baseline, e.g. the healthy plate's sensor signals), ``set`` (overrides for every run),
+``vary`` (one block or a list of blocks, combined as a product; a block is ``product``,
 ``zip``, ``list`` or ``random``), ``labels`` (varied names that are not case entries, e.g. a
 damage type, usable in expressions), ``derived`` (case entries computed from the others with
 the expressions of :mod:`peridyn.physics.expressions`, in order), ``derived_by`` (more derived
