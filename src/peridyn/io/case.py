@@ -8,11 +8,11 @@ was expected (with "did you mean" for misspelt keys).
 
 from __future__ import annotations
 
-import math
 import re
 from pathlib import Path
 from typing import Annotated, Literal
 
+import numpy as np
 import yaml
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, ValidationError, model_validator
 
@@ -260,12 +260,18 @@ def check_horizon(horizon: float | None, horizon_m: float | None, spacing) -> No
         )
 
 
+def box_cells(horizon, spacing):
+    """Cells a box neighbourhood reaches along an axis of ``spacing`` (m; a number or an array of
+    the axes' spacings): round(horizon / spacing), halves up."""
+    return np.floor(horizon / spacing + 0.5)
+
+
 def check_box_horizon(horizon_m: float, spacing) -> None:
-    """Refuse the horizon (m) of a box neighbourhood (round(horizon / spacing) cells along each
-    axis) that reaches no cell along any axis of the ``spacing`` (m, one value or a list;
-    Peridigm's older BondBreakingInitialVelocity deck reaches along y only) (ValueError)."""
+    """Refuse the horizon (m) of a box neighbourhood (``box_cells`` along each axis) that reaches
+    no cell along any axis of the ``spacing`` (m, one value or a list; Peridigm's older
+    BondBreakingInitialVelocity deck reaches along y only) (ValueError)."""
     spacing = min(spacing) if isinstance(spacing, list) else spacing
-    if spacing is not None and math.floor(horizon_m / spacing + 0.5) < 1:
+    if spacing is not None and box_cells(horizon_m, spacing) < 1:
         raise ValueError(
             f"horizon_m = {horizon_m:g} m reaches no cell of a box neighbourhood: at least half "
             f"the smallest spacing {spacing:g} m"

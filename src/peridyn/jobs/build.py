@@ -25,7 +25,7 @@ from peridyn.discretization.bonds import (
 )
 from peridyn.errors import CaseFileError, InputError
 from peridyn.io import exodus, mesh_text
-from peridyn.io.case import Case, Geometry, Region
+from peridyn.io.case import Case, Geometry, Region, box_cells
 from peridyn.parallel.contact import RankContact
 from peridyn.parallel.domain import Domain, agree
 from peridyn.parallel.halo import Halo, clearance, ghost_layers, plan_halo
@@ -428,10 +428,10 @@ def _build_part(case: Case, comm, base_dir):
 
 def neighbourhood_box(case: Case, body: Body, horizon: float) -> np.ndarray | None:
     """(3,) half-widths (m) of the box families of ``discretization.neighbourhood: box``:
-    round(horizon / spacing) cells along each axis, halves up; None for spheres."""
+    ``box_cells`` along each axis; None for spheres."""
     if case.discretization.neighbourhood != "box":
         return None
-    return np.floor(horizon / body.cells[0] + 0.5) * body.cells[0]
+    return box_cells(horizon, body.cells[0]) * body.cells[0]
 
 
 def bond_reach(case: Case, body: Body) -> float:
