@@ -178,6 +178,7 @@ def run_case_benchmark(
                 for obj, name in wrapped:
                     delattr(obj, name)  # back to the class's method
         finally:
+            gathered.detach()
             recorder.close()
         records = _record_counts(out / RESULTS)
     say("force kernel alone")

@@ -464,9 +464,6 @@ def _run_explicit(
         prepare = [*prepare, (spec.exodus_due, collect)]
     damage_due = [spec.snapshot_due, spec.exodus_due, *([cracks.due] if cracks is not None else [])]
     record = recorder.record_series if recorder is not None else None
-    gathered.attach(
-        watched, due, prepare, damage_due, (spec.series_due, probes.u_points, probes.v_points, record)
-    )
     try:
         if resume is None:
             if pieces is not None:
@@ -481,8 +478,12 @@ def _run_explicit(
         traffic = d.comm.traffic.copy()
         loop_start = time.perf_counter()
         try:
+            gathered.attach(
+                watched, due, prepare, damage_due, (spec.series_due, probes.u_points, probes.v_points, record)
+            )
             solver.run(state, remaining, observers, bar)
         finally:
+            gathered.detach()
             if bar is not None:
                 bar.close()
         loop_seconds = time.perf_counter() - loop_start

@@ -87,6 +87,12 @@ class RootObservers:
             limit = self.domain.runaway_limit(self.model.body.points)
             self._series = series_due, PointGather(self.domain, u_points, v_points), record, limit
 
+    def detach(self) -> None:
+        """Forget ``attach``'s observers. Observers hold this object's ``damage``: until they are
+        detached, the two keep each other, and the run's model, alive (a reference cycle that only
+        a garbage collection frees; a sweep worker would grow by a model per run)."""
+        self.observers, self.due, self.prepare, self.damage_due, self._series = [], [], [], None, None
+
     def damage(self) -> np.ndarray:
         """The damage index (n_points,) of the whole body at the last gathered state (rank 0)."""
         if self.domain.size == 1:
