@@ -2,12 +2,13 @@
 
 Reference ("before"): the float64 kernels as they were before the two-loop chunks, one
 loop per family (``tests/kernels/single_loop_kernels.py``). Candidates: today's kernels
-(``peridyn.kernels``, chunked) and variants of the single loop written the same way (family
-slices, unsigned neighbour index, select on ``intact``, ``bond_differences``). For each:
-the reference's time over the candidate's (best of ``--rounds`` interleaved calls on the
-same inputs, any per-call layout conversion included; wall clock and process CPU time,
-the latter less sensitive to other jobs on a shared machine), and the largest force
-difference relative to the largest force (0 = the same bits). Results in RESULTS.md.
+(``peridyn.kernels``, chunked, reading the stored bond vectors) and variants of the single
+loop written the same way (family slices, unsigned neighbour index, select on ``intact``,
+``bond_differences``). For each: the reference's time over the candidate's (best of
+``--rounds`` interleaved calls on the same inputs, any per-call layout conversion included;
+wall clock and process CPU time, the latter less sensitive to other jobs on a shared
+machine), and the largest force difference relative to the largest force (0 = the same
+bits). Results in RESULTS.md.
 
     PYTHONPATH=src python benchmarks/kernel_candidates.py --side 49 --rounds 15
 """
@@ -228,12 +229,13 @@ def candidates(side: int, seed: int = 0):
     r = np.empty(b.n_bonds)
 
     pmb_args = (x, u, b.offsets, b.neighbours, pmb.inv_length, pmb.bond_stiffness, b.intact)
+    xi = pmb.bond_vectors
 
     def pmb_before():
         return single.pmb_force(*pmb_args, out["a"])
 
     def pmb_chunked():
-        return pmb_force(*pmb_args, out["b"])
+        return pmb_force(xi, *pmb_args[1:], out["b"])
 
     def soa():
         for a in range(3):
@@ -250,18 +252,18 @@ def candidates(side: int, seed: int = 0):
     def lean():
         return pmb_force_lean(x, u, b.offsets, b.neighbours, il32, k_broken, out["b"])
 
-    def lps_pair(dilatation, pair_force, f):
+    def lps_pair(dilatation, pair_force, f, where=x):
         theta = dilatation(
-            x, u, b.offsets, b.neighbours, lps.length, lps.w, b.intact, lps._theta_coef, lps._theta
+            where, u, b.offsets, b.neighbours, lps.length, lps.w, b.intact, lps._theta_coef, lps._theta
         )
         p = np.multiply(theta, lps._p_coef, out=lps._p)
-        return pair_force(x, u, b.offsets, b.neighbours, lps.length, lps.w, lps.dev, b.intact, p, f)
+        return pair_force(where, u, b.offsets, b.neighbours, lps.length, lps.w, lps.dev, b.intact, p, f)
 
     def lps_before():
         return lps_pair(single.lps_dilatation, single.lps_pair_force, out["a"])
 
     def lps_chunked():
-        return lps_pair(lps_dilatation, lps_pair_force, out["b"])
+        return lps_pair(lps_dilatation, lps_pair_force, out["b"], xi)
 
     def lps_keep_r():
         theta = lps_dilatation_keep_r(
@@ -273,11 +275,11 @@ def candidates(side: int, seed: int = 0):
         )
 
     return b.n_bonds, {
-        "pmb: chunks of 16, two loops (today)": (pmb_before, pmb_chunked),
+        "pmb: chunks of 16, stored xi (today)": (pmb_before, pmb_chunked),
         "pmb: SoA x, u (six (n,) arrays)": (pmb_before, soa),
         "pmb: x, u interleaved (n, 6)": (pmb_before, interleaved),
         "pmb: float32 1/|xi|, no intact (16 B/bond)": (pmb_before, lean),
-        "lps: chunks of 16, two loops (today)": (lps_before, lps_chunked),
+        "lps: chunks of 16, stored xi (today)": (lps_before, lps_chunked),
         "lps: |Y| stored by the dilatation pass": (lps_before, lps_keep_r),
     }
 

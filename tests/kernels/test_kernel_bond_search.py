@@ -78,3 +78,16 @@ def test_box_fraction_in_ball(rng, q):
     expected = ref.box_fraction_in_ball(centres, sides, radius, q)
     assert_close(got, expected, TOL64, 1.0)
     assert np.any(expected == 0) and np.any((expected > 0) & (expected < 1))
+
+
+def test_initial_bond_vectors(rng):
+    """x_j - x_i of every directed bond, exactly (one subtraction, as in the reference); the
+    reverse bond's vector is its negative to the last bit (Newton's third law of the kernels
+    that read it)."""
+    fam = jittered_families(rng)
+    got = bond_search.initial_bond_vectors(fam.x, fam.offsets, fam.nbr, np.full((len(fam.nbr), 3), np.nan))
+    np.testing.assert_array_equal(got, ref.initial_bond_vectors(fam.x, fam.offsets, fam.nbr))
+    owner = np.repeat(np.arange(fam.n), np.diff(fam.offsets))
+    pair = {(i, j): b for b, (i, j) in enumerate(zip(owner, fam.nbr, strict=True))}
+    reverse = np.array([pair[(j, i)] for i, j in zip(owner, fam.nbr, strict=True)])
+    np.testing.assert_array_equal(got[reverse], -got)

@@ -1,8 +1,10 @@
 """The chunked two-loop force kernels sum each family in its written order (``peridyn.kernels``).
 
 Oracle: the float64 kernels as they were before the chunks (``single_loop_kernels``, one
-loop per family, same ``FASTMATH``). Same operations in the same order give the same bits,
-whatever the chunk boundaries (the families here have 19 to 44 bonds, ``CHUNK`` 16).
+loop per family, same ``FASTMATH``, gathering the neighbours' positions). Same operations in
+the same order give the same bits, whatever the chunk boundaries (the families here have 19
+to 44 bonds, ``CHUNK`` 16), and whether ``xi = x_j - x_i`` is computed in the loop or read
+from the stored bond vectors (``initial_bond_vectors``, the same subtraction).
 """
 
 import numpy as np
@@ -11,6 +13,7 @@ import single_loop_kernels as single
 from kernel_inputs import displacement, jittered_families, per_bond
 
 from peridyn.kernels import CHUNK, lps, pmb
+from peridyn.kernels.bond_search import initial_bond_vectors
 
 pytestmark = pytest.mark.kernels
 
@@ -24,11 +27,12 @@ def test_chunks_sum_in_written_order(rng):
     theta_coef = rng.uniform(0.5, 1.5, fam.n)
     p = 1e11 * rng.uniform(-1.0, 1.0, fam.n)
     args = (x, u, fam.offsets, fam.nbr)
+    xi = initial_bond_vectors(x, fam.offsets, fam.nbr, np.empty((len(fam.nbr), 3)))
     inv_len = 1.0 / fam.length
     for kernel, oracle, extra, out in (
         (pmb.pmb_force, single.pmb_force, (inv_len, k, fam.intact), (fam.n, 3)),
         (lps.lps_dilatation, single.lps_dilatation, (fam.length, w, fam.intact, theta_coef), (fam.n,)),
         (lps.lps_pair_force, single.lps_pair_force, (fam.length, w, dev, fam.intact, p), (fam.n, 3)),
     ):
-        got = kernel(*args, *extra, np.full(out, np.nan))
+        got = kernel(xi, *args[1:], *extra, np.full(out, np.nan))
         np.testing.assert_array_equal(got, oracle(*args, *extra, np.full(out, np.nan)))

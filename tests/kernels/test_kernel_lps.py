@@ -19,6 +19,7 @@ from kernel_inputs import (
 from peridyn.kernels import lps
 from peridyn.kernels.reference import bond_vectors, owners
 from peridyn.kernels.reference import lps as ref
+from peridyn.kernels.reference.bond_search import initial_bond_vectors
 
 pytestmark = pytest.mark.kernels
 
@@ -52,7 +53,8 @@ def test_lps_dilatation_length_form(rng, dtype, strain):
     """theta_coef sum w |xi| (|Y| - |xi|): the extension cancels terms of size |xi|."""
     fam, x, u, w, _, theta_coef, _ = _inputs(rng, dtype, strain)
     length = fam.length.astype(dtype)
-    args = (x, u, fam.offsets, fam.nbr, length, w, fam.intact, theta_coef)
+    xi = initial_bond_vectors(x, fam.offsets, fam.nbr).astype(dtype)
+    args = (xi, u, fam.offsets, fam.nbr, length, w, fam.intact, theta_coef)
     got = lps.lps_dilatation(*args, np.full(fam.n, np.nan, dtype))
     scale = theta_coef * family_magnitude(fam.offsets, fam.intact * w * length * length)
     assert got.dtype == dtype
@@ -78,7 +80,8 @@ def test_lps_pair_force_length_form(rng, dtype, strain):
     """[w |xi| (P_i + P_j) + dev (|Y| - |xi|)] Y / |Y|: the extension cancels dev |xi|."""
     fam, x, u, w, dev, _, p = _inputs(rng, dtype, strain)
     length = fam.length.astype(dtype)
-    args = (x, u, fam.offsets, fam.nbr, length, w, dev, fam.intact, p)
+    xi = initial_bond_vectors(x, fam.offsets, fam.nbr).astype(dtype)
+    args = (xi, u, fam.offsets, fam.nbr, length, w, dev, fam.intact, p)
     got = lps.lps_pair_force(*args, np.full_like(x, np.nan))
     pair = np.abs(p[owners(fam.offsets)]) + np.abs(p[fam.nbr])
     scale = family_magnitude(fam.offsets, fam.intact * (w * length * pair + dev * length))
@@ -105,7 +108,8 @@ def test_lps_deviatoric_energy(rng, dim):
     """sum_j w (e - theta |xi| / d)^2 (float64, the only dtype it is called with): the
     deviatoric extension is rounded to ~1e-16 |xi|, its square to ~1e-16 of |e_d| |xi|."""
     fam, x, u, w, _, theta_coef, _ = _inputs(rng, np.float64, 1e-3)
-    theta = ref.lps_dilatation(x, u, fam.offsets, fam.nbr, fam.length, w, fam.intact, theta_coef)
+    xi = initial_bond_vectors(x, fam.offsets, fam.nbr)
+    theta = ref.lps_dilatation(xi, u, fam.offsets, fam.nbr, fam.length, w, fam.intact, theta_coef)
     args = (x, u, fam.offsets, fam.nbr, fam.length, w, fam.intact, theta, dim)
     got = lps.lps_deviatoric_energy(*args, np.full(fam.n, np.nan))
     _, _, r = _lengths(x, u, fam)

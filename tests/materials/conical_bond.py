@@ -77,7 +77,7 @@ class ConicalBondModel(Model):
         if self.dtype == np.float32:
             return pmb_force_cf(self.x, u, b.offsets, b.neighbours, self.bond_stiffness, b.intact, out)
         return pmb_force(
-            self.x, u, b.offsets, b.neighbours, self.inv_length, self.bond_stiffness, b.intact, out
+            self.bond_vectors, u, b.offsets, b.neighbours, self.inv_length, self.bond_stiffness, b.intact, out
         )
 
     def energy_density(self, u):

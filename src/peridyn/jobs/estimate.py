@@ -46,27 +46,29 @@ class Costs:
 #: influence 8, volume factor 8, intact 1 = 29 B) and, while they are built, the pairs of the
 #: search (8 B) and the reverse-bond permutation with its sort temporaries (24 B).
 #: ``explicit``: + the model's per-bond arrays (PMB: length, 1/length, stiffness, surface
-#: factor; LPS: length, weight, deviatoric coefficient, shear factor: 32 B) and the kernels'
-#: temporaries: about 100 B; per point the body (points, volumes, cells, sets: 64 B) and the
-#: state (x, u, v, a, f, forces, damping: 8 x 24 B).
+#: factor; LPS: length, weight, deviatoric coefficient, shear factor: 32 B), the reference bond
+#: vectors that the float64 force kernels read (24 B) and the kernels' temporaries: about
+#: 124 B; per point the body (points, volumes, cells, sets: 64 B) and the state (x, u, v, a, f,
+#: forces, damping: 8 x 24 B).
 #: ``static``, ``newton``, ``newmark``: + a bond-stiffness assembly (9 entries of 8 B values + 2 x 4 B
-#: indices per bond, COO then CSR): about 400 B.
+#: indices per bond, COO then CSR) and the bond vectors of the force: about 424 B.
 #: ``fatigue``: statics by AMG-preconditioned CG (or a factor) and modal analyses before and after:
 #: 2 400 B per bond, fitted to one measured run (dog-bone at 0.33 mm, 795 k directed bonds,
 #: 2.05 GiB peak) and 7-11 % high on the SEN strip at 132 k-1.24 M bonds (benchmarks/RESULTS.md).
 #: ``modal``: + the stiffness parts P and G (LPS) in COO and CSR and the augmented matrix:
 #: about 500 B; per point the mode shapes are small (n_modes x 24 B) next to the bonds.
 COSTS = {
-    "explicit": Costs(per_point=350.0, per_bond=100.0),
-    "newmark": Costs(per_point=600.0, per_bond=400.0),
-    "static": Costs(per_point=600.0, per_bond=400.0),
-    "newton": Costs(per_point=600.0, per_bond=400.0),
+    "explicit": Costs(per_point=350.0, per_bond=124.0),
+    "newmark": Costs(per_point=600.0, per_bond=424.0),
+    "static": Costs(per_point=600.0, per_bond=424.0),
+    "newton": Costs(per_point=600.0, per_bond=424.0),
     "fatigue": Costs(per_point=600.0, per_bond=2400.0),
     "modal": Costs(per_point=600.0, per_bond=500.0),
 }
 
-#: Bytes per directed bond an explicit run saves with float32 kernels (half of the model's 32 B).
-FLOAT32_SAVING = 16.0
+#: Bytes per directed bond an explicit run saves with float32 kernels: half of the model's 32 B,
+#: and the 24 B of bond vectors that only the float64 kernels read.
+FLOAT32_SAVING = 40.0
 
 #: Bytes per entry of a sparse factor (8-byte value, 4-byte index), as ``jobs.modal`` counts.
 FACTOR_ENTRY_BYTES = 12.0

@@ -36,7 +36,12 @@ How the force kernels are written (what makes them fast, see ``benchmarks/RESULT
 - every constant has the kernel's dtype (``f.dtype.type(...)``): a Python ``0 * r`` or
   ``1 / r`` turns a float32 kernel into float64 arithmetic;
 - the bond vector differences come from :func:`bond_differences`, compiled without
-  fast-math, so ``Y_ij = -Y_ji`` holds exactly whatever the optimiser does with the rest.
+  fast-math, so ``Y_ij = -Y_ji`` holds exactly whatever the optimiser does with the rest;
+- the float64 force kernels read each bond's reference vector ``xi = x_j - x_i`` from a
+  stored (n_bonds, 3) array (``bond_search.initial_bond_vectors``, the same subtraction, so
+  the same bits) and gather only ``u_j``: three gathers a bond instead of six, which is
+  what the force loop waits on (1.16-1.20x on AMD Zen 4, ``benchmarks/RESULTS.md``). The
+  deformed vector is :func:`deformed_component`, also exact.
 
 Two forms of the stretch are used:
 
@@ -102,6 +107,18 @@ def bond_differences(xj, xi, uj, ui):
     d = xj - xi
     du = uj - ui
     return d, du, d + du
+
+
+@exact_helper("{t}({t}, {t}, {t})")
+def deformed_component(xi, uj, ui):
+    """One component of a bond's deformed vector from its stored reference one:
+    ``Y_a = xi_a + (uj - ui)``.
+
+    Compiled without fast-math (``exact_helper``), like :func:`bond_differences`: with ``xi``
+    = ``xj - xi`` rounded as there, it returns the same bits as the third value of
+    ``bond_differences(xj, xi, uj, ui)``, and swapping the ends negates it exactly.
+    """
+    return xi + (uj - ui)
 
 
 def stack_array(size, dtype):

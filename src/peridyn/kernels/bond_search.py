@@ -1,5 +1,6 @@
 """Bond search kernels: CSR families from neighbour pairs, bond lengths and partial-volume
-factors (the fraction of a neighbour's cell inside the horizon ball)."""
+factors (the fraction of a neighbour's cell inside the horizon ball), and the reference bond
+vectors that the float64 force kernels read."""
 
 import numba
 import numpy as np
@@ -44,6 +45,19 @@ def bond_geometry(x, cells, offsets, nbr, radius, partial, q):
             else:
                 factor[b] = 1.0 if length[b] <= radius else 0.0
     return length, factor
+
+
+@numba.njit(parallel=True, cache=True)
+def initial_bond_vectors(x, offsets, nbr, xi):
+    """Reference bond vectors ``xi`` (OUT, (n_bonds, 3), m): ``x_j - x_i`` of every directed bond,
+    rounded as the force kernels' ``bond_differences`` rounds it (one subtraction)."""
+    n = x.shape[0]
+    for i in numba.prange(n):
+        for b in range(offsets[i], offsets[i + 1]):
+            j = nbr[b]
+            for a in range(3):
+                xi[b, a] = x[j, a] - x[i, a]
+    return xi
 
 
 @numba.njit(cache=True)

@@ -12,7 +12,8 @@ The pair force on i is (t_ij + t_ji) Y/|Y| beta V_j, which the kernel writes as
 with the per-bond deviatoric stiffness ``dev`` = k_ij.
 
 The force takes two passes over the bonds (the pair force needs the neighbours'
-dilatations). ``lps_dilatation`` / ``lps_pair_force`` (float64) and the ``*_cf``
+dilatations). ``lps_dilatation`` / ``lps_pair_force`` (float64, from the stored bond vectors
+``xi``) and the ``*_cf``
 versions (float32) compute the same quantities; see ``peridyn.kernels`` for the two
 forms of the extension.
 """
@@ -20,21 +21,28 @@ forms of the extension.
 import numba
 import numpy as np
 
-from peridyn.kernels import CHUNK, CHUNK_BUFFER, FASTMATH, bond_differences, stack_array
+from peridyn.kernels import (
+    CHUNK,
+    CHUNK_BUFFER,
+    FASTMATH,
+    bond_differences,
+    deformed_component,
+    stack_array,
+)
 
 
 @numba.njit(parallel=True, fastmath=FASTMATH, cache=True)
-def lps_dilatation(x, u, offsets, nbr, length, w, intact, theta_coef, theta):
+def lps_dilatation(xi, u, offsets, nbr, length, w, intact, theta_coef, theta):
     """Dilatation ``theta`` (OUT): theta_i = theta_coef_i sum_j w_ij |xi| e_ij, coef = d / m_i.
 
-    Length form, e = |Y| - |xi| with the stored ``length`` (float64; see ``peridyn.kernels``).
+    Length form, e = |Y| - |xi| with the stored ``length`` and bond vectors ``xi`` (n_bonds,
+    3), m (float64; see ``peridyn.kernels``).
     """
-    n = x.shape[0]
+    n = u.shape[0]
     zero = theta.dtype.type(0.0)
-    xf = x.reshape(3 * n)
     uf = u.reshape(3 * n)
+    xif = xi.reshape(3 * xi.shape[0])
     for i in numba.prange(n):
-        xi0, xi1, xi2 = xf[3 * i], xf[3 * i + 1], xf[3 * i + 2]
         ui0, ui1, ui2 = uf[3 * i], uf[3 * i + 1], uf[3 * i + 2]
         buf = stack_array(CHUNK_BUFFER, theta.dtype)
         hi = offsets[i + 1]
@@ -42,14 +50,15 @@ def lps_dilatation(x, u, offsets, nbr, length, w, intact, theta_coef, theta):
         for c in range(offsets[i], hi, CHUNK):
             m = min(CHUNK, hi - c)
             fam = nbr[c : c + m]
+            xib = xif[3 * c : 3 * (c + m)]
             lb = length[c : c + m]
             wb = w[c : c + m]
             ok = intact[c : c + m]
             for q in range(m):
                 j = 3 * np.uint64(np.uint32(fam[q]))
-                _, _, y0 = bond_differences(xf[j], xi0, uf[j], ui0)
-                _, _, y1 = bond_differences(xf[j + 1], xi1, uf[j + 1], ui1)
-                _, _, y2 = bond_differences(xf[j + 2], xi2, uf[j + 2], ui2)
+                y0 = deformed_component(xib[3 * q], uf[j], ui0)
+                y1 = deformed_component(xib[3 * q + 1], uf[j + 1], ui1)
+                y2 = deformed_component(xib[3 * q + 2], uf[j + 2], ui2)
                 r = np.sqrt(y0 * y0 + y1 * y1 + y2 * y2)
                 t = wb[q] * lb[q] * (r - lb[q])
                 buf[q] = t if ok[q] else zero
@@ -60,17 +69,16 @@ def lps_dilatation(x, u, offsets, nbr, length, w, intact, theta_coef, theta):
 
 
 @numba.njit(parallel=True, fastmath=FASTMATH, cache=True)
-def lps_pair_force(x, u, offsets, nbr, length, w, dev, intact, p, f):
+def lps_pair_force(xi, u, offsets, nbr, length, w, dev, intact, p, f):
     """Force density ``f`` (OUT) from the per-point ``p`` = P_i and per-bond ``dev`` (see module).
 
-    Length form (float64).
+    Length form (float64), from the stored bond vectors ``xi`` (n_bonds, 3), m.
     """
-    n = x.shape[0]
+    n = u.shape[0]
     zero = f.dtype.type(0.0)
-    xf = x.reshape(3 * n)
     uf = u.reshape(3 * n)
+    xif = xi.reshape(3 * xi.shape[0])
     for i in numba.prange(n):
-        xi0, xi1, xi2 = xf[3 * i], xf[3 * i + 1], xf[3 * i + 2]
         ui0, ui1, ui2 = uf[3 * i], uf[3 * i + 1], uf[3 * i + 2]
         buf = stack_array(CHUNK_BUFFER, f.dtype)
         hi = offsets[i + 1]
@@ -81,6 +89,7 @@ def lps_pair_force(x, u, offsets, nbr, length, w, dev, intact, p, f):
         for c in range(offsets[i], hi, CHUNK):
             m = min(CHUNK, hi - c)
             fam = nbr[c : c + m]
+            xib = xif[3 * c : 3 * (c + m)]
             lb = length[c : c + m]
             wb = w[c : c + m]
             kb = dev[c : c + m]
@@ -88,9 +97,9 @@ def lps_pair_force(x, u, offsets, nbr, length, w, dev, intact, p, f):
             for q in range(m):
                 jp = np.uint32(fam[q])
                 j = 3 * np.uint64(jp)
-                _, _, y0 = bond_differences(xf[j], xi0, uf[j], ui0)
-                _, _, y1 = bond_differences(xf[j + 1], xi1, uf[j + 1], ui1)
-                _, _, y2 = bond_differences(xf[j + 2], xi2, uf[j + 2], ui2)
+                y0 = deformed_component(xib[3 * q], uf[j], ui0)
+                y1 = deformed_component(xib[3 * q + 1], uf[j + 1], ui1)
+                y2 = deformed_component(xib[3 * q + 2], uf[j + 2], ui2)
                 r = np.sqrt(y0 * y0 + y1 * y1 + y2 * y2)
                 L = lb[q]
                 t = (wb[q] * L * (pi + p[jp]) + kb[q] * (r - L)) / r

@@ -16,23 +16,30 @@ is the straightforward loop kept as the reference row of ``peridyn bench``.
 import numba
 import numpy as np
 
-from peridyn.kernels import CHUNK, CHUNK_BUFFER, FASTMATH, bond_differences, stack_array
+from peridyn.kernels import (
+    CHUNK,
+    CHUNK_BUFFER,
+    FASTMATH,
+    bond_differences,
+    deformed_component,
+    stack_array,
+)
 
 
 @numba.njit(parallel=True, fastmath=FASTMATH, cache=True)
-def pmb_force(x, u, offsets, nbr, inv_len, k, intact, f):
+def pmb_force(xi, u, offsets, nbr, inv_len, k, intact, f):
     """Internal force density ``f`` (OUT, overwritten) of the PMB model ("length form").
 
-    ``s = k (1/|xi| - 1/|Y|)`` with the stored ``inv_len = 1/|xi|``: one square root
-    and one division per bond. Used for float64 (see the package docstring).
+    ``s = k (1/|xi| - 1/|Y|)`` with the stored ``inv_len = 1/|xi|`` and bond vectors ``xi``
+    (n_bonds, 3), m (``bond_search.initial_bond_vectors``): one square root and one division
+    per bond, and only ``u_j`` gathered. Used for float64 (see the package docstring).
     """
-    n = x.shape[0]
+    n = u.shape[0]
     zero = f.dtype.type(0.0)
     one = f.dtype.type(1.0)
-    xf = x.reshape(3 * n)
     uf = u.reshape(3 * n)
+    xif = xi.reshape(3 * xi.shape[0])
     for i in numba.prange(n):
-        xi0, xi1, xi2 = xf[3 * i], xf[3 * i + 1], xf[3 * i + 2]
         ui0, ui1, ui2 = uf[3 * i], uf[3 * i + 1], uf[3 * i + 2]
         buf = stack_array(CHUNK_BUFFER, f.dtype)
         hi = offsets[i + 1]
@@ -42,14 +49,15 @@ def pmb_force(x, u, offsets, nbr, inv_len, k, intact, f):
         for c in range(offsets[i], hi, CHUNK):
             m = min(CHUNK, hi - c)
             fam = nbr[c : c + m]
+            xib = xif[3 * c : 3 * (c + m)]
             il = inv_len[c : c + m]
             kb = k[c : c + m]
             ok = intact[c : c + m]
             for q in range(m):
                 j = 3 * np.uint64(np.uint32(fam[q]))
-                _, _, y0 = bond_differences(xf[j], xi0, uf[j], ui0)
-                _, _, y1 = bond_differences(xf[j + 1], xi1, uf[j + 1], ui1)
-                _, _, y2 = bond_differences(xf[j + 2], xi2, uf[j + 2], ui2)
+                y0 = deformed_component(xib[3 * q], uf[j], ui0)
+                y1 = deformed_component(xib[3 * q + 1], uf[j + 1], ui1)
+                y2 = deformed_component(xib[3 * q + 2], uf[j + 2], ui2)
                 s = kb[q] * (il[q] - one / np.sqrt(y0 * y0 + y1 * y1 + y2 * y2))
                 buf[q] = s if ok[q] else zero
                 buf[CHUNK + q] = y0

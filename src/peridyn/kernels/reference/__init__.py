@@ -29,6 +29,12 @@ def bond_differences(xj, xi, uj, ui):
     return d, du, d + du
 
 
+def deformed_component(xi, uj, ui):
+    """``xi + (uj - ui)`` in the inputs' dtype: the reference of
+    :func:`peridyn.kernels.deformed_component`."""
+    return xi + (uj - ui)
+
+
 def owners(offsets):
     """(n_bonds,) int64: the point whose CSR family holds each directed bond."""
     return np.repeat(np.arange(len(offsets) - 1), np.diff(offsets))
@@ -44,6 +50,23 @@ def bond_vectors(x, u, offsets, nbr):
     xi = x[j] - x[i]
     du = u[j] - u[i]
     return xi, du, xi + du
+
+
+def deformed_vectors(xi, u, offsets, nbr):
+    """(n_bonds, 3) float64, m: ``Y = xi + (u_j - u_i)`` of every directed bond from its stored
+    reference vector ``xi`` (n_bonds, 3) (the float64 force kernels' input)."""
+    i = owners(offsets)
+    j = np.asarray(nbr, dtype=np.int64)
+    u = np.asarray(u, dtype=np.float64)
+    return np.asarray(xi, dtype=np.float64) + (u[j] - u[i])
+
+
+def stored_extension(xi, u, offsets, nbr, length):
+    """``(|xi|, e, Y)`` as :func:`extension` with a stored ``length``, from the stored reference
+    vectors ``xi`` (n_bonds, 3) instead of the points: the float64 force kernels' inputs."""
+    length = np.asarray(length, dtype=np.float64)
+    y = deformed_vectors(xi, u, offsets, nbr)
+    return length, np.linalg.norm(y, axis=1) - length, y
 
 
 def extension(x, u, offsets, nbr, length=None):

@@ -1,9 +1,10 @@
-"""References of ``peridyn.kernels.bond_search``: CSR families from i<j pairs, bond lengths
-and the partial-volume factor (the fraction of a neighbour's cell inside the horizon ball)."""
+"""References of ``peridyn.kernels.bond_search``: CSR families from i<j pairs, bond lengths,
+the partial-volume factor (the fraction of a neighbour's cell inside the horizon ball) and the
+reference bond vectors."""
 
 import numpy as np
 
-from peridyn.kernels.reference import as64, owners
+from peridyn.kernels.reference import as64, bond_vectors, owners
 
 
 def bond_families(pairs, n):
@@ -15,6 +16,12 @@ def bond_families(pairs, n):
     order = np.lexsort((other, owner))
     offsets = np.concatenate([[0], np.cumsum(np.bincount(owner, minlength=n))]).astype(np.int64)
     return offsets, other[order].astype(np.int32)
+
+
+def initial_bond_vectors(x, offsets, nbr):
+    """(n_bonds, 3) float64, m: ``x_j - x_i`` of every directed bond i->j."""
+    xi, _, _ = bond_vectors(x, np.zeros_like(x), offsets, nbr)
+    return xi
 
 
 def box_fraction_in_ball(centre, sides, radius, q):

@@ -7,53 +7,59 @@ with extension ``e = |Y| - |xi|``:
 - force density ``f_i = sum_j [w_ij |xi| (P_i + P_j) + dev_ij e_ij] Y / |Y|`` (N/m^3);
 - deviatoric sum ``sum_j w_ij (e_ij - theta_i |xi| / d)^2`` (m^5).
 
-The ``*_cf`` kernels take ``|xi| = |x_j - x_i|``, the others the stored ``length``.
+The ``*_cf`` kernels take ``|xi| = |x_j - x_i|`` from the points, the others the stored
+bond vectors ``xi`` (n_bonds, 3) and ``length``.
 """
 
 import numpy as np
 
-from peridyn.kernels.reference import as64, extension, family_sum, owners
+from peridyn.kernels.reference import as64, extension, family_sum, owners, stored_extension
 
 
-def _dilatation(x, u, offsets, nbr, length, w, intact, theta_coef):
-    length, e, _ = extension(x, u, offsets, nbr, length)
+def _dilatation(offsets, length, e, w, intact, theta_coef):
     w, theta_coef = as64(w, theta_coef)
     return theta_coef * family_sum(offsets, np.where(intact, w * length * e, 0.0))
 
 
-def _pair_force(x, u, offsets, nbr, length, w, dev, intact, p):
-    length, e, y = extension(x, u, offsets, nbr, length)
+def _pair_force(offsets, nbr, length, e, y, w, dev, intact, p):
     w, dev, p = as64(w, dev, p)
     t = w * length * (p[owners(offsets)] + p[nbr]) + dev * e
     t = np.where(intact, t / np.linalg.norm(y, axis=1), 0.0)
     return family_sum(offsets, t[:, None] * y)
 
 
-def lps_dilatation(x, u, offsets, nbr, length, w, intact, theta_coef):
-    """(n_points,) float64: theta with the stored |xi| = ``length``."""
-    return _dilatation(x, u, offsets, nbr, length, w, intact, theta_coef)
+def lps_dilatation(xi, u, offsets, nbr, length, w, intact, theta_coef):
+    """(n_points,) float64: theta from the stored bond vectors ``xi`` (n_bonds, 3) and |xi| =
+    ``length``."""
+    length, e, _ = stored_extension(xi, u, offsets, nbr, length)
+    return _dilatation(offsets, length, e, w, intact, theta_coef)
 
 
 def lps_dilatation_cf(x, u, offsets, nbr, w, intact, theta_coef):
     """(n_points,) float64: theta with |xi| = |x_j - x_i|."""
-    return _dilatation(x, u, offsets, nbr, None, w, intact, theta_coef)
+    length, e, _ = extension(x, u, offsets, nbr)
+    return _dilatation(offsets, length, e, w, intact, theta_coef)
 
 
-def lps_pair_force(x, u, offsets, nbr, length, w, dev, intact, p):
-    """(n_points, 3) float64, N/m^3: the pair force with the stored |xi| = ``length``."""
-    return _pair_force(x, u, offsets, nbr, length, w, dev, intact, p)
+def lps_pair_force(xi, u, offsets, nbr, length, w, dev, intact, p):
+    """(n_points, 3) float64, N/m^3: the pair force from the stored bond vectors ``xi``
+    (n_bonds, 3) and |xi| = ``length``."""
+    length, e, y = stored_extension(xi, u, offsets, nbr, length)
+    return _pair_force(offsets, nbr, length, e, y, w, dev, intact, p)
 
 
 def lps_pair_force_cf(x, u, offsets, nbr, w, dev, intact, p):
     """(n_points, 3) float64, N/m^3: the pair force with |xi| = |x_j - x_i|."""
-    return _pair_force(x, u, offsets, nbr, None, w, dev, intact, p)
+    length, e, y = extension(x, u, offsets, nbr)
+    return _pair_force(offsets, nbr, length, e, y, w, dev, intact, p)
 
 
-def lps_force(x, u, offsets, nbr, length, w, dev, intact, theta_coef, p_coef):
+def lps_force(xi, u, offsets, nbr, length, w, dev, intact, theta_coef, p_coef):
     """(n_points, 3) float64, N/m^3: the whole LPS force, P_i = theta_i ``p_coef``_i (what
-    ``LPSModel.force`` computes with the two kernels)."""
-    theta = lps_dilatation(x, u, offsets, nbr, length, w, intact, theta_coef)
-    return lps_pair_force(x, u, offsets, nbr, length, w, dev, intact, theta * np.asarray(p_coef, np.float64))
+    ``LPSModel.force`` computes with the two kernels), from the stored bond vectors ``xi``."""
+    theta = lps_dilatation(xi, u, offsets, nbr, length, w, intact, theta_coef)
+    p = theta * np.asarray(p_coef, np.float64)
+    return lps_pair_force(xi, u, offsets, nbr, length, w, dev, intact, p)
 
 
 def lps_deviatoric_energy(x, u, offsets, nbr, length, w, intact, theta, dim):

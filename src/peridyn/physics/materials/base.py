@@ -28,6 +28,7 @@ import numpy as np
 from peridyn.discretization.body import Body
 from peridyn.discretization.bonds import Bonds, range_offsets
 from peridyn.errors import InputError
+from peridyn.kernels.bond_search import initial_bond_vectors
 from peridyn.kernels.lps import lps_dilatation
 from peridyn.kernels.stress import partial_stress
 from peridyn.physics.materials.linearisation import BondLinearisation
@@ -59,6 +60,8 @@ class Model:
     density : (n_points,) float64, kg/m^3
     bond_volume : (n_bonds,) float64, m^3
         Neighbour volume times the bond's partial-volume factor.
+    bond_vectors : (n_bonds, 3) float64, m
+        Reference bond vectors ``xi = x_j - x_i`` (see the property).
     """
 
     name = "model"
@@ -81,6 +84,7 @@ class Model:
         # neighbour volume times its volume factor, (n_bonds,) m^3
         self.bond_volume = body.volumes[bonds.neighbours] * bonds.volume_factor
         self._linearisation: BondLinearisation | None = None
+        self._bond_vectors: np.ndarray | None = None
         self._row_offsets_cache: dict = {}
         self._scratch_cache: dict = {}
 
@@ -117,6 +121,28 @@ class Model:
 
     def __repr__(self) -> str:
         return f"{type(self).__name__}(n_points={self.body.n_points}, dtype={self.dtype.name})"
+
+    @property
+    def bond_vectors(self) -> np.ndarray:
+        """(n_bonds, 3) float64, m: the reference vector ``xi = x_j - x_i`` of every bond.
+
+        The float64 force kernels read it instead of gathering the neighbours' positions
+        (``peridyn.kernels``): 24 bytes a bond, computed on the first call and kept. One-off
+        computations use :meth:`bond_vectors_once` instead.
+        """
+        if self._bond_vectors is None:
+            self._bond_vectors = self.bond_vectors_once()
+        return self._bond_vectors
+
+    def bond_vectors_once(self) -> np.ndarray:
+        """:attr:`bond_vectors` without keeping them: the kept array once the force has made it,
+        else a new one, freed after its use. For the float64 computations done once or at
+        records (corrections, energies, stresses) of models whose force may never read the
+        bond vectors (float32 kernels, modal analyses), which should not hold 24 B a bond."""
+        if self._bond_vectors is not None:
+            return self._bond_vectors
+        x = np.ascontiguousarray(self.body.points, dtype=np.float64)
+        return initial_bond_vectors(x, self.offsets, self.neighbours, np.empty((len(self.neighbours), 3)))
 
     def _as_state(self, u: np.ndarray) -> np.ndarray:
         return np.ascontiguousarray(u, dtype=self.dtype)
@@ -227,8 +253,9 @@ class Model:
         u = np.ascontiguousarray(u, dtype=np.float64)
         n = self.body.n_points
         if lin.has_dilatation:
+            xi = self.bond_vectors_once()
             theta = lps_dilatation(
-                x, u, b.offsets, b.neighbours, b.length, lin.weight, b.intact, lin.theta_coef, np.empty(n)
+                xi, u, b.offsets, b.neighbours, b.length, lin.weight, b.intact, lin.theta_coef, np.empty(n)
             )
             p, axial = lin.p_coef * theta, lin.weight * b.length
         else:

@@ -177,7 +177,7 @@ class LPSModel(Model):
         VALIDATION.md V4 to all printed digits (40 000 points, 1.4143 h).
         """
         body, b = self.body, self.bonds
-        x = body.points
+        x, xi = body.points, self.bond_vectors_once()
         gamma = 1e-6
         planes = [(0, 1), (0, 2), (1, 2)] if self.dim == 3 else [(0, 1)]
         largest = np.zeros(body.n_points)
@@ -186,7 +186,15 @@ class LPSModel(Model):
             u[:, a] = gamma * x[:, c]
             u[:, c] = gamma * x[:, a]
             theta = lps_dilatation(
-                x, u, b.offsets, b.neighbours, b.length, w, b.intact, self.theta_coef, np.empty(body.n_points)
+                xi,
+                u,
+                b.offsets,
+                b.neighbours,
+                b.length,
+                w,
+                b.intact,
+                self.theta_coef,
+                np.empty(body.n_points),
             )
             norm = lps_deviatoric_energy(
                 x,
@@ -215,7 +223,15 @@ class LPSModel(Model):
                 self.x, u, offsets, b.neighbours, self.w, b.intact, self._theta_coef, theta
             )
         return lps_dilatation(
-            self.x, u, offsets, b.neighbours, self.length, self.w, b.intact, self._theta_coef, theta
+            self.bond_vectors,
+            u,
+            offsets,
+            b.neighbours,
+            self.length,
+            self.w,
+            b.intact,
+            self._theta_coef,
+            theta,
         )
 
     def _pair_force(self, u: np.ndarray, offsets, p: np.ndarray, out: np.ndarray) -> np.ndarray:
@@ -224,7 +240,7 @@ class LPSModel(Model):
         if self.dtype == np.float32:
             return lps_pair_force_cf(self.x, u, offsets, b.neighbours, self.w, self.dev, b.intact, p, out)
         return lps_pair_force(
-            self.x, u, offsets, b.neighbours, self.length, self.w, self.dev, b.intact, p, out
+            self.bond_vectors, u, offsets, b.neighbours, self.length, self.w, self.dev, b.intact, p, out
         )
 
     def dilatation(self, u) -> np.ndarray:
@@ -270,7 +286,7 @@ class LPSModel(Model):
         x64 = self.body.points
         w64 = self.w.astype(np.float64)
         theta = lps_dilatation(
-            x64,
+            self.bond_vectors_once(),
             u64,
             b.offsets,
             b.neighbours,

@@ -164,7 +164,14 @@ class PMBModel(Model):
         if self.dtype == np.float32:
             return pmb_force_cf(self.x, state, offsets, b.neighbours, self.bond_stiffness, b.intact, out)
         return pmb_force(
-            self.x, state, offsets, b.neighbours, self.inv_length, self.bond_stiffness, b.intact, out
+            self.bond_vectors,
+            state,
+            offsets,
+            b.neighbours,
+            self.inv_length,
+            self.bond_stiffness,
+            b.intact,
+            out,
         )
 
     def energy_density(self, u):
