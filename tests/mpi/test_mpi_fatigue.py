@@ -1,6 +1,8 @@
 """``mpiexec -n 2`` and ``-n 3 peridyn fatigue`` (issue 20 item 5) give the serial run's fatigue
 history: the same crack lengths and bonds broken at the same cycles, the same broken bonds at the
-end, in the same files.
+end, in the same files; and with the modal analyses before and after (the dog-bone, below:
+``test_mpi_fatigue_modal_analyses_give_the_serial_modes``) the serial modes to the LOBPCG's
+tolerance.
 
 Case: the 2D SEN specimen (cases/sen_fatigue_2d.yaml) at 1 mm (200 points), stopped at a 3.5 mm
 crack (260-460 steps, about 100 directed bonds broken by the cycles; pre-crack, no-damage sets,
