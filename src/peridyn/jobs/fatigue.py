@@ -32,7 +32,7 @@ from peridyn.fatigue.model import FatigueParameters, scale_A_II
 from peridyn.fatigue.run import FatigueResult, run_fatigue
 from peridyn.fatigue.specimen import compliance_energy, compliance_stress_intensity, straight_crack_cut
 from peridyn.fatigue.tip import AXES
-from peridyn.io.case import Case
+from peridyn.io.case import Case, FatigueModal
 from peridyn.io.outdir import json_job_status, prepare_output
 from peridyn.io.vtk import write_vtu
 from peridyn.jobs.build import build
@@ -216,12 +216,13 @@ def _run_fatigue(case, setup, out, modal, progress, start) -> dict:
 
 def _modal_modes(case: Case, modal: bool | None) -> int:
     """Number of modes of the analyses before and after the cycles: ``fatigue.modal_after.modes``
-    (12 with ``--modal`` alone), 0 for none (``modal`` False, or None without ``modal_after``)."""
+    (its default, 12, with ``--modal`` alone), 0 for none (``modal`` False, or None without
+    ``modal_after``)."""
     f = case.fatigue
     wanted = f.modal_after is not None if modal is None else modal
     if not wanted:
         return 0
-    return f.modal_after.modes if f.modal_after is not None else 12
+    return (f.modal_after or FatigueModal()).modes
 
 
 def _write_fatigue(case, setup, out, summary, result, before, after, start) -> dict:
