@@ -1,6 +1,8 @@
 """``mpiexec -n 2`` and ``-n 3 peridyn fatigue`` (issue 20 item 5) give the serial run's fatigue
 history: the same crack lengths and bonds broken at the same cycles, the same broken bonds at the
-end, in the same files.
+end, in the same files; and with the modal analyses before and after (the dog-bone, below:
+``test_mpi_fatigue_modal_analyses_give_the_serial_modes``) the serial modes to the LOBPCG's
+tolerance.
 
 Case: the 2D SEN specimen (cases/sen_fatigue_2d.yaml) at 1 mm (200 points), stopped at a 3.5 mm
 crack (260-460 steps, about 100 directed bonds broken by the cycles; pre-crack, no-damage sets,
@@ -57,9 +59,11 @@ CSV_RTOL = CYCLES_RTOL + 5e-6
 FILES = {"crack_length.csv", "damage.vtu", "fatigue.json", "status.json"}
 
 
-def _fatigue(out: Path, ranks: int, *extra: str):
-    argv = ["fatigue", str(CASE), "-o", str(out), "--json", "--no-progress"]
-    for s in [*SETS, *extra]:
+def _fatigue(out: Path, ranks: int, *extra: str, case: Path = CASE, sets=SETS, flags=()):
+    """``peridyn fatigue`` of ``case`` with the ``--set`` overrides ``sets`` and ``extra`` and the
+    command-line ``flags``, into ``out`` with ``--json``, on ``ranks`` processes."""
+    argv = ["fatigue", str(case), "-o", str(out), "--json", "--no-progress", *flags]
+    for s in [*sets, *extra]:
         argv += ["--set", s]
     return peridyn_process(argv, ranks)
 
@@ -153,12 +157,12 @@ def test_mpi_fatigue_gives_the_serial_crack_history(serial, case, ranks, tmp_pat
 @pytest.mark.parametrize(
     "extra, key",
     [
-        (["fatigue.modal_after={modes: 8}"], "fatigue.modal_after"),
         (["fatigue.solver=direct"], "fatigue.solver"),
+        (["fatigue.paris.k=compliance"], "fatigue.paris.k"),
     ],
 )
 def test_what_mpi_fatigue_cannot_do_is_refused_by_its_key(extra, key, tmp_path):
-    """The modal analyses and the serial solvers are not distributed: one error naming the key."""
+    """The serial solvers and the compliance K are not distributed: one error naming the key."""
     if shutil.which("mpiexec") is None:
         pytest.skip("mpiexec not installed")
     pytest.importorskip("mpi4py")
@@ -179,3 +183,81 @@ def test_fatigue_calibrate_is_refused_under_mpi_once(tmp_path):
     assert done.returncode == 1
     lines = [line for line in done.stderr.splitlines() if "error" in line]
     assert len(lines) == 1 and "does not run over MPI ranks" in lines[0], done.stderr
+
+
+#: The dog-bone (cases/dogbone_fatigue.yaml, V5: fatigue, then free-free modal analyses of the
+#: healthy and the damaged body, 12 modes) at 1 mm: 1 746 points, the shipped 870 000 cycles break
+#: 24 directed bonds at the notch root (no crack through the depth), which lower the elastic
+#: frequencies by 0.009 % to 4.3 %. About 8 s serial, 15 s on 2 ranks.
+DOGBONE = ROOT / "cases" / "dogbone_fatigue.yaml"
+DOGBONE_SETS = ["discretization.spacing=1e-3"]
+#: relative agreement of the elastic frequencies: the residual target of LOBPCG and the serial
+#: shift-invert (1e-7 relative) bounds the eigenvalue errors by its square (about 1e-14); 1e-6 is
+#: the serial-vs-MPI tolerance of ``peridyn modal`` (tests/mpi/test_mpi_solve.py)
+FREQUENCY_RTOL = 1e-6
+#: MAC of a mode before with a mode after: the shapes are within sin(theta) <= residual / relative
+#: eigenvalue gap of the exact ones, 1e-7 / 0.13 (the closest elastic pair here: 9 728 and 10 365
+#: Hz) ~ 1e-6 in each run, and a MAC moves by at most twice that per run: 4e-6, bounded by 1e-5
+MAC_ATOL = 1e-5
+
+
+@pytest.fixture(scope="module")
+def serial_modal(tmp_path_factory):
+    """The serial dog-bone run with its modal analyses: (summary, output folder)."""
+    if shutil.which("mpiexec") is None:
+        pytest.skip("mpiexec not installed (pip install 'peridyn[mpi]')")
+    pytest.importorskip("mpi4py")
+    out = tmp_path_factory.mktemp("serial") / "dogbone"
+    done = _fatigue(out, 1, case=DOGBONE, sets=DOGBONE_SETS)
+    assert done.returncode == 0, done.stderr
+    return json.loads(done.stdout), out
+
+
+def _elastic(rows: list[dict]) -> list[dict]:
+    return [r for r in rows if r["type"] != "rigid"]
+
+
+@pytest.mark.parametrize("ranks, asked_by", [(2, "case"), (3, "flag")])
+def test_mpi_fatigue_modal_analyses_give_the_serial_modes(serial_modal, ranks, asked_by, tmp_path):
+    """``mpiexec -n 2`` and ``-n 3 peridyn fatigue`` of the dog-bone with its modal analyses before
+    and after the cycles (``fatigue.modal_after``; on 3 ranks asked by ``--modal`` instead, 12 modes
+    either way) write the serial run's files, figure and summary keys; the same bonds break; the
+    elastic frequencies before and after equal the serial ones to ``FREQUENCY_RTOL`` with the same
+    mode types (rigid modes: the same number, their near-zero frequencies not compared); each mode
+    before is matched to the same mode after, with a MAC above 0.99 equal to the serial one to
+    ``MAC_ATOL``, and its frequency moves the same way as in serial, by the same amount to twice
+    ``FREQUENCY_RTOL`` (every serial change here is larger than that: the direction is decided)."""
+    want, folder = serial_modal
+    out = tmp_path / "run"
+    extra, flags = ([], []) if asked_by == "case" else (["fatigue.modal_after=null"], ["--modal"])
+    done = _fatigue(out, ranks, *extra, case=DOGBONE, sets=DOGBONE_SETS, flags=flags)
+    assert done.returncode == 0, done.stderr
+    got = json.loads(done.stdout)
+    files = FILES | {"crack_length.png", "modal.json"}  # figures on
+    assert {p.name for p in out.iterdir()} == {p.name for p in folder.iterdir()} == files
+    assert got.keys() == want.keys() and got["modal"].keys() == want["modal"].keys()
+    assert [Path(p).name for p in got["plots"]] == [Path(p).name for p in want["plots"]]
+    assert json.loads((out / "modal.json").read_text()) == got["modal"]
+    for key in ("points", "bonds", "broken_bonds", "fatigue_broken_bonds", "cycles"):
+        assert got[key] == want[key], key
+    assert want["fatigue_broken_bonds"] > 0  # the body after differs from the body before
+    for stage in ("before", "after"):
+        mine, theirs = got["modal"][stage], want["modal"][stage]
+        assert len(mine) == len(theirs) == 12
+        assert [(r["type"], r["order"]) for r in mine] == [(r["type"], r["order"]) for r in theirs]
+        np.testing.assert_allclose(
+            [r["frequency_hz"] for r in _elastic(mine)],
+            [r["frequency_hz"] for r in _elastic(theirs)],
+            rtol=FREQUENCY_RTOL,
+        )
+    pairs, serial_pairs = got["modal"]["matches"], want["modal"]["matches"]
+    assert [(p["before"], p["after"]) for p in pairs] == [(p["before"], p["after"]) for p in serial_pairs]
+    mac, serial_mac = (np.array([p["mac"] for p in m]) for m in (pairs, serial_pairs))
+    assert mac.min() > 0.99 and serial_mac.min() > 0.99
+    np.testing.assert_allclose(mac, serial_mac, rtol=0, atol=MAC_ATOL)
+    np.testing.assert_allclose(got["modal"]["mac"], want["modal"]["mac"], rtol=0, atol=MAC_ATOL)
+    change, serial_change = (np.array([p["frequency_change"] for p in m]) for m in (pairs, serial_pairs))
+    assert np.all(np.abs(serial_change) > 2 * FREQUENCY_RTOL)
+    np.testing.assert_array_equal(np.sign(change), np.sign(serial_change))
+    np.testing.assert_allclose(change, serial_change, rtol=0, atol=2 * FREQUENCY_RTOL)
+    assert json.loads((out / "status.json").read_text())["status"] == "complete"

@@ -1,6 +1,7 @@
 """The distributed equilibrium of the fatigue loop (``fatigue.distributed.RankStatics``) in one
 process, where the Domain is the serial stand-in: the same code runs on each MPI rank (the
-multi-rank runs are in tests/mpi/test_mpi_fatigue.py), and the refusals of an MPI fatigue run.
+multi-rank runs are in tests/mpi/test_mpi_fatigue.py), and what an MPI fatigue run refuses and
+accepts.
 
 Reference: the serial ``LinearStatics`` with the sparse factorisation (``method="direct"``), itself
 checked against an assembled solve (tests/unit/test_fatigue_statics.py). Tolerances are the
@@ -61,7 +62,6 @@ def test_rank_statics_refuses_a_load_free_case():
 @pytest.mark.parametrize(
     "override, key",
     [
-        ("fatigue.modal_after={modes: 8}", "fatigue.modal_after"),
         ("fatigue.solver=direct", "fatigue.solver"),
         ("fatigue.paris.k=compliance", "fatigue.paris.k"),
     ],
@@ -72,8 +72,8 @@ def test_what_an_mpi_fatigue_run_cannot_do_is_refused_by_its_key(override, key):
         check_parallel_fatigue(case)
 
 
-def test_the_modal_flag_is_refused_under_mpi_and_the_shipped_case_is_accepted():
-    case = load_case(SEN)
-    check_parallel_fatigue(case)  # eq. 7.12, solver auto, no modal analyses: runs over ranks
-    with pytest.raises(InputError, match="--modal"):
-        check_parallel_fatigue(case, modal=True)
+@pytest.mark.parametrize("overrides", [[], ["fatigue.modal_after={modes: 8}"]])
+def test_modal_analyses_and_the_shipped_case_are_accepted_under_mpi(overrides):
+    """The shipped case (eq. 7.12, solver auto) runs over ranks, and so do the modal analyses
+    before and after (distributed LOBPCG, tests/mpi/test_mpi_fatigue.py), which were refused."""
+    check_parallel_fatigue(load_case(SEN, overrides))

@@ -7,9 +7,11 @@ the cycles),
 and ``fatigue.json`` (the summary).
 
 Under ``mpiexec -n N`` (N > 1) each rank builds its part of the body and runs the fatigue loop on
-it (``fatigue.run``: the distributed CG for the equilibrium); rank 0 writes the same files as a
-serial run. The modal analyses and the compliance K of the Paris fit are not distributed: they
-are refused by their case keys (``check_parallel_fatigue``).
+it (``fatigue.run``: the distributed CG for the equilibrium); the modal analyses before and after
+run on the parts too (``jobs.modal.case_modes``: the distributed LOBPCG, after the cycles with the
+bonds each rank's loop broke); rank 0 writes the same files as a serial run. The compliance K of
+the Paris fit and the serial solvers are not distributed: they are refused by their case keys
+(``check_parallel_fatigue``).
 """
 
 from __future__ import annotations
@@ -23,18 +25,18 @@ from pathlib import Path
 import numpy as np
 
 from peridyn import interrupts
-from peridyn.errors import CaseFileError, InputError, did_you_mean
+from peridyn.errors import CaseFileError, did_you_mean
 from peridyn.fatigue.calibration import growth_rates, paris_fit, stress_intensity
 from peridyn.fatigue.mapping import CycleMapping
 from peridyn.fatigue.model import FatigueParameters, scale_A_II
 from peridyn.fatigue.run import FatigueResult, run_fatigue
 from peridyn.fatigue.specimen import compliance_energy, compliance_stress_intensity, straight_crack_cut
 from peridyn.fatigue.tip import AXES
-from peridyn.io.case import Case
+from peridyn.io.case import Case, FatigueModal
 from peridyn.io.outdir import json_job_status, prepare_output
 from peridyn.io.vtk import write_vtu
 from peridyn.jobs.build import build
-from peridyn.jobs.modal import match_modes, modal_table
+from peridyn.jobs.modal import case_modes, match_modes
 from peridyn.jobs.run import output_directory
 from peridyn.jobs.summary import finish_summary
 
@@ -58,19 +60,11 @@ def check_fatigue_case(case: Case) -> None:
             )
 
 
-def check_parallel_fatigue(case: Case, modal: bool | None = None) -> None:
-    """Refuse what an MPI fatigue run (mpiexec -n N, N > 1) cannot do: the modal analyses before
-    and after (``fatigue.modal_after`` or ``--modal``), the compliance K of the Paris fit
-    (``fatigue.paris.k: compliance``), and the serial linear solvers (``fatigue.solver``)."""
+def check_parallel_fatigue(case: Case) -> None:
+    """Refuse what an MPI fatigue run (mpiexec -n N, N > 1) cannot do: the compliance K of the
+    Paris fit (``fatigue.paris.k: compliance``) and the serial linear solvers (``fatigue.solver``).
+    The modal analyses (``fatigue.modal_after``, ``--modal``) run distributed."""
     f = case.fatigue
-    if modal or (modal is None and f.modal_after is not None):
-        if modal is None:
-            raise CaseFileError(
-                case.name, "fatigue.modal_after", "set", "no modal analyses in an MPI run (mpiexec -n N)"
-            )
-        raise InputError(
-            "--modal: an MPI fatigue run (mpiexec -n N) has no modal analyses; run without mpiexec"
-        )
     if f.paris is not None and f.paris.k == "compliance":
         raise CaseFileError(
             case.name, "fatigue.paris.k", f.paris.k, "eq. 7.12 (not compliance) in an MPI run"
@@ -169,7 +163,7 @@ def run_fatigue_case(
     start = time.perf_counter()
     check_fatigue_case(case)
     if comm is not None and comm.size > 1:
-        check_parallel_fatigue(case, modal)
+        check_parallel_fatigue(case)
     setup = build(case, base_dir, comm)
     d = setup.domain
     out = d.on_root(prepare_output, output_directory(case, output_dir), "fatigue.json", overwrite)
@@ -178,13 +172,10 @@ def run_fatigue_case(
 
 
 def _run_fatigue(case, setup, out, modal, progress, start) -> dict:
-    """The fatigue run of ``run_fatigue_case`` in its checked output folder."""
+    """The fatigue run of ``run_fatigue_case`` in its checked output folder (collective)."""
     f = case.fatigue
-    n_modes = f.modal_after.modes if f.modal_after is not None else 12
-    do_modal = f.modal_after is not None if modal is None else modal
-    before = setup_rows = None
-    if do_modal:
-        before, _, setup_rows = modal_table(setup.model, n_modes)
+    modes = _modal_modes(case, modal)
+    before = case_modes(setup, modes) if modes else None  # the healthy body
     k_curve = specimen_k(case, setup)
     mapping = CycleMapping(tuple((b.steps, b.tau) for b in f.mapping), f.adaptive)
     d = setup.domain
@@ -219,18 +210,27 @@ def _run_fatigue(case, setup, out, modal, progress, start) -> dict:
         "broken_bonds": d.count(int((~setup.bonds.intact[owned]).sum())),
         "fatigue_broken_bonds": int(result.broken[-1]),
     }
-    return d.on_root(_write_fatigue, case, setup, out, summary, result, do_modal, before, setup_rows, start)
+    after = case_modes(setup, modes) if modes else None  # the damaged body: bonds broken now
+    return d.on_root(_write_fatigue, case, setup, out, summary, result, before, after, start)
 
 
-def _write_fatigue(case, setup, out, summary, result, do_modal, before, setup_rows, start) -> dict:
-    """The modal analysis after (one process), the files of the run and its summary (rank 0)."""
+def _modal_modes(case: Case, modal: bool | None) -> int:
+    """Number of modes of the analyses before and after the cycles: ``fatigue.modal_after.modes``
+    (its default, 12, with ``--modal`` alone), 0 for none (``modal`` False, or None without
+    ``modal_after``)."""
     f = case.fatigue
-    n_modes = f.modal_after.modes if f.modal_after is not None else 12
-    if do_modal:
-        after, _, after_rows = modal_table(setup.model, n_modes)
-        masses = setup.model.density * setup.body.volumes
-        mac, pairs = match_modes(before, after, masses)
-        summary["modal"] = {"before": setup_rows, "after": after_rows, "mac": mac.tolist(), "matches": pairs}
+    wanted = f.modal_after is not None if modal is None else modal
+    if not wanted:
+        return 0
+    return (f.modal_after or FatigueModal()).modes
+
+
+def _write_fatigue(case, setup, out, summary, result, before, after, start) -> dict:
+    """The files of the run and its summary (rank 0), with ``modal.json`` from the ModeTables
+    ``before`` and ``after`` the cycles when they are given."""
+    if before is not None:
+        mac, pairs = match_modes(before.result, after.result, before.masses)
+        summary["modal"] = {"before": before.rows, "after": after.rows, "mac": mac.tolist(), "matches": pairs}
         (out / "modal.json").write_text(json.dumps(summary["modal"], indent=1))
     _write_history(out / "crack_length.csv", result)
     body = setup.whole_body

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import csv
 import json
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -19,7 +20,7 @@ from peridyn.io.hdf5 import HDF5Writer
 from peridyn.io.provenance import provenance
 from peridyn.io.vtk import write_vtu
 from peridyn.linalg.ordering import estimated_factor_entries
-from peridyn.solvers.modal import modal_analysis
+from peridyn.solvers.modal import ModalResult, modal_analysis
 
 #: Share of the machine's memory the factorisation may take.
 MEMORY_SHARE = 0.7
@@ -28,40 +29,74 @@ MEMORY_SHARE = 0.7
 FACTOR_BUDGET = 2**30
 
 
-def run_modal(case, setup, out: Path, case_path=None) -> tuple[dict, list[Path]]:
-    """Modal analysis of a built case; returns the summary's own keys (docs/user-guide.md,
-    "Summaries and results files") and the figures drawn. Under MPI (``setup.domain`` of
-    several ranks) the modes are found by the distributed LOBPCG (``solvers.distributed_eigen``)
-    and rank 0 writes the same files as a serial run (collective)."""
-    fixed = setup.loading.constrained if setup.loading.has_loads else None
+@dataclass(frozen=True)
+class ModeTable:
+    """Modes of a built case's whole body, classified (``case_modes``).
+
+    Attributes
+    ----------
+    result : ModalResult
+        Frequencies (n_modes,) Hz and mode shapes (n_modes, n_points, 3) of the whole body.
+    types : list of ``analysis.modes.ModeType``, one per mode
+    rows : list of dict
+        The JSON/CSV rows of ``mode_rows`` (index, frequency_hz, type, order, label, residual).
+    masses : (n_points,) float64, kg
+        Lumped mass rho V of each point of the whole body (the MAC's weights).
+    stats : dict
+        The distributed solver's ``iterations`` (LOBPCG) under MPI; empty in one process.
+    """
+
+    result: ModalResult
+    types: list
+    rows: list[dict]
+    masses: np.ndarray
+    stats: dict
+
+
+def case_modes(setup, n_modes: int, fixed=None, eigensolver: str = "auto") -> ModeTable | None:
+    """The ``n_modes`` lowest modes of a built case's model with the bonds intact now
+    (collective under MPI).
+
+    In one process ``modal_table`` (eigensolver by ``choose_eigensolver``). Over several ranks
+    (``setup.domain``) the distributed LOBPCG on each rank's part (``solvers.distributed_eigen``:
+    its owned free rows of K, ghosts by the halo exchange; ``eigensolver`` is then not used),
+    the modes classified on rank 0 over the whole body. ``fixed``: (n_local, 3) bool, dofs held
+    at zero, or None (free). Returns the table on rank 0, None on the other ranks.
+    """
     d = setup.domain
+    masses = d.gather(setup.model.density * setup.model.body.volumes)
     if d.size == 1:
-        result, types, modes = modal_table(
-            setup.model, case.solver.modes, fixed=fixed, eigensolver=case.solver.eigensolver
-        )
-        return _write_modal(case, setup.body, setup.bonds.n_bonds, result, types, modes, out, case_path)
+        result, types, rows = modal_table(setup.model, n_modes, fixed=fixed, eigensolver=eigensolver)
+        return ModeTable(result, types, rows, masses, {})
     from peridyn.linalg.distributed import RankDofs
     from peridyn.solvers.distributed_eigen import distributed_modes
 
-    result, stats = distributed_modes(RankDofs(setup.model, d, fixed), case.solver.modes)
-    masses = d.gather(setup.model.density * setup.model.body.volumes)
+    result, stats = distributed_modes(RankDofs(setup.model, d, fixed), n_modes)
+    classified = d.on_root(mode_rows, setup.whole_body, masses, result)
+    if not d.is_root:
+        return None
+    return ModeTable(result, *classified, masses, {"iterations": stats["iterations"]})
+
+
+def run_modal(case, setup, out: Path, case_path=None) -> tuple[dict, list[Path]]:
+    """Modal analysis of a built case; returns the summary's own keys (docs/user-guide.md,
+    "Summaries and results files") and the figures drawn. Under MPI (``setup.domain`` of
+    several ranks) the modes are found by the distributed LOBPCG (``case_modes``) and rank 0
+    writes the same files as a serial run, the summary adding the LOBPCG's ``iterations``
+    (collective)."""
+    fixed = setup.loading.constrained if setup.loading.has_loads else None
+    d = setup.domain
+    table = case_modes(setup, case.solver.modes, fixed, case.solver.eigensolver)
     n_bonds = d.count(setup.bonds.offsets[d.n_owned])  # the owned points' families come first
-    written = d.on_root(_write_classified, case, setup.whole_body, masses, n_bonds, result, out, case_path)
+    written = d.on_root(_write_modal, case, setup.whole_body, n_bonds, table, out, case_path)
     summary, plots = written if d.is_root else (None, [])
-    summary = d.comm.bcast(summary)
-    summary["iterations"] = stats["iterations"]
-    return summary, plots
+    return d.comm.bcast({**summary, **table.stats} if d.is_root else None), plots
 
 
-def _write_classified(case, body, masses, n_bonds, result, out, case_path):
-    """``_write_modal`` of a ModalResult of the whole ``body`` (rank 0), classified first."""
-    types, modes = mode_rows(body, masses, result)
-    return _write_modal(case, body, n_bonds, result, types, modes, out, case_path)
-
-
-def _write_modal(case, body, n_bonds, result, types, modes, out, case_path) -> tuple[dict, list[Path]]:
-    """Write the tables, results.h5, the mode-shape VTUs and figure of the modes ``result`` of
+def _write_modal(case, body, n_bonds, table: ModeTable, out, case_path) -> tuple[dict, list[Path]]:
+    """Write the tables, results.h5, the mode-shape VTUs and figure of the modes ``table`` of
     ``body``; the summary's own keys and the figures."""
+    result, types, modes = table.result, table.types, table.rows
     _write_tables(out, modes)
     with HDF5Writer(
         out / "results.h5", body.points[:, : body.dim], body.volumes, provenance(case_path, case=case)
