@@ -126,13 +126,11 @@ def test_distributed_equilibrium_meets_the_serial_criterion(material):
     [
         ("bar_tension_static.yaml", ["solver.type=newton"], "newton run"),
         ("pmma_plate.yaml", ["solver.eigensolver=shift-invert"], "solver.eigensolver"),
-        ("plate2d_stretch.yaml", ["solver.type=static"], "neither bond breaking nor contact"),
     ],
 )
 def test_what_an_mpi_run_cannot_do_is_refused_before_the_build(case_file, overrides, refused):
-    """Newton runs, shift-invert (a factor of the whole body) and static runs with bond breaking
-    are refused under MPI with one clear error (jobs.run._check_parallel), before anything is
-    built or written."""
+    """Newton runs and shift-invert (a factor of the whole body) are refused under MPI with one
+    clear error (jobs.run._check_parallel), before anything is built or written."""
     from peridyn.errors import PeridynError
     from peridyn.io.case import load_case
     from peridyn.jobs.run import _check_parallel
