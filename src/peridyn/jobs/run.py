@@ -636,14 +636,10 @@ def _run_static(case, setup, out, case_path) -> dict:
                 f"iterations (residual {result.residual:.3g} > {s.tolerance:g}): raise "
                 "solver.max_iterations or solver.load_steps"
             )
-    return _record_equilibrium(
-        case,
-        setup,
-        out,
-        case_path,
-        u,
-        {"steps": s.load_steps, "iterations": iterations, "residual": result.residual},
-    )
+    results = {"steps": s.load_steps, "iterations": iterations, "residual": result.residual}
+    if setup.contact is not None:
+        results["contact_rebuilds"] = setup.contact.rebuilds
+    return _record_equilibrium(case, setup, out, case_path, u, results)
 
 
 def _static_solver(setup: Setup):
