@@ -22,13 +22,14 @@ rank 0 over the gathered values in global point order: the serial iterates bit f
 
 from __future__ import annotations
 
+from contextlib import contextmanager
 from dataclasses import dataclass
 
 import numpy as np
 
 from peridyn import interrupts
-from peridyn.errors import InputError
-from peridyn.parallel.domain import Domain
+from peridyn.errors import InputError, Interrupted
+from peridyn.parallel.domain import Domain, failed_alone
 from peridyn.physics.contact import Contact
 from peridyn.physics.damage import BondDamage
 from peridyn.physics.loads import Loading
@@ -93,7 +94,16 @@ def relax(
     if not tolerance > 0:
         raise InputError(f"relaxation tolerance must be positive, got {tolerance!r}")
     d = domain if domain is not None else Domain.serial(model.body.n_points)
-    agree = d.max if d.size > 1 else None
+    with _one_rank_errors(d):
+        u, free, lam, b = _start(model, loading, time, u0, contact, d)
+        return _iterate(model, u, free, lam, b, tolerance, max_iterations, damage, check_every, contact, d)
+
+
+def _start(model: Model, loading: Loading, time: float, u0, contact: Contact | None, d: Domain):
+    """The relaxation's start at load time ``time`` (s): u (n_local, 3) m with the initial and
+    prescribed displacements and its ghost rows exchanged, and of the owned rows the free DOFs
+    (n_owned, 3) bool, the fictitious density lambda (n_owned, 3) and the body force b
+    (n_owned, 3) N/m^3."""
     n = model.body.n_points
     u = np.zeros((n, 3)) if u0 is None else np.array(u0, dtype=float)
     v = np.zeros((n, 3))
@@ -108,24 +118,27 @@ def relax(
     if contact is not None:
         bound = bound + contact.stiffness_bound()
     lam = np.repeat((0.25 * bound[own])[:, None], 3, axis=1)
+    b = loading.body_force_density(time, np.zeros((n, 3)))[own]
+    return u, free, lam, b
+
+
+def _iterate(model, u, free, lam, b, tolerance, max_iterations, damage, check_every, contact, d: Domain):
+    """The iterations of ``relax`` from ``_start``'s arrays (module docstring); u updated in place."""
+    own = d.owned
+    agree = d.max if d.size > 1 else None
 
     def internal_force(u):
         f = np.asarray(model.force(u), dtype=float)
         return (contact.add_force(u, f) if contact is not None else f)[own]
 
-    b = loading.body_force_density(time, np.zeros((n, 3)))[own]
     intact_before = _owned_intact(model, d)
     f = internal_force(u)
+    v = np.zeros_like(u[own])  # m per iteration (of the fictitious unit step)
     c = 0.0
-    residual = np.inf
     for it in range(1, max_iterations + 1):
         interrupts.check(where="relaxing to equilibrium", agree=agree)
-        r = (f + b) * free
-        a = r / lam
-        if it == 1:
-            v = 0.5 * a
-        else:
-            v = ((2.0 - c) * v + 2.0 * a) / (2.0 + c)
+        a = (f + b) * free / lam
+        v = 0.5 * a if it == 1 else ((2.0 - c) * v + 2.0 * a) / (2.0 + c)
         v *= free
         u[own] += v
         d.exchange(u)
@@ -136,17 +149,35 @@ def relax(
         if it % check_every == 0:
             residual = d.reduce(_relative_residual, f, b, free)
             if not np.isfinite(residual):
-                raise InputError("relaxation diverged (non-finite forces)")
+                error = InputError("relaxation diverged (non-finite forces)")
+                error.every_rank = True  # the residual is every rank's
+                raise error
             if residual < tolerance:
                 return RelaxationResult(u, residual, it, True, _broken(model, d, intact_before))
     residual = d.reduce(_relative_residual, f, b, free)
     return RelaxationResult(u, residual, max_iterations, False, _broken(model, d, intact_before))
 
 
+@contextmanager
+def _one_rank_errors(d: Domain):
+    """Under MPI, mark an error raised on this rank alone with ``failed_rank``
+    (``parallel.domain.failed_alone``), for the CLI to end every rank: the others wait in a
+    collective it will never join. An interruption is every rank's (``interrupts.check`` agrees)."""
+    try:
+        yield
+    except Interrupted:
+        raise
+    except Exception as exc:
+        if d.size > 1:
+            failed_alone(exc, d.comm)
+        raise
+
+
 def _damping(u, v, f, f_prev, lam, domain: Domain) -> float:
     """The damping c = 2 sqrt(u^T K_loc u / u^T u) of the next iteration, at most 1.9, with
     K_loc,ii = -(f_i - f_prev_i) / (lam_i v_i) on the moving DOFs (module docstring); all
-    arrays (n_owned, 3): u m, v m per iteration, f and f_prev N/m^3, lam N/m^3 per m. The two
+    arrays (n_owned, 3): u m, v m per (unit) step, f and f_prev N/m^3, lam the fictitious
+    density (a quarter of the stiffness bound, N/m^4, for the unit step). The two
     sums are over the whole body in global order (``Domain.reduce``: the serial rounding)."""
     moving = np.abs(v) > 0
     k_loc = np.zeros_like(u)
