@@ -26,13 +26,19 @@ Run with ``PYTHONPATH=src python -m pytest -m mpi -q -p no:cacheprovider tests/m
 """
 
 import json
+import os
 import shutil
+import subprocess
+import sys
+import textwrap
 from pathlib import Path
 
 import h5py
 import numpy as np
 import pytest
 from conftest import peridyn_process
+
+import peridyn
 
 pytestmark = pytest.mark.mpi
 
@@ -128,3 +134,44 @@ def test_mpi_static_relaxation_is_the_serial_run(case, ranks, serial, tmp_path):
     assert sorted(got) == sorted(want)
     for name, values in want.items():
         np.testing.assert_array_equal(got[name], values, err_msg=name)
+
+
+#: ``python -c`` wrapper of ``peridyn`` that raises a MemoryError on one rank (argv[1]) at its
+#: relaxation's bond test number argv[2] (an error no other rank knows of, as from a kernel), then
+#: runs ``peridyn`` with the other arguments.
+HOOK = textwrap.dedent(
+    """
+    import sys
+    from peridyn.cli import main
+    from peridyn.parallel.comm import world
+    from peridyn.physics.damage import BondDamage
+
+    rank, at = int(sys.argv[1]), int(sys.argv[2])
+    original, calls = BondDamage.update, []
+
+    def update(self, u):
+        calls.append(1)
+        if world().rank == rank and len(calls) == at:
+            raise MemoryError("injected on one rank")
+        return original(self, u)
+
+    BondDamage.update = update
+    sys.exit(main(sys.argv[3:]))
+    """
+)
+
+
+@pytest.mark.parametrize("rank", [0, 1])
+def test_an_error_on_one_rank_inside_the_relaxation_ends_every_rank_with_one_line(serial, rank, tmp_path):
+    """An error that one rank alone raises in an iteration (the others wait for its halo messages
+    or its part of the damping's gather) ends the run at once, not a hang: the failing rank prints
+    the one error line and MPI_Abort ends the others (status 1), as in an explicit run."""
+    argv = ["run", str(CASE), "-o", str(tmp_path / "run"), "--no-progress"]
+    for s in [*BASE, *CASES["notched"]]:
+        argv += ["--set", s]
+    command = ["mpiexec", "-n", "2", sys.executable, "-c", HOOK, str(rank), "50", *argv]
+    env = dict(os.environ, PYTHONPATH=str(Path(peridyn.__file__).parents[1]), NUMBA_NUM_THREADS="1")
+    done = subprocess.run(command, capture_output=True, text=True, env=env, timeout=120)
+    assert done.returncode == 1, done.stderr
+    lines = [line for line in done.stderr.splitlines() if "error:" in line]
+    assert len(lines) == 1 and "out of memory (injected on one rank)" in lines[0], done.stderr
