@@ -126,13 +126,11 @@ def test_distributed_equilibrium_meets_the_serial_criterion(material):
     [
         ("bar_tension_static.yaml", ["solver.type=newton"], "newton run"),
         ("pmma_plate.yaml", ["solver.eigensolver=shift-invert"], "solver.eigensolver"),
-        ("plate2d_stretch.yaml", ["solver.type=static"], "neither bond breaking nor contact"),
     ],
 )
 def test_what_an_mpi_run_cannot_do_is_refused_before_the_build(case_file, overrides, refused):
-    """Newton runs, shift-invert (a factor of the whole body) and static runs with bond breaking
-    are refused under MPI with one clear error (jobs.run._check_parallel), before anything is
-    built or written."""
+    """Newton runs and shift-invert (a factor of the whole body) are refused under MPI with one
+    clear error (jobs.run._check_parallel), before anything is built or written."""
     from peridyn.errors import PeridynError
     from peridyn.io.case import load_case
     from peridyn.jobs.run import _check_parallel
@@ -140,3 +138,52 @@ def test_what_an_mpi_run_cannot_do_is_refused_before_the_build(case_file, overri
     case = load_case(Path(__file__).resolve().parents[2] / "cases" / case_file, overrides)
     with pytest.raises(PeridynError, match=refused):
         _check_parallel(case)
+
+
+@pytest.mark.parametrize(
+    ("case_file", "overrides"),
+    [
+        ("plate2d_stretch.yaml", ["solver.type=static"]),
+        ("plate2d_cyclic.yaml", ["solver.type=static"]),
+    ],
+)
+def test_static_mpi_runs_with_damage_or_contact_are_accepted(case_file, overrides):
+    """Static runs with bond breaking (plate2d_stretch) and with contact as well
+    (plate2d_cyclic) run under MPI by dynamic relaxation on each rank's part: not refused."""
+    from peridyn.io.case import load_case
+    from peridyn.jobs.run import _check_parallel
+
+    case = load_case(Path(__file__).resolve().parents[2] / "cases" / case_file, overrides)
+    assert case.material.damage is not None
+    _check_parallel(case)
+
+
+def test_relax_with_damage_leaves_every_intact_bond_within_its_critical_stretch():
+    """Dynamic relaxation with bond breaking (solvers.static.relax, the code every MPI rank runs)
+    on the clamped bar of cases/bar_tension_static.yaml at 2 mm with a pre-crack to mid-height at
+    mid-length and a critical stretch of 8.5e-5 (below the elastic solution's 9.1e-5 at the crack
+    tip): it converges with bonds broken beyond the pre-crack's, every intact bond's deformed
+    length at the end within its critical length |xi| (1 + s_c) (bonds are tested at every
+    iterate), both copies of every broken bond broken, and ``broken_bonds`` the bonds it broke."""
+    from peridyn.io.case import load_case
+    from peridyn.jobs.build import build
+    from peridyn.solvers.static import relax
+
+    root = Path(__file__).resolve().parents[2] / "cases"
+    precrack = (
+        "precracks=[{type: rectangle, origin: [0.02, -0.001, -0.001], edge_u: [0, 0.006, 0], "
+        "edge_v: [0, 0, 0.012]}]"
+    )
+    overrides = ["discretization.spacing=2e-3", precrack, "material.damage.critical_stretch=8.5e-5"]
+    setup = build(load_case(root / "bar_tension_static.yaml", overrides), root)
+    bonds = setup.bonds
+    cut = int((~bonds.intact).sum())
+    model, loading, damage = setup.model, setup.loading, setup.damage
+    result = relax(model, loading, 1.0, tolerance=1e-7, max_iterations=20_000, damage=damage)
+    assert result.converged
+    assert result.broken_bonds == int((~bonds.intact).sum()) - cut > 0
+    assert np.array_equal(bonds.intact, bonds.intact[bonds.reverse()])
+    x, u, i, j = setup.body.points, result.u, bonds.owners(), bonds.neighbours
+    length = np.linalg.norm(x[j] - x[i], axis=1)
+    deformed = np.linalg.norm(x[j] + u[j] - x[i] - u[i], axis=1)
+    assert np.all(deformed[bonds.intact] <= length[bonds.intact] * (1 + 8.5e-5) * (1 + 1e-12))

@@ -129,6 +129,7 @@ def test_serial_domain_reduces_like_numpy():
     d = Domain.serial(1001)
     assert d.gather(a) is a
     assert d.sum(a) == np.sum(a) and d.dot(a, b) == np.dot(a, b)
+    assert d.reduce(lambda x, y: (np.sum(x), np.linalg.norm(y)), a, b) == (np.sum(a), np.linalg.norm(b))
     assert d.max(2.5) == 2.5 and d.count(7) == 7
     points = rng.normal(size=(1001, 3))
     assert d.runaway_limit(points) == runaway_limit(points)

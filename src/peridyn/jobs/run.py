@@ -4,6 +4,7 @@ runs are ``jobs.modal``), recording, checkpoints, crack history and the stored s
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import json
 import shutil
@@ -126,8 +127,10 @@ def run_case(
         ``peridyn.parallel.comm.world()`` under ``mpiexec -n N`` (N > 1): each rank runs its
         part of the body (``peridyn.parallel``), rank 0 writes the one results.h5 with every
         record equal to a serial run's, and every rank returns the summary. An explicit run,
-        for now; checkpoints hold the whole body, so a run may restart on another number of
-        ranks. None: one process.
+        or a static run with bond breaking or contact (dynamic relaxation on each rank's part),
+        bit for bit; a static run without them (modified Newton with CG) and a modal run, to the
+        solver tolerance. Checkpoints hold the whole body, so a run may restart on another
+        number of ranks. None: one process.
 
     Raises
     ------
@@ -185,8 +188,6 @@ def _check_parallel(case: Case) -> None:
             "an MPI run (mpiexec -n N) is an explicit, static or modal run for now, not a "
             f"{case.solver.type} run"
         )
-    if case.solver.type == "static" and (case.material.damage is not None or case.contact is not None):
-        raise InputError("a static MPI run (mpiexec -n N) has neither bond breaking nor contact for now")
     if case.solver.type == "modal" and case.solver.eigensolver == "shift-invert":
         raise CaseFileError(case.name, "solver.eigensolver", "shift-invert", "lobpcg or auto in an MPI run")
 
@@ -616,7 +617,7 @@ def _run_static(case, setup, out, case_path) -> dict:
     s = case.solver
     u = None
     iterations = 0
-    solve = relax if setup.domain.size == 1 else _distributed_static(setup)
+    solve = _static_solver(setup)
     for k in range(1, s.load_steps + 1):
         result = solve(
             setup.model,
@@ -635,20 +636,28 @@ def _run_static(case, setup, out, case_path) -> dict:
                 f"iterations (residual {result.residual:.3g} > {s.tolerance:g}): raise "
                 "solver.max_iterations or solver.load_steps"
             )
-    return _record_equilibrium(
-        case,
-        setup,
-        out,
-        case_path,
-        u,
-        {"steps": s.load_steps, "iterations": iterations, "residual": result.residual},
-    )
+    results = {"steps": s.load_steps, "iterations": iterations, "residual": result.residual}
+    if setup.contact is not None:
+        results["contact_rebuilds"] = setup.contact.rebuilds
+    return _record_equilibrium(case, setup, out, case_path, u, results)
+
+
+def _static_solver(setup: Setup):
+    """The solve of each load step of a static run, called as ``relax``: ``relax`` itself in one
+    process; under MPI ``relax`` on the rank's part (the serial iterates bit for bit) when bonds
+    break or contact acts, else modified Newton with CG (``_distributed_static``)."""
+    d = setup.domain
+    if d.size == 1:
+        return relax
+    if setup.damage is not None or setup.contact is not None:
+        return functools.partial(relax, domain=d)
+    return _distributed_static(setup)
 
 
 def _distributed_static(setup: Setup):
-    """``relax``'s stand-in under MPI: modified Newton with CG (``solvers.distributed_static``) on
-    the rank's dofs, its preconditioner built once for every load step (no damage, no contact:
-    ``_check_parallel``)."""
+    """``relax``'s stand-in under MPI for a linear-elastic body (no damage, no contact): modified
+    Newton with CG (``solvers.distributed_static``) on the rank's dofs, its preconditioner built
+    once for every load step."""
     from peridyn.linalg.distributed import RankDofs, rank_preconditioner
     from peridyn.solvers.distributed_static import distributed_equilibrium
 

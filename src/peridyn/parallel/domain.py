@@ -154,14 +154,22 @@ class Domain:
                 whole[ids] = part
         return out
 
+    def reduce(self, fn, *arrays: np.ndarray):
+        """``fn(*arrays)`` over the whole body, on every rank: the owned rows of the per-point
+        ``arrays`` gathered in global point order (one ``gather_many``), ``fn`` called on rank 0
+        and its result broadcast, so that whatever ``fn`` rounds (sums, norms) rounds as in serial.
+        In one process ``fn(*arrays)`` itself."""
+        whole = self.gather_many(*arrays)
+        return self.comm.bcast(fn(*whole) if self.is_root else None)
+
     def sum(self, a: np.ndarray) -> float:
         """``np.sum`` of the per-point values ``a`` (owned rows) over the whole body, in global
         order (the serial rounding), on every rank."""
-        return self._on_root_value(np.sum, self.gather(a))
+        return self.reduce(np.sum, a)
 
     def dot(self, a: np.ndarray, b: np.ndarray) -> float:
         """``np.dot`` of two per-point arrays over the whole body, as in serial, on every rank."""
-        return self._on_root_value(np.dot, self.gather(a), self.gather(b))
+        return self.reduce(np.dot, a, b)
 
     def allsum(self, value):
         """The sum of every rank's ``value`` (a number or an array, element by element) by one
@@ -169,10 +177,6 @@ class Domain:
         dot products of Krylov solvers (``peridyn.linalg.distributed``), whose answers must
         equal a serial run's to the solver tolerance only, at the cost of one message round."""
         return self.comm.allreduce(value, "sum")
-
-    def _on_root_value(self, fn, *args):
-        value = fn(*args) if self.is_root else None
-        return self.comm.bcast(value)
 
     def runaway_limit(self, points: np.ndarray) -> float:
         """``runaway_limit`` of the whole body from the local ``points`` (n_local, 3), m."""
