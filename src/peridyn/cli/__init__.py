@@ -15,6 +15,7 @@ import importlib
 import json
 import os
 import sys
+import time
 
 from peridyn.cli.errors import ArgumentParser, report, writing
 from peridyn.cli.logs import plain_warnings
@@ -115,6 +116,9 @@ def _dispatch(parser: ArgumentParser, args) -> int:
     return 0
 
 
+#: Seconds a rank waits between printing its own error and ``MPI_Abort`` (``_abort_every_rank``).
+ABORT_GRACE_SECONDS = 1.0
+
 #: The commands that run over MPI ranks (``mpiexec -n N peridyn ...``, N > 1).
 MPI_COMMANDS = ("run", "modal", "fatigue")
 
@@ -154,6 +158,9 @@ def _abort_every_rank(status: int) -> None:
 
     sys.stdout.flush()
     sys.stderr.flush()
+    # mpiexec forwards a rank's output through a pipe to its proxy, which MPI_Abort may tear
+    # down before it has passed the error line on (seen once in 50 MPI tests at load 6)
+    time.sleep(ABORT_GRACE_SECONDS)
     world().abort(status)
 
 
