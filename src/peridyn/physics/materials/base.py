@@ -60,8 +60,6 @@ class Model:
     density : (n_points,) float64, kg/m^3
     bond_volume : (n_bonds,) float64, m^3
         Neighbour volume times the bond's partial-volume factor.
-    bond_vectors : (n_bonds, 3) float64, m
-        Reference bond vectors ``xi = x_j - x_i`` (see the property).
     """
 
     name = "model"
