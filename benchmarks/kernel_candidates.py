@@ -4,14 +4,15 @@ Reference ("before"): the float64 kernels as they were before the two-loop chunk
 loop per family (``tests/kernels/single_loop_kernels.py``). Candidates: today's kernels
 (``peridyn.kernels``, chunked, reading the stored bond vectors) and variants of the single
 loop written the same way (family slices, unsigned neighbour index, select on ``intact``,
-``bond_differences``). The fused LPS candidates (the dilatation and pair-force passes in
-one, row block by row block, see :func:`lps_force_fused`) are measured against today's two
-passes instead. For each: the reference's time over the candidate's (best of ``--rounds``
-interleaved calls on the same inputs, any per-call layout conversion included; wall clock
-and process CPU time, the latter less sensitive to other jobs on a shared machine), the
-median of the rounds' ratios (steadier than the best when the load moves during a run), and
-the largest force difference relative to the largest force (0 = the same bits). Results in
-RESULTS.md.
+``bond_differences``). The fused LPS forms (the dilatation and pair-force passes in one, row
+block by row block: today's ``kernels.lps.lps_force_fused`` and the candidates
+:func:`lps_force_fused_no_ring`, :func:`lps_force_block_prange`) are measured against the two
+passes ``lps_dilatation`` + ``lps_pair_force`` instead. For each: the reference's time over
+the candidate's (best of ``--rounds`` interleaved calls on the same inputs, any per-call
+layout conversion included; wall clock and process CPU time, the latter less sensitive to
+other jobs on a shared machine), the median of the rounds' ratios (steadier than the best
+when the load moves during a run), and the largest force difference relative to the
+largest force (0 = the same bits). Results in RESULTS.md.
 
     PYTHONPATH=src python benchmarks/kernel_candidates.py --side 49 --rounds 15
     PYTHONPATH=src python benchmarks/kernel_candidates.py --case cases/lamb_plate.yaml --rounds 40
@@ -30,16 +31,17 @@ from pathlib import Path
 import numba
 import numpy as np
 
+from peridyn.discretization.bonds import fused_plan, fused_ring_columns
 from peridyn.jobs.bench import DEFAULT_POINTS_PER_SIDE, SPACING, benchmark_grid
-from peridyn.kernels import (
-    CHUNK,
-    CHUNK_BUFFER,
-    FASTMATH,
-    bond_differences,
-    deformed_component,
-    stack_array,
+from peridyn.kernels import FASTMATH, bond_differences
+from peridyn.kernels.lps import (
+    lps_dilatation,
+    lps_dilatation_rows,
+    lps_dilatation_sum,
+    lps_force_fused,
+    lps_pair_force,
+    lps_pair_force_row,
 )
-from peridyn.kernels.lps import lps_dilatation, lps_pair_force
 from peridyn.kernels.pmb import pmb_force
 from peridyn.physics.materials import make_model
 from peridyn.physics.materials.lps import LPSModel
@@ -227,109 +229,19 @@ def lps_pair_force_given_r(x, u, offsets, nbr, length, w, dev, intact, p, r_in, 
 
 
 # --- LPS dilatation and pair force fused (issue 22 item 1) -----------------------------------
-# Row functions: the bodies of ``kernels.lps.lps_dilatation`` and ``lps_pair_force`` for one
-# point (inlined in numba's IR, so they are compiled inside the calling kernel with its flags:
-# as separate functions the pair force did not vectorise). The fused kernels call them on
-# rows in an order that respects the dependence (a row's pair force reads the dilatation of
-# each of its neighbours), so every row gets the same arithmetic as in the two passes.
-
-
-@numba.njit(fastmath=FASTMATH, cache=True, inline="always")
-def lps_dilatation_sum(i, xif, uf, offsets, nbr, length, w, intact):
-    """sum_j w_ij |xi| e_ij over the family of point ``i`` (m^5): ``lps_dilatation``'s row.
-
-    ``xif`` (3 n_bonds,) and ``uf`` (3 n,) are the flat bond vectors and displacements (m).
-    """
-    zero = uf.dtype.type(0.0)
-    ui0, ui1, ui2 = uf[3 * i], uf[3 * i + 1], uf[3 * i + 2]
-    buf = stack_array(CHUNK_BUFFER, uf.dtype)
-    hi = offsets[i + 1]
-    acc = zero
-    for c in range(offsets[i], hi, CHUNK):
-        m = min(CHUNK, hi - c)
-        fam = nbr[c : c + m]
-        xib = xif[3 * c : 3 * (c + m)]
-        lb = length[c : c + m]
-        wb = w[c : c + m]
-        ok = intact[c : c + m]
-        for q in range(m):
-            j = 3 * np.uint64(np.uint32(fam[q]))
-            y0 = deformed_component(xib[3 * q], uf[j], ui0)
-            y1 = deformed_component(xib[3 * q + 1], uf[j + 1], ui1)
-            y2 = deformed_component(xib[3 * q + 2], uf[j + 2], ui2)
-            r = np.sqrt(y0 * y0 + y1 * y1 + y2 * y2)
-            t = wb[q] * lb[q] * (r - lb[q])
-            buf[q] = t if ok[q] else zero
-        for q in range(m):
-            acc += buf[q]
-    return acc
-
-
-@numba.njit(fastmath=FASTMATH, cache=True, inline="always")
-def lps_pair_force_row(i, xif, uf, offsets, nbr, length, w, dev, intact, p, f):
-    """``f[i]`` (OUT, N/m^3) from the per-point ``p`` (n,): ``lps_pair_force``'s row."""
-    zero = f.dtype.type(0.0)
-    ui0, ui1, ui2 = uf[3 * i], uf[3 * i + 1], uf[3 * i + 2]
-    buf = stack_array(CHUNK_BUFFER, f.dtype)
-    hi = offsets[i + 1]
-    pi = p[i]
-    f0 = zero
-    f1 = zero
-    f2 = zero
-    for c in range(offsets[i], hi, CHUNK):
-        m = min(CHUNK, hi - c)
-        fam = nbr[c : c + m]
-        xib = xif[3 * c : 3 * (c + m)]
-        lb = length[c : c + m]
-        wb = w[c : c + m]
-        kb = dev[c : c + m]
-        ok = intact[c : c + m]
-        for q in range(m):
-            jp = np.uint32(fam[q])
-            j = 3 * np.uint64(jp)
-            y0 = deformed_component(xib[3 * q], uf[j], ui0)
-            y1 = deformed_component(xib[3 * q + 1], uf[j + 1], ui1)
-            y2 = deformed_component(xib[3 * q + 2], uf[j + 2], ui2)
-            r = np.sqrt(y0 * y0 + y1 * y1 + y2 * y2)
-            L = lb[q]
-            t = (wb[q] * L * (pi + p[jp]) + kb[q] * (r - L)) / r
-            buf[q] = t if ok[q] else zero
-            buf[CHUNK + q] = y0
-            buf[2 * CHUNK + q] = y1
-            buf[3 * CHUNK + q] = y2
-        for q in range(m):
-            t = buf[q]
-            f0 += t * buf[CHUNK + q]
-            f1 += t * buf[2 * CHUNK + q]
-            f2 += t * buf[3 * CHUNK + q]
-    f[i, 0] = f0
-    f[i, 1] = f1
-    f[i, 2] = f2
-
-
-@numba.njit(fastmath=FASTMATH, cache=True)
-def lps_dilatation_rows(lo, hi, xif, uf, offsets, nbr, length, w, intact, theta_coef, p_coef, theta, p):
-    """``theta`` and ``p`` = theta p_coef (OUT, (n,)) of the rows ``lo .. hi - 1``, one after the other."""
-    for i in range(lo, hi):
-        th = theta_coef[i] * lps_dilatation_sum(i, xif, uf, offsets, nbr, length, w, intact)
-        theta[i] = th
-        p[i] = th * p_coef[i]
+# Today's ``LPSModel.force`` (float64) runs ``kernels.lps.lps_force_fused``: per-thread parts, and
+# each bond's Y and |Y| kept from the dilatation for the force in a ring. The candidates here
+# are the other forms measured: the same parts without the ring, and one parallel loop a block.
 
 
 @numba.njit(parallel={"fusion": False}, fastmath=FASTMATH, cache=True)
-def lps_force_fused(
+def lps_force_fused_no_ring(
     xi, u, offsets, nbr, length, w, dev, intact, theta_coef, p_coef, parts, inner, blocks, need, theta, p, f
 ):
-    """LPS force ``f`` (OUT, (n, 3)), ``theta`` and ``p`` (OUT, (n,)) in one go, with the plan of
-    :func:`fused_plan`: the same bits as ``lps_dilatation``, ``theta * p_coef`` and ``lps_pair_force``.
-
-    One thread a part (a range of rows). First loop: the dilatation of each part's outer rows
-    (those outside its inner rows: the rows of other parts may read them). Second loop: each
-    part's force, block of rows by block, the dilatation of its inner rows computed just
-    before the first block that reads it (rows up to ``need``), so that a block's per-bond
-    data is read twice within a window of about (index bandwidth + block) rows: from the
-    cache the second time if that fits.
-    """
+    """``kernels.lps.lps_force_fused`` without its ring: the force of the inner rows gathers
+    ``u`` and takes |Y| again, so only the per-bond data is reused (read a second time while
+    still in the cache, if the window of about index bandwidth + block rows fits). The same
+    bits."""
     n = u.shape[0]
     uf = u.reshape(3 * n)
     xif = xi.reshape(3 * xi.shape[0])
@@ -353,9 +265,9 @@ def lps_force_fused(
 def lps_force_block_prange(
     xi, u, offsets, nbr, length, w, dev, intact, theta_coef, p_coef, blocks, need, theta, p, f
 ):
-    """:func:`lps_force_fused` the other way round: the blocks one after the other (``blocks``,
-    ``need`` of a one-part :func:`fused_plan`), each block's dilatation rows and then its force
-    rows a parallel loop over all threads (two parallel regions a block). The same bits."""
+    """``kernels.lps.lps_force_fused`` the other way round: the blocks one after the other
+    (``blocks``, ``need`` of a one-part ``fused_plan``), each block's dilatation rows and then its
+    force rows a parallel loop over all threads (two parallel regions a block). The same bits."""
     n = u.shape[0]
     uf = u.reshape(3 * n)
     xif = xi.reshape(3 * xi.shape[0])
@@ -373,217 +285,17 @@ def lps_force_block_prange(
     return f
 
 
-@numba.njit(fastmath=FASTMATH, cache=True, inline="always")
-def lps_dilatation_sum_kept(i, xif, uf, offsets, nbr, length, w, intact, ring, s):
-    """:func:`lps_dilatation_sum` that also writes each bond's deformed vector Y (m) and |Y| to
-    ``ring`` (4, size): bond ``offsets[i] + k`` of the family at column ``s + k``."""
-    zero = uf.dtype.type(0.0)
-    ui0, ui1, ui2 = uf[3 * i], uf[3 * i + 1], uf[3 * i + 2]
-    buf = stack_array(CHUNK_BUFFER, uf.dtype)
-    lo = offsets[i]
-    hi = offsets[i + 1]
-    acc = zero
-    for c in range(lo, hi, CHUNK):
-        m = min(CHUNK, hi - c)
-        fam = nbr[c : c + m]
-        xib = xif[3 * c : 3 * (c + m)]
-        lb = length[c : c + m]
-        wb = w[c : c + m]
-        ok = intact[c : c + m]
-        k0 = s + (c - lo)
-        ry0 = ring[0, k0 : k0 + m]
-        ry1 = ring[1, k0 : k0 + m]
-        ry2 = ring[2, k0 : k0 + m]
-        rr = ring[3, k0 : k0 + m]
-        for q in range(m):
-            j = 3 * np.uint64(np.uint32(fam[q]))
-            y0 = deformed_component(xib[3 * q], uf[j], ui0)
-            y1 = deformed_component(xib[3 * q + 1], uf[j + 1], ui1)
-            y2 = deformed_component(xib[3 * q + 2], uf[j + 2], ui2)
-            r = np.sqrt(y0 * y0 + y1 * y1 + y2 * y2)
-            ry0[q] = y0
-            ry1[q] = y1
-            ry2[q] = y2
-            rr[q] = r
-            t = wb[q] * lb[q] * (r - lb[q])
-            buf[q] = t if ok[q] else zero
-        for q in range(m):
-            acc += buf[q]
-    return acc
-
-
-@numba.njit(fastmath=FASTMATH, cache=True, inline="always")
-def lps_pair_force_row_kept(i, offsets, nbr, length, w, dev, intact, p, ring, s, f):
-    """:func:`lps_pair_force_row` from the Y and |Y| that :func:`lps_dilatation_sum_kept` wrote
-    at column ``s`` of ``ring``: no gather of ``u`` and no square root (the same values)."""
-    zero = f.dtype.type(0.0)
-    buf = stack_array(CHUNK_BUFFER, f.dtype)
-    lo = offsets[i]
-    hi = offsets[i + 1]
-    pi = p[i]
-    f0 = zero
-    f1 = zero
-    f2 = zero
-    for c in range(lo, hi, CHUNK):
-        m = min(CHUNK, hi - c)
-        fam = nbr[c : c + m]
-        lb = length[c : c + m]
-        wb = w[c : c + m]
-        kb = dev[c : c + m]
-        ok = intact[c : c + m]
-        k0 = s + (c - lo)
-        ry0 = ring[0, k0 : k0 + m]
-        ry1 = ring[1, k0 : k0 + m]
-        ry2 = ring[2, k0 : k0 + m]
-        rr = ring[3, k0 : k0 + m]
-        for q in range(m):
-            r = rr[q]
-            L = lb[q]
-            t = (wb[q] * L * (pi + p[np.uint32(fam[q])]) + kb[q] * (r - L)) / r
-            buf[q] = t if ok[q] else zero
-        for q in range(m):
-            t = buf[q]
-            f0 += t * ry0[q]
-            f1 += t * ry1[q]
-            f2 += t * ry2[q]
-    f[i, 0] = f0
-    f[i, 1] = f1
-    f[i, 2] = f2
-
-
-@numba.njit(fastmath=FASTMATH, cache=True)
-def ring_slot(pos, count, size):
-    """Column of a family of ``count`` bonds in a ring of ``size`` columns whose next free one is
-    ``pos``: ``pos``, or 0 when the family would not fit before the end (families are not split)."""
-    return 0 if pos + count > size else pos
-
-
-@numba.njit(parallel={"fusion": False}, fastmath=FASTMATH, cache=True)
-def lps_force_fused_kept(
-    xi,
-    u,
-    offsets,
-    nbr,
-    length,
-    w,
-    dev,
-    intact,
-    theta_coef,
-    p_coef,
-    parts,
-    inner,
-    blocks,
-    need,
-    ring,
-    theta,
-    p,
-    f,
-):
-    """:func:`lps_force_fused` in which the dilatation of each part's inner rows keeps every
-    bond's Y and |Y| in the part's ``ring`` ((n_parts, 4, size), :func:`ring_size`) for the pair
-    force of the row; the outer rows' force recomputes them. The same bits."""
-    n = u.shape[0]
-    uf = u.reshape(3 * n)
-    xif = xi.reshape(3 * xi.shape[0])
-    args = (offsets, nbr, length, w, intact, theta_coef, p_coef, theta, p)
-    for t in numba.prange(parts.shape[0]):
-        lps_dilatation_rows(parts[t, 0], inner[t, 0], xif, uf, *args)
-        lps_dilatation_rows(inner[t, 1], parts[t, 1], xif, uf, *args)
-    for t in numba.prange(parts.shape[0]):
-        inner_lo, inner_hi = inner[t, 0], inner[t, 1]
-        rg = ring[t]
-        size = rg.shape[1]
-        done = inner_lo
-        put = 0
-        take = 0
-        for k in range(parts[t, 2], parts[t, 3]):
-            while done < min(need[k], inner_hi):
-                count = offsets[done + 1] - offsets[done]
-                put = ring_slot(put, count, size)
-                acc = lps_dilatation_sum_kept(done, xif, uf, offsets, nbr, length, w, intact, rg, put)
-                th = theta_coef[done] * acc
-                theta[done] = th
-                p[done] = th * p_coef[done]
-                put += count
-                done += 1
-            for i in range(blocks[k], blocks[k + 1]):
-                if inner_lo <= i < inner_hi:
-                    count = offsets[i + 1] - offsets[i]
-                    take = ring_slot(take, count, size)
-                    lps_pair_force_row_kept(i, offsets, nbr, length, w, dev, intact, p, rg, take, f)
-                    take += count
-                else:
-                    lps_pair_force_row(i, xif, uf, offsets, nbr, length, w, dev, intact, p, f)
-    return f
-
-
 def index_bandwidth(offsets: np.ndarray, nbr: np.ndarray) -> int:
     """max |j - i| over the bonds (i, j) of the CSR families (points)."""
     owners = np.repeat(np.arange(len(offsets) - 1), np.diff(offsets))
     return int(np.max(np.abs(nbr.astype(np.int64) - owners), initial=0))
 
 
-def fused_plan(offsets: np.ndarray, nbr: np.ndarray, n_parts: int, block_rows: int):
-    """Plan of :func:`lps_force_fused` for ``n_parts`` threads and blocks of ``block_rows`` rows.
-
-    Returns int64 arrays ``parts`` (n_parts, 4): first row, end row, first block, end block of
-    each part (parts of about equal bonds); ``inner`` (n_parts, 2): the part's inner rows
-    [inner[t, 0], inner[t, 1]), the only ones no row of another part reads (the rows outside
-    them are computed before any force); ``blocks`` (n_blocks + 1,): block row bounds, part
-    bounds among them; ``need`` (n_blocks,): 1 + the largest row a block's forces read (its own
-    rows and their neighbours).
-    """
-    n = len(offsets) - 1
-    owners = np.repeat(np.arange(n), np.diff(offsets))
-    lowest, need_row = np.arange(n, dtype=np.int64), np.arange(1, n + 1, dtype=np.int64)
-    np.minimum.at(lowest, owners, nbr)
-    np.maximum.at(need_row, owners, nbr.astype(np.int64) + 1)
-    reach_up = np.maximum.accumulate(need_row)  # 1 + largest row read by rows 0 .. r
-    reach_down = np.minimum.accumulate(lowest[::-1])[::-1]  # smallest row read by rows r .. n - 1
-    bounds = np.searchsorted(offsets, np.linspace(0, offsets[-1], n_parts + 1)).astype(np.int64)
-    bounds[0], bounds[-1] = 0, n
-    parts = np.empty((n_parts, 4), np.int64)
-    inner = np.empty((n_parts, 2), np.int64)
-    blocks = [0]
-    for t in range(n_parts):
-        lo, hi = bounds[t], bounds[t + 1]
-        inner_lo = lo if lo == 0 else min(max(reach_up[lo - 1], lo), hi)
-        inner_hi = hi if hi == n else min(max(reach_down[hi], inner_lo), hi)
-        inner[t] = inner_lo, inner_hi
-        parts[t, :2] = lo, hi
-        parts[t, 2] = len(blocks) - 1
-        blocks.extend(range(lo + block_rows, hi, block_rows))
-        if hi > lo:
-            blocks.append(hi)
-        parts[t, 3] = len(blocks) - 1
-    blocks = np.array(blocks, np.int64)
-    need = np.maximum.reduceat(need_row, blocks[:-1]) if n else np.zeros(0, np.int64)
-    return parts, inner, blocks, need
-
-
-def ring_size(offsets: np.ndarray, parts, inner, blocks, need) -> int:
-    """Columns of each part's ring for :func:`lps_force_fused_kept`: the most bonds of inner rows
-    computed and not yet used at any block (from its first row to ``need``), plus two families.
-
-    Families are written one after the other and start again at column 0 when the next would
-    not fit before the end (:func:`ring_slot`), so the live ones span at most their bonds plus
-    one gap shorter than a family: less than the ring, which is never overwritten before it is
-    read. The smallest ring keeps the least data in the cache."""
-    widest = 0
-    for t in range(len(parts)):
-        done = inner[t, 0]
-        for k in range(parts[t, 2], parts[t, 3]):
-            done = max(done, min(need[k], inner[t, 1]))
-            first = min(max(blocks[k], inner[t, 0]), inner[t, 1])
-            widest = max(widest, offsets[max(done, first)] - offsets[first])
-    return int(widest + 2 * np.diff(offsets).max(initial=0))
-
-
 def lps_fused_candidates(lps, u, out, block_rows=(64, 256, 1024), prange_rows=(2048, 8192)):
     """{name: (today's two passes, fused candidate)} on the LPS float64 model ``lps`` at ``u``
     (n, 3), m; forces into ``out`` ("a", "b": (n, 3) arrays). ``block_rows``: the block sizes of
-    :func:`lps_force_fused` and :func:`lps_force_fused_kept`; ``prange_rows``: those of
-    :func:`lps_force_block_prange` (two parallel regions a block: larger blocks)."""
+    ``kernels.lps.lps_force_fused`` (today's, with its ring) and :func:`lps_force_fused_no_ring`;
+    ``prange_rows``: those of :func:`lps_force_block_prange` (two parallel regions a block)."""
     b, xi, n = lps.bonds, lps.bond_vectors, lps.body.n_points
     families = (xi, u, b.offsets, b.neighbours, lps.length, lps.w)
     common = (*families, lps.dev, b.intact, lps._theta_coef, lps._p_coef)
@@ -597,14 +309,14 @@ def lps_fused_candidates(lps, u, out, block_rows=(64, 256, 1024), prange_rows=(2
     cands = {}
     for rows in block_rows:
         plan = fused_plan(b.offsets, b.neighbours, numba.get_num_threads(), rows)
-        ring = np.empty((len(plan[0]), 4, ring_size(b.offsets, *plan)))
-        cands[f"lps: fused, blocks of {rows} rows"] = (
+        ring = np.empty((len(plan.parts), 4, fused_ring_columns(b.offsets, plan)))
+        cands[f"lps: fused, blocks of {rows} rows, no ring"] = (
             two_pass,
-            lambda plan=plan: lps_force_fused(*common, *plan, theta, p, out["b"]),
+            lambda plan=plan: lps_force_fused_no_ring(*common, *plan, theta, p, out["b"]),
         )
         cands[f"lps: fused, {rows} rows, Y and |Y| kept"] = (
             two_pass,
-            lambda plan=plan, ring=ring: lps_force_fused_kept(*common, *plan, ring, theta, p, out["b"]),
+            lambda plan=plan, ring=ring: lps_force_fused(*common, *plan, ring, theta, p, out["b"]),
         )
     for rows in prange_rows:
         _, _, blocks, need = fused_plan(b.offsets, b.neighbours, 1, rows)
