@@ -9,6 +9,7 @@ MPI, by the neighbours' global index: ``peridyn.parallel``).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 from scipy.spatial import cKDTree
@@ -312,6 +313,75 @@ def range_offsets(offsets: np.ndarray, start: int, stop: int) -> np.ndarray:
     out[: start + 1] = out[start]
     out[stop + 1 :] = out[stop]
     return out
+
+
+class FusedPlan(NamedTuple):
+    """Row order of ``kernels.lps.lps_force_fused`` (int64 arrays), made by :func:`fused_plan`.
+
+    parts : (n_parts, 4)
+        First row, end row, first block, end block of each part (one a thread).
+    inner : (n_parts, 2)
+        The part's inner rows [inner[t, 0], inner[t, 1]): the rows that no row of another
+        part reads (a row's force reads the dilatation of its neighbours and its own).
+    blocks : (n_blocks + 1,)
+        Row bounds of the blocks; every part bound is one.
+    need : (n_blocks,)
+        1 + the largest row whose dilatation a block's forces read.
+    """
+
+    parts: np.ndarray
+    inner: np.ndarray
+    blocks: np.ndarray
+    need: np.ndarray
+
+
+def fused_plan(offsets: np.ndarray, neighbours: np.ndarray, n_parts: int, block_rows: int) -> FusedPlan:
+    """The :class:`FusedPlan` of the families ``offsets``, ``neighbours`` for ``n_parts`` parts of
+    about equal bonds, in blocks of ``block_rows`` rows."""
+    n = len(offsets) - 1
+    owners = np.repeat(np.arange(n), np.diff(offsets))
+    lowest, need_row = np.arange(n, dtype=np.int64), np.arange(1, n + 1, dtype=np.int64)
+    np.minimum.at(lowest, owners, neighbours)
+    np.maximum.at(need_row, owners, neighbours.astype(np.int64) + 1)
+    reach_up = np.maximum.accumulate(need_row)  # 1 + the largest row read by rows 0 .. r
+    reach_down = np.minimum.accumulate(lowest[::-1])[::-1]  # the smallest row read by rows r ..
+    bounds = np.searchsorted(offsets, np.linspace(0, offsets[-1], n_parts + 1)).astype(np.int64)
+    bounds[0], bounds[-1] = 0, n
+    parts = np.empty((n_parts, 4), np.int64)
+    inner = np.empty((n_parts, 2), np.int64)
+    blocks = [0]
+    for t in range(n_parts):
+        lo, hi = bounds[t], bounds[t + 1]
+        inner_lo = lo if lo == 0 else min(max(reach_up[lo - 1], lo), hi)
+        inner_hi = hi if hi == n else min(max(reach_down[hi], inner_lo), hi)
+        inner[t] = inner_lo, inner_hi
+        parts[t] = lo, hi, len(blocks) - 1, 0
+        blocks.extend(range(lo + block_rows, hi, block_rows))
+        if hi > lo:
+            blocks.append(hi)
+        parts[t, 3] = len(blocks) - 1
+    blocks = np.array(blocks, np.int64)
+    need = np.maximum.reduceat(need_row, blocks[:-1]) if n else np.zeros(0, np.int64)
+    return FusedPlan(parts, inner, blocks, need)
+
+
+def fused_ring_columns(offsets: np.ndarray, plan: FusedPlan) -> int:
+    """Columns (bonds) of each part's ring in ``kernels.lps.lps_force_fused``: the most bonds of
+    inner rows whose dilatation is done and force not yet, at any block, plus two families.
+
+    Families are written one after the other and start again at column 0 when the next would
+    not fit before the end (``kernels.lps.ring_slot``), so the live ones span at most their
+    bonds plus one gap shorter than a family: less than the ring, which is thus never
+    overwritten before it is read. The smallest such ring keeps the least data in the cache.
+    """
+    widest = 0
+    for t, (lo, hi) in enumerate(plan.inner):
+        done = lo
+        for k in range(plan.parts[t, 2], plan.parts[t, 3]):
+            done = max(done, min(plan.need[k], hi))
+            first = min(max(plan.blocks[k], lo), hi)
+            widest = max(widest, offsets[max(done, first)] - offsets[first])
+    return int(widest + 2 * np.diff(offsets).max(initial=0))
 
 
 def cell_fraction_in_ball(

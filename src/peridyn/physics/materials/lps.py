@@ -30,15 +30,17 @@ from __future__ import annotations
 
 import warnings
 
+import numba
 import numpy as np
 
 from peridyn.discretization.body import Body
-from peridyn.discretization.bonds import Bonds, family_sums
+from peridyn.discretization.bonds import Bonds, family_sums, fused_plan, fused_ring_columns
 from peridyn.errors import InputError
 from peridyn.kernels.lps import (
     lps_deviatoric_energy,
     lps_dilatation,
     lps_dilatation_cf,
+    lps_force_fused,
     lps_pair_force,
     lps_pair_force_cf,
 )
@@ -55,6 +57,15 @@ from peridyn.physics.materials.registry import register_material
 
 #: ``shear-factor``: Peridigm's former "Apply Shear Correction Factor" (see ``LPSModel``).
 SURFACE_CORRECTIONS = ("none", "shear-factor", "energy")
+
+#: Rows a block of the fused float64 force (``kernels.lps.lps_force_fused``; 256 measured as
+#: fast as 1024 and faster than 64 or 2048 on the seed Lamb plate, benchmarks/RESULTS.md).
+FUSED_BLOCK_ROWS = 256
+#: The fused force is used when each thread's ring holds at most this many bonds (32 B each:
+#: 8 MiB), i.e. when the point order's index bandwidth keeps a block's bonds in the cache
+#: between its dilatation and its force (the seed Lamb plate: 131 k; the 49^3 bench cube,
+#: bandwidth 7203 rows: 850 k, where the two passes are used).
+FUSED_RING_BONDS = 2**18
 
 
 @register_material("lps")
@@ -164,6 +175,7 @@ class LPSModel(Model):
         )
         self._theta = np.empty(body.n_points, dtype=self.dtype)
         self._p = np.empty(body.n_points, dtype=self.dtype)
+        self._fused_cache: tuple | None = None
 
     def _shear_correction_factor(self, w: np.ndarray) -> np.ndarray:
         """Shear correction factor (Peridigm's former "Apply Shear Correction Factor").
@@ -248,7 +260,8 @@ class LPSModel(Model):
         return self._dilatation(self._as_state(u)).copy()
 
     def force(self, u, out=None):
-        """Internal force density (see ``Model.force``): two passes over the bonds.
+        """Internal force density (see ``Model.force``): two passes over the bonds, or in float64
+        where :meth:`_fused` allows, the fused kernel (the same bits, one go).
 
         float64 uses the stored ``length``; float32 the cancellation-free kernels, which
         recompute |xi| from ``x`` (see ``peridyn.kernels``). Both read ``bonds.intact``
@@ -256,8 +269,30 @@ class LPSModel(Model):
         """
         out = np.empty_like(self.x) if out is None else out
         u = self._as_state(u)
-        p = np.multiply(self._dilatation(u), self._p_coef, out=self._p)
-        return self._pair_force(u, self.bonds.offsets, p, out)
+        fused = self._fused()
+        if fused is None:
+            p = np.multiply(self._dilatation(u), self._p_coef, out=self._p)
+            return self._pair_force(u, self.bonds.offsets, p, out)
+        b = self.bonds
+        plan, ring = fused
+        args = (self.bond_vectors, u, b.offsets, b.neighbours, self.length, self.w, self.dev, b.intact)
+        return lps_force_fused(*args, self._theta_coef, self._p_coef, *plan, ring, self._theta, self._p, out)
+
+    def _fused(self):
+        """(``FusedPlan``, ring (n_threads, 4, columns) float64) of ``kernels.lps.lps_force_fused``
+        for numba's present number of threads, made once per number; None where the two passes
+        are used instead: float32, or a ring above ``FUSED_RING_BONDS``."""
+        threads = numba.get_num_threads()
+        if self.dtype != np.float64:
+            return None
+        if self._fused_cache is None or self._fused_cache[0] != threads:
+            b = self.bonds
+            plan = fused_plan(b.offsets, b.neighbours, threads, FUSED_BLOCK_ROWS)
+            columns = fused_ring_columns(b.offsets, plan)
+            ring = np.empty((threads, 4, columns)) if columns <= FUSED_RING_BONDS else None
+            self._fused_cache = (threads, plan, ring)
+        _, plan, ring = self._fused_cache
+        return None if ring is None else (plan, ring)
 
     def force_overlapped(self, u, out, clear_rows, n_owned, finish):
         """See ``Model.force_overlapped``. The dilatation of the first ``clear_rows[0]`` rows
