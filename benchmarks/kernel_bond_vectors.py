@@ -6,10 +6,10 @@ gathers a bond); "today": ``peridyn.kernels`` (the same loops reading ``xi = x_j
 stored (n_bonds, 3) array: three gathers a bond, 24 B more streamed). Also measured, and not
 taken: PMB with the chunk's sums in 16 lanes (a vector accumulator per component, summed by a
 fixed tree at the end of the family): faster on its own, but it changes the order of each
-point's sum, hence the last bits. For each pair: the other kernel's time over today's (above
-1: today's is faster; best of ``--rounds`` interleaved calls on the same inputs; wall clock and
-process CPU time), and the largest force difference relative to the largest force (0 = the
-same bits). Results in RESULTS.md.
+point's sum, hence the last bits. Each pair is timed by ``kernel_candidates.compare``
+(interleaved calls on the same inputs: the before / candidate ratio of the best wall and CPU
+times and the median of the rounds' ratios, and the largest force difference). Results in
+RESULTS.md.
 
     PYTHONPATH=src python benchmarks/kernel_bond_vectors.py --side 49 --rounds 10
 """
@@ -18,10 +18,10 @@ from __future__ import annotations
 
 import argparse
 import os
-import time
 
 import numba
 import numpy as np
+from kernel_candidates import compare
 
 from peridyn.jobs.bench import DEFAULT_POINTS_PER_SIDE, SPACING, benchmark_grid
 from peridyn.kernels import CHUNK, CHUNK_BUFFER, FASTMATH, bond_differences, deformed_component, stack_array
@@ -205,7 +205,7 @@ def pmb_force_lanes(xi, u, offsets, nbr, inv_len, k, intact, f):
 
 
 def candidates(side: int, seed: int = 0):
-    """{name: (today's call, candidate's call)}; each call returns the force (n, 3)."""
+    """{name: (the "before" call, the candidate's call)}; each call returns the force (n, 3)."""
     body, b = benchmark_grid(side)
     u = 1e-4 * SPACING * np.random.default_rng(seed).standard_normal(body.points.shape)
     pmb = make_model("pmb", body, b, E=E, nu=NU, density=DENSITY)
@@ -222,13 +222,13 @@ def candidates(side: int, seed: int = 0):
         return pair_force(where, u, b.offsets, b.neighbours, lps.length, lps.w, lps.dev, b.intact, p, f)
 
     return b.n_bonds, {
-        "pmb: stored xi (today) / x gathered": (
-            lambda: pmb_force(xi, u, b.offsets, b.neighbours, *per_bond, out["a"]),
-            lambda: pmb_force_gather_x(x, u, b.offsets, b.neighbours, *per_bond, out["b"]),
+        "pmb: x gathered / stored xi (today)": (
+            lambda: pmb_force_gather_x(x, u, b.offsets, b.neighbours, *per_bond, out["a"]),
+            lambda: pmb_force(xi, u, b.offsets, b.neighbours, *per_bond, out["b"]),
         ),
-        "lps: stored xi (today) / x gathered": (
-            lambda: lps_force(lps_dilatation, lps_pair_force, xi, out["a"]),
-            lambda: lps_force(lps_dilatation_gather_x, lps_pair_force_gather_x, x, out["b"]),
+        "lps: x gathered / stored xi (today)": (
+            lambda: lps_force(lps_dilatation_gather_x, lps_pair_force_gather_x, x, out["a"]),
+            lambda: lps_force(lps_dilatation, lps_pair_force, xi, out["b"]),
         ),
         "pmb: stored xi (today) / + lane sums": (
             lambda: pmb_force(xi, u, b.offsets, b.neighbours, *per_bond, out["a"]),
@@ -247,22 +247,8 @@ def main(argv=None):
         f"{args.side}^3 grid, {n_bonds} bonds, {numba.get_num_threads()} threads, "
         f"load {os.getloadavg()[0]:.2f}"
     )
-    for name, (today, other) in cands.items():
-        fa, fb = today().copy(), other().copy()
-        rel = float(np.max(np.abs(fb - fa)) / np.max(np.abs(fa)))
-        wall = [np.inf, np.inf]
-        cpu = [np.inf, np.inf]
-        for _ in range(args.rounds):
-            for k, call in enumerate((today, other)):
-                t0, c0 = time.perf_counter(), time.process_time()
-                call()
-                wall[k] = min(wall[k], time.perf_counter() - t0)
-                cpu[k] = min(cpu[k], time.process_time() - c0)
-        print(
-            f"{name:<40} today {n_bonds / wall[0] / 1e6:5.0f} M/s, other {n_bonds / wall[1] / 1e6:5.0f} M/s; "
-            f"other / today wall {wall[1] / wall[0]:.3f}, CPU {cpu[1] / cpu[0]:.3f}; "
-            f"max |df| / max |f| {rel:.1e}"
-        )
+    for name, (before, cand) in cands.items():
+        print(compare(name, before, cand, n_bonds, args.rounds))
     print(f"load {os.getloadavg()[0]:.2f}")
 
 

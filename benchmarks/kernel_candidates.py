@@ -422,6 +422,30 @@ def case_candidates(path: str, block_rows=(64, 256, 1024), seed: int = 0):
     return b.n_bonds, index_bandwidth(b.offsets, b.neighbours), lps_fused_candidates(lps, u, out, block_rows)
 
 
+def compare(name: str, before, cand, n_bonds: int, rounds: int) -> str:
+    """One line: the calls ``before`` and ``cand`` (each returns a force) timed ``rounds`` times,
+    interleaved; their best rates (M bond/s of ``n_bonds``), the ratio before / candidate of the
+    best wall and CPU times and the median of the rounds' ratios (above 1: the candidate is
+    faster), and the largest force difference relative to the largest force (0: the same bits)."""
+    fa, fb = before().copy(), cand().copy()
+    rel = float(np.max(np.abs(fb - fa)) / np.max(np.abs(fa)))
+    wall, cpu = np.empty((2, rounds)), np.empty((2, rounds))
+    for r in range(rounds):
+        for k, call in enumerate((before, cand)):
+            t0, c0 = time.perf_counter(), time.process_time()
+            call()
+            wall[k, r] = time.perf_counter() - t0
+            cpu[k, r] = time.process_time() - c0
+    best_wall, best_cpu = wall.min(axis=1), cpu.min(axis=1)
+    return (
+        f"{name:<44} before {n_bonds / best_wall[0] / 1e6:5.0f} M/s, "
+        f"candidate {n_bonds / best_wall[1] / 1e6:5.0f} M/s; "
+        f"ratio wall {best_wall[0] / best_wall[1]:.3f}, CPU {best_cpu[0] / best_cpu[1]:.3f} "
+        f"(median of the rounds' ratios {np.median(wall[0] / wall[1]):.3f}, "
+        f"{np.median(cpu[0] / cpu[1]):.3f}); max |df| / max |f| {rel:.1e}"
+    )
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--side", type=int, default=DEFAULT_POINTS_PER_SIDE)
@@ -444,23 +468,7 @@ def main(argv=None):
     for name, (before, cand) in cands.items():
         if args.only and args.only not in name:
             continue
-        fa, fb = before().copy(), cand().copy()
-        rel = float(np.max(np.abs(fb - fa)) / np.max(np.abs(fa)))
-        wall, cpu = np.empty((2, args.rounds)), np.empty((2, args.rounds))
-        for r in range(args.rounds):
-            for k, call in enumerate((before, cand)):
-                t0, c0 = time.perf_counter(), time.process_time()
-                call()
-                wall[k, r] = time.perf_counter() - t0
-                cpu[k, r] = time.process_time() - c0
-        best_wall, best_cpu = wall.min(axis=1), cpu.min(axis=1)
-        print(
-            f"{name:<44} before {n_bonds / best_wall[0] / 1e6:5.0f} M/s, "
-            f"candidate {n_bonds / best_wall[1] / 1e6:5.0f} M/s; "
-            f"ratio wall {best_wall[0] / best_wall[1]:.3f}, CPU {best_cpu[0] / best_cpu[1]:.3f} "
-            f"(median of the rounds' ratios {np.median(wall[0] / wall[1]):.3f}, "
-            f"{np.median(cpu[0] / cpu[1]):.3f}); max |df| / max |f| {rel:.1e}"
-        )
+        print(compare(name, before, cand, n_bonds, args.rounds))
     print(f"load {os.getloadavg()[0]:.2f}")
 
 
