@@ -88,12 +88,12 @@ def test_fused_plan_orders_the_rows_it_reads(rng, parts, block_rows):
 @pytest.mark.parametrize("dim", [2, 3])
 def test_lps_model_force_is_fused_and_the_two_passes(dim, rng):
     """``LPSModel.force`` (float64) takes the fused kernel on a small body, with the same bits as
-    the model's own two passes (those of ``force_overlapped``)."""
+    the model's own two passes."""
     model = small_model("lps", dim, n=8)
     b = model.bonds
     b.intact[rng.random(b.n_bonds) < 0.05] = False
     u = 1e-5 * rng.standard_normal(model.x.shape)
-    assert model._fused() is not None
+    assert model._fused(model.body.n_points) is not None
     got = model.force(u)
     theta = model._dilatation(u).copy()
     ref = model._pair_force(u, b.offsets, theta * model._p_coef, np.empty_like(got))

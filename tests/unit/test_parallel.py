@@ -26,6 +26,7 @@ from peridyn.parallel.comm import SerialComm, launched_by_mpi
 from peridyn.parallel.domain import Domain
 from peridyn.parallel.halo import ghost_layers, plan_halo
 from peridyn.parallel.partition import rcb
+from peridyn.physics.materials.lps import LPSModel
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 
@@ -208,6 +209,8 @@ def test_each_rank_part_matches_the_serial_build(name, overrides, size):
         local_force = setup.model.force(np.ascontiguousarray(u[ids]))
         assert np.array_equal(local_force[:n], force[owned])
         _assert_clear_rows(pb, n, clear_rows)
+        if isinstance(setup.model, LPSModel) and setup.model.dtype == np.float64:
+            assert setup.model._fused(clear_rows[1]) is not None  # the fused force before the halo
         assert np.array_equal(_overlapped_force(setup.model, u[ids], n, clear_rows)[:n], force[owned])
         assert np.array_equal(setup.loading.constrained, whole.loading.constrained[ids])
     assert (owned_by >= 0).all()

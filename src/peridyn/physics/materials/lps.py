@@ -175,7 +175,7 @@ class LPSModel(Model):
         )
         self._theta = np.empty(body.n_points, dtype=self.dtype)
         self._p = np.empty(body.n_points, dtype=self.dtype)
-        self._fused_cache: tuple | None = None
+        self._fused_cache: dict = {}
 
     def _shear_correction_factor(self, w: np.ndarray) -> np.ndarray:
         """Shear correction factor (Peridigm's former "Apply Shear Correction Factor").
@@ -269,30 +269,37 @@ class LPSModel(Model):
         """
         out = np.empty_like(self.x) if out is None else out
         u = self._as_state(u)
-        fused = self._fused()
-        if fused is None:
+        n = self.body.n_points
+        if self._fused(n) is None:
             p = np.multiply(self._dilatation(u), self._p_coef, out=self._p)
             return self._pair_force(u, self.bonds.offsets, p, out)
+        return self._force_fused(u, n, out)
+
+    def _force_fused(self, u: np.ndarray, rows: int, out: np.ndarray) -> np.ndarray:
+        """The fused kernel's theta, p and force of the first ``rows`` rows (where :meth:`_fused`
+        has a plan), whose neighbours' theta and p are among them or already in ``self._theta``,
+        ``self._p``; the other rows of ``out`` are not written."""
         b = self.bonds
-        plan, ring = fused
+        plan, ring = self._fused(rows)
         args = (self.bond_vectors, u, b.offsets, b.neighbours, self.length, self.w, self.dev, b.intact)
         return lps_force_fused(*args, self._theta_coef, self._p_coef, *plan, ring, self._theta, self._p, out)
 
-    def _fused(self):
+    def _fused(self, rows: int):
         """(``FusedPlan``, ring (n_threads, 4, columns) float64) of ``kernels.lps.lps_force_fused``
-        for numba's present number of threads, made once per number; None where the two passes
-        are used instead: float32, or a ring above ``FUSED_RING_BONDS``."""
+        over the first ``rows`` rows, for numba's present number of threads, made once per
+        number and ``rows``; None where the two passes are used instead: float32, no rows, or a
+        ring above ``FUSED_RING_BONDS``."""
         threads = numba.get_num_threads()
-        if self.dtype != np.float64:
+        if self.dtype != np.float64 or rows == 0:
             return None
-        if self._fused_cache is None or self._fused_cache[0] != threads:
-            b = self.bonds
-            plan = fused_plan(b.offsets, b.neighbours, threads, FUSED_BLOCK_ROWS)
-            columns = fused_ring_columns(b.offsets, plan)
+        key = (threads, rows)
+        if key not in self._fused_cache:
+            offsets = self.bonds.offsets[: rows + 1]
+            plan = fused_plan(offsets, self.bonds.neighbours[: offsets[-1]], threads, FUSED_BLOCK_ROWS)
+            columns = fused_ring_columns(offsets, plan)
             ring = np.empty((threads, 4, columns)) if columns <= FUSED_RING_BONDS else None
-            self._fused_cache = (threads, plan, ring)
-        _, plan, ring = self._fused_cache
-        return None if ring is None else (plan, ring)
+            self._fused_cache[key] = None if ring is None else (plan, ring)
+        return self._fused_cache[key]
 
     def force_overlapped(self, u, out, clear_rows, n_owned, finish):
         """See ``Model.force_overlapped``. The dilatation of the first ``clear_rows[0]`` rows
@@ -303,9 +310,17 @@ class LPSModel(Model):
         clear, clear_force = clear_rows[0], clear_rows[1]
         theta, p, p_coef = self._theta, self._p, self._p_coef
         state = self._as_state(u)
-        self._dilatation(state, self._row_offsets(0, clear), theta)
-        np.multiply(theta[:clear], p_coef[:clear], out=p[:clear])
-        self._pair_force(state, self._row_offsets(0, clear_force), p, out)
+        # with the fused force of rows 0 .. clear_force - 1, the dilatation of the rows after
+        # them that they read comes first; else that of all rows 0 .. clear - 1
+        fused = self._fused(clear_force) is not None
+        first = clear_force if fused else 0
+        self._dilatation(state, self._row_offsets(first, clear), theta)
+        np.multiply(theta[first:clear], p_coef[first:clear], out=p[first:clear])
+        if fused:
+            self._force_fused(state, clear_force, out)
+            out[n_owned:] = 0.0
+        else:
+            self._pair_force(state, self._row_offsets(0, clear_force), p, out)
         finish()
         state = self._refresh_ghosts(state, u, n_owned)
         rest = self._dilatation(state, self._row_offsets(clear, len(theta)), self._scratch(theta))
