@@ -72,7 +72,8 @@ def main(argv=None) -> int:
             load = os.getloadavg()[0]
             rates = concurrent_rates(args.case, args.calls, copies)
             rows.append({"round": r, "copies": copies, "calls_per_s": rates, "load_before": load})
-            print(f"round {r}, {copies} process(es): {', '.join(f'{x:.2f}' for x in rates)} calls/s (load {load:.2f})")
+            shown = ", ".join(f"{x:.2f}" for x in rates)
+            print(f"round {r}, {copies} process(es): {shown} calls/s (load {load:.2f})")
     solo = [x for row in rows if row["copies"] == 1 for x in row["calls_per_s"]]
     pair = [x for row in rows if row["copies"] == 2 for x in row["calls_per_s"]]
     kept = sorted(p / max(solo) for p in pair)

@@ -74,9 +74,11 @@ def _brute_ghosts(points, owned, reach, layers):
 
 
 @pytest.mark.parametrize("layers", [1, 2])
-def test_ghosts_are_the_points_within_reach_not_owned(layers):
+@pytest.mark.parametrize("horizon", [2.015e-3, None])
+def test_ghosts_are_the_points_within_reach_not_owned(layers, horizon):
+    """Also at a reach of exactly two spacings (None), where grid points lie at the reach."""
     body = geometry.rectangle(0.012, 0.009, 1e-3, thickness=1e-3)
-    reach = search_reach(body, 2.015e-3)
+    reach = 2e-3 if horizon is None else search_reach(body, horizon)
     part = rcb(body.points, 3)
     for rank in range(3):
         owned = np.flatnonzero(part == rank)

@@ -168,6 +168,8 @@ def _as_index_array(name: str, selection, n: int) -> np.ndarray:
     arr = arr.astype(np.int64).ravel()
     if arr.size and (arr.min() < 0 or arr.max() >= n):
         raise InputError(f"node set {name!r}: indices must lie in [0, {n}), got {arr.min()}..{arr.max()}")
+    if np.all(arr[1:] > arr[:-1]):  # already sorted and unique, as a body's own sets are
+        return arr
     return np.unique(arr)
 
 

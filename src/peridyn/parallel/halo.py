@@ -34,17 +34,23 @@ def ghost_layers(points: np.ndarray, owned: np.ndarray, reach: float, layers: in
     ``owned`` points (global indices) and not owned.
 
     One hop: the points within ``reach`` of a point of the previous layer (layer 0: the owned).
+    Each hop asks, of the points not yet taken inside the previous layer's box grown by
+    ``reach``, how many points of that layer lie within ``reach`` (a tree of the layer's
+    points): the work grows with the points near the part, not with its bonds.
     """
-    tree = cKDTree(points)
+    points = np.asarray(points, dtype=np.float64)
     taken = np.zeros(len(points), dtype=bool)
     taken[owned] = True
     frontier = np.asarray(owned, dtype=np.int64)
     for _ in range(layers):
         if frontier.size == 0:
             break
-        found = tree.query_ball_point(points[frontier], reach, return_sorted=False)
-        near = np.unique(np.concatenate([np.asarray(f, dtype=np.int64) for f in found]))
-        frontier = near[~taken[near]]
+        at = points[frontier]
+        pad = reach * (1.0 + 1e-9)  # a point at exactly ``reach`` stays a candidate
+        inside = np.all((points >= at.min(axis=0) - pad) & (points <= at.max(axis=0) + pad), axis=1)
+        candidates = np.flatnonzero(inside & ~taken)
+        hits = cKDTree(at).query_ball_point(points[candidates], reach, return_length=True)
+        frontier = candidates[np.asarray(hits) > 0]
         taken[frontier] = True
     taken[owned] = False
     return np.flatnonzero(taken).astype(np.int64)
