@@ -337,12 +337,15 @@ class FusedPlan(NamedTuple):
 
 def fused_plan(offsets: np.ndarray, neighbours: np.ndarray, n_parts: int, block_rows: int) -> FusedPlan:
     """The :class:`FusedPlan` of the families ``offsets``, ``neighbours`` for ``n_parts`` parts of
-    about equal bonds, in blocks of ``block_rows`` rows."""
+    about equal bonds, in blocks of ``block_rows`` rows. A neighbour at row ``n = len(offsets) -
+    1`` or after is a row outside the plan whose dilatation is known before the fused kernel
+    runs (an MPI rank's rows next to its ghosts): it orders nothing."""
     n = len(offsets) - 1
     owners = np.repeat(np.arange(n), np.diff(offsets))
+    inside = neighbours < n
     lowest, need_row = np.arange(n, dtype=np.int64), np.arange(1, n + 1, dtype=np.int64)
     np.minimum.at(lowest, owners, neighbours)
-    np.maximum.at(need_row, owners, neighbours.astype(np.int64) + 1)
+    np.maximum.at(need_row, owners[inside], neighbours[inside].astype(np.int64) + 1)
     reach_up = np.maximum.accumulate(need_row)  # 1 + the largest row read by rows 0 .. r
     reach_down = np.minimum.accumulate(lowest[::-1])[::-1]  # the smallest row read by rows r ..
     bounds = np.searchsorted(offsets, np.linspace(0, offsets[-1], n_parts + 1)).astype(np.int64)
