@@ -99,3 +99,24 @@ def test_lps_model_force_is_fused_and_the_two_passes(dim, rng):
     ref = model._pair_force(u, b.offsets, theta * model._p_coef, np.empty_like(got))
     assert np.array_equal(got, ref)
     assert np.array_equal(model._theta, theta)
+
+
+@pytest.mark.parametrize("parts", [1, 2, 3])
+def test_fused_force_of_leading_rows_after_the_rest_is_the_two_passes(rng, parts):
+    """An MPI rank's overlapped force (``LPSModel.force_overlapped``): the dilatation of the rows
+    after ``rows`` first, then the fused force of the first ``rows`` rows on the plan of their
+    families alone. Neighbours past ``rows`` order nothing (the plan's ``need`` stays within
+    ``rows``), and the leading rows' theta, p and force are the two passes' bits."""
+    fam, xi, u, w, dev, theta_coef, p_coef = _inputs(rng, (6, 3, 2), 3.015)
+    rows = fam.n // 2
+    offsets = fam.offsets[: rows + 1]
+    plan = fused_plan(offsets, fam.nbr[: offsets[-1]], parts, 5)
+    assert plan.need.max() <= rows
+    theta_ref, p_ref, f_ref = _two_passes(fam, xi, u, w, dev, theta_coef, p_coef)
+    theta, p, f = np.full(fam.n, np.nan), np.full(fam.n, np.nan), np.full((fam.n, 3), np.nan)
+    theta[rows:], p[rows:] = theta_ref[rows:], p_ref[rows:]
+    ring = np.full((parts, 4, fused_ring_columns(offsets, plan)), np.nan)
+    args = (xi, u, fam.offsets, fam.nbr, fam.length, w, dev, fam.intact, theta_coef, p_coef)
+    lps.lps_force_fused(*args, *plan, ring, theta, p, f)
+    assert np.array_equal(theta, theta_ref) and np.array_equal(p, p_ref)
+    assert np.array_equal(f[:rows], f_ref[:rows]) and np.isnan(f[rows:]).all()
