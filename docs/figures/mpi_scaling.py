@@ -14,9 +14,10 @@ One explicit step on P ranks of one thread each takes
   point of the rest of the step (integration, loads), from the serial step's parts measured on
   one thread (``peridyn bench --case``: force / B, rest / N); B_r and N_r the largest rank's
   share (owned points, bonds in proportion), times P / C when the P ranks outnumber the C
-  cores (3 ranks on this machine's 2 cores), over the cores' efficiency e when they all work
-  (memory bandwidth and cache shared: e = t(1 x 1) / (C t(1 x C)), the 1-rank runs on one and
-  on C threads; ``core_efficiency``);
+  cores (3 ranks on this machine's 2 cores), over the efficiency e of a core when they all work
+  (e = t(1 x 1) / (C t(1 x C)), the 1-rank runs on one and on C threads; ``core_efficiency``:
+  what the one-thread coefficients miss in a whole step on all cores, the threaded run's serial
+  parts included; not the cores' sharing alone, which ``benchmarks/core_sharing.py`` measures);
 - ``t_root``: the recorder's time per step (observers), on rank 0 alone, not divided;
 - ``t_halo = m alpha + s / beta``: the largest rank's counted messages m and bytes s per step,
   with the latency alpha and bandwidth beta of ``benchmarks/mpi_pingpong.py``;
@@ -97,9 +98,9 @@ def coefficients(record: dict) -> dict:
 
 
 def core_efficiency(runs: list[dict]) -> float:
-    """How much of its one-core speed each core keeps when all of them work at once (memory
-    bandwidth and the shared cache are shared): the 1-rank step on one thread over the
-    threads x the 1-rank step on all the machine's threads (1.0 without such a run)."""
+    """How much of its one-core speed each core keeps in a whole step when all of them work at
+    once: the 1-rank step on one thread over the threads x the 1-rank step on all the machine's
+    threads (1.0 without such a run)."""
     one = next(r for r in runs if r["ranks"] == 1 and r["threads"] == 1)
     many = [r for r in runs if r["ranks"] == 1 and r["threads"] > 1]
     if not many:
@@ -119,7 +120,7 @@ def predicted_step(c: dict, run: dict) -> dict:
     others = c["probe_points"] * (c["points"] - owned[0]) / c["points"]
     gather = messages * c["alpha"] + 24.0 * others / c["beta"]
     shared = max(1.0, ranks / c["cpus"])  # more ranks than cores: each gets cpus / ranks of one
-    shared /= c["core_efficiency"]  # several cores at work: each slower (memory, cache)
+    shared /= c["core_efficiency"]  # several cores at work: each slower in a whole step
     terms = {
         "compute": shared * (c["t_bond"] * c["bonds"] * n_r / c["points"] + c["t_point"] * n_r),
         "root": c["t_root"],
