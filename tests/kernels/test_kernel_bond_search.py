@@ -91,3 +91,18 @@ def test_initial_bond_vectors(rng):
     pair = {(i, j): b for b, (i, j) in enumerate(zip(owner, fam.nbr, strict=True))}
     reverse = np.array([pair[(j, i)] for i, j in zip(owner, fam.nbr, strict=True)])
     np.testing.assert_array_equal(got[reverse], -got)
+
+
+def test_family_sums_are_bincounts_to_the_bit(rng):
+    """Per-family sums in each family's bond order, empty families included: bit for bit the
+    ``np.bincount`` over the bonds' owners that the reference (and peridyn before the kernel)
+    computes."""
+    sizes = rng.integers(0, 9, 60)
+    sizes[[0, 17, -1]] = 0  # empty families first, inside and last
+    offsets = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
+    values = rng.normal(size=offsets[-1]) * 10.0 ** rng.integers(-8, 8, offsets[-1])
+    got, expected = np.full(60, np.nan), np.full(60, np.nan)
+    bond_search.family_sums(offsets, values, got)
+    ref.family_sums(offsets, values, expected)
+    np.testing.assert_array_equal(got, expected)
+    assert got[0] == got[17] == got[-1] == 0.0

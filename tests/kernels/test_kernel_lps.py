@@ -116,3 +116,20 @@ def test_lps_deviatoric_energy(rng, dim):
     deviatoric = r - fam.length - theta[owners(fam.offsets)] * fam.length / dim
     scale = family_magnitude(fam.offsets, fam.intact * w * deviatoric * fam.length)
     assert_close(got, ref.lps_deviatoric_energy(*args), TOL64, scale)
+
+
+@pytest.mark.parametrize("dev_dtype", [np.float64, np.float32])
+def test_lps_stiffness_bound_is_the_numpy_form_to_the_bit(rng, dev_dtype):
+    """The stiffness bound that sets the stable time step, with broken bonds and a float32
+    deviatoric coefficient (a float32 model's): bit for bit the NumPy form, so that a run's
+    time step, and every bit after it, is the same as before the kernel."""
+    fam, *_ = _inputs(rng, np.float64, 1e-3)
+    intact = fam.intact.copy()
+    intact[rng.random(len(intact)) < 0.1] = False
+    w = per_bond(rng, fam, 1e-9)
+    dev = per_bond(rng, fam, 1e14).astype(dev_dtype)
+    bulk = rng.uniform(5e10, 8e10, fam.n)
+    theta_coef = rng.uniform(0.5, 1.5, fam.n) * 3.0 / (30 * fam.length.mean() ** 2)
+    args = (fam.offsets, fam.nbr, intact, w, fam.length, dev, bulk, theta_coef)
+    got = lps.lps_stiffness_bound(*args, np.full(fam.n, np.nan), np.full(fam.n, np.nan))
+    np.testing.assert_array_equal(got, ref.lps_stiffness_bound(*args))

@@ -74,6 +74,7 @@ def run(args) -> dict:
         overwrite=args.overwrite,
         command=command_line(),
         comm=world(),
+        figure_worker=True,
     )
     if not args.json:
         print_summary(summary)

@@ -17,6 +17,7 @@ from scipy.spatial import cKDTree
 from peridyn.discretization.body import Body
 from peridyn.errors import InputError, did_you_mean
 from peridyn.kernels.bond_search import bond_families, bond_geometry, box_fraction_in_ball
+from peridyn.kernels.bond_search import family_sums as kernel_family_sums
 
 #: Relative tolerance on the horizon: a neighbour at exactly ``delta`` is in.
 HORIZON_RTOL = 1e-12
@@ -341,11 +342,11 @@ def fused_plan(offsets: np.ndarray, neighbours: np.ndarray, n_parts: int, block_
     1`` or after is a row outside the plan whose dilatation is known before the fused kernel
     runs (an MPI rank's rows next to its ghosts): it orders nothing."""
     n = len(offsets) - 1
-    owners = np.repeat(np.arange(n), np.diff(offsets))
-    inside = neighbours < n
-    lowest, need_row = np.arange(n, dtype=np.int64), np.arange(1, n + 1, dtype=np.int64)
-    np.minimum.at(lowest, owners, neighbours)
-    np.maximum.at(need_row, owners[inside], neighbours[inside].astype(np.int64) + 1)
+    lowest = np.minimum(np.arange(n, dtype=np.int64), _family_extreme(np.minimum, offsets, neighbours, n))
+    inside = np.where(neighbours < n, neighbours, -1)  # a row past the plan orders nothing
+    need_row = np.maximum(
+        np.arange(1, n + 1, dtype=np.int64), _family_extreme(np.maximum, offsets, inside, -1) + 1
+    )
     reach_up = np.maximum.accumulate(need_row)  # 1 + the largest row read by rows 0 .. r
     reach_down = np.minimum.accumulate(lowest[::-1])[::-1]  # the smallest row read by rows r ..
     bounds = np.searchsorted(offsets, np.linspace(0, offsets[-1], n_parts + 1)).astype(np.int64)
@@ -366,6 +367,18 @@ def fused_plan(offsets: np.ndarray, neighbours: np.ndarray, n_parts: int, block_
     blocks = np.array(blocks, np.int64)
     need = np.maximum.reduceat(need_row, blocks[:-1]) if n else np.zeros(0, np.int64)
     return FusedPlan(parts, inner, blocks, need)
+
+
+def _family_extreme(ufunc, offsets: np.ndarray, values: np.ndarray, empty: int) -> np.ndarray:
+    """(n_points,) int64: ``ufunc.reduce`` (np.minimum or np.maximum) of ``values`` over each
+    family of ``offsets``; ``empty`` for a family without bonds."""
+    n = len(offsets) - 1
+    sizes = np.diff(offsets)
+    out = np.full(n, empty, dtype=np.int64)
+    full = sizes > 0
+    if full.any():
+        out[full] = ufunc.reduceat(values.astype(np.int64), offsets[:-1][full])
+    return out
 
 
 def fused_ring_columns(offsets: np.ndarray, plan: FusedPlan) -> int:
@@ -497,8 +510,10 @@ def both_copies(mask: np.ndarray, reverse: np.ndarray) -> np.ndarray:
 def family_sums(offsets: np.ndarray, values: np.ndarray) -> np.ndarray:
     """(n_points,) float64 sums of ``values`` (n_bonds,) over the CSR families ``offsets``.
 
-    Unlike ``np.add.reduceat``, an empty family sums to 0.
+    Unlike ``np.add.reduceat``, an empty family sums to 0. Each family is summed in its bonds'
+    order (``kernels.bond_search.family_sums``: the bits of ``np.bincount`` over the owners).
     """
-    sizes = np.diff(offsets)
-    owners = np.repeat(np.arange(len(sizes)), sizes)
-    return np.bincount(owners, weights=np.asarray(values, dtype=np.float64), minlength=len(sizes))
+    out = np.empty(len(offsets) - 1)
+    offsets = np.asarray(offsets, dtype=np.int64)
+    kernel_family_sums(offsets, np.ascontiguousarray(values, dtype=np.float64), out)
+    return out

@@ -28,6 +28,7 @@ from peridyn.io.recorder import LineProbe, Probes, Recorder, RecorderSpec
 from peridyn.io.vtu_pieces import VtuPieces
 from peridyn.jobs.build import Setup, build, pad3
 from peridyn.jobs.exodus_variables import GatheredVariables, check_variables, variable_values
+from peridyn.jobs.figure_worker import figure_worker_for, figures_of, submit
 from peridyn.jobs.figures import draw_crack_figures, draw_run_figures, final_crack_paths
 from peridyn.jobs.lamb_analysis import analyse
 from peridyn.jobs.peridigm_step import peridigm_stable_step
@@ -103,6 +104,7 @@ def run_case(
     overwrite: bool = False,
     command: str | None = None,
     comm=None,
+    figure_worker: bool = False,
 ) -> dict:
     """Run a case and write its results; returns the summary (also stored in results.h5; keys
     in docs/user-guide.md, "Summaries and results files").
@@ -131,6 +133,12 @@ def run_case(
         bit for bit; a static run without them (modified Newton with CG) and a modal run, to the
         solver tolerance. Checkpoints hold the whole body, so a run may restart on another
         number of ranks. None: one process.
+    figure_worker : bool
+        Draw the run figures in a second process while this one analyses the records
+        (``peridyn.jobs.figure_worker``: one process on two or more numba threads, a body of
+        ``MIN_POINTS`` or more). What ``peridyn run`` does; a script that asks for it must
+        guard its own run with ``if __name__ == "__main__":``, as every program that starts
+        processes by ``spawn`` must.
 
     Raises
     ------
@@ -151,34 +159,38 @@ def run_case(
         )
     if restart and not stepping:
         raise InputError(f"--restart continues an explicit or newmark run, not a {case.solver.type} run")
-    if comm is not None and comm.size > 1:
+    parallel = comm is not None and comm.size > 1
+    if parallel:
         _check_parallel(case)
-    setup = build(case, base_dir, comm)
-    domain = setup.domain
-    solver = time_stepper(case, setup) if stepping else None
-    out = output_directory(case, output_dir)
-    spec = recorder_spec(case, setup.whole_body, solver.dt) if stepping else None
-    if stepping:
-        domain.on_root(check_output_fits, spec, setup.whole_body, step_count(case, solver), solver.dt, out)
-    domain.on_root(prepare_output, out, RESULTS, overwrite, restart)
-    written = not restart  # a restart writes once its checkpoint is accepted (the recorder's part)
-    try:
-        summary, plots = _solve(
-            case, setup, solver, spec, out, case_path, checkpoint_every, restart, progress, start
-        )
-        written = True
-        _finish(case, setup, out, summary, plots, start)
-    except Exception as exc:
-        if written and domain.is_root:
-            try:
-                _set_status(out / RESULTS, setup.whole_body, end_status(exc))
-            except Exception:  # noqa: BLE001 - e.g. the full disk that failed the run: its error is the one to report
-                pass
-        if isinstance(exc, Interrupted):
-            hint = _resume_hint(command) if exc.resume else ""
-            raise Interrupted(exc.signal_name, exc.step, hint, exc.where) from None
-        raise
-    return domain.comm.bcast(summary)
+    wanted = figure_worker and _draws_run_figures(case) and not parallel
+    with figure_worker_for(case, base_dir, wanted) as worker:
+        setup = build(case, base_dir, comm)
+        domain = setup.domain
+        solver = time_stepper(case, setup) if stepping else None
+        out = output_directory(case, output_dir)
+        spec = recorder_spec(case, setup.whole_body, solver.dt) if stepping else None
+        if stepping:
+            n_steps = step_count(case, solver)
+            domain.on_root(check_output_fits, spec, setup.whole_body, n_steps, solver.dt, out)
+        domain.on_root(prepare_output, out, RESULTS, overwrite, restart)
+        written = not restart  # a restart writes once its checkpoint is accepted (the recorder's part)
+        try:
+            summary, plots = _solve(
+                case, setup, solver, spec, out, case_path, checkpoint_every, restart, progress, start
+            )
+            written = True
+            _finish(case, setup, out, summary, plots, start, worker)
+        except Exception as exc:
+            if written and domain.is_root:
+                try:
+                    _set_status(out / RESULTS, setup.whole_body, end_status(exc))
+                except Exception:  # noqa: BLE001 - e.g. the full disk that failed the run: its error is the one to report
+                    pass
+            if isinstance(exc, Interrupted):
+                hint = _resume_hint(command) if exc.resume else ""
+                raise Interrupted(exc.signal_name, exc.step, hint, exc.where) from None
+            raise
+        return domain.comm.bcast(summary)
 
 
 def _check_parallel(case: Case) -> None:
@@ -293,23 +305,31 @@ def _solve(case, setup, solver, spec, out, case_path, checkpoint_every, restart,
     return summary, []
 
 
-def _finish(case, setup, out, summary, plots, start) -> None:
+def _draws_run_figures(case: Case) -> bool:
+    """Whether the run ends with ``draw_run_figures`` (a modal run draws its own)."""
+    return case.output.plots and case.solver.type != "modal"
+
+
+def _finish(case, setup, out, summary, plots, start, worker=None) -> None:
     """Analyses, figures and the stored summary after the solve; the status becomes complete
-    (on rank 0, with the damage of the whole body)."""
+    (on rank 0, with the damage of the whole body). ``worker``: a figure worker
+    (``start_figure_worker``) that draws the run figures while this process analyses."""
     d = setup.domain
     phi = d.gather(damage_field(setup.model)) if setup.damage is not None else None
-    d.on_root(_finish_on_root, case, setup.whole_body, out, summary, plots, start, phi)
+    d.on_root(_finish_on_root, case, setup.whole_body, out, summary, plots, start, phi, worker)
 
 
-def _finish_on_root(case, body, out, summary, plots, start, phi) -> None:
+def _finish_on_root(case, body, out, summary, plots, start, phi, worker=None) -> None:
     """``_finish`` on rank 0: ``body`` the whole body, ``phi`` its damage (None without damage)."""
+    draw = _draws_run_figures(case)
+    pending = submit(worker, draw_run_figures, case, body, out) if draw else None
     analysis, figures = analyse(case, body, out, plots=case.output.plots)
     summary.update(analysis)
     paths = final_crack_paths(case, body, phi) if phi is not None else None
     if paths is not None:
         summary["crack_paths"] = [p.summary() for p in paths]
-    if case.output.plots and case.solver.type != "modal":  # a modal run draws its own
-        plots = [*draw_run_figures(case, body, out), *figures]
+    if draw:
+        plots = [*figures_of(pending, draw_run_figures, case, body, out), *figures]
         if paths is not None:
             plots += draw_crack_figures(body, out, paths, summary)
     finish_summary(summary, "modal" if case.solver.type == "modal" else "run", out, start, plots)

@@ -1,6 +1,6 @@
 """Bond search kernels: CSR families from neighbour pairs, bond lengths and partial-volume
-factors (the fraction of a neighbour's cell inside the horizon ball), and the reference bond
-vectors that the float64 force kernels read."""
+factors (the fraction of a neighbour's cell inside the horizon ball), the reference bond
+vectors that the float64 force kernels read, and sums over each family."""
 
 import numba
 import numpy as np
@@ -85,3 +85,15 @@ def box_fraction_in_ball(c0, c1, c2, h0, h1, h2, radius, q):
                 s = np.sqrt(rest)
                 total += max(0.0, min(hi, s) - max(lo, -s))
     return total / (h0 * q * qz)
+
+
+@numba.njit(parallel=True, cache=True)
+def family_sums(offsets, values, out):
+    """``out[i]`` = the sum of ``values[offsets[i]:offsets[i + 1]]``, added one bond after the
+    other from 0 (an empty family sums to 0): the order, and so the bits, of ``np.bincount``
+    over the bonds' owners. ``values`` (n_bonds,) and ``out`` (n_points,) float64."""
+    for i in numba.prange(len(out)):
+        total = 0.0
+        for b in range(offsets[i], offsets[i + 1]):
+            total += values[b]
+        out[i] = total

@@ -404,3 +404,28 @@ def lps_deviatoric_energy(x, u, offsets, nbr, length, w, intact, theta, dim, out
             acc += w[b] * ed * ed
         out[i] = acc
     return out
+
+
+@numba.njit(parallel=True, cache=True)
+def lps_stiffness_bound(offsets, nbr, intact, w, length, dev, bulk, theta_coef, s, out):
+    """``out`` (OUT, (n_points,), N/m^5): the block-Gershgorin bound of the LPS stiffness
+    (``LPSModel.stiffness_bound``), with ``s`` (OUT, (n_points,)) = ``theta_coef`` x the
+    family sum of ``w |xi|`` over intact bonds. ``w`` (n_bonds,) influence x bond volume,
+    ``dev`` the deviatoric bond coefficient, ``bulk`` and ``theta_coef`` (n_points,); all
+    float64. Each sum is taken in its family's bond order, every product in the order of the
+    NumPy form (``reference.lps.lps_stiffness_bound``): the same bits."""
+    n = len(out)
+    for i in numba.prange(n):
+        total = 0.0
+        for b in range(offsets[i], offsets[i + 1]):
+            total += (w[b] if intact[b] else 0.0) * length[b]
+        s[i] = theta_coef[i] * total
+    for i in numba.prange(n):
+        total = 0.0
+        for b in range(offsets[i], offsets[i + 1]):
+            j = nbr[b]
+            wb = w[b] if intact[b] else 0.0
+            pair = 2.0 * (np.float64(dev[b]) if intact[b] else 0.0)
+            total += pair + 2.0 * bulk[j] * theta_coef[j] * wb * length[b] * s[j]
+        out[i] = total + 2.0 * bulk[i] * (s[i] * s[i])
+    return out

@@ -54,3 +54,10 @@ def bond_geometry(x, cells, offsets, nbr, radius, partial, q):
     if partial:
         return length, box_fraction_in_ball(xi, np.asarray(cells)[nbr], radius, q)
     return length, (length <= radius).astype(np.float64)
+
+
+def family_sums(offsets, values, out):
+    """Sum of ``values`` over each family, by ``np.bincount`` over the bonds' owners."""
+    out[:] = np.bincount(
+        owners(offsets), weights=np.asarray(values, dtype=np.float64), minlength=len(offsets) - 1
+    )

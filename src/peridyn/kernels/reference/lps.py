@@ -68,3 +68,13 @@ def lps_deviatoric_energy(x, u, offsets, nbr, length, w, intact, theta, dim):
     w, theta = as64(w, theta)
     deviatoric = e - theta[owners(offsets)] * length / dim
     return family_sum(offsets, np.where(intact, w * deviatoric**2, 0.0))
+
+
+def lps_stiffness_bound(offsets, nbr, intact, w, length, dev, bulk, theta_coef):
+    """Block-Gershgorin bound of the LPS stiffness, per point, in NumPy (peridyn's form
+    before the kernel)."""
+    w = np.where(intact, w, 0.0)
+    s = theta_coef * family_sum(offsets, w * length)
+    pair = 2.0 * np.where(intact, np.asarray(dev, dtype=np.float64), 0.0)
+    dil = 2.0 * bulk[nbr] * theta_coef[nbr] * w * length * s[nbr]
+    return family_sum(offsets, pair + dil) + 2.0 * bulk * s**2

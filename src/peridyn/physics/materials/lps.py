@@ -43,6 +43,7 @@ from peridyn.kernels.lps import (
     lps_force_fused,
     lps_pair_force,
     lps_pair_force_cf,
+    lps_stiffness_bound,
 )
 from peridyn.physics.materials.base import Model
 from peridyn.physics.materials.elastic import (
@@ -386,14 +387,11 @@ class LPSModel(Model):
         blocks kappa V_k g_k g_k^T with |g_k,j| = (d / m_k) w |xi| and
         sum_j |g_k,j| <= 2 S_k, S_k = (d / m_k) sum_j w |xi|.
         """
-        b = self.bonds
-        w = np.where(b.intact, b.influence * self.bond_volume, 0.0)
-        nbr = b.neighbours
-        bulk = np.broadcast_to(self.bulk, (self.body.n_points,))
-        s = self.theta_coef * family_sums(b.offsets, w * b.length)
-        pair = 2.0 * np.where(b.intact, self.dev.astype(np.float64), 0.0)
-        dil = 2.0 * bulk[nbr] * self.theta_coef[nbr] * w * b.length * s[nbr]
-        return family_sums(b.offsets, pair + dil) + 2.0 * bulk * s**2
+        b, n = self.bonds, self.body.n_points
+        bulk = np.ascontiguousarray(np.broadcast_to(self.bulk, (n,)), dtype=np.float64)
+        w = b.influence * self.bond_volume
+        args = (b.offsets, b.neighbours, b.intact, w, b.length, self.dev, bulk, self.theta_coef)
+        return lps_stiffness_bound(*args, np.empty(n), np.empty(n))
 
     def critical_stretch(self, fracture_energy):
         """s_c from G_c for LPS with a constant influence function (Madenci and Oterkus 2014).
