@@ -54,6 +54,19 @@ def test_rcb_refuses_more_parts_than_points():
         rcb(np.zeros((4, 3)), 5)
 
 
+@pytest.mark.parametrize("shares", [[0.9, 1.1], [1.0, 2.0, 2.0], [0.5, 1.0, 1.0, 1.0, 1.2]])
+def test_rcb_parts_follow_their_shares(shares):
+    body = geometry.box((0.031, 0.017, 0.005), 1e-3)
+    part = rcb(body.points, len(shares), shares)
+    counts = np.bincount(part, minlength=len(shares))
+    expected = body.n_points * np.asarray(shares) / np.sum(shares)
+    assert counts.sum() == body.n_points
+    assert np.abs(counts - expected).max() <= 1 + np.ceil(np.log2(len(shares)))  # a point a cut
+    assert np.array_equal(rcb(body.points, 3, [1.0, 1.0, 1.0]), rcb(body.points, 3))  # equal: as before
+    with pytest.raises(InputError, match="shares must be 2 positive numbers"):
+        rcb(body.points, 2, [1.0, 0.0])
+
+
 def test_rcb_cuts_the_longest_side_first():
     body = geometry.rectangle(0.040, 0.004, 1e-3, thickness=1e-3)
     part = rcb(body.points, 2)
@@ -195,7 +208,9 @@ def test_each_rank_part_matches_the_serial_build(name, overrides, size):
     force = m.force(u)
     owned_by = np.full(whole.body.n_points, -1)
     for rank in range(size):
-        setup, owned, ghosts, _, clear_rows = _build_part(case, SimpleNamespace(rank=rank, size=size), CASES)
+        setup, owned, ghosts, ghost_owner, clear_rows = _build_part(
+            case, SimpleNamespace(rank=rank, size=size), CASES
+        )
         assert not (owned_by[owned] >= 0).any()
         owned_by[owned] = rank
         ids = np.concatenate([owned, ghosts])
@@ -211,6 +226,14 @@ def test_each_rank_part_matches_the_serial_build(name, overrides, size):
         local_force = setup.model.force(np.ascontiguousarray(u[ids]))
         assert np.array_equal(local_force[:n], force[owned])
         _assert_clear_rows(pb, n, clear_rows)
+        # in each owner's block of ghosts, the ones an owned family holds (layer 1) come first
+        held = np.zeros(len(ids), dtype=bool)
+        held[pb.neighbours[:nb]] = True
+        for r in np.unique(ghost_owner):
+            block = held[n:][ghost_owner == r]
+            assert not np.any(block[1:] & ~block[:-1]), "a layer-1 ghost after a layer-2 one"
+        if isinstance(setup.model, LPSModel):  # the dilatation of the layer-2 ghosts is skipped
+            assert setup.model._rows_read(n) == np.flatnonzero(held).max() + 1 < len(ids)
         if isinstance(setup.model, LPSModel) and setup.model.dtype == np.float64:
             assert setup.model._fused(clear_rows[1]) is not None  # the fused force before the halo
         assert np.array_equal(_overlapped_force(setup.model, u[ids], n, clear_rows)[:n], force[owned])

@@ -26,6 +26,7 @@ from peridyn.discretization.bonds import (
 from peridyn.errors import CaseFileError, InputError
 from peridyn.io import exodus, mesh_text
 from peridyn.io.case import Case, Geometry, Region, box_cells
+from peridyn.jobs.rank_shares import rank_shares
 from peridyn.parallel.contact import RankContact
 from peridyn.parallel.domain import Domain, agree
 from peridyn.parallel.halo import Halo, clearance, ghost_layers, plan_halo
@@ -396,10 +397,11 @@ def _build_part(case: Case, comm, base_dir):
     body, actuation = add_actuators(case, body)
     loading = build_loading(case, body, actuation)
     check_loading(case, loading)
-    owner = rcb(body.points, comm.size)
+    reach = bond_reach(case, body)
+    owner = rcb(body.points, comm.size, rank_shares(case, body, comm.size, reach))
     owned = np.flatnonzero(owner == comm.rank)
     of_block = block_index(case, body) if case.blocks else None  # of the whole body's points
-    ghosts = ghost_layers(body.points, owned, bond_reach(case, body), GHOST_LAYERS)
+    ghosts = ghost_layers(body.points, owned, reach, GHOST_LAYERS)
     near = np.union1d(owned, ghosts)
     bonds = build_bonds(
         case,
@@ -409,7 +411,14 @@ def _build_part(case: Case, comm, base_dir):
     )
     # ghosts without a neighbour on the rank (an outer ghost whose cells all miss) are dropped
     ghosts = ghosts[np.diff(bonds.offsets)[np.searchsorted(near, ghosts)] > 0]
-    ghosts = ghosts[np.lexsort((ghosts, owner[ghosts]))]
+    # by owner rank; in each rank's block, the ghosts an owned point's family holds first (the
+    # rows whose dilatation an owned force reads: ``LPSModel.force_overlapped``)
+    read = np.zeros(len(near), dtype=bool)
+    owned_row = np.zeros(len(near), dtype=bool)
+    owned_row[np.searchsorted(near, owned)] = True
+    read[bonds.neighbours[np.repeat(owned_row, np.diff(bonds.offsets))]] = True
+    unread = ~read[np.searchsorted(near, ghosts)]
+    ghosts = ghosts[np.lexsort((ghosts, unread, owner[ghosts]))]
     clear = clearance(bonds.offsets, bonds.neighbours, np.searchsorted(near, owned), GHOST_LAYERS)
     owned = owned[np.argsort(-clear, kind="stable")]  # farthest from the ghosts first
     clear_rows = tuple(int(np.count_nonzero(clear >= c)) for c in range(1, GHOST_LAYERS + 1))

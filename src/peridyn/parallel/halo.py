@@ -11,8 +11,9 @@ A rank owns some points and keeps copies (ghosts) of the points it needs from ot
   a single exchange of u per step.
 
 Local numbering: owned points first, then the ghosts grouped by the rank that owns them (ranks
-ascending, global order within a rank), so that each rank's ghosts are one block of rows that a
-message fills in place. The owned points are ordered by their ``clearance`` from the ghosts,
+ascending), so that each rank's ghosts are one block of rows that a message fills in place; in
+a block, the layer-1 ghosts (those an owned point's family holds) come first, each layer in
+global order. The owned points are ordered by their ``clearance`` from the ghosts,
 the farthest first (global order within a clearance), so that the rows a force needs no ghost
 for are leading blocks, computed while the ghosts' values are on their way.
 """
@@ -117,7 +118,7 @@ def plan_halo(comm, owned_ids: np.ndarray, ghost_ids: np.ndarray, ghost_owner: n
     """The exchange plan of one rank (collective: every rank calls it).
 
     ``owned_ids`` (global) are this rank's points in local order, ``ghost_ids`` its ghosts in local
-    order (grouped by owner rank ascending, global order within) and ``ghost_owner`` their ranks.
+    order (grouped by owner rank ascending) and ``ghost_owner`` their ranks.
     """
     n_owned = len(owned_ids)
     recv_ranks = np.unique(ghost_owner)

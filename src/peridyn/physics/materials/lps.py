@@ -176,6 +176,7 @@ class LPSModel(Model):
         )
         self._theta = np.empty(body.n_points, dtype=self.dtype)
         self._p = np.empty(body.n_points, dtype=self.dtype)
+        self._rows_read_cache: dict[int, int] = {}
         self._fused_cache: dict = {}
 
     def _shear_correction_factor(self, w: np.ndarray) -> np.ndarray:
@@ -305,9 +306,9 @@ class LPSModel(Model):
     def force_overlapped(self, u, out, clear_rows, n_owned, finish):
         """See ``Model.force_overlapped``. The dilatation of the first ``clear_rows[0]`` rows
         and the force of the first ``clear_rows[1]`` (whose neighbours are all among the
-        former) need no ghost value; after ``finish()`` the dilatation of every other row (the
-        ghosts' included: an owned point's force reads its neighbours') and the other owned
-        rows' force."""
+        former) need no ghost value; after ``finish()`` the dilatation of the other rows that
+        an owned row's force reads (its neighbours', layer-1 ghosts included: ``_rows_read``)
+        and the other owned rows' force."""
         clear, clear_force = clear_rows[0], clear_rows[1]
         theta, p, p_coef = self._theta, self._p, self._p_coef
         state = self._as_state(u)
@@ -324,12 +325,21 @@ class LPSModel(Model):
             self._pair_force(state, self._row_offsets(0, clear_force), p, out)
         finish()
         state = self._refresh_ghosts(state, u, n_owned)
-        rest = self._dilatation(state, self._row_offsets(clear, len(theta)), self._scratch(theta))
-        theta[clear:] = rest[clear:]
-        np.multiply(theta[clear:], p_coef[clear:], out=p[clear:])
+        read = self._rows_read(n_owned)  # the ghosts after it (layer 2) are read by no owned row
+        rest = self._dilatation(state, self._row_offsets(clear, read), self._scratch(theta))
+        theta[clear:read] = rest[clear:read]
+        np.multiply(theta[clear:read], p_coef[clear:read], out=p[clear:read])
         rest = self._pair_force(state, self._row_offsets(clear_force, n_owned), p, self._scratch(out))
         out[clear_force:n_owned] = rest[clear_force:n_owned]
         return out
+
+    def _rows_read(self, n_owned: int) -> int:
+        """1 + the last row that a family of the rows ``0 .. n_owned - 1`` holds (at least
+        ``n_owned``): the rows whose dilatation their forces read end there."""
+        if n_owned not in self._rows_read_cache:
+            held = self.bonds.neighbours[: self.bonds.offsets[n_owned]]
+            self._rows_read_cache[n_owned] = max(n_owned, int(held.max()) + 1 if len(held) else 0)
+        return self._rows_read_cache[n_owned]
 
     def energy_density(self, u):
         b = self.bonds
