@@ -39,6 +39,24 @@ def test_pair_matrix_is_scipys_coo_conversion(monkeypatch, chunk):
     np.testing.assert_array_equal(got.data, expected.data)  # exact: the same sums in the same order
 
 
+@pytest.mark.parametrize("chunk", [2**22, 1000, 1], ids=["one chunk", "chunks", "a row per chunk"])
+def test_zeros_dropped_chunk_by_chunk_are_the_whole_matrix_without_them(monkeypatch, chunk):
+    """``drop_zeros`` (the AMG proxy's: an axis-parallel bond's block is mostly zeros, which a
+    whole matrix held all at once) gives the canonical matrix less its zero entries, same bits."""
+    model = small_model("pmb", n=6)  # a grid: most bonds along an axis or a face diagonal
+    i, j, n_vec, coef = _bonds(model)
+    n = model.body.n_points
+    expected = stiffness.pair_matrix(i, j, n_vec, coef, n)
+    zeros = int(np.count_nonzero(expected.data == 0))
+    expected.eliminate_zeros()
+    monkeypatch.setattr(stiffness, "PAIR_CHUNK_ENTRIES", chunk)
+    got = stiffness.pair_matrix(i, j, n_vec, coef, n, drop_zeros=True)
+    assert zeros > got.nnz // 10  # there were zeros to drop
+    assert got.has_canonical_format and not np.any(got.data == 0)
+    for attr in ("indptr", "indices", "data"):
+        np.testing.assert_array_equal(getattr(got, attr), getattr(expected, attr))
+
+
 def test_pair_matrix_without_bonds():
     got = stiffness.pair_matrix(np.zeros(0, int), np.zeros(0, np.int32), np.zeros((0, 3)), np.zeros(0), 4)
     assert got.shape == (12, 12) and got.nnz == 0

@@ -88,10 +88,10 @@ def proxy_stiffness(model: Model, dofs: np.ndarray) -> sp.csr_matrix:
     i, j = owners[short], b.neighbours[short]
     n_vec = (x[j] - x[i]) / b.length[short, None]
     coef = model.body.volumes[i] / b.length[short] ** 2
-    proxy = pair_matrix(i, j, n_vec, coef, model.body.n_points)
+    # an axis-parallel bond couples one component of each point only: most entries are zeros
+    proxy = pair_matrix(i, j, n_vec, coef, model.body.n_points, drop_zeros=True)
     if not np.array_equal(dofs, np.arange(proxy.shape[0])):  # no copy of a free body's matrix
         proxy = proxy[dofs][:, dofs].tocsr()
-    proxy.eliminate_zeros()  # an axis-parallel bond couples one component of each point only
     return proxy
 
 

@@ -137,15 +137,19 @@ def assemble_stiffness(model: Model, energy_of: np.ndarray | None = None) -> sp.
     return stiffness_parts(model, energy_of).assemble()
 
 
-#: Entries (duplicates included) of the pair-matrix rows handled at once: 12 B each, 400 MB.
-PAIR_CHUNK_ENTRIES = 2**25
+#: Entries (duplicates included) of the pair-matrix rows handled at once: 12 B each, 48 MB (400
+#: MB at 2**25 was the peak of an MPI rank's modal run: 990 of 1031 MiB for the 135k plate's
+#: proxy, whose matrix holds 44 MB; the rows' sums are the same bits at any chunk size).
+PAIR_CHUNK_ENTRIES = 2**22
 
 
-def pair_matrix(i, j, n_vec, coef, n_points) -> sp.csr_matrix:
+def pair_matrix(i, j, n_vec, coef, n_points, drop_zeros: bool = False) -> sp.csr_matrix:
     """Sum over bonds of coef (n n^T) / 2 on the blocks ii, jj and -coef (n n^T) / 2 on ij, ji.
 
     ``i``, ``j``: (n_bonds,) int; ``n_vec``: (n_bonds, 3) float64; ``coef``: (n_bonds,) float64.
-    Returns (3 n_points, 3 n_points) CSR, canonical (sorted, no duplicates). The rows are
+    Returns (3 n_points, 3 n_points) CSR, canonical (sorted, no duplicates); ``drop_zeros``:
+    without the entries that sum to zero (most of an axis-parallel bond's block), dropped chunk
+    by chunk, so that they are never all held at once. The rows are
     written with their duplicates by ``kernels.pairs`` a chunk of about ``PAIR_CHUNK_ENTRIES``
     entries at a time and summed by scipy, in the same order as scipy's COO conversion of the
     whole list (the same bits), without the 24 B per entry of a COO list of 36 entries per bond.
@@ -169,6 +173,8 @@ def pair_matrix(i, j, n_vec, coef, n_points) -> sp.csr_matrix:
         chunk = sp.csr_matrix((data, indices, indptr), shape=(stop - row, 3 * n_points))
         chunk.has_sorted_indices = False  # sort every row, as scipy sorts a whole unsorted matrix
         chunk.sum_duplicates()
+        if drop_zeros:
+            chunk.eliminate_zeros()
         chunks.append(chunk)
         row = stop
     if len(chunks) <= 1:

@@ -127,11 +127,10 @@ def block_lobpcg(
             pa, kpa = _m_orthonormal(dofs, p[:, active], kp[:, active], [x, w], [kx, kw])
             blocks.append(pa)
             images.append(kpa)
-        s, ks = np.hstack(blocks), np.hstack(images)
-        lam_all, c = np.linalg.eigh(_symmetric(dofs.gram(s, ks)))
+        lam_all, c = np.linalg.eigh(_symmetric(_block_gram(dofs, blocks, images)))
         lam, c = lam_all[:k], c[:, :k]
-        p, kp = s[:, k:] @ c[k:], ks[:, k:] @ c[k:]
-        x, kx = s @ c, ks @ c
+        p, kp = _combine(blocks[1:], c[k:]), _combine(images[1:], c[k:])
+        x, kx = _combine(blocks, c), _combine(images, c)
     raise InputError(
         f"lobpcg did not reach the residual {RESIDUAL_TARGET:g} in {max_iterations} iterations "
         f"(worst {worst:.2e})"
@@ -160,6 +159,28 @@ def _m_orthonormal(dofs: RankDofs, v, kv, against: list, against_k: list = ()):
         if kv is not None:
             kv = kv @ c
     return v, kv
+
+
+def _block_gram(dofs: RankDofs, blocks: list, images: list) -> np.ndarray:
+    """``[b_0 b_1 ...]^T [k_0 k_1 ...]`` over every rank's rows (one allreduce), without
+    stacking the blocks (n_free, k_i) side by side: a stacked copy of the search space and of its
+    image would be the largest arrays of an iteration."""
+    bounds = np.cumsum([0] + [b.shape[1] for b in blocks])
+    local = np.empty((bounds[-1], bounds[-1]))
+    for i, b in enumerate(blocks):
+        for j, kb in enumerate(images):
+            local[bounds[i] : bounds[i + 1], bounds[j] : bounds[j + 1]] = b.T @ kb
+    return dofs.domain.allsum(local)
+
+
+def _combine(blocks: list, c: np.ndarray) -> np.ndarray:
+    """``[b_0 b_1 ...] @ c`` for blocks (n_free, k_i) and ``c`` (sum k_i, m), block by block."""
+    start = blocks[0].shape[1]
+    out = blocks[0] @ c[:start]
+    for b in blocks[1:]:
+        out += b @ c[start : start + b.shape[1]]
+        start += b.shape[1]
+    return out
 
 
 def _symmetric(a: np.ndarray) -> np.ndarray:
