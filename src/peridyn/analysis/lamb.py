@@ -19,7 +19,8 @@ Dividing S by ``q`` and A by ``p`` removes the trivial roots ``q = 0`` and
 
 Both are real, entire functions of ``k`` and ``omega`` for real and imaginary
 ``p, q`` alike: no poles (unlike the ``tan`` forms), so every sign change of a
-scan in ``k`` brackets a root, refined by :func:`scipy.optimize.brentq`. The
+scan in ``k`` brackets a root, refined by a bracketing secant (Illinois) method
+that refines every bracket of every frequency at once. The
 group velocity ``d omega / d k = -F_k / F_omega`` comes from implicit
 differentiation of these functions, the partial derivatives taken by complex
 steps (exact to round-off).
@@ -63,8 +64,12 @@ _SIN_TERMS = np.array([(-1) ** n / math.factorial(2 * n + 1) for n in range(_N_T
 _CROSS_TERMS = np.outer(_SIN_TERMS, _SIN_TERMS) / (
     2.0 * np.add.outer(np.arange(_N_TERMS), np.arange(_N_TERMS)) + 3.0
 )
-#: Relative imaginary step of the complex-step derivatives in _group_velocity.
+#: Relative imaginary step of the complex-step derivatives in _group_velocities.
 _COMPLEX_STEP = 1e-30
+#: Relative width to which a root's bracket is refined (``_refine``).
+ROOT_RTOL = 1e-13
+#: Refinement steps after which a root that has not converged is an error (``_refine``).
+_MAX_REFINE_STEPS = 200
 #: Scan points per radian of the shear phase ``omega h / cT`` (and at least 400).
 _SCAN_DENSITY = 32
 #: Points of the scan over phase velocities below the shear speed.
@@ -278,14 +283,11 @@ def lamb_modes(
     freqs = _check_frequencies(frequencies)
     if max_order is not None and (int(max_order) != max_order or max_order < 0):
         raise InputError(f"max_order = {max_order!r}: must be a non-negative integer")
+    by_family = {family: _family_modes(plate, freqs, family) for family in "SA"}
     modes = []
-    for f in freqs.tolist():
+    for k in range(len(freqs)):
         for family in "SA":
-            modes.extend(
-                m
-                for m in _family_modes(plate, f, family)
-                if max_order is None or int(m.mode[1:]) <= max_order
-            )
+            modes.extend(m for m in by_family[family][k] if max_order is None or int(m.mode[1:]) <= max_order)
     return modes
 
 
@@ -435,7 +437,7 @@ def _thickness_functions(x, z, h: float):
     pos, neg = ~small & (x.real > 0), ~small & (x.real < 0)
     xs, zs = x[small], z[small]
     scale = np.exp(-np.sqrt(np.maximum(-xs.real, 0.0)) * h)
-    powers = np.power.outer(xs * zs**2, np.arange(_N_TERMS))
+    powers = _powers(xs * zs**2)
     c[small] = scale * (powers @ _COS_TERMS)
     s[small] = scale * zs * (powers @ _SIN_TERMS)
     r = np.sqrt(x[pos])
@@ -445,6 +447,17 @@ def _thickness_functions(x, z, h: float):
     c[neg] = (grow + decay) / 2.0
     s[neg] = -np.sign(z[neg]) * grow * np.expm1(-2.0 * a * zn) / (2.0 * a)
     return c, s
+
+
+def _powers(x: np.ndarray) -> np.ndarray:
+    """(len(x), _N_TERMS): ``x**0 .. x**(_N_TERMS - 1)`` of the Taylor series, by repeated
+    products (``np.power`` is several times slower; the products round within a few ulps of
+    it, far below the series' own truncation)."""
+    out = np.empty((len(x), _N_TERMS), dtype=np.result_type(x, 1.0))
+    out[:, 0] = 1.0
+    for n in range(1, _N_TERMS):
+        np.multiply(out[:, n - 1], x, out=out[:, n])
+    return out
 
 
 def _cross_term(p2, q2, gap, h: float, cp, sp, cq, sq):
@@ -460,11 +473,8 @@ def _cross_term(p2, q2, gap, h: float, cp, sp, cq, sq):
     """
     small = (np.abs(p2) * h * h < 1.0) & (np.abs(q2) * h * h < 1.0)
     direct = cp * sq - sp * cq
-    powers = np.arange(_N_TERMS)
     x, y = np.where(small, p2, 0.0) * h * h, np.where(small, q2, 0.0) * h * h
-    integral = (
-        np.einsum("in,nm,im->i", np.power.outer(x, powers), _CROSS_TERMS, np.power.outer(y, powers)) * h**3
-    )
+    integral = np.einsum("in,nm,im->i", _powers(x), _CROSS_TERMS, _powers(y)) * h**3
     scale = np.exp(-np.sqrt(np.maximum(-x.real, 0.0)) - np.sqrt(np.maximum(-y.real, 0.0)))
     return np.where(small, gap * scale * integral, direct)
 
@@ -490,8 +500,8 @@ def _lamb_function(plate: _Plate, k, omega: float, family: str) -> np.ndarray:
     return (omega / plate.ct) ** 4 * sp * cq + 4.0 * kk * q2 * cross
 
 
-def _group_velocity(plate: _Plate, k: float, omega: float, family: str) -> float:
-    """``d omega / d k = -F_k / F_omega`` at a root ``(k, omega)``.
+def _group_velocities(plate: _Plate, k: np.ndarray, omega: np.ndarray, family: str) -> np.ndarray:
+    """``d omega / d k = -F_k / F_omega`` at roots ``(k, omega)`` (arrays of one shape).
 
     Implicit differentiation of the dispersion function ``F``, its partial
     derivatives taken by complex steps, ``F_k = Im F(k + i e) / e``, which is
@@ -499,9 +509,9 @@ def _group_velocity(plate: _Plate, k: float, omega: float, family: str) -> float
     ratio because ``F = 0`` at the root.
     """
     dk, dw = _COMPLEX_STEP * k, _COMPLEX_STEP * omega
-    f_k = _lamb_function(plate, k + 1j * dk, omega, family)[0].imag / dk
-    f_w = _lamb_function(plate, k, omega + 1j * dw, family)[0].imag / dw
-    return float(-f_k / f_w)
+    f_k = _lamb_function(plate, k + 1j * dk, omega, family).imag / dk
+    f_w = _lamb_function(plate, k, omega + 1j * dw, family).imag / dw
+    return -f_k / f_w
 
 
 # --- roots and labels -------------------------------------------------------------
@@ -525,16 +535,53 @@ def _scan_grid(plate: _Plate, omega: float) -> np.ndarray:
     return np.concatenate([fast, slow[1:]])
 
 
-def _roots(plate: _Plate, omega: float, family: str) -> np.ndarray:
-    """Wavenumbers (rad/m) of all propagating modes of one symmetry, descending."""
+def _root_brackets(plate: _Plate, omega: float, family: str) -> list[tuple[float, float]]:
+    """Intervals of wavenumber (rad/m) holding one root each of one symmetry at ``omega``."""
     grid = _scan_grid(plate, omega)
 
     def f(k):
         return float(_lamb_function(plate, k, omega, family)[0])
 
-    brackets = _brackets(grid, _lamb_function(plate, grid, omega, family), f)
-    roots = [brentq(f, a, b, xtol=1e-300, rtol=1e-13) for a, b in brackets]
-    return np.sort(np.array(roots))[::-1]
+    return _brackets(grid, _lamb_function(plate, grid, omega, family), f)
+
+
+def _refine(plate: _Plate, omega: np.ndarray, family: str, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """The root (rad/m) in each bracket ``[lo, hi]`` (one sign change of ``F`` at ``omega``), to
+    ``ROOT_RTOL`` relative, every bracket at once.
+
+    Illinois steps (a secant through the bracket's ends whose end that stays twice in a row
+    has its value halved, which keeps the convergence superlinear), a bisection whenever a step
+    would leave the bracket or two steps have not halved it.
+    """
+    lo, hi = lo.astype(float), hi.astype(float)
+    f_lo = _lamb_function(plate, lo, omega, family)
+    f_hi = _lamb_function(plate, hi, omega, family)
+    root = np.where(f_lo == 0.0, lo, np.where(f_hi == 0.0, hi, np.nan))
+    width, side = hi - lo, np.zeros(len(lo), dtype=np.int8)
+    for it in range(_MAX_REFINE_STEPS):
+        open_ = np.flatnonzero(np.isnan(root))
+        if not open_.size:
+            return root
+        a, b, fa, fb = lo[open_], hi[open_], f_lo[open_], f_hi[open_]
+        c = (a * fb - b * fa) / (fb - fa)
+        bisect = ~((c > a) & (c < b)) | (it % 2 == 1) & (b - a > 0.5 * width[open_])
+        c = np.where(bisect, 0.5 * (a + b), c)
+        if it % 2 == 1:
+            width[open_] = b - a
+        fc = _lamb_function(plate, c, omega[open_], family)
+        left = np.signbit(fc) == np.signbit(fa)  # the root is in [c, b]: c replaces a
+        done = (fc == 0.0) | (np.where(left, b - c, c - a) <= ROOT_RTOL * np.abs(c))
+        root[open_[done]] = c[done]
+        # Illinois: the end kept twice in a row has its value halved
+        s_prev = side[open_]
+        f_hi[open_] = np.where(left & (s_prev == 1), 0.5 * fb, fb)
+        f_lo[open_] = np.where(~left & (s_prev == -1), 0.5 * fa, fa)
+        lo[open_] = np.where(left, c, a)
+        f_lo[open_] = np.where(left, fc, f_lo[open_])
+        hi[open_] = np.where(left, b, c)
+        f_hi[open_] = np.where(left, f_hi[open_], fc)
+        side[open_] = np.where(left, 1, -1)
+    raise RuntimeError(f"Rayleigh-Lamb roots not refined in {_MAX_REFINE_STEPS} steps")
 
 
 def _brackets(grid, values, f) -> list[tuple[float, float]]:
@@ -563,21 +610,34 @@ def _brackets(grid, values, f) -> list[tuple[float, float]]:
     return brackets
 
 
-def _family_modes(plate: _Plate, frequency: float, family: str) -> list[LambMode]:
-    """The modes of one symmetry at one frequency, labelled by branch.
+def _family_modes(plate: _Plate, frequencies: np.ndarray, family: str) -> list[list[LambMode]]:
+    """The modes of one symmetry at each of ``frequencies`` (Hz), labelled by branch.
 
     In descending ``k`` the branches come in order; a forward root opens the
     next branch and a backward root (``cg < 0``) belongs to the branch of the
     forward root just before it (the two meet at the branch's ZGV point).
     """
-    omega = 2.0 * math.pi * frequency
-    modes, forward = [], 0
-    for k in _roots(plate, omega, family).tolist():
-        cg = _group_velocity(plate, k, omega, family)
-        order = forward - 1 if cg < 0 else forward
-        forward += cg >= 0
-        modes.append(LambMode(f"{family}{order}", float(frequency), omega / k, cg, k))
-    return sorted(modes, key=lambda m: int(m.mode[1:]))
+    omegas = 2.0 * np.pi * np.asarray(frequencies, dtype=float)
+    found = [(i, a, b) for i, omega in enumerate(omegas) for a, b in _root_brackets(plate, omega, family)]
+    owner = np.array([i for i, _, _ in found], dtype=np.int64)
+    omega = omegas[owner]
+    roots = _refine(
+        plate, omega, family, np.array([a for _, a, _ in found]), np.array([b for _, _, b in found])
+    )
+    speeds = _group_velocities(plate, roots, omega, family) if len(roots) else roots
+    table = []
+    for i, frequency in enumerate(np.asarray(frequencies, dtype=float).tolist()):
+        mine = np.flatnonzero(owner == i)
+        modes, forward = [], 0
+        for r in mine[np.argsort(-roots[mine], kind="stable")]:
+            cg = float(speeds[r])
+            order = forward - 1 if cg < 0 else forward
+            forward += cg >= 0
+            modes.append(
+                LambMode(f"{family}{order}", frequency, float(omegas[i] / roots[r]), cg, float(roots[r]))
+            )
+        table.append(sorted(modes, key=lambda m: int(m.mode[1:])))
+    return table
 
 
 def _branch(label: str, modes: list[LambMode]) -> DispersionBranch:
