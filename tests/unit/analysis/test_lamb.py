@@ -319,3 +319,20 @@ def test_plot_draws_every_branch_in_both_panels():
     ax_c, ax_k = fig.axes[:2]
     assert [line.get_label() for line in ax_k.lines] == list(curves)
     assert [line.get_linestyle() for line in ax_c.lines] == ["-", "--", "--"]
+
+
+@pytest.mark.parametrize("family", ["S", "A"])
+def test_roots_refined_together_are_brents_roots(family):
+    """Every bracket of every frequency refined at once (``_refine``, Illinois steps) lands on
+    the root scipy's ``brentq`` finds in that bracket, to the 1e-13 both are asked for."""
+    from peridyn.analysis import lamb
+
+    plate = lamb._plate(E, NU, RHO, THICKNESS)
+    omegas = 2 * np.pi * np.array([2e3, 150e3, 900e3, 2.5e6])
+    found = [(w, a, b) for w in omegas for a, b in lamb._root_brackets(plate, w, family)]
+    omega, lo, hi = (np.array(column) for column in zip(*found, strict=True))
+    refined = lamb._refine(plate, omega, family, lo, hi)
+    for w, a, b, k in zip(omega, lo, hi, refined, strict=True):
+        expected = brentq(lambda x, w=w: lamb._lamb_function(plate, x, w, family)[0], a, b, rtol=1e-13)
+        assert k == pytest.approx(expected, rel=3e-13)
+    assert len(found) > len(omegas)  # higher modes too, not only S0 or A0
