@@ -313,7 +313,7 @@ def _draws_run_figures(case: Case) -> bool:
 def _finish(case, setup, out, summary, plots, start, worker=None) -> None:
     """Analyses, figures and the stored summary after the solve; the status becomes complete
     (on rank 0, with the damage of the whole body). ``worker``: a figure worker
-    (``start_figure_worker``) that draws the run figures while this process analyses."""
+    (``figure_worker_for``) that draws the run figures while this process analyses."""
     d = setup.domain
     phi = d.gather(damage_field(setup.model)) if setup.damage is not None else None
     d.on_root(_finish_on_root, case, setup.whole_body, out, summary, plots, start, phi, worker)
