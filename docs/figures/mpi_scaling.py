@@ -18,9 +18,8 @@ One explicit step on P ranks of one thread each takes
   (e = t(1 x 1) / (C t(1 x C)), the 1-rank runs on one and on C threads; ``core_efficiency``:
   what the one-thread coefficients miss in a whole step on all cores, the threaded run's serial
   parts included; not the cores' sharing alone, which ``benchmarks/core_sharing.py`` measures);
-- ``t_root``: the recorder's time per step (observers), on rank 0 alone, beside its part (made
-  smaller by ``peridyn.jobs.rank_shares``): the step waits for the busiest of rank 0's part plus
-  t_root and the others' parts;
+- ``t_root``: the recorder's time per step (observers), on rank 0 alone, not divided (the other
+  ranks wait for its outcome: ``benchmarks/mpi_wait_trace.py``);
 - ``t_halo = m alpha + s / beta``: the largest rank's counted messages m and bytes s per step,
   with the latency alpha and bandwidth beta of ``benchmarks/mpi_pingpong.py``;
 - ``t_gather``: a series record checks the state (an allgather: ``2 log2(P) alpha``), gathers
@@ -115,6 +114,7 @@ def predicted_step(c: dict, run: dict) -> dict:
     """The model's seconds per step of a measured MPI run, by term."""
     per_rank = run["per_rank"]
     owned = [r["owned"] for r in per_rank]
+    n_r = max(owned)
     ranks = run["ranks"]
     halo = max(r["messages_per_step"] * c["alpha"] + r["bytes_per_step"] / c["beta"] for r in per_rank)
     messages = ranks - 1 + 3 * math.log2(ranks)
@@ -122,12 +122,9 @@ def predicted_step(c: dict, run: dict) -> dict:
     gather = messages * c["alpha"] + 24.0 * others / c["beta"]
     shared = max(1.0, ranks / c["cpus"])  # more ranks than cores: each gets cpus / ranks of one
     shared /= c["core_efficiency"]  # several cores at work: each slower in a whole step
-    compute = [shared * (c["t_bond"] * c["bonds"] * n / c["points"] + c["t_point"] * n) for n in owned]
     terms = {
-        "compute": max(compute),
-        # rank 0 records beside its part (smaller by ``jobs.rank_shares``): what of it the
-        # others' larger parts do not cover
-        "root": max(0.0, compute[0] + c["t_root"] - max(compute)),
+        "compute": shared * (c["t_bond"] * c["bonds"] * n_r / c["points"] + c["t_point"] * n_r),
+        "root": c["t_root"],
         "halo": halo,
         "gather": gather,
     }

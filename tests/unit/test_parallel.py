@@ -54,19 +54,6 @@ def test_rcb_refuses_more_parts_than_points():
         rcb(np.zeros((4, 3)), 5)
 
 
-@pytest.mark.parametrize("shares", [[0.9, 1.1], [1.0, 2.0, 2.0], [0.5, 1.0, 1.0, 1.0, 1.2]])
-def test_rcb_parts_follow_their_shares(shares):
-    body = geometry.box((0.031, 0.017, 0.005), 1e-3)
-    part = rcb(body.points, len(shares), shares)
-    counts = np.bincount(part, minlength=len(shares))
-    expected = body.n_points * np.asarray(shares) / np.sum(shares)
-    assert counts.sum() == body.n_points
-    assert np.abs(counts - expected).max() <= 1 + np.ceil(np.log2(len(shares)))  # a point a cut
-    assert np.array_equal(rcb(body.points, 3, [1.0, 1.0, 1.0]), rcb(body.points, 3))  # equal: as before
-    with pytest.raises(InputError, match="shares must be 2 positive numbers"):
-        rcb(body.points, 2, [1.0, 0.0])
-
-
 def test_rcb_cuts_the_longest_side_first():
     body = geometry.rectangle(0.040, 0.004, 1e-3, thickness=1e-3)
     part = rcb(body.points, 2)

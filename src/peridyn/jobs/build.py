@@ -26,7 +26,6 @@ from peridyn.discretization.bonds import (
 from peridyn.errors import CaseFileError, InputError
 from peridyn.io import exodus, mesh_text
 from peridyn.io.case import Case, Geometry, Region, box_cells
-from peridyn.jobs.rank_shares import rank_shares
 from peridyn.parallel.contact import RankContact
 from peridyn.parallel.domain import Domain, agree
 from peridyn.parallel.halo import Halo, clearance, ghost_layers, plan_halo
@@ -397,11 +396,10 @@ def _build_part(case: Case, comm, base_dir):
     body, actuation = add_actuators(case, body)
     loading = build_loading(case, body, actuation)
     check_loading(case, loading)
-    reach = bond_reach(case, body)
-    owner = rcb(body.points, comm.size, rank_shares(case, body, comm.size, reach))
+    owner = rcb(body.points, comm.size)
     owned = np.flatnonzero(owner == comm.rank)
     of_block = block_index(case, body) if case.blocks else None  # of the whole body's points
-    ghosts = ghost_layers(body.points, owned, reach, GHOST_LAYERS)
+    ghosts = ghost_layers(body.points, owned, bond_reach(case, body), GHOST_LAYERS)
     near = np.union1d(owned, ghosts)
     bonds = build_bonds(
         case,

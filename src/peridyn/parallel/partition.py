@@ -20,7 +20,7 @@ import numpy as np
 from peridyn.errors import InputError
 
 
-def rcb(points: np.ndarray, n_parts: int, shares=None) -> np.ndarray:
+def rcb(points: np.ndarray, n_parts: int) -> np.ndarray:
     """The part (0 .. n_parts - 1) of each point, (n_points,) int64.
 
     Parameters
@@ -29,26 +29,19 @@ def rcb(points: np.ndarray, n_parts: int, shares=None) -> np.ndarray:
         2D bodies (z = 0) are cut in the plane: a zero extent is never the longest.
     n_parts : int
         At least 1 and at most n_points.
-    shares : (n_parts,) float, optional
-        Relative sizes of the parts (positive); default equal.
 
-    Part sizes differ by at most one point from n_points x share / the shares' sum (rounded
-    at each cut); with equal shares, from n_points / n_parts.
+    Part sizes differ by at most one point from n_points / n_parts (rounded at each cut).
     """
     points = np.asarray(points, dtype=np.float64)
     n = len(points)
     if not 1 <= n_parts <= n:
         raise InputError(f"cannot split {n} points into {n_parts} parts: use 1 to {n} ranks")
-    if shares is not None:
-        shares = np.asarray(shares, dtype=np.float64)
-        if shares.shape != (n_parts,) or not np.all(np.isfinite(shares) & (shares > 0)):
-            raise InputError(f"rcb: shares must be {n_parts} positive numbers, got {shares!r}")
     part = np.empty(n, dtype=np.int64)
-    _bisect(points, np.arange(n), 0, n_parts, part, shares)
+    _bisect(points, np.arange(n), 0, n_parts, part)
     return part
 
 
-def _bisect(points: np.ndarray, idx: np.ndarray, first: int, n_parts: int, part: np.ndarray, shares) -> None:
+def _bisect(points: np.ndarray, idx: np.ndarray, first: int, n_parts: int, part: np.ndarray) -> None:
     """Assign the points ``idx`` to parts ``first .. first + n_parts - 1``."""
     if n_parts == 1:
         part[idx] = first
@@ -57,11 +50,6 @@ def _bisect(points: np.ndarray, idx: np.ndarray, first: int, n_parts: int, part:
     axis = int(np.argmax(np.ptp(x, axis=0)))
     order = np.lexsort((idx, x[:, axis]))  # by coordinate, then by point index
     left = n_parts // 2
-    if shares is None:
-        cut = (len(idx) * left) // n_parts
-    else:
-        group = shares[first : first + n_parts]
-        cut = int(round(len(idx) * group[:left].sum() / group.sum()))
-        cut = min(max(cut, left), len(idx) - (n_parts - left))  # a point for every part
-    _bisect(points, idx[order[:cut]], first, left, part, shares)
-    _bisect(points, idx[order[cut:]], first + left, n_parts - left, part, shares)
+    cut = (len(idx) * left) // n_parts
+    _bisect(points, idx[order[:cut]], first, left, part)
+    _bisect(points, idx[order[cut:]], first + left, n_parts - left, part)
