@@ -23,6 +23,7 @@ from contextlib import contextmanager
 import numba
 import numpy as np
 
+from peridyn.errors import InputError
 from peridyn.io.case import Case
 from peridyn.jobs.estimate import grid_shape
 
@@ -44,7 +45,11 @@ def figure_worker_for(case: Case, base_dir=".", wanted: bool = True) -> Iterator
     if not wanted or case.geometry.is_mesh or _threads() < 2:
         yield None
         return
-    if np.prod(grid_shape(case, base_dir)[0]) < MIN_POINTS:
+    try:
+        points = np.prod(grid_shape(case, base_dir)[0])
+    except InputError:  # a bad grid: the build reports it
+        points = 0
+    if points < MIN_POINTS:
         yield None
         return
     pool = ProcessPoolExecutor(1, mp_context=multiprocessing.get_context("spawn"), initializer=_initialise)
