@@ -479,8 +479,9 @@ def _cross_term(p2, q2, gap, h: float, cp, sp, cq, sq):
     return np.where(small, gap * scale * integral, direct)
 
 
-def _lamb_function(plate: _Plate, k, omega: float, family: str) -> np.ndarray:
-    """Scaled Rayleigh-Lamb function of one symmetry at wavenumbers ``k`` (rad/m).
+def _lamb_function(plate: _Plate, k, omega, family: str) -> np.ndarray:
+    """Scaled Rayleigh-Lamb function of one symmetry at wavenumbers ``k`` (rad/m) and angular
+    frequency ``omega`` (rad/s: a number, or an array of ``k``'s shape, one per wavenumber).
 
     S: ``(q^2 - k^2)^2 C(p^2) S(q^2) + 4 k^2 p^2 S(p^2) C(q^2)``. A: the module's
     form rewritten with ``(q^2 - k^2)^2 = (q^2 + k^2)^2 - 4 k^2 q^2``,
@@ -564,7 +565,9 @@ def _refine(plate: _Plate, omega: np.ndarray, family: str, lo: np.ndarray, hi: n
             return root
         a, b, fa, fb = lo[open_], hi[open_], f_lo[open_], f_hi[open_]
         c = (a * fb - b * fa) / (fb - fa)
-        bisect = ~((c > a) & (c < b)) | (it % 2 == 1) & (b - a > 0.5 * width[open_])
+        outside = ~((c > a) & (c < b))
+        slow = (it % 2 == 1) & (b - a > 0.5 * width[open_])  # two steps have not halved it
+        bisect = outside | slow
         c = np.where(bisect, 0.5 * (a + b), c)
         if it % 2 == 1:
             width[open_] = b - a

@@ -414,7 +414,7 @@ def _build_part(case: Case, comm, base_dir):
     read = np.zeros(len(near), dtype=bool)
     owned_row = np.zeros(len(near), dtype=bool)
     owned_row[np.searchsorted(near, owned)] = True
-    read[bonds.neighbours[np.repeat(owned_row, np.diff(bonds.offsets))]] = True
+    read[bonds.neighbours[owned_row[bonds.owners()]]] = True
     unread = ~read[np.searchsorted(near, ghosts)]
     ghosts = ghosts[np.lexsort((ghosts, unread, owner[ghosts]))]
     clear = clearance(bonds.offsets, bonds.neighbours, np.searchsorted(near, owned), GHOST_LAYERS)
