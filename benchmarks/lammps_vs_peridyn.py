@@ -12,6 +12,13 @@ shared machine hits both alike. Rates are directed bond updates per second, best
 - LAMMPS "loop": bonds x steps / the whole loop time (adds the ghost exchange and NVE);
 - peridyn: the ``peridyn bench`` rows (one force evaluation, best of its rounds).
 
+Threads are bound on both sides: Open MPI's ``mpirun`` binds each LAMMPS rank to a core
+(``--report-bindings`` shows it for 2 ranks), and the script sets ``OMP_PROC_BIND``
+(``--thread-binding``, default ``spread``) before peridyn's first kernel, which binds numba's
+threads to cores. Unbound, about one process in five ran peridyn's kernels at 0.8 of the
+bound rate on the 2-core VM of ``RESULTS.md``. LAMMPS is started with the CPU set the script
+started with, not the core its bound main thread then holds.
+
 Writes ``benchmarks/lammps_vs_peridyn.json`` (command, machine, date, load averages)::
 
     PYTHONPATH=src python benchmarks/lammps_vs_peridyn.py --rounds 3
@@ -34,6 +41,7 @@ from bench_kernels import machine
 from peridyn.jobs.bench import run_benchmark
 
 HERE = Path(__file__).resolve().parent
+START_CPUS = os.sched_getaffinity(0)  # before numba binds this process's main thread
 LAMMPS_DIR = HERE / "lammps"
 SIDE = 49
 
@@ -69,7 +77,12 @@ def run_lammps(style: str, steps: int, ranks: int) -> dict:
     if os.geteuid() == 0:  # Open MPI refuses root without these
         env.update(OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
     cmd = lammps_command(style, steps, ranks)
-    proc = subprocess.run(cmd, cwd=LAMMPS_DIR, env=env, capture_output=True, text=True, check=True)
+    bound = os.sched_getaffinity(0)
+    os.sched_setaffinity(0, START_CPUS)  # the child inherits the CPU set of this thread
+    try:
+        proc = subprocess.run(cmd, cwd=LAMMPS_DIR, env=env, capture_output=True, text=True, check=True)
+    finally:
+        os.sched_setaffinity(0, bound)
     r = parse_lammps(proc.stdout)
     work = r["bonds"] * r["steps"]
     return {**r, "pair_rate": work / r["pair_s"], "loop_rate": work / r["loop_s"]}
@@ -82,7 +95,14 @@ def main(argv: list[str] | None = None) -> dict:
     parser.add_argument("--ranks", type=int, default=2, help="LAMMPS MPI ranks")
     parser.add_argument("--repeat", type=int, default=5, help="peridyn bench rounds per round")
     parser.add_argument("--output", "-o", type=Path, default=HERE / "lammps_vs_peridyn.json")
+    parser.add_argument(
+        "--thread-binding",
+        default="spread",
+        help="OMP_PROC_BIND for peridyn's numba threads unless already set; 'none' leaves them unbound",
+    )
     args = parser.parse_args(argv)
+    if args.thread_binding != "none":
+        os.environ.setdefault("OMP_PROC_BIND", args.thread_binding)
     load_before = os.getloadavg()[0]
     lammps = {"pmb": [], "lps": []}
     peridyn = []
@@ -133,6 +153,7 @@ def main(argv: list[str] | None = None) -> dict:
         "lammps_runs": lammps,
         "lammps_best": best_l,
         "peridyn_threads": peridyn[0]["threads"],
+        "peridyn_omp_proc_bind": peridyn[0]["omp_proc_bind"],
         "peridyn_runs": peridyn,  # every round's full ``peridyn bench`` result (roofs included)
         "rows": rows,
     }

@@ -2,8 +2,8 @@
 
 Oracle: the float64 kernels as they were before the chunks (``single_loop_kernels``, one
 loop per family, same ``FASTMATH``, gathering the neighbours' positions). Same operations in
-the same order give the same bits, whatever the chunk boundaries (the families here have 19
-to 44 bonds, ``CHUNK`` 16), and whether ``xi = x_j - x_i`` is computed in the loop or read
+the same order give the same bits, whatever the chunk boundaries (the families here have 41
+to 99 bonds, ``CHUNK`` 32: up to four chunks, the last one partial), and whether ``xi = x_j - x_i`` is computed in the loop or read
 from the stored bond vectors (``initial_bond_vectors``, the same subtraction).
 """
 
@@ -19,9 +19,9 @@ pytestmark = pytest.mark.kernels
 
 
 def test_chunks_sum_in_written_order(rng):
-    fam = jittered_families(rng)
+    fam = jittered_families(rng, shape=(5, 5, 4), horizon_factor=3.015)
     sizes = np.diff(fam.offsets)
-    assert sizes.max() > 2 * CHUNK and np.any(sizes % CHUNK)  # up to three chunks, partial ones
+    assert sizes.max() > 2 * CHUNK and np.any(sizes % CHUNK)  # several chunks, partial ones
     x, u = fam.x, displacement(rng, fam, 1e-3)
     k, w, dev = (per_bond(rng, fam, s) for s in (1e14, 1.0, 1e14))
     theta_coef = rng.uniform(0.5, 1.5, fam.n)

@@ -28,7 +28,14 @@ TINY_TRIAD = 1 << 16
 
 
 def _check(result, points):
-    assert set(result) == {"bandwidth_bytes_per_s", "sqrt_per_s", "div_per_s", "threads", "results"}
+    assert set(result) == {
+        "bandwidth_bytes_per_s",
+        "sqrt_per_s",
+        "div_per_s",
+        "threads",
+        "omp_proc_bind",
+        "results",
+    }
     bandwidth = result["bandwidth_bytes_per_s"]
     assert bandwidth > 0
     for rates in (result["sqrt_per_s"], result["div_per_s"]):
@@ -54,10 +61,15 @@ def _check(result, points):
     assert rows[0]["speedup_vs_baseline"] == pytest.approx(1.0)
 
 
-def test_run_benchmark_tiny_grid():
+def test_run_benchmark_tiny_grid(monkeypatch):
+    monkeypatch.delenv("OMP_PROC_BIND", raising=False)
     result = benchmark.run_benchmark(points=8**3, repeat=1, triad_elements=TINY_TRIAD)
     _check(result, 512)
-    assert "pmb-baseline" in benchmark.format_table(result)
+    assert result["omp_proc_bind"] is None
+    table = benchmark.format_table(result)
+    assert "pmb-baseline" in table and "OMP_PROC_BIND" not in table
+    # the table says when the threads were bound
+    assert "(OMP_PROC_BIND=spread)" in benchmark.format_table({**result, "omp_proc_bind": "spread"})
 
 
 def test_bench_cli_json(monkeypatch, capsys):

@@ -18,6 +18,10 @@ passes count as one update of each bond):
 Timing: every row is called once first (JIT compilation or cache load, excluded); then
 ``repeat`` rounds each call every row once, in turn, and a row's time is its best
 round. Interleaving the rows makes their ratios robust to a machine whose load drifts.
+The result records ``omp_proc_bind``, the ``OMP_PROC_BIND`` of the process's environment
+(``None``: numba's threads unbound). Bound threads give steadier rates: on the 2-core VM of
+``benchmarks/RESULTS.md`` about one process in five ran its unbound threads at 0.8 of the bound
+rate for its whole life (see the user guide's "Threads").
 
 Memory bandwidth: a STREAM-like triad ``a[:] = b + s c`` (numba ``prange``, float64
 arrays of ``triad_elements`` items, 128 MiB each by default, far beyond any L3),
@@ -54,6 +58,7 @@ Two roofs, each a bond-update rate that one resource alone would allow:
 
 from __future__ import annotations
 
+import os
 import time
 from collections.abc import Callable
 
@@ -273,8 +278,15 @@ def run_benchmark(
         "sqrt_per_s": {dtype: float(r[0]) for dtype, r in rates.items()},
         "div_per_s": {dtype: float(r[1]) for dtype, r in rates.items()},
         "threads": int(numba.get_num_threads()),
+        "omp_proc_bind": os.environ.get("OMP_PROC_BIND"),
         "results": results,
     }
+
+
+def _binding(result: dict) -> str:
+    """`` (OMP_PROC_BIND=...)`` when the benchmark's threads were bound, else nothing."""
+    bind = result.get("omp_proc_bind")
+    return f" (OMP_PROC_BIND={bind})" if bind else ""
 
 
 def format_table(result: dict) -> str:
@@ -282,7 +294,7 @@ def format_table(result: dict) -> str:
     rows = result["results"]
     head = (
         f"{rows[0]['points']} points, {rows[0]['bonds']} directed bonds, "
-        f"{result['threads']} numba threads, triad bandwidth "
+        f"{result['threads']} numba threads{_binding(result)}, triad bandwidth "
         f"{result['bandwidth_bytes_per_s'] / 1e9:.1f} GB/s; square roots / divisions per ns: "
         + ", ".join(
             f"{dtype} {result['sqrt_per_s'][dtype] / 1e9:.2f} / {result['div_per_s'][dtype] / 1e9:.2f}"

@@ -62,8 +62,12 @@ from numba.core import cgutils
 from numba.extending import intrinsic, overload
 
 #: Bonds per chunk of the force kernels' two-loop form (see above); the stack buffer of a
-#: kernel holds 4 values per bond of a chunk (``CHUNK_BUFFER``).
-CHUNK = 16
+#: kernel holds 4 values per bond of a chunk (``CHUNK_BUFFER``). 32 bonds give the vector loop
+#: four independent 8-lane iterations whose gathers, square roots and divisions overlap while
+#: the previous chunk's sums run; 16 left the loop waiting on one iteration's latency and 64 or
+#: more delay the sums (``benchmarks/RESULTS.md``: PMB float64 1.06-1.07x over 16, float32
+#: 1.15x, LPS 1.04-1.07x; the chunk size does not change the bits).
+CHUNK = 32
 CHUNK_BUFFER = 4 * CHUNK
 
 #: Fast-math flags used by the force kernels: fused multiply-adds, no signed zeros, reciprocal
@@ -143,7 +147,9 @@ def _stack_pointer(typingctx, size, dtype):
     n = size.literal_value
 
     def codegen(context, builder, signature, args):
-        return cgutils.alloca_once(builder, context.get_value_type(dtype.dtype), size=n)
+        ptr = cgutils.alloca_once(builder, context.get_value_type(dtype.dtype), size=n)
+        ptr.align = 64  # one cache line: the vector loop's stores then never split across two
+        return ptr
 
     return types.CPointer(dtype.dtype)(size, dtype), codegen
 
