@@ -3,8 +3,9 @@
 Oracle: the float64 kernels as they were before the chunks (``single_loop_kernels``, one
 loop per family, same ``FASTMATH``, gathering the neighbours' positions). Same operations in
 the same order give the same bits, whatever the chunk boundaries (the families here have 41
-to 99 bonds, ``CHUNK`` 32: up to four chunks, the last one partial), and whether ``xi = x_j - x_i`` is computed in the loop or read
-from the stored bond vectors (``initial_bond_vectors``, the same subtraction).
+to 99 bonds, ``CHUNK`` 32: up to four chunks, the last one partial), and whether
+``xi = x_j - x_i`` is computed in the loop or read from the stored bond vectors
+(``initial_bond_vectors``, the same subtraction).
 """
 
 import numpy as np

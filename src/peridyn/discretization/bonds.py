@@ -302,20 +302,6 @@ def reorder_bonds(bonds: Bonds, order: np.ndarray, n_points: int) -> Bonds:
     )
 
 
-def range_offsets(offsets: np.ndarray, start: int, stop: int) -> np.ndarray:
-    """(n_points + 1,) int64: the family offsets ``offsets`` with every family outside the points
-    ``start .. stop - 1`` emptied, the others kept in place.
-
-    A force kernel given them computes the rows ``start .. stop - 1`` exactly as with
-    ``offsets`` (the same bonds in the same order) and writes zero on the other rows, at the
-    cost of a loop over empty families.
-    """
-    out = np.array(offsets, dtype=np.int64)
-    out[: start + 1] = out[start]
-    out[stop + 1 :] = out[stop]
-    return out
-
-
 class FusedPlan(NamedTuple):
     """Row order of ``kernels.lps.lps_force_fused`` (int64 arrays), made by :func:`fused_plan`.
 

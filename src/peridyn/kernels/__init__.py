@@ -8,6 +8,12 @@ Layout expected by every kernel (the drivers in ``peridyn.physics.materials`` an
 - per-bond arrays (n_bonds,) and per-point arrays (n_points,) of the float dtype;
 - ``intact``: (n_bonds,) bool.
 
+The force and dilatation kernels of ``pmb`` and ``lps`` take optional row bounds
+``first=0, stop=-1``: they compute the rows ``first .. stop - 1`` (``stop`` < 0: to the last
+row) and leave the other rows of their output as they were. An MPI rank computes its rows
+clear of the ghosts, then the others once the ghosts have arrived (``force_overlapped`` of
+``peridyn.physics.materials``).
+
 ``peridyn.kernels.reference`` (one module per kernel module) holds a plain NumPy version of
 every kernel, written from its definition; ``tests/kernels`` compares each kernel with it on
 small random inputs. Those tests carry the pytest marker ``kernels`` and are run a second

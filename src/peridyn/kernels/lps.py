@@ -110,7 +110,7 @@ def lps_pair_force_row(i, xif, uf, offsets, nbr, length, w, dev, intact, p, f):
 
 
 @numba.njit(parallel=True, fastmath=FASTMATH, cache=True)
-def lps_dilatation(xi, u, offsets, nbr, length, w, intact, theta_coef, theta):
+def lps_dilatation(xi, u, offsets, nbr, length, w, intact, theta_coef, theta, first=0, stop=-1):
     """Dilatation ``theta`` (OUT): theta_i = theta_coef_i sum_j w_ij |xi| e_ij, coef = d / m_i.
 
     Length form, e = |Y| - |xi| with the stored ``length`` and bond vectors ``xi`` (n_bonds,
@@ -119,13 +119,14 @@ def lps_dilatation(xi, u, offsets, nbr, length, w, intact, theta_coef, theta):
     n = u.shape[0]
     uf = u.reshape(3 * n)
     xif = xi.reshape(3 * xi.shape[0])
-    for i in numba.prange(n):
+    end = n if stop < 0 else stop
+    for i in numba.prange(first, end):
         theta[i] = theta_coef[i] * lps_dilatation_sum(i, xif, uf, offsets, nbr, length, w, intact)
     return theta
 
 
 @numba.njit(parallel=True, fastmath=FASTMATH, cache=True)
-def lps_pair_force(xi, u, offsets, nbr, length, w, dev, intact, p, f):
+def lps_pair_force(xi, u, offsets, nbr, length, w, dev, intact, p, f, first=0, stop=-1):
     """Force density ``f`` (OUT) from the per-point ``p`` = P_i and per-bond ``dev`` (see module).
 
     Length form (float64), from the stored bond vectors ``xi`` (n_bonds, 3), m.
@@ -133,7 +134,8 @@ def lps_pair_force(xi, u, offsets, nbr, length, w, dev, intact, p, f):
     n = u.shape[0]
     uf = u.reshape(3 * n)
     xif = xi.reshape(3 * xi.shape[0])
-    for i in numba.prange(n):
+    end = n if stop < 0 else stop
+    for i in numba.prange(first, end):
         lps_pair_force_row(i, xif, uf, offsets, nbr, length, w, dev, intact, p, f)
     return f
 
@@ -301,7 +303,7 @@ def lps_force_fused(
 
 
 @numba.njit(parallel=True, fastmath=FASTMATH, cache=True)
-def lps_dilatation_cf(x, u, offsets, nbr, w, intact, theta_coef, theta):
+def lps_dilatation_cf(x, u, offsets, nbr, w, intact, theta_coef, theta, first=0, stop=-1):
     """:func:`lps_dilatation` in the cancellation-free form (float32).
 
     ``|xi|`` is recomputed from ``x`` and e = du . (Y + xi) / (|Y| + |xi|); no per-bond
@@ -311,7 +313,8 @@ def lps_dilatation_cf(x, u, offsets, nbr, w, intact, theta_coef, theta):
     zero = theta.dtype.type(0.0)
     xf = x.reshape(3 * n)
     uf = u.reshape(3 * n)
-    for i in numba.prange(n):
+    end = n if stop < 0 else stop
+    for i in numba.prange(first, end):
         xi0, xi1, xi2 = xf[3 * i], xf[3 * i + 1], xf[3 * i + 2]
         ui0, ui1, ui2 = uf[3 * i], uf[3 * i + 1], uf[3 * i + 2]
         buf = stack_array(CHUNK_BUFFER, theta.dtype)
@@ -339,7 +342,7 @@ def lps_dilatation_cf(x, u, offsets, nbr, w, intact, theta_coef, theta):
 
 
 @numba.njit(parallel=True, fastmath=FASTMATH, cache=True)
-def lps_pair_force_cf(x, u, offsets, nbr, w, dev, intact, p, f):
+def lps_pair_force_cf(x, u, offsets, nbr, w, dev, intact, p, f, first=0, stop=-1):
     """:func:`lps_pair_force` in the cancellation-free form (float32), one division per bond:
 
     t = [ w |xi| (|Y| + |xi|) (P_i + P_j) + dev du . (Y + xi) ] / (|Y| (|Y| + |xi|)).
@@ -352,7 +355,8 @@ def lps_pair_force_cf(x, u, offsets, nbr, w, dev, intact, p, f):
     zero = f.dtype.type(0.0)
     xf = x.reshape(3 * n)
     uf = u.reshape(3 * n)
-    for i in numba.prange(n):
+    end = n if stop < 0 else stop
+    for i in numba.prange(first, end):
         xi0, xi1, xi2 = xf[3 * i], xf[3 * i + 1], xf[3 * i + 2]
         ui0, ui1, ui2 = uf[3 * i], uf[3 * i + 1], uf[3 * i + 2]
         lo = offsets[i]

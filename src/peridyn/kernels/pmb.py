@@ -27,8 +27,9 @@ from peridyn.kernels import (
 
 
 @numba.njit(parallel=True, fastmath=FASTMATH, cache=True)
-def pmb_force(xi, u, offsets, nbr, inv_len, k, intact, f):
-    """Internal force density ``f`` (OUT, overwritten) of the PMB model ("length form").
+def pmb_force(xi, u, offsets, nbr, inv_len, k, intact, f, first=0, stop=-1):
+    """Internal force density ``f`` (OUT: the rows ``first .. stop - 1``, see ``peridyn.kernels``)
+    of the PMB model ("length form").
 
     ``s = k (1/|xi| - 1/|Y|)`` with the stored ``inv_len = 1/|xi|`` and bond vectors ``xi``
     (n_bonds, 3), m (``bond_search.initial_bond_vectors``): one square root and one division
@@ -39,7 +40,8 @@ def pmb_force(xi, u, offsets, nbr, inv_len, k, intact, f):
     one = f.dtype.type(1.0)
     uf = u.reshape(3 * n)
     xif = xi.reshape(3 * xi.shape[0])
-    for i in numba.prange(n):
+    end = n if stop < 0 else stop
+    for i in numba.prange(first, end):
         ui0, ui1, ui2 = uf[3 * i], uf[3 * i + 1], uf[3 * i + 2]
         buf = stack_array(CHUNK_BUFFER, f.dtype)
         hi = offsets[i + 1]
@@ -75,7 +77,7 @@ def pmb_force(xi, u, offsets, nbr, inv_len, k, intact, f):
 
 
 @numba.njit(parallel=True, fastmath=FASTMATH, cache=True)
-def pmb_force_cf(x, u, offsets, nbr, k, intact, f):
+def pmb_force_cf(x, u, offsets, nbr, k, intact, f, first=0, stop=-1):
     """PMB force density ``f`` (OUT), cancellation-free form (used for float32).
 
     Same force as :func:`pmb_force`, written
@@ -87,7 +89,8 @@ def pmb_force_cf(x, u, offsets, nbr, k, intact, f):
     zero = f.dtype.type(0.0)
     xf = x.reshape(3 * n)
     uf = u.reshape(3 * n)
-    for i in numba.prange(n):
+    end = n if stop < 0 else stop
+    for i in numba.prange(first, end):
         xi0, xi1, xi2 = xf[3 * i], xf[3 * i + 1], xf[3 * i + 2]
         ui0, ui1, ui2 = uf[3 * i], uf[3 * i + 1], uf[3 * i + 2]
         buf = stack_array(CHUNK_BUFFER, f.dtype)

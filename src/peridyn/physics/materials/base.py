@@ -26,7 +26,7 @@ from __future__ import annotations
 import numpy as np
 
 from peridyn.discretization.body import Body
-from peridyn.discretization.bonds import Bonds, range_offsets
+from peridyn.discretization.bonds import Bonds
 from peridyn.errors import InputError
 from peridyn.kernels.bond_search import initial_bond_vectors
 from peridyn.kernels.lps import lps_dilatation
@@ -83,8 +83,6 @@ class Model:
         self.bond_volume = body.volumes[bonds.neighbours] * bonds.volume_factor
         self._linearisation: BondLinearisation | None = None
         self._bond_vectors: np.ndarray | None = None
-        self._row_offsets_cache: dict = {}
-        self._scratch_cache: dict = {}
 
     @classmethod
     def from_parameters(
@@ -163,22 +161,6 @@ class Model:
         """
         finish()
         return self.force(u, out)
-
-    def _row_offsets(self, start: int, stop: int) -> np.ndarray:
-        """The bonds' offsets with only the families of rows ``start .. stop - 1`` kept
-        (``range_offsets``), made once per range."""
-        cache = self._row_offsets_cache
-        if (start, stop) not in cache:
-            cache[(start, stop)] = range_offsets(self.bonds.offsets, start, stop)
-        return cache[(start, stop)]
-
-    def _scratch(self, like: np.ndarray) -> np.ndarray:
-        """A work array of ``like``'s shape and dtype, made once (contents undefined)."""
-        cache = self._scratch_cache
-        key = (like.shape, like.dtype.str)
-        if key not in cache:
-            cache[key] = np.empty_like(like)
-        return cache[key]
 
     def _refresh_ghosts(self, state: np.ndarray, u: np.ndarray, n_owned: int) -> np.ndarray:
         """``state`` (``_as_state(u)`` taken before the ghost rows of ``u`` arrived) with them:

@@ -174,8 +174,8 @@ class LPSModel(Model):
         self._p_coef = (dim * self.bulk / m - self.alpha * self.dev_weighted_volume / (dim * m)).astype(
             self.dtype
         )
-        self._theta = np.empty(body.n_points, dtype=self.dtype)
-        self._p = np.empty(body.n_points, dtype=self.dtype)
+        self._theta = np.zeros(body.n_points, dtype=self.dtype)
+        self._p = np.zeros(body.n_points, dtype=self.dtype)
         self._rows_read_cache: dict[int, int] = {}
         self._fused_cache: dict = {}
 
@@ -226,36 +226,37 @@ class LPSModel(Model):
         bulk = 4.0 * gamma**2 * self.weighted_volume / (15.0 if self.dim == 3 else 8.0)
         return bulk / largest
 
-    def _dilatation(self, u: np.ndarray, offsets=None, theta=None) -> np.ndarray:
-        """theta into ``theta`` (default ``self._theta``) for the families of ``offsets``
-        (default all); ``u`` already in the kernel dtype and layout."""
+    def _dilatation(self, u: np.ndarray, first: int = 0, stop: int = -1) -> np.ndarray:
+        """theta into the rows ``first .. stop - 1`` (``stop`` < 0: to the last row) of
+        ``self._theta``; ``u`` already in the kernel dtype and layout."""
         b = self.bonds
-        offsets = b.offsets if offsets is None else offsets
-        theta = self._theta if theta is None else theta
         if self.dtype == np.float32:
-            return lps_dilatation_cf(
-                self.x, u, offsets, b.neighbours, self.w, b.intact, self._theta_coef, theta
-            )
+            args = (self.x, u, b.offsets, b.neighbours, self.w, b.intact, self._theta_coef, self._theta)
+            return lps_dilatation_cf(*args, first, stop)
         return lps_dilatation(
             self.bond_vectors,
             u,
-            offsets,
+            b.offsets,
             b.neighbours,
             self.length,
             self.w,
             b.intact,
             self._theta_coef,
-            theta,
+            self._theta,
+            first,
+            stop,
         )
 
-    def _pair_force(self, u: np.ndarray, offsets, p: np.ndarray, out: np.ndarray) -> np.ndarray:
-        """The pair-force kernel of the dtype into ``out`` for the families of ``offsets``."""
+    def _pair_force(self, u: np.ndarray, out: np.ndarray, first: int = 0, stop: int = -1) -> np.ndarray:
+        """The pair-force kernel of the dtype, from ``self._p``, into the rows ``first .. stop - 1``
+        of ``out``."""
         b = self.bonds
+        p = self._p
         if self.dtype == np.float32:
-            return lps_pair_force_cf(self.x, u, offsets, b.neighbours, self.w, self.dev, b.intact, p, out)
-        return lps_pair_force(
-            self.bond_vectors, u, offsets, b.neighbours, self.length, self.w, self.dev, b.intact, p, out
-        )
+            args = (self.x, u, b.offsets, b.neighbours, self.w, self.dev, b.intact, p, out)
+            return lps_pair_force_cf(*args, first, stop)
+        args = (self.bond_vectors, u, b.offsets, b.neighbours, self.length, self.w, self.dev, b.intact)
+        return lps_pair_force(*args, p, out, first, stop)
 
     def dilatation(self, u) -> np.ndarray:
         """Dilatation theta (n_points,), dimensionless."""
@@ -273,8 +274,8 @@ class LPSModel(Model):
         u = self._as_state(u)
         n = self.body.n_points
         if self._fused(n) is None:
-            p = np.multiply(self._dilatation(u), self._p_coef, out=self._p)
-            return self._pair_force(u, self.bonds.offsets, p, out)
+            np.multiply(self._dilatation(u), self._p_coef, out=self._p)
+            return self._pair_force(u, out)
         return self._force_fused(u, n, out)
 
     def _force_fused(self, u: np.ndarray, rows: int, out: np.ndarray) -> np.ndarray:
@@ -316,21 +317,19 @@ class LPSModel(Model):
         # them that they read comes first; else that of all rows 0 .. clear - 1
         fused = self._fused(clear_force) is not None
         first = clear_force if fused else 0
-        self._dilatation(state, self._row_offsets(first, clear), theta)
+        self._dilatation(state, first, clear)
         np.multiply(theta[first:clear], p_coef[first:clear], out=p[first:clear])
         if fused:
             self._force_fused(state, clear_force, out)
-            out[n_owned:] = 0.0
         else:
-            self._pair_force(state, self._row_offsets(0, clear_force), p, out)
+            self._pair_force(state, out, 0, clear_force)
         finish()
         state = self._refresh_ghosts(state, u, n_owned)
         read = self._rows_read(n_owned)  # the ghosts after it (layer 2) are read by no owned row
-        rest = self._dilatation(state, self._row_offsets(clear, read), self._scratch(theta))
-        theta[clear:read] = rest[clear:read]
+        self._dilatation(state, clear, read)
         np.multiply(theta[clear:read], p_coef[clear:read], out=p[clear:read])
-        rest = self._pair_force(state, self._row_offsets(clear_force, n_owned), p, self._scratch(out))
-        out[clear_force:n_owned] = rest[clear_force:n_owned]
+        self._pair_force(state, out, clear_force, n_owned)
+        out[n_owned:] = 0.0
         return out
 
     def _rows_read(self, n_owned: int) -> int:

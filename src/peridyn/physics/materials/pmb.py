@@ -144,34 +144,38 @@ class PMBModel(Model):
         ``bonds.intact`` on every call, so broken bonds need no notification.
         """
         out = np.empty_like(self.x) if out is None else out
-        return self._kernel_force(self._as_state(u), self.bonds.offsets, out)
+        return self._kernel_force(self._as_state(u), out)
 
     def force_overlapped(self, u, out, clear_rows, n_owned, finish):
         """See ``Model.force_overlapped``: a bond-based force needs no ghost value on the first
         ``clear_rows[0]`` rows."""
         clear = clear_rows[0]
         state = self._as_state(u)
-        self._kernel_force(state, self._row_offsets(0, clear), out)
+        self._kernel_force(state, out, 0, clear)
         finish()
         state = self._refresh_ghosts(state, u, n_owned)
-        rest = self._kernel_force(state, self._row_offsets(clear, n_owned), self._scratch(out))
-        out[clear:n_owned] = rest[clear:n_owned]
+        self._kernel_force(state, out, clear, n_owned)
+        out[n_owned:] = 0.0
         return out
 
-    def _kernel_force(self, state, offsets, out):
-        """The force kernel of the dtype on ``state`` (``_as_state``) with family ``offsets``."""
+    def _kernel_force(self, state, out, first: int = 0, stop: int = -1):
+        """The force kernel of the dtype on ``state`` (``_as_state``) into the rows
+        ``first .. stop - 1`` of ``out`` (``stop`` < 0: to the last row)."""
         b = self.bonds
         if self.dtype == np.float32:
-            return pmb_force_cf(self.x, state, offsets, b.neighbours, self.bond_stiffness, b.intact, out)
+            args = (self.x, state, b.offsets, b.neighbours, self.bond_stiffness, b.intact, out)
+            return pmb_force_cf(*args, first, stop)
         return pmb_force(
             self.bond_vectors,
             state,
-            offsets,
+            b.offsets,
             b.neighbours,
             self.inv_length,
             self.bond_stiffness,
             b.intact,
             out,
+            first,
+            stop,
         )
 
     def energy_density(self, u):
