@@ -333,6 +333,10 @@ class HDF5Writer:
         for name, group in self._file.get("series", {}).items():
             self._series[name] = _Series.open(group)
 
+    def series_dtype(self, name: str) -> np.dtype:
+        """The dtype in which series ``name`` (made by :meth:`create_series`) stores its records."""
+        return self._get_series(name).data.dtype
+
     def _check_existing_series(self, name: str, shape: tuple, dtype: np.dtype) -> None:
         data = self._series[name].data
         if data.shape[1:] != shape or data.dtype != dtype:

@@ -297,12 +297,12 @@ class Recorder:
             rows, sensor_rows = self._point_rows, self.sensor_index
         h5, step, t = self.series, state.step, state.time
         if self.sensor_names:
-            h5.append("sensor_u", step, t, state.u[rows["sensor_u"]])
-            h5.append("sensor_v", step, t, state.v[sensor_rows])
+            h5.append("sensor_u", step, t, state.u, rows["sensor_u"])
+            h5.append("sensor_v", step, t, state.v, sensor_rows)
         for name in self.line_index:
-            h5.append(f"line_{name}", step, t, state.u[rows[f"line_{name}"]])
+            h5.append(f"line_{name}", step, t, state.u, rows[f"line_{name}"])
         for name in self.plane_index:
-            h5.append(f"plane_{name}", step, t, state.u[rows[f"plane_{name}"]])
+            h5.append(f"plane_{name}", step, t, state.u, rows[f"plane_{name}"])
         if self.spec.pzt_sensors:
             signals = [
                 np.sum(w * state.u[rows[f"pzt_{k}"], :2]) for k, (_, w) in self.spec.pzt_sensors.items()

@@ -5,8 +5,13 @@ flushing the file after every record (what keeps it readable after a crash) cost
 still. ``SeriesBuffer`` holds the records of every series in memory, each series in one
 preallocated block of at most ``max_bytes`` (and at most ``max_records`` records), and
 writes them with one ``HDF5Writer.append_block`` per series, then one file flush, when a
-block is full or when asked (``flush``). The records are kept in the dtype they are given
-in: the writer casts them to the series' dtype exactly as an ``append`` of each would.
+block is full or when asked (``flush``).
+
+The records are cast to the series' dtype as they are held (NumPy's cast, 0.3 ms for 8 float64
+plane records of the seed Lamb case where HDF5's own conversion took 1.5 ms). It rounds as
+HDF5 does, with one exception at the edge of float32's range: a value less than half an ulp
+above the largest float32 becomes that float32 here and infinity in HDF5. A run's checked state
+(finite, within its runaway limit) never comes near it.
 """
 
 from __future__ import annotations
@@ -27,16 +32,17 @@ MAX_RECORDS = 256
 class _Block:
     """The records of one series not yet written: (capacity, *shape) values, steps and times."""
 
-    def __init__(self, values: np.ndarray, max_bytes: int, max_records: int):
-        capacity = max(1, min(max_records, max_bytes // max(values.nbytes, 1)))
-        self.values = np.empty((capacity, *values.shape), dtype=values.dtype)
+    def __init__(self, shape: tuple, dtype: np.dtype, max_bytes: int, max_records: int):
+        record_bytes = dtype.itemsize * int(np.prod(shape))
+        capacity = max(1, min(max_records, max_bytes // max(record_bytes, 1)))
+        self.values = np.empty((capacity, *shape), dtype=dtype)
         self.steps = np.empty(capacity, dtype=np.int64)
         self.times = np.empty(capacity)
         self.count = 0
 
-    def fits(self, values: np.ndarray) -> bool:
-        """True when a record like ``values`` goes into this block as it is."""
-        return values.shape == self.values.shape[1:] and values.dtype == self.values.dtype
+    def fits(self, shape: tuple) -> bool:
+        """True when a record of ``shape`` goes into this block."""
+        return shape == self.values.shape[1:]
 
 
 class SeriesBuffer:
@@ -72,17 +78,29 @@ class SeriesBuffer:
         """Records held in memory, all series together."""
         return sum(block.count for block in self._blocks.values())
 
-    def append(self, name: str, step: int, time: float, values) -> None:
+    def append(self, name: str, step: int, time: float, values, rows=None) -> None:
         """Hold one record of series ``name`` ((step, time s, values of the record's shape));
-        write every series' records when this one's block is full."""
+        write every series' records when this one's block is full.
+
+        With ``rows`` (an integer index array or a slice), the record is ``values[rows]``; an
+        index array's rows are taken straight into the buffer, with no temporary array (a plane
+        of 41 750 points of the seed Lamb case: 0.15 ms instead of 0.42 ms a record).
+        """
         values = np.asarray(values)
+        if isinstance(rows, slice):
+            values, rows = values[rows], None
+        shape = values.shape if rows is None else (len(rows), *values.shape[1:])
         block = self._blocks.get(name)
-        if block is not None and block.count and not block.fits(values):
-            self.flush()  # a record of another shape or dtype: the writer checks it
-        if block is None or not block.fits(values):
-            block = self._blocks[name] = _Block(values, self.max_bytes, self.max_records)
+        if block is not None and block.count and not block.fits(shape):
+            self.flush()  # a record of another shape: the writer checks it
+        if block is None or not block.fits(shape):
+            dtype = self.writer.series_dtype(name)
+            block = self._blocks[name] = _Block(shape, dtype, self.max_bytes, self.max_records)
         k = block.count
-        block.values[k] = values
+        if rows is None:
+            block.values[k] = values
+        else:
+            np.take(values, rows, axis=0, out=block.values[k])
         block.steps[k] = step
         block.times[k] = time
         block.count = k + 1

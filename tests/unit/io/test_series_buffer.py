@@ -94,6 +94,33 @@ def test_buffered_records_equal_direct_appends(tmp_path, geometry):
             np.testing.assert_array_equal(a, b)
 
 
+@pytest.mark.parametrize("dtype", ["float64", "float32"])
+def test_records_given_by_rows_are_those_rows(tmp_path, geometry, dtype):
+    """``append(..., values, rows)`` holds ``values[rows]`` (an index array is taken straight
+    into the buffer, a slice is viewed), cast to the series' dtype: the file of direct appends
+    of ``values[rows]``."""
+    fields = records(10, seed=2).reshape(5, 2 * N, 3)  # five records of 2 N points
+    picks = {"spread": np.array([7, 0, 11, 3, 3, 5]), "layer": slice(1, 2 * N, 2)}
+    for name in ("direct", "buffered"):
+        with HDF5Writer(tmp_path / f"{name}.h5", *geometry, {}, flush_every=None) as out:
+            for series in picks:
+                out.create_series(series, (N, 3), dtype)
+            target = out if name == "direct" else SeriesBuffer(out, max_records=2)
+            for step, field in enumerate(fields):
+                for series, rows in picks.items():
+                    if name == "direct":
+                        out.append(series, step, step * 1e-7, field[rows])
+                    else:
+                        target.append(series, step, step * 1e-7, field, rows)
+            if name == "buffered":
+                target.flush()
+    for series in picks:
+        direct, buffered = _series(tmp_path / "direct.h5", series), _series(tmp_path / "buffered.h5", series)
+        for a, b in zip(direct, buffered, strict=True):
+            assert a.dtype == b.dtype
+            np.testing.assert_array_equal(a, b)
+
+
 def test_buffer_holds_at_most_max_bytes_or_max_records_per_series(tmp_path, geometry):
     record_bytes = records(1)[0].nbytes
     with HDF5Writer(tmp_path / "run.h5", *geometry, {}, flush_every=None) as out:
