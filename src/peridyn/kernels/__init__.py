@@ -69,10 +69,10 @@ from numba.extending import intrinsic, overload
 
 #: Bonds per chunk of the force kernels' two-loop form (see above); the stack buffer of a
 #: kernel holds 4 values per bond of a chunk (``CHUNK_BUFFER``). 32 bonds give the vector loop
-#: four independent 8-lane iterations whose gathers, square roots and divisions overlap while
-#: the previous chunk's sums run; 16 left the loop waiting on one iteration's latency and 64 or
-#: more delay the sums (``benchmarks/RESULTS.md``: PMB float64 1.06-1.07x over 16, float32
-#: 1.15x, LPS 1.04-1.07x; the chunk size does not change the bits).
+#: four independent 8-lane iterations to overlap with each other and with the previous chunk's
+#: sums; 16 gave it two (our reading of timings, this VM has no hardware counters). Measured
+#: (``benchmarks/RESULTS.md``): PMB float64 1.06-1.07x over 16, float32 1.15x, LPS
+#: 1.04-1.07x; 24, 48 and 64 in between or below. The chunk size does not change the bits.
 CHUNK = 32
 CHUNK_BUFFER = 4 * CHUNK
 
