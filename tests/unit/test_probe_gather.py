@@ -24,9 +24,9 @@ from peridyn.parallel.points import PointGather
 
 
 class _Gathering:
-    """A rank's communicator in a one-process simulation of ``size`` ranks: rank 0's ``gather``
-    and ``allgather`` answer from what the other ranks posted before it (call rank 0 last);
-    the others' ``allgather`` answers from the previous round."""
+    """A rank's communicator in a one-process simulation of ``size`` ranks: rank 0's ``gather``,
+    ``gatherv`` and ``allgather`` answer from what the other ranks posted before it (call rank 0
+    last); the others' ``allgather`` answers from the previous round."""
 
     def __init__(self, rank, size, posted):
         self.rank, self.size, self.posted = rank, size, posted
@@ -34,6 +34,13 @@ class _Gathering:
     def gather(self, obj, root=0):
         self.posted[self.rank] = obj
         return [self.posted[r] for r in range(self.size)] if self.rank == root else None
+
+    def gatherv(self, send, recv, counts, root=0):
+        self.posted.setdefault(("gatherv", self.rank), []).append(send.copy())
+        if self.rank == root:
+            sent = [self.posted[("gatherv", r)].pop(0) for r in range(self.size)]
+            assert [a.size for a in sent] == counts  # MPI's Gatherv needs the counts right
+            recv.reshape(-1)[:] = np.concatenate([a.reshape(-1) for a in sent])
 
     def allgather(self, obj):
         self.posted[self.rank] = obj

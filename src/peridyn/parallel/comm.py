@@ -1,12 +1,13 @@
 """The communicator of a run: MPI's COMM_WORLD under ``mpiexec -n N`` (N > 1), a serial stand-in
 otherwise.
 
-Both expose the same small set of methods (rank, size, barrier, bcast, gather, allgather,
-alltoall, allreduce of numbers and arrays, and the non-blocking point-to-point messages of the
-halo exchange), so that code written for ranks runs unchanged in one process; a serial run
-never imports mpi4py. Each keeps a ``Traffic`` count of what it did (messages, bytes, seconds
-waiting), which a run reports per rank. ``world()`` picks one: MPI only when mpi4py imports and
-the environment shows an MPI launch (``PMI_SIZE``, ``OMPI_COMM_WORLD_SIZE``, ``MPI_LOCALNRANKS`` ...).
+Both expose the same small set of methods (rank, size, barrier, bcast, gather, allgather, a
+typed gather of arrays (gatherv), alltoall, allreduce of numbers and arrays, and the
+non-blocking point-to-point messages of the halo exchange), so that code written for ranks
+runs unchanged in one process; a serial run never imports mpi4py. Each keeps a ``Traffic``
+count of what it did (messages, bytes, seconds waiting), which a run reports per rank.
+``world()`` picks one: MPI only when mpi4py imports and the environment shows an MPI launch
+(``PMI_SIZE``, ``OMPI_COMM_WORLD_SIZE``, ``MPI_LOCALNRANKS`` ...).
 """
 
 from __future__ import annotations
@@ -38,7 +39,8 @@ class Traffic:
     wait_seconds : float
         The part of ``halo_seconds`` spent in ``finish``, waiting for the messages, s.
     collective_seconds : float
-        Wall time, s, in collectives (barrier, bcast, gather, allgather, alltoall, allreduce):
+        Wall time, s, in collectives (barrier, bcast, gather, gatherv, allgather, alltoall,
+        allreduce):
         their transfer and the wait for the slowest rank.
     """
 
@@ -77,6 +79,10 @@ class SerialComm:
 
     def allgather(self, obj) -> list:
         return [obj]
+
+    def gatherv(self, send: np.ndarray, recv: np.ndarray | None, counts, root: int = 0) -> None:
+        """``recv`` gets ``send``'s values."""
+        recv.reshape(-1)[:] = send.reshape(-1)
 
     def alltoall(self, objs: list) -> list:
         return list(objs)
@@ -132,6 +138,14 @@ class MPIComm:
 
     def allgather(self, obj) -> list:
         return self._timed(self._comm.allgather, obj)
+
+    def gatherv(self, send: np.ndarray, recv: np.ndarray | None, counts, root: int = 0) -> None:
+        """Every rank's contiguous array ``send`` into ``recv`` on ``root``, in rank order:
+        ``counts`` (one per rank) values each, on ``root``; ``recv`` and ``counts`` are ignored
+        elsewhere. No pickling: on 2 ranks a 21 000 x 3 float64 part took 0.32 ms against 0.84
+        ms for ``gather`` (``benchmarks/RESULTS.md``)."""
+        spec = [recv, list(counts)] if self.rank == root else None
+        self._timed(self._comm.Gatherv, send, spec, root=root)
 
     def alltoall(self, objs: list) -> list:
         return self._timed(self._comm.alltoall, objs)

@@ -1,5 +1,5 @@
 """Gathering the values of a few named points on rank 0 (``PointGather``): each rank sends the
-values of those it owns, in one message, and rank 0 places them in the order asked.
+values of those it owns, one typed message per array, and rank 0 places them in the order asked.
 
 Used at a recorder's series records (``peridyn.parallel.observers.RootObservers``): the probe
 points (sensors, lines, planes, PZT sensors) are a small part of the body, and gathering them
@@ -70,6 +70,12 @@ class PointGather:
         #: on rank 0: every rank's slots, per set of ids
         self._slots = domain.comm.gather(slots) if domain.size > 1 else [slots]
         domain.on_root(self._check_cover)
+        if domain.is_root:
+            #: per set of ids: the positions of the values as they arrive (rank after rank), and
+            #: how many each rank sends
+            by_set = [[rank_slots[j] for rank_slots in self._slots] for j in range(len(ids))]
+            self._order = [np.concatenate(slots) for slots in by_set]
+            self._counts = [[len(s) for s in slots] for slots in by_set]
 
     def _check_cover(self) -> None:
         for j, k in enumerate(self.sizes):
@@ -85,14 +91,18 @@ class PointGather:
     def __call__(self, *arrays: np.ndarray) -> list | None:
         """``[arrays[j][ids[j]] ...]`` of the whole body, on rank 0 (None elsewhere): each
         ``arrays[j]`` is a local per-point array (n_local, ...) of the rank."""
-        parts = tuple(np.ascontiguousarray(a[rows]) for a, rows in zip(arrays, self.rows, strict=True))
+        parts = [np.ascontiguousarray(a[rows]) for a, rows in zip(arrays, self.rows, strict=True)]
         if self.domain.size == 1:
-            return list(parts)
-        every = self.domain.comm.gather(parts)
-        if not self.domain.is_root:
-            return None
-        out = [np.empty((k, *a.shape[1:]), dtype=a.dtype) for k, a in zip(self.sizes, arrays, strict=True)]
-        for rank_slots, rank_parts in zip(self._slots, every, strict=True):
-            for whole, slots, part in zip(out, rank_slots, rank_parts, strict=True):
-                whole[slots] = part
-        return out
+            return parts
+        root = self.domain.is_root
+        out = []
+        for j, (a, part) in enumerate(zip(arrays, parts, strict=True)):
+            row = int(np.prod(a.shape[1:], dtype=np.int64))
+            by_rank = np.empty((self.sizes[j], *a.shape[1:]), dtype=a.dtype) if root else None
+            counts = [row * c for c in self._counts[j]] if root else None
+            self.domain.comm.gatherv(part, by_rank, counts)
+            if root:
+                whole = np.empty_like(by_rank)
+                whole[self._order[j]] = by_rank
+                out.append(whole)
+        return out if root else None
