@@ -90,17 +90,15 @@ class PointGather:
 
     def __call__(self, *arrays: np.ndarray) -> list | None:
         """``[arrays[j][ids[j]] ...]`` of the whole body, on rank 0 (None elsewhere): each
-        ``arrays[j]`` is a local per-point array (n_local, ...) of the rank."""
-        parts = [np.ascontiguousarray(a[rows]) for a, rows in zip(arrays, self.rows, strict=True)]
-        if self.domain.size == 1:
-            return parts
+        ``arrays[j]`` is a local per-point array (n_local, ...) of the rank. One path for one
+        process and for ranks (``SerialComm.gatherv`` copies)."""
         root = self.domain.is_root
         out = []
-        for j, (a, part) in enumerate(zip(arrays, parts, strict=True)):
+        for j, (a, rows) in enumerate(zip(arrays, self.rows, strict=True)):
             row = int(np.prod(a.shape[1:], dtype=np.int64))
             by_rank = np.empty((self.sizes[j], *a.shape[1:]), dtype=a.dtype) if root else None
             counts = [row * c for c in self._counts[j]] if root else None
-            self.domain.comm.gatherv(part, by_rank, counts)
+            self.domain.comm.gatherv(np.ascontiguousarray(a[rows]), by_rank, counts)
             if root:
                 whole = np.empty_like(by_rank)
                 whole[self._order[j]] = by_rank
