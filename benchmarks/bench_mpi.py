@@ -85,7 +85,7 @@ def run_once(case: Path, sets: list[str], ranks: int, threads: int, out: Path) -
 def _env(threads: int) -> dict:
     return dict(
         os.environ,
-        PYTHONPATH=str(ROOT / "src"),
+        PYTHONPATH=os.pathsep.join(filter(None, [str(ROOT / "src"), os.environ.get("PYTHONPATH")])),
         NUMBA_NUM_THREADS=str(threads),
         OMP_NUM_THREADS="1",
         OPENBLAS_NUM_THREADS="1",
