@@ -36,7 +36,7 @@ dilatation of every ghost at half the force's cost per bond (an estimate); the l
 and bandwidth of a cluster interconnect (``CLUSTER``, stated, not measured here) and this
 machine's t_bond and t_point per core measured quietly (``QUIET``); plus the state check's
 allgather every 10 steps (2 log2(P) alpha / 10). Memory per rank: ``peridyn.jobs.estimate``'s
-explicit costs (300 MB base, 350 B per point, 124 B per directed bond) on the rank's owned and
+explicit costs (300 MB base, 350 B per point, 116 B per directed bond) on the rank's owned and
 ghost points, plus the whole body that every rank builds today (``WHOLE_BODY_BYTES`` per point
 of the whole body).
 """

@@ -3,11 +3,13 @@
 import functools
 import json
 
+import numpy as np
 import pytest
 
 from peridyn.cli import bench_cmd, main
 from peridyn.errors import InputError
 from peridyn.jobs import bench as benchmark
+from peridyn.physics.materials import make_model
 
 ROW_KEYS = {
     "model",
@@ -80,10 +82,25 @@ def test_bench_cli_json(monkeypatch, capsys):
     _check(json.loads(capsys.readouterr().out), 512)
 
 
-def test_bytes_per_bond_counts_the_per_bond_arrays():
-    assert benchmark.bytes_per_bond("pmb-baseline", "float64") == 4 + 8 + 8 + 1
-    assert benchmark.bytes_per_bond("pmb", "float32") == 4 + 4 + 1
-    assert benchmark.bytes_per_bond("lps", "float64") == 2 * (4 + 8 + 8 + 1)
+@pytest.mark.parametrize("dtype", ["float64", "float32"])
+def test_bytes_per_bond_counts_the_arrays_the_kernels_read(dtype):
+    """The per-bond arrays that ``model.force`` hands its kernels (``PMBModel._kernel_force``;
+    ``kernels.lps.lps_dilatation`` and ``lps_pair_force``, or their ``_cf`` forms), by their
+    item sizes: float64 reads the stored bond vectors, float32 the points."""
+    body, bonds = benchmark.benchmark_grid(4)
+    pmb, lps = (
+        make_model(m, body, bonds, E=200e9, nu=0.25, density=7850.0, dtype=dtype) for m in ("pmb", "lps")
+    )
+    index, flag = bonds.neighbours.itemsize, bonds.intact.itemsize
+    vector = pmb.bond_vectors[0].nbytes if dtype == "float64" else 0
+    inverse_length = pmb.inv_length.itemsize if dtype == "float64" else 0
+    stiffness = pmb.bond_stiffness.itemsize
+    assert benchmark.bytes_per_bond("pmb", dtype) == index + vector + inverse_length + stiffness + flag
+    length = lps.length.itemsize if dtype == "float64" else 0
+    dilatation = index + vector + length + lps.w.itemsize + flag
+    assert benchmark.bytes_per_bond("lps", dtype) == dilatation + dilatation + lps.dev.itemsize
+    baseline = index + bonds.length.itemsize + pmb.bond_stiffness.astype(np.float64).itemsize + flag
+    assert benchmark.bytes_per_bond("pmb-baseline", "float64") == baseline
 
 
 def test_ops_per_bond_counts_the_kernels_square_roots_and_divisions():

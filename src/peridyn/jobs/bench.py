@@ -33,10 +33,11 @@ arrays the kernel reads, summed over its passes (:func:`bytes_per_bond`):
 
 - baseline: neighbour index (int32, 4) + reference length (8) + micromodulus (8) +
   intact flag (bool, 1) = 21;
-- pmb float64: index 4 + 1/|xi| 8 + stiffness 8 + intact 1 = 21;
-  pmb float32 (cancellation-free kernel, |xi| recomputed): 4 + 4 + 1 = 9;
-- lps float64: 2 passes x (index 4 + length 8 + weight 8 + intact 1) = 42;
-  lps float32: 2 x (4 + 4 + 1) = 18.
+- pmb float64: index 4 + reference bond vector 24 + 1/|xi| 8 + stiffness 8 + intact 1 = 45;
+  pmb float32 (cancellation-free kernel, |xi| recomputed from the points): 4 + 4 + 1 = 9;
+- lps float64: the dilatation pass (index 4 + bond vector 24 + length 8 + weight 8 +
+  intact 1 = 45) and the force pass (the same + deviatoric coefficient 8 = 53) = 98;
+  lps float32: (4 + weight 4 + intact 1) + (4 + 4 + deviatoric 4 + 1) = 22.
 
 Not counted: the neighbours' coordinates, displacements and per-point coefficients
 (gathered, but neighbours are close in index on a grid, so they come from cache), the
@@ -161,14 +162,16 @@ def bytes_per_bond(model: str, dtype: str) -> int:
     """Bytes of per-bond arrays one bond update streams (see the module docstring)."""
     index, flag = np.dtype(np.int32).itemsize, np.dtype(bool).itemsize
     real = np.dtype(dtype).itemsize
+    vector = 3 * real if dtype == "float64" else 0  # the float64 kernels read stored bond vectors
     if model == "pmb-baseline":
         return index + 2 * real + flag  # neighbour, length, micromodulus, intact
     if model == "pmb":
-        # float64: inv_length and stiffness; float32 (cancellation-free): stiffness only
-        return index + (2 if dtype == "float64" else 1) * real + flag
+        inverse_length = real if dtype == "float64" else 0  # float32 recomputes |xi| from the points
+        return index + vector + inverse_length + real + flag  # + stiffness
     if model == "lps":
-        # two passes; float64: length and weight; float32 (cancellation-free): weight only
-        return 2 * (index + (2 if dtype == "float64" else 1) * real + flag)
+        length = real if dtype == "float64" else 0  # float32 recomputes |xi| from the points
+        dilatation = index + vector + length + real + flag  # + weight
+        return dilatation + (dilatation + real)  # the force pass also reads the deviatoric coefficient
     raise InputError(f"unknown benchmark row {model!r}")
 
 

@@ -45,10 +45,10 @@ class Costs:
 #: Per-job costs. Per directed bond, every job holds the Bonds arrays (neighbour 4, length 8,
 #: influence 8, volume factor 8, intact 1 = 29 B) and, while they are built, the pairs of the
 #: search (8 B) and the reverse-bond permutation with its sort temporaries (24 B).
-#: ``explicit``: + the model's per-bond arrays (PMB: length, 1/length, stiffness, surface
-#: factor; LPS: length, weight, deviatoric coefficient, shear factor: 32 B), the reference bond
+#: ``explicit``: + the model's per-bond arrays (PMB: 1/length, stiffness, surface factor: 24 B;
+#: LPS: weight, deviatoric coefficient, shear factor: 24 B, and in float32 the length), the reference bond
 #: vectors that the float64 force kernels read (24 B) and the kernels' temporaries: about
-#: 124 B; per point the body (points, volumes, cells, sets: 64 B) and the state (x, u, v, a, f,
+#: 116 B; per point the body (points, volumes, cells, sets: 64 B) and the state (x, u, v, a, f,
 #: forces, damping: 8 x 24 B).
 #: ``static``, ``newton``, ``newmark``: + a bond-stiffness assembly (9 entries of 8 B values + 2 x 4 B
 #: indices per bond, COO then CSR) and the bond vectors of the force: about 424 B.
@@ -58,7 +58,7 @@ class Costs:
 #: ``modal``: + the stiffness parts P and G (LPS) in COO and CSR and the augmented matrix:
 #: about 500 B; per point the mode shapes are small (n_modes x 24 B) next to the bonds.
 COSTS = {
-    "explicit": Costs(per_point=350.0, per_bond=124.0),
+    "explicit": Costs(per_point=350.0, per_bond=116.0),
     "newmark": Costs(per_point=600.0, per_bond=424.0),
     "static": Costs(per_point=600.0, per_bond=424.0),
     "newton": Costs(per_point=600.0, per_bond=424.0),

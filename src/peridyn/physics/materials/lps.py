@@ -167,7 +167,7 @@ class LPSModel(Model):
             point_dev = point_dev * self.dev_factor
         # k_ij = w (alpha_i g_ij + alpha_j g_ji), the bond's deviatoric stiffness (both energies)
         self.dev = (w * (point_dev + point_dev[b.reverse()])).astype(self.dtype)
-        self.length = b.length.astype(self.dtype)
+        self.length = b.length.astype(self.dtype, copy=False)  # float64: the bonds' own array
         self.w = w.astype(self.dtype)
         self._theta_coef = self.theta_coef.astype(self.dtype)
         # P_i = theta_i * p_coef_i, see peridyn.kernels.lps

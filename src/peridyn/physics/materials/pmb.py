@@ -122,7 +122,6 @@ class PMBModel(Model):
             E, body.dim, bonds.horizons(), bonds.influence_name, body.plane, body.thickness
         )
         self.bond_c0 = bond_micromodulus(self.c0, bonds)
-        self.length = bonds.length.astype(self.dtype)
         self.inv_length = (1.0 / bonds.length).astype(self.dtype)
         base = self.bond_c0 * bonds.influence * self.bond_volume
         self.bond_stiffness = base.astype(self.dtype)
