@@ -40,6 +40,19 @@ def test_unknown_material_names_the_choices():
         make_model("pmv", body, bonds, E=200e9, density=7850.0)
 
 
+def test_float64_lps_reads_the_bonds_lengths_without_a_copy():
+    """8 B a bond less (``benchmarks/RESULTS.md``): the float64 model's ``length`` is the bonds'
+    array; float32 keeps its own rounded copy."""
+    body = small_body(3, None, n=4)
+    bonds = find_bonds(body, 3.015 * body.spacing)
+    lps64, lps32 = (
+        make_model("lps", body, bonds, E=200e9, nu=0.25, density=7850.0, dtype=d)
+        for d in (np.float64, np.float32)
+    )
+    assert np.shares_memory(lps64.length, bonds.length)
+    assert lps32.length.dtype == np.float32 and not np.shares_memory(lps32.length, bonds.length)
+
+
 def test_lps_needs_a_poisson_ratio():
     body = small_body(3, n=4)
     bonds = find_bonds(body, 1.5 * body.spacing)

@@ -154,6 +154,15 @@ def test_launch_detection_reads_the_rank_count():
     assert SerialComm().allreduce(3.0, "max") == 3.0
 
 
+def test_serial_gatherv_fills_recv_whatever_its_layout():
+    """One process: the gather is a copy into ``recv``, also a non-contiguous view (a copy made
+    by a reshape would drop the values)."""
+    send = np.arange(6.0).reshape(3, 2)
+    recv = np.zeros((2, 3)).T  # (3, 2), Fortran order
+    SerialComm().gatherv(send, recv, [6])
+    np.testing.assert_array_equal(recv, send)
+
+
 PARTS = [
     ("bar_pulse.yaml", ["geometry.size=[0.03, 0.008, 0.006]", "output.sensors={}", "output.lines={}"]),
     (

@@ -81,8 +81,8 @@ class SerialComm:
         return [obj]
 
     def gatherv(self, send: np.ndarray, recv: np.ndarray | None, counts, root: int = 0) -> None:
-        """``recv`` gets ``send``'s values."""
-        recv.reshape(-1)[:] = send.reshape(-1)
+        """``recv`` gets ``send``'s values (any layout of ``recv``; ``counts`` is one rank's)."""
+        recv[...] = send.reshape(recv.shape)
 
     def alltoall(self, objs: list) -> list:
         return list(objs)
