@@ -3,6 +3,7 @@
 import functools
 import json
 
+import numba
 import numpy as np
 import pytest
 
@@ -17,6 +18,7 @@ ROW_KEYS = {
     "points",
     "bonds",
     "bond_updates_per_s",
+    "half_list",
     "bytes_per_bond",
     "memory_roof_bond_updates_per_s",
     "memory_roof_fraction",
@@ -51,6 +53,7 @@ def _check(result, points):
         assert r["bonds"] > 0
         assert r["bond_updates_per_s"] > 0
         assert r["bytes_per_bond"] > 0
+        assert r["half_list"] is False or (r["model"], r["dtype"]) == ("pmb", "float64")
         # the roofs as the module docstring defines them, from the rates the result reports
         rate = r["bond_updates_per_s"]
         assert r["memory_roof_bond_updates_per_s"] == pytest.approx(bandwidth / r["bytes_per_bond"])
@@ -101,6 +104,25 @@ def test_bytes_per_bond_counts_the_arrays_the_kernels_read(dtype):
     assert benchmark.bytes_per_bond("lps", dtype) == dilatation + dilatation + lps.dev.itemsize
     baseline = index + bonds.length.itemsize + pmb.bond_stiffness.astype(np.float64).itemsize + flag
     assert benchmark.bytes_per_bond("pmb-baseline", "float64") == baseline
+
+
+def test_half_list_row_counts_a_pairs_arrays_for_two_bond_updates():
+    """The PMB float64 half list (``discretization.pairs.HalfList``) streams, per pair, the
+    arrays ``kernels.pmb.pmb_pair_force`` reads and one ``intact`` flag of the full list."""
+    body, bonds = benchmark.benchmark_grid(24)
+    pmb = make_model("pmb", body, bonds, E=200e9, nu=0.25, density=7850.0)
+    threads = numba.get_num_threads()
+    try:
+        numba.set_num_threads(1)  # 7 row blocks: the half list runs on up to 3 threads
+        assert pmb.runs_half_list()
+    finally:
+        numba.set_num_threads(threads)
+    p = pmb._pairs
+    per_pair = p.neighbours.itemsize + p.xi[0].nbytes + p.inv_len.itemsize + p.k.itemsize + p.k_rev.itemsize
+    assert (
+        benchmark.bytes_per_bond("pmb", "float64", half_list=True) == (per_pair + bonds.intact.itemsize) / 2
+    )
+    assert benchmark.ops_per_bond("pmb", "float64", half_list=True) == (0.5, 0.5)
 
 
 def test_ops_per_bond_counts_the_kernels_square_roots_and_divisions():

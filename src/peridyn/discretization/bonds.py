@@ -82,6 +82,11 @@ class Bonds:
         Each point's own horizon in a body whose blocks have different horizons
         (docs/blocks.md): a bond joins i and j within the smaller of their horizons, which its
         influence function and partial volume use. None: every point's is ``horizon``.
+    global_rows : (n_points,) int64 or None
+        An MPI rank's part: each row's index in the whole body. None: the rows are the body's.
+    row_blocks : (n_blocks + 1,) int64 or None
+        An MPI rank's part: the whole body's row blocks (``discretization.pairs``, in whole-body
+        rows), which fix the order of the PMB force's sums. None: from these bonds.
     """
 
     offsets: np.ndarray
@@ -93,6 +98,8 @@ class Bonds:
     horizon: float
     influence_name: str
     point_horizon: np.ndarray | None = None
+    global_rows: np.ndarray | None = None
+    row_blocks: np.ndarray | None = None
 
     def horizons(self):
         """Each point's horizon (m): ``point_horizon``, or the float ``horizon`` shared by all."""

@@ -34,6 +34,9 @@ arrays the kernel reads, summed over its passes (:func:`bytes_per_bond`):
 - baseline: neighbour index (int32, 4) + reference length (8) + micromodulus (8) +
   intact flag (bool, 1) = 21;
 - pmb float64: index 4 + reference bond vector 24 + 1/|xi| 8 + stiffness 8 + intact 1 = 45;
+  with the half list (``PMBModel.runs_half_list``: each bond pair once, the row's
+  ``half_list`` is true) a pair streams that and the reverse stiffness 8 for two bond
+  updates: 26.5, and half a square root and half a division a bond update;
   pmb float32 (cancellation-free kernel, |xi| recomputed from the points): 4 + 4 + 1 = 9;
 - lps float64: the dilatation pass (index 4 + bond vector 24 + length 8 + weight 8 +
   intact 1 = 45) and the force pass (the same + deviatoric coefficient 8 = 53) = 98;
@@ -127,11 +130,13 @@ def op_rates(dtype: str, repeat: int = 5) -> tuple[float, float]:
     return sqrt_rate, div_rate
 
 
-def ops_per_bond(model: str, dtype: str) -> tuple[int, int]:
-    """(square roots, divisions) one bond update of the row computes (see the module docstring)."""
+def ops_per_bond(model: str, dtype: str, half_list: bool = False) -> tuple[float, float]:
+    """(square roots, divisions) one bond update of the row computes (see the module docstring);
+    ``half_list``: the PMB float64 half list, one pair's for two bond updates."""
     if (model, dtype) not in OPS_PER_BOND:
         raise InputError(f"unknown benchmark row {model!r} {dtype}")
-    return OPS_PER_BOND[model, dtype]
+    n_sqrt, n_div = OPS_PER_BOND[model, dtype]
+    return (n_sqrt / 2, n_div / 2) if half_list else (n_sqrt, n_div)
 
 
 def best_seconds(call: Callable[[], object], repeat: int) -> float:
@@ -158,8 +163,9 @@ def benchmark_grid(points_per_side: int = DEFAULT_POINTS_PER_SIDE, partial_volum
     return body, bonds
 
 
-def bytes_per_bond(model: str, dtype: str) -> int:
-    """Bytes of per-bond arrays one bond update streams (see the module docstring)."""
+def bytes_per_bond(model: str, dtype: str, half_list: bool = False) -> float:
+    """Bytes of per-bond arrays one bond update streams (see the module docstring);
+    ``half_list``: the PMB float64 half list."""
     index, flag = np.dtype(np.int32).itemsize, np.dtype(bool).itemsize
     real = np.dtype(dtype).itemsize
     vector = 3 * real if dtype == "float64" else 0  # the float64 kernels read stored bond vectors
@@ -167,7 +173,8 @@ def bytes_per_bond(model: str, dtype: str) -> int:
         return index + 2 * real + flag  # neighbour, length, micromodulus, intact
     if model == "pmb":
         inverse_length = real if dtype == "float64" else 0  # float32 recomputes |xi| from the points
-        return index + vector + inverse_length + real + flag  # + stiffness
+        full = index + vector + inverse_length + real + flag  # + stiffness
+        return (full + real) / 2 if half_list else full  # + the reverse stiffness, per two updates
     if model == "lps":
         length = real if dtype == "float64" else 0  # float32 recomputes |xi| from the points
         dilatation = index + vector + length + real + flag  # + weight
@@ -175,8 +182,11 @@ def bytes_per_bond(model: str, dtype: str) -> int:
     raise InputError(f"unknown benchmark row {model!r}")
 
 
-def _row_callables(body, bonds, u64: np.ndarray) -> dict[tuple[str, str], Callable[[], np.ndarray]]:
-    """One zero-argument callable per row, each computing a full force evaluation."""
+def _row_callables(
+    body, bonds, u64: np.ndarray
+) -> tuple[dict[tuple[str, str], Callable[[], np.ndarray]], set]:
+    """One zero-argument callable per row, each computing a full force evaluation, and the
+    rows that run the PMB half list."""
     calls = {}
     models = {}
     for name, dtype in ROWS:
@@ -199,7 +209,8 @@ def _row_callables(body, bonds, u64: np.ndarray) -> dict[tuple[str, str], Callab
         u = np.ascontiguousarray(u64, dtype=model.dtype)
         out = np.empty_like(model.x)
         calls[key] = lambda model=model, u=u, out=out: model.force(u, out)
-    return calls
+    half = {key for key, model in models.items() if key[0] == "pmb" and model.runs_half_list()}
+    return calls, half
 
 
 def run_benchmark(
@@ -235,7 +246,7 @@ def run_benchmark(
     body, bonds = benchmark_grid(side, partial_volumes)
     rng = np.random.default_rng(seed)
     u64 = 1e-4 * SPACING * rng.standard_normal(body.points.shape)
-    calls = _row_callables(body, bonds, u64)
+    calls, half = _row_callables(body, bonds, u64)
     say(f"{body.n_points} points, {bonds.n_bonds} directed bonds; warming up (JIT)")
     for call in calls.values():
         call()
@@ -254,8 +265,8 @@ def run_benchmark(
     results = []
     for name, dtype in ROWS:
         rate = bonds.n_bonds / best[name, dtype]
-        nbytes = bytes_per_bond(name, dtype)
-        n_sqrt, n_div = ops_per_bond(name, dtype)
+        nbytes = bytes_per_bond(name, dtype, (name, dtype) in half)
+        n_sqrt, n_div = ops_per_bond(name, dtype, (name, dtype) in half)
         sqrt_rate, div_rate = rates[dtype]
         memory_roof = bandwidth / nbytes
         compute_roof = 1.0 / (n_sqrt / sqrt_rate + n_div / div_rate)
@@ -266,7 +277,8 @@ def run_benchmark(
                 "points": int(body.n_points),
                 "bonds": int(bonds.n_bonds),
                 "bond_updates_per_s": float(rate),
-                "bytes_per_bond": int(nbytes),
+                "half_list": (name, dtype) in half,
+                "bytes_per_bond": float(nbytes),
                 "memory_roof_bond_updates_per_s": float(memory_roof),
                 "memory_roof_fraction": float(rate / memory_roof),
                 "sqrt_per_bond": n_sqrt,
@@ -313,7 +325,7 @@ def format_table(result: dict) -> str:
     for r in rows:
         lines.append(
             f"{r['model']:<13} {r['dtype']:<8} {r['bond_updates_per_s'] / 1e6:>9.1f} "
-            f"{r['speedup_vs_baseline']:>10.2f} {r['bytes_per_bond']:>7d} "
+            f"{r['speedup_vs_baseline']:>10.2f} {r['bytes_per_bond']:>7.1f} "
             f"{r['memory_roof_bond_updates_per_s'] / 1e6:>9.0f} {r['memory_roof_fraction']:>6.2f} "
             f"{str(r['sqrt_per_bond']) + ',' + str(r['div_per_bond']):>8} "
             f"{r['compute_roof_bond_updates_per_s'] / 1e6:>9.0f} {r['compute_roof_fraction']:>6.2f}"

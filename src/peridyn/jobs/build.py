@@ -4,7 +4,7 @@ half-way (e.g. to inspect the bonds)."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -23,6 +23,7 @@ from peridyn.discretization.bonds import (
     reorder_bonds,
     search_reach,
 )
+from peridyn.discretization.pairs import index_bandwidth, row_blocks
 from peridyn.errors import CaseFileError, InputError
 from peridyn.io import exodus, mesh_text
 from peridyn.io.case import Case, Geometry, Region, box_cells
@@ -422,6 +423,7 @@ def _build_part(case: Case, comm, base_dir):
     clear_rows = tuple(int(np.count_nonzero(clear >= c)) for c in range(1, GHOST_LAYERS + 1))
     local_ids = np.concatenate([owned, ghosts])
     bonds = reorder_bonds(bonds, np.searchsorted(near, local_ids), len(near))
+    bonds = with_whole_body_rows(comm, bonds, local_ids, len(owned), body.n_points)
     part = body.subset(local_ids)
     part_blocks = None if of_block is None else of_block[local_ids]
     model = build_model(case, part, bonds, part_blocks)
@@ -431,6 +433,17 @@ def _build_part(case: Case, comm, base_dir):
     damage = build_damage(case, model, protected, part_blocks)
     setup = Setup(part, bonds, model, loading.restricted(part, local_ids), damage, None, None, body)
     return setup, owned, ghosts, owner[ghosts], clear_rows
+
+
+def with_whole_body_rows(comm, bonds: Bonds, local_ids: np.ndarray, n_owned: int, n_points: int) -> Bonds:
+    """A rank's ``bonds`` with the whole body's row numbers ``local_ids`` and row blocks
+    (``discretization.pairs``: the PMB force then sums in the serial run's order). The index
+    bandwidth is the largest over the ranks' owned families (every bond is in one)."""
+    owned_bonds = bonds.offsets[n_owned]
+    offsets = bonds.offsets[: n_owned + 1]
+    bandwidth = index_bandwidth(offsets, bonds.neighbours[:owned_bonds], local_ids)
+    blocks = row_blocks(n_points, int(comm.allreduce(bandwidth, "max")))
+    return replace(bonds, global_rows=local_ids, row_blocks=blocks)
 
 
 def neighbourhood_box(case: Case, body: Body, horizon: float) -> np.ndarray | None:

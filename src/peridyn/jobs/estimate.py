@@ -47,7 +47,8 @@ class Costs:
 #: search (8 B) and the reverse-bond permutation with its sort temporaries (24 B).
 #: ``explicit``: + the model's per-bond arrays (PMB: 1/length, stiffness, surface factor: 24 B;
 #: LPS: weight, deviatoric coefficient, shear factor: 24 B, and in float32 the length), the reference bond
-#: vectors that the float64 force kernels read (24 B) and the kernels' temporaries: about
+#: vectors that the float64 force kernels read (24 B; a PMB half list holds its per-pair copies
+#: instead, 26 B a directed bond, ``discretization.pairs``) and the kernels' temporaries: about
 #: 116 B; per point the body (points, volumes, cells, sets: 64 B) and the state (x, u, v, a, f,
 #: forces, damping: 8 x 24 B).
 #: ``static``, ``newton``, ``newmark``: + a bond-stiffness assembly (9 entries of 8 B values + 2 x 4 B

@@ -47,7 +47,11 @@ How the force kernels are written (what makes them fast, see ``benchmarks/RESULT
   stored (n_bonds, 3) array (``bond_search.initial_bond_vectors``, the same subtraction, so
   the same bits) and gather only ``u_j``: three gathers a bond instead of six, which is
   what the force loop waits on (1.16-1.20x on AMD Zen 4, ``benchmarks/RESULTS.md``). The
-  deformed vector is :func:`deformed_component`, also exact.
+  deformed vector is :func:`deformed_component`, also exact;
+- the PMB float64 force of a whole body computes each bond pair once and adds it to both
+  ends (``pmb.pmb_pair_force``; per pair it streams 53 bytes where the full list streams
+  2 x 45), row block by row block so that every sum keeps an order that the full-list kernel
+  follows too (``peridyn.discretization.pairs``): the two give the same bits.
 
 Two forms of the stretch are used:
 

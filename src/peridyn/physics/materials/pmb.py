@@ -21,12 +21,14 @@ G = (sum_a (n_a / g_a)^2)^(-1/2) of the two end points' averaged factors.
 
 from __future__ import annotations
 
+import numba
 import numpy as np
 
 from peridyn.discretization.body import Body
 from peridyn.discretization.bonds import Bonds
+from peridyn.discretization.pairs import block_split, half_list, index_bandwidth, row_blocks
 from peridyn.errors import InputError
-from peridyn.kernels.pmb import pmb_energy, pmb_force, pmb_force_cf
+from peridyn.kernels.pmb import pmb_energy, pmb_force, pmb_force_cf, pmb_pair_force
 from peridyn.physics.materials.base import Model
 from peridyn.physics.materials.elastic import (
     bulk_modulus,
@@ -129,6 +131,10 @@ class PMBModel(Model):
         if surface_correction == "energy":
             self.surface_factor = self._energy_surface_factor()
             self.bond_stiffness = (base * self.surface_factor).astype(self.dtype)
+        self._split: np.ndarray | None = None
+        self._pairs = None
+        self._pairs_h: np.ndarray | None = None
+        self._sums_planned = False
 
     @classmethod
     def implied_poisson_ratio(cls, dim, plane=None):
@@ -140,7 +146,12 @@ class PMBModel(Model):
 
         float64 uses the stored ``inv_length``; float32 the cancellation-free kernel,
         which recomputes |xi| from ``x`` (see ``peridyn.kernels``). Both read
-        ``bonds.intact`` on every call, so broken bonds need no notification.
+        ``bonds.intact`` on every call, so broken bonds need no notification (a bond breaks in
+        both directions together: the float64 half list reads one of them).
+
+        float64 sums each family in the row-block order of ``discretization.pairs``; the half
+        list (each pair once, ``kernels.pmb.pmb_pair_force``) is used where each of its two phases
+        has a block for every thread, else the full list: the same bits.
         """
         out = np.empty_like(self.x) if out is None else out
         return self._kernel_force(self._as_state(u), out)
@@ -164,18 +175,41 @@ class PMBModel(Model):
         if self.dtype == np.float32:
             args = (self.x, state, b.offsets, b.neighbours, self.bond_stiffness, b.intact, out)
             return pmb_force_cf(*args, first, stop)
+        if first == 0 and stop < 0 and self.runs_half_list():
+            pairs = self._pairs
+            args = (pairs.xi, state, pairs.offsets, pairs.neighbours, pairs.inv_len, pairs.k, pairs.k_rev)
+            for phase in (0, 1):
+                pmb_pair_force(*args, b.intact, pairs.intact_at, pairs.blocks, phase, out, self._pairs_h)
+            return out
+        self._plan_sums()
+        per_bond = (self.inv_length, self.bond_stiffness, b.intact)
         return pmb_force(
-            self.bond_vectors,
-            state,
-            b.offsets,
-            b.neighbours,
-            self.inv_length,
-            self.bond_stiffness,
-            b.intact,
-            out,
-            first,
-            stop,
+            self.bond_vectors, state, b.offsets, b.neighbours, *per_bond, out, first, stop, self._split
         )
+
+    def runs_half_list(self) -> bool:
+        """Whether :meth:`force` runs the half list now: float64, a whole body whose families
+        allow it, and at least one row block per numba thread in each of its two phases."""
+        if self.dtype != np.float64:
+            return False
+        self._plan_sums()
+        return self._pairs is not None and len(self._pairs.blocks) > 2 * numba.get_num_threads()
+
+    def _plan_sums(self):
+        """Once (float64): the row blocks of the sums, each family's ``h`` / ``g`` split and, for
+        a whole body whose families allow it, the half list (``discretization.pairs``)."""
+        if self._sums_planned:
+            return
+        b = self.bonds
+        blocks = b.row_blocks
+        if blocks is None:
+            blocks = row_blocks(len(b.offsets) - 1, index_bandwidth(b.offsets, b.neighbours, b.global_rows))
+        self._split = block_split(b.offsets, b.neighbours, blocks, b.global_rows)
+        if self._split is not None and b.global_rows is None and len(blocks) > 2:
+            xi = self.bond_vectors_once()
+            self._pairs = half_list(b, xi, self.inv_length, self.bond_stiffness, blocks)
+            self._pairs_h = None if self._pairs is None else np.empty_like(self.x)
+        self._sums_planned = True
 
     def energy_density(self, u):
         b = self.bonds
