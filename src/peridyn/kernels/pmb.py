@@ -77,7 +77,7 @@ def pmb_force(xi, u, offsets, nbr, inv_len, k, intact, f, first=0, stop=-1, spli
     """Internal force density ``f`` (OUT: the rows ``first .. stop - 1``, see ``peridyn.kernels``)
     of the PMB model ("length form").
 
-    ``s = k (1/|xi|- 1/|Y|)`` with the stored ``inv_len = 1/|xi|`` and bond vectors ``xi``
+    ``s = k (1/|xi| - 1/|Y|)`` with the stored ``inv_len = 1/|xi|`` and bond vectors ``xi``
     (n_bonds, 3), m (``bond_search.initial_bond_vectors``): one square root and one division
     per bond, and only ``u_j`` gathered. Used for float64 (see the package docstring).
 

@@ -131,10 +131,11 @@ class PMBModel(Model):
         if surface_correction == "energy":
             self.surface_factor = self._energy_surface_factor()
             self.bond_stiffness = (base * self.surface_factor).astype(self.dtype)
+        self._blocks: np.ndarray | None = None  # row blocks and splits of the float64 sums
         self._split: np.ndarray | None = None
-        self._pairs = None
+        self._pairs = None  # the half list, once made (None if the families do not allow it)
         self._pairs_h: np.ndarray | None = None
-        self._sums_planned = False
+        self._pairs_tried = False
 
     @classmethod
     def implied_poisson_ratio(cls, dim, plane=None):
@@ -189,27 +190,37 @@ class PMBModel(Model):
 
     def runs_half_list(self) -> bool:
         """Whether :meth:`force` runs the half list now: float64, a whole body whose families
-        allow it, and at least one row block per numba thread in each of its two phases."""
+        allow it, and at least one row block per numba thread in each of its two phases. The
+        half list is made the first time this holds."""
         if self.dtype != np.float64:
             return False
         self._plan_sums()
-        return self._pairs is not None and len(self._pairs.blocks) > 2 * numba.get_num_threads()
+        b = self.bonds
+        if (
+            self._split is None
+            or b.global_rows is not None
+            or len(self._blocks) <= 2 * numba.get_num_threads()
+        ):
+            return False
+        if not self._pairs_tried:
+            self._pairs = half_list(
+                b, self.bond_vectors_once(), self.inv_length, self.bond_stiffness, self._blocks
+            )
+            self._pairs_h = None if self._pairs is None else np.empty_like(self.x)
+            self._pairs_tried = True
+        return self._pairs is not None
 
     def _plan_sums(self):
-        """Once (float64): the row blocks of the sums, each family's ``h`` / ``g`` split and, for
-        a whole body whose families allow it, the half list (``discretization.pairs``)."""
-        if self._sums_planned:
+        """Once (float64): the row blocks of the sums and each family's ``h`` / ``g`` split
+        (``discretization.pairs``; a rank's part takes the whole body's from its bonds)."""
+        if self._blocks is not None:
             return
         b = self.bonds
         blocks = b.row_blocks
         if blocks is None:
-            blocks = row_blocks(len(b.offsets) - 1, index_bandwidth(b.offsets, b.neighbours, b.global_rows))
+            blocks = row_blocks(len(b.offsets) - 1, index_bandwidth(b.offsets, b.neighbours))
         self._split = block_split(b.offsets, b.neighbours, blocks, b.global_rows)
-        if self._split is not None and b.global_rows is None and len(blocks) > 2:
-            xi = self.bond_vectors_once()
-            self._pairs = half_list(b, xi, self.inv_length, self.bond_stiffness, blocks)
-            self._pairs_h = None if self._pairs is None else np.empty_like(self.x)
-        self._sums_planned = True
+        self._blocks = blocks
 
     def energy_density(self, u):
         b = self.bonds
