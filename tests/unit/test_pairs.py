@@ -72,8 +72,8 @@ def test_families_out_of_order_get_one_chain_and_no_half_list():
     backwards = replace(bonds, neighbours=bonds.neighbours[perm], length=bonds.length[perm])
     assert block_split(backwards.offsets, backwards.neighbours, blocks) is None
     k = np.ones(bonds.n_bonds)
-    assert half_list(backwards, np.zeros((bonds.n_bonds, 3)), 1.0 / backwards.length, k, blocks) is None
-    assert half_list(bonds, np.zeros((bonds.n_bonds, 3)), 1.0 / bonds.length, k, blocks) is not None
+    assert half_list(backwards, body.points, 1.0 / backwards.length, k, blocks) is None
+    assert half_list(bonds, body.points, 1.0 / bonds.length, k, blocks) is not None
 
 
 def test_pmb_force_uses_the_half_list_and_gives_the_full_lists_bits():

@@ -23,6 +23,8 @@ from typing import NamedTuple
 
 import numpy as np
 
+from peridyn.discretization.bonds import family_sums
+
 
 def index_bandwidth(offsets: np.ndarray, neighbours: np.ndarray, rows: np.ndarray | None = None) -> int:
     """max ``|j - i|`` over the bonds (i, j) of the CSR families; ``rows`` (n_points,) int: each
@@ -49,18 +51,16 @@ def block_split(
     ``blocks`` in those numbers. None when those bonds are not all after the others in some
     family (families not in ascending order): the families are then summed in one chain."""
     n = len(offsets) - 1
-    owners = np.repeat(np.arange(n), np.diff(offsets))
-    nbr = neighbours.astype(np.int64)
-    own = np.arange(n) if rows is None else np.asarray(rows, dtype=np.int64)
-    if rows is not None:
-        nbr = own[nbr]
+    counts = np.diff(offsets)
+    own = np.arange(n, dtype=np.int64) if rows is None else np.asarray(rows, dtype=np.int64)
     start = blocks[np.searchsorted(blocks, own, side="right") - 1]
-    before = nbr < start[owners]
-    split = offsets[:-1] + np.bincount(owners[before], minlength=n)
-    position = np.arange(len(nbr)) - offsets[owners]
-    if np.any(position[before] >= (split - offsets[:-1])[owners[before]]):
+    nbr = neighbours if rows is None else own[neighbours]
+    before = nbr < np.repeat(start, counts)
+    first = np.zeros(len(before), dtype=bool)  # each family's first bond
+    first[offsets[:-1][counts > 0]] = True
+    if np.any(before[1:] & ~before[:-1] & ~first[1:]):  # an earlier-block neighbour after another
         return None
-    return split
+    return offsets[:-1] + family_sums(offsets, before).astype(np.int64)
 
 
 class HalfList(NamedTuple):
@@ -81,30 +81,46 @@ class HalfList(NamedTuple):
 
 
 def half_list(
-    bonds, xi: np.ndarray, inv_len: np.ndarray, k: np.ndarray, blocks: np.ndarray
+    bonds, x: np.ndarray, inv_len: np.ndarray, k: np.ndarray, blocks: np.ndarray
 ) -> HalfList | None:
-    """The :class:`HalfList` of ``bonds`` (``Bonds`` of a whole body) with the per-bond ``xi``
-    (n_bonds, 3), ``inv_len``, ``k`` (n_bonds,); None unless every family is in strictly
-    ascending order and every bond has its reverse with the same ``1/|xi|`` (the half list
-    reproduces the full list's sums only then)."""
+    """The :class:`HalfList` of ``bonds`` (``Bonds`` of a whole body of points ``x`` (n_points, 3)
+    m) with the per-bond ``inv_len`` and ``k`` (n_bonds,); None unless every family is in
+    strictly ascending order and every bond has its reverse with the same ``1/|xi|`` (the half
+    list reproduces the full list's sums only then). A pair's ``xi`` is ``x_j - x_i``, the
+    subtraction of ``kernels.bond_search.initial_bond_vectors``. Its temporaries hold about
+    30 B a directed bond."""
     offsets, nbr = bonds.offsets, bonds.neighbours
     n = len(offsets) - 1
-    owners = bonds.owners()
+    counts = np.diff(offsets)
+    owners = np.repeat(np.arange(n, dtype=np.int32), counts)
     same = owners[1:] == owners[:-1]
-    if np.any(nbr[1:][same] <= nbr[:-1][same]):
-        return None
-    rev = bonds.reverse()
-    if not (np.array_equal(owners[rev], nbr) and np.array_equal(inv_len[rev], inv_len)):
+    if np.any((nbr[1:] <= nbr[:-1]) & same):
         return None
     upper = nbr > owners
-    counts = np.bincount(owners[upper], minlength=n)
+    i_up, j_up = owners[upper], nbr[upper]
+    lower = np.flatnonzero(~upper)  # the bonds j -> i, j > i: in (j, i) order
+    if len(lower) != len(j_up):
+        return None
+    by_j = np.argsort(j_up, kind="stable")  # the pairs in (j, i) order
+    if not (np.array_equal(owners[lower], j_up[by_j]) and np.array_equal(nbr[lower], i_up[by_j])):
+        return None
+    rev = np.empty(len(j_up), dtype=np.int64)
+    rev[by_j] = lower
+    del owners, lower, by_j
+    inv_up = inv_len[upper]
+    if not np.array_equal(inv_len[rev], inv_up):
+        return None
+    xi = np.empty((len(j_up), 3))
+    for a in range(3):  # a column at a time: small temporaries
+        xi[:, a] = x[j_up, a] - x[i_up, a]
+    n_upper = family_sums(offsets, upper).astype(np.int64)
     return HalfList(
-        offsets=np.concatenate([[0], np.cumsum(counts)]).astype(np.int64),
-        neighbours=np.ascontiguousarray(nbr[upper]),
-        xi=np.ascontiguousarray(xi[upper]),
-        inv_len=inv_len[upper],
+        offsets=np.concatenate([[0], np.cumsum(n_upper)]).astype(np.int64),
+        neighbours=np.ascontiguousarray(j_up),
+        xi=xi,
+        inv_len=inv_up,
         k=k[upper],
-        k_rev=k[rev[upper]],
-        intact_at=(offsets[1:] - counts).astype(np.int64),
+        k_rev=k[rev],
+        intact_at=offsets[1:] - n_upper,
         blocks=blocks,
     )

@@ -203,9 +203,7 @@ class PMBModel(Model):
         ):
             return False
         if not self._pairs_tried:
-            self._pairs = half_list(
-                b, self.bond_vectors_once(), self.inv_length, self.bond_stiffness, self._blocks
-            )
+            self._pairs = half_list(b, self.x, self.inv_length, self.bond_stiffness, self._blocks)
             self._pairs_h = None if self._pairs is None else np.empty_like(self.x)
             self._pairs_tried = True
         return self._pairs is not None
