@@ -570,6 +570,8 @@ class Output(Strict):
     pzt_sensors: dict[str, PZTSensor] = {}
     series_dtype: Literal["float64", "float32"] = "float64"
     vtu: bool = True
+    #: the VTU snapshots' data arrays: "none" (the default: written 8 times as fast) or "zlib"
+    vtu_compression: Literal["none", "zlib"] = "none"
     exodus: bool | ExodusOutput = False
     plots: bool = True
     #: per-point partial stress and Green-Lagrange strain in the final fields and VTU snapshots

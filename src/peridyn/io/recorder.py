@@ -79,6 +79,8 @@ class RecorderSpec:
         Storage type of the line and plane series (float32 halves big records).
     vtu : bool
         Write VTU snapshots and a PVD collection.
+    vtu_compression : {"none", "zlib"}
+        Their data arrays' compression (``peridyn.io.vtk.write_vtu``).
     stress, strain : bool
         Write the per-point partial stress / Green-Lagrange strain (final fields and VTU).
     exodus : bool
@@ -104,6 +106,7 @@ class RecorderSpec:
     pzt_sensors: dict = field(default_factory=dict)
     series_dtype: str = "float64"
     vtu: bool = True
+    vtu_compression: str = "none"
     exodus: bool = False
     exodus_file: str = "results.e"
     exodus_every: int | None = None
@@ -324,7 +327,9 @@ class Recorder:
         damage = self.damage() if self.damage is not None else None
         data = snapshot_fields(state.u, state.v, self.body.dim, damage, self._tensor_fields(state.u))
         name = snapshot_name(state.step, ".vtu")
-        write_vtu(self.directory / name, self.body.points[:, : self.body.dim], data)
+        write_vtu(
+            self.directory / name, self.body.points[:, : self.body.dim], data, self.spec.vtu_compression
+        )
         self.pvd.add(state.time, name)
 
     def write_exodus(self, state: State) -> None:

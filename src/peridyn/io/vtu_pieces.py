@@ -32,14 +32,17 @@ class VtuPieces:
         The rank's damage index (owned rows written).
     tensors : callable (u) -> dict of str to array, or None
         The rank's per-point tensor fields at its local displacement (``Recorder``'s ``tensors``).
+    compression : {"none", "zlib"}
+        The pieces' data arrays (``peridyn.io.vtk.write_vtu``).
     """
 
-    def __init__(self, domain: Domain, body: Body, directory, damage=None, tensors=None):
+    def __init__(self, domain: Domain, body: Body, directory, damage=None, tensors=None, compression="none"):
         self.domain = domain
         self.body = body
         self.directory = Path(directory)
         self.damage = damage
         self.tensors = tensors
+        self.compression = compression
 
     def write(self, state: State) -> None:
         """Write this rank's piece of the snapshot of ``state`` (the rank's, local rows) and, on
@@ -57,4 +60,4 @@ class VtuPieces:
     def _write_piece(self, folder: Path, piece: str, data: dict) -> None:
         folder.mkdir(parents=True, exist_ok=True)
         n, dim = self.domain.n_owned, self.body.dim
-        write_vtu(folder.parent / piece, self.body.points[:n, :dim], data)
+        write_vtu(folder.parent / piece, self.body.points[:n, :dim], data, self.compression)

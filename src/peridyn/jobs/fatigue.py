@@ -242,6 +242,7 @@ def _write_fatigue(case, setup, out, summary, result, before, after, start) -> d
             "first_break_cycle": np.where(np.isfinite(result.first_break), result.first_break, -1.0),
             "u_max": result.u_max[:, : body.dim],
         },
+        case.output.vtu_compression,
     )
     plots = []
     if case.output.plots:

@@ -111,6 +111,7 @@ def _write_modal(case, body, n_bonds, table: ModeTable, out, case_path) -> tuple
             out / "modes" / f"mode_{i:02d}.vtu",
             body.points[:, : body.dim],
             {"mode_shape": shape[:, : body.dim]},
+            case.output.vtu_compression,
         )
     summary = {
         "rigid_modes": result.n_rigid,

@@ -58,6 +58,7 @@ def recorder_spec(case: Case, body: Body, dt: float) -> RecorderSpec:
         pzt_sensors={k: _pzt_weights(body, v) for k, v in out.pzt_sensors.items()},
         series_dtype=out.series_dtype,
         vtu=out.vtu,
+        vtu_compression=out.vtu_compression,
         stress=out.stress,
         strain=out.strain,
         **exodus_spec(out.exodus),
@@ -446,7 +447,9 @@ def _run_explicit(
         info.update(d.provenance())
     pieces = None  # under MPI, each rank writes its piece of the VTU snapshots
     if d.size > 1 and spec.vtu:
-        pieces = VtuPieces(d, setup.body, out, lambda: damage_field(setup.model), tensors)
+        pieces = VtuPieces(
+            d, setup.body, out, lambda: damage_field(setup.model), tensors, spec.vtu_compression
+        )
     if d.size > 1 and tensors is not None:
         tensors = gathered.tensor_fields
     fields = exodus_values(case, setup, spec)

@@ -10,7 +10,8 @@ from peridyn.errors import InputError
 from peridyn.io.vtk import PVDCollection, read_pvtu_pieces, write_pvtu, write_vtu
 
 
-def test_vtu_round_trip_3d(tmp_path):
+@pytest.mark.parametrize("compression", ["none", "zlib"])
+def test_vtu_round_trip_3d(tmp_path, compression):
     rng = np.random.default_rng(2)
     points = rng.random((8, 3))
     fields = {
@@ -20,7 +21,8 @@ def test_vtu_round_trip_3d(tmp_path):
         "stress": rng.random((8, 6)).astype(np.float32),
     }
     path = tmp_path / "out.vtu"
-    write_vtu(path, points, fields)
+    write_vtu(path, points, fields, compression)
+    assert ('compressor="vtkZLibDataCompressor"' in path.read_text()) == (compression == "zlib")
     mesh = meshio.read(path)
     np.testing.assert_array_equal(mesh.points, points)
     assert [(block.type, len(block)) for block in mesh.cells] == [("vertex", 8)]
@@ -46,6 +48,11 @@ def test_vtu_pads_2d_points_and_vectors(tmp_path):
 def test_vtu_rejects_field_of_wrong_length(tmp_path):
     with pytest.raises(InputError, match=r"field 'damage' has shape \(2,\), expected \(3,\)"):
         write_vtu(tmp_path / "out.vtu", np.zeros((3, 3)), {"damage": np.zeros(2)})
+
+
+def test_vtu_rejects_an_unknown_compression(tmp_path):
+    with pytest.raises(InputError, match="compression must be one of"):
+        write_vtu(tmp_path / "out.vtu", np.zeros((3, 3)), {}, "gzip")
 
 
 def test_vtu_rejects_bad_points(tmp_path):
