@@ -35,19 +35,19 @@ def write_vtu(path: str | os.PathLike, points, point_data: dict, compression: st
     Raises
     ------
     InputError
-        Points of a bad shape, or a field whose first dimension is not
-        ``n_points`` or that is not numeric.
+        An unknown compression, points of a bad shape, or a field whose first dimension is
+        not ``n_points`` or that is not numeric.
     """
+    if compression not in VTU_COMPRESSIONS:
+        raise InputError(
+            f"write_vtu: compression must be one of {sorted(VTU_COMPRESSIONS)}, got {compression!r}"
+        )
     points = _pad_columns(np.asarray(points, dtype=np.float64))
     if points.ndim != 2 or points.shape[1] != 3:
         raise InputError(f"write_vtu: points must have shape (n_points, 2 or 3), got {points.shape}")
     n = points.shape[0]
     fields = {name: _vtk_field(name, values, n) for name, values in point_data.items()}
     cells = [("vertex", np.arange(n, dtype=np.int64).reshape(-1, 1))]
-    if compression not in VTU_COMPRESSIONS:
-        raise InputError(
-            f"write_vtu: compression must be one of {sorted(VTU_COMPRESSIONS)}, got {compression!r}"
-        )
     mesh = meshio.Mesh(points, cells, point_data=fields)
     meshio.vtu.write(os.fspath(path), mesh, compression=VTU_COMPRESSIONS[compression])
 
