@@ -32,6 +32,7 @@ import numba
 import numpy as np
 
 from peridyn.discretization.bonds import fused_plan, fused_ring_columns
+from peridyn.discretization.pairs import index_bandwidth
 from peridyn.jobs.bench import DEFAULT_POINTS_PER_SIDE, SPACING, benchmark_grid
 from peridyn.kernels import FASTMATH, bond_differences
 from peridyn.kernels.lps import (
@@ -283,12 +284,6 @@ def lps_force_block_prange(
         for i in numba.prange(blocks[k], blocks[k + 1]):
             lps_pair_force_row(i, xif, uf, offsets, nbr, length, w, dev, intact, p, f)
     return f
-
-
-def index_bandwidth(offsets: np.ndarray, nbr: np.ndarray) -> int:
-    """max |j - i| over the bonds (i, j) of the CSR families (points)."""
-    owners = np.repeat(np.arange(len(offsets) - 1), np.diff(offsets))
-    return int(np.max(np.abs(nbr.astype(np.int64) - owners), initial=0))
 
 
 def lps_fused_candidates(lps, u, out, block_rows=(64, 256, 1024), prange_rows=(2048, 8192)):
