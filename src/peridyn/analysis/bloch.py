@@ -80,7 +80,7 @@ class Discretisation:
                 f"Bloch analysis needs one grid spacing (a cubic lattice), got "
                 f"discretization.spacing = {d.spacing!r}"
             )
-        horizon = d.horizon_m if d.horizon_m is not None else d.horizon * spacing[0]
+        horizon = d.horizon_metres(float(spacing[0]))
         plate = g.type == "plate"
         return cls(
             spacing=float(spacing[0]),

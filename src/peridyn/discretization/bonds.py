@@ -143,11 +143,20 @@ class Bonds:
         )
 
 
+def horizon_metres(horizon_m: float | None, horizon_factor: float | None, spacing: float) -> float:
+    """The horizon (m): ``horizon_m`` when given, else ``horizon_factor`` times ``spacing`` (m).
+
+    The one rule of the package (case files' ``horizon`` and ``horizon_m``, blocks, estimates,
+    Bloch analysis, the Python API); whether exactly one was given is the caller's check.
+    """
+    return horizon_m if horizon_m is not None else horizon_factor * spacing
+
+
 def resolve_horizon(body: Body, horizon: float | None = None, horizon_factor: float | None = None) -> float:
     """The horizon in metres from either metres or a multiple of ``body.spacing``."""
     if (horizon is None) == (horizon_factor is None):
         raise InputError("give exactly one of horizon (m) or horizon_factor (multiple of spacing)")
-    delta = horizon if horizon is not None else horizon_factor * body.spacing
+    delta = horizon_metres(horizon, horizon_factor, body.spacing)
     if not (np.isfinite(delta) and delta > 0):
         raise InputError(f"the horizon must be positive, got {delta!r} m")
     return float(delta)

@@ -16,6 +16,7 @@ import numpy as np
 import yaml
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, ValidationError, model_validator
 
+from peridyn.discretization.bonds import horizon_metres
 from peridyn.errors import CaseFileError, InputError, did_you_mean
 from peridyn.io.exodus_write import PERIDIGM_VARIABLES
 from peridyn.physics.loads import parse_components
@@ -233,6 +234,10 @@ class Discretization(Strict):
     #: within round(horizon / spacing) cells along each axis, Peridigm's PdQuickGrid families
     neighbourhood: Literal["sphere", "box"] = "sphere"
 
+    def horizon_metres(self, spacing: float) -> float:
+        """The horizon (m) on a grid of ``spacing`` (m): ``horizon_m``, or ``horizon`` spacings."""
+        return horizon_metres(self.horizon_m, self.horizon, spacing)
+
     @model_validator(mode="after")
     def _one_horizon(self):
         if (self.horizon is None) == (self.horizon_m is None):
@@ -350,6 +355,12 @@ class Block(Strict):
     set: str | None = None
     horizon: Positive | None = None
     horizon_m: Positive | None = None
+
+    def horizon_metres(self, spacing: float, default: float) -> float:
+        """The block's horizon (m) on a grid of ``spacing`` (m); ``default`` (m) without one."""
+        if self.horizon is None and self.horizon_m is None:
+            return default
+        return horizon_metres(self.horizon_m, self.horizon, spacing)
 
     @model_validator(mode="after")
     def _one_selection(self):

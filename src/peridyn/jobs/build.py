@@ -176,8 +176,7 @@ def pad3(v) -> list:
 
 def case_horizon(case: Case, body: Body) -> float:
     """The horizon of the case's discretisation, m."""
-    d = case.discretization
-    return d.horizon_m if d.horizon_m is not None else d.horizon * body.spacing
+    return case.discretization.horizon_metres(body.spacing)
 
 
 def block_horizons(case: Case, body: Body, of_block=None) -> np.ndarray | None:
@@ -185,16 +184,7 @@ def block_horizons(case: Case, body: Body, of_block=None) -> np.ndarray | None:
     that differ (docs/blocks.md); None when every point's is ``case_horizon``. ``of_block``:
     the points' block indices (``block_index``), given by a rank's part of the body."""
     default = case_horizon(case, body)
-    values = np.array(
-        [
-            b.horizon_m
-            if b.horizon_m is not None
-            else default
-            if b.horizon is None
-            else b.horizon * body.spacing
-            for b in case.blocks.values()
-        ]
-    )
+    values = np.array([b.horizon_metres(body.spacing, default) for b in case.blocks.values()])
     if np.all(values == default):
         return None
     return values[block_index(case, body) if of_block is None else of_block]

@@ -212,7 +212,7 @@ def estimate_case(case: Case, base_dir=".", job: str | None = None) -> Estimate:
     counts, cell, dim = grid_shape(case, base_dir)
     d = case.discretization
     spacing = float(np.max(cell[:dim])) if case.geometry.type != "plate" else float(cell[0])
-    horizon = d.horizon_m if d.horizon_m is not None else d.horizon * spacing
+    horizon = d.horizon_metres(spacing)
     share = kept_share(case, counts, base_dir)
     points = float(np.prod(counts.astype(float))) * share
     bonds = lattice_bonds(counts, cell, horizon, d.partial_volumes, dim) * share

@@ -49,7 +49,7 @@ def estimated_stable_step(case: Case, base_dir=".") -> float:
     d, g = case.discretization, case.geometry
     stiffest = _stiffest(case, dim)
     spacing = float(cell[0]) if g.type == "plate" else float(np.max(cell[:dim]))
-    default = d.horizon_m if d.horizon_m is not None else d.horizon * spacing
+    default = d.horizon_metres(spacing)
     volume = float(np.prod(cell)) if not g.is_mesh else spacing**3
     bound = 0.0
     for horizon in _horizons(case, default, spacing):
@@ -66,10 +66,7 @@ def estimated_stable_step(case: Case, base_dir=".") -> float:
 
 def _horizons(case: Case, default: float, spacing: float) -> list[float]:
     """The distinct horizons (m) of the case: ``default``, or those of its blocks."""
-    found = {
-        b.horizon_m if b.horizon_m is not None else default if b.horizon is None else b.horizon * spacing
-        for b in case.blocks.values()
-    }
+    found = {b.horizon_metres(spacing, default) for b in case.blocks.values()}
     return sorted(found) or [default]
 
 

@@ -27,6 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from peridyn.analysis.convergence import ConvergenceError, richardson
+from peridyn.discretization.bonds import horizon_metres
 from peridyn.errors import CaseFileError, InputError
 from peridyn.io.case import load_case, parse_yaml
 from peridyn.io.results import Results
@@ -69,7 +70,7 @@ class StudyRun:
     @property
     def horizon(self) -> float:
         """Horizon delta in metres."""
-        return self.horizon_factor * self.spacing
+        return horizon_metres(None, self.horizon_factor, self.spacing)
 
     def to_dict(self) -> dict:
         return {
