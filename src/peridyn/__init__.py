@@ -7,21 +7,53 @@ material model (``make_model``), loads on node sets (``Loading`` with
 (many runs) through ``run_sweep``, its dataset read back with ``load_sweep``.
 """
 
-from peridyn.discretization import geometry
-from peridyn.discretization.body import Body
-from peridyn.discretization.bonds import Bonds, find_bonds
-from peridyn.errors import CaseFileError, InputError, InstabilityError, PeridynError
-from peridyn.io.case import load_case
-from peridyn.io.dataset import load_sweep
-from peridyn.io.provenance import package_version
-from peridyn.jobs.run import run_case
-from peridyn.jobs.sweep import run_sweep
-from peridyn.physics.damage import BondDamage, damage_field
-from peridyn.physics.loads import BoundaryCondition, InitialCondition, Loading
-from peridyn.physics.materials import LPSModel, PMBModel, make_model
-from peridyn.solvers import ExplicitSolver, State, relax
+from importlib import import_module
 
-__version__ = package_version()
+#: public name -> the module that defines it. Imported on first use (PEP 562), so that
+#: ``import peridyn.kernels`` or any other lower layer loads nothing above it.
+_PUBLIC = {
+    "geometry": "peridyn.discretization",
+    "Body": "peridyn.discretization.body",
+    "Bonds": "peridyn.discretization.bonds",
+    "find_bonds": "peridyn.discretization.bonds",
+    "CaseFileError": "peridyn.errors",
+    "InputError": "peridyn.errors",
+    "InstabilityError": "peridyn.errors",
+    "PeridynError": "peridyn.errors",
+    "load_case": "peridyn.io.case",
+    "load_sweep": "peridyn.io.dataset",
+    "run_case": "peridyn.jobs.run",
+    "run_sweep": "peridyn.jobs.sweep",
+    "BondDamage": "peridyn.physics.damage",
+    "damage_field": "peridyn.physics.damage",
+    "BoundaryCondition": "peridyn.physics.loads",
+    "InitialCondition": "peridyn.physics.loads",
+    "Loading": "peridyn.physics.loads",
+    "LPSModel": "peridyn.physics.materials",
+    "PMBModel": "peridyn.physics.materials",
+    "make_model": "peridyn.physics.materials",
+    "ExplicitSolver": "peridyn.solvers",
+    "State": "peridyn.solvers",
+    "relax": "peridyn.solvers",
+}
+
+
+def __getattr__(name: str):
+    if name == "__version__":
+        from peridyn.io.provenance import package_version
+
+        value = package_version()
+    elif name in _PUBLIC:
+        value = getattr(import_module(_PUBLIC[name]), name)
+    else:
+        raise AttributeError(f"module 'peridyn' has no attribute {name!r}")
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(__all__)
+
 
 __all__ = [
     "Body",
