@@ -16,7 +16,7 @@ built again from the bonds intact now and the solve goes on from where it was.
 - ``direct``: a sparse factorisation of K (``linalg.shift_invert.shifted_inverse``: the augmented LPS
   system in nested-dissection order). Fresh, it solves the system in one iteration; after bonds
   break, a few more, fewer still because the search directions of the earlier solves (up to
-  ``recycle``) deflate the later ones (``fatigue.pcg``). Each iteration is a triangular solve
+  ``recycle``) deflate the later ones (``linalg.krylov``). Each iteration is a triangular solve
   with the whole factor, whose size grows faster than the points (3 GB and 1.5 s per solve at
   48 000 points of the dog-bone under load, against 0.12-0.2 s for a V-cycle).
 - ``auto`` (default): ``direct`` up to ``DIRECT_DOFS`` free dofs, ``amg`` above.
@@ -41,10 +41,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from peridyn.errors import InputError
-from peridyn.fatigue.pcg import PCGResult, RecycledDirections, deflated_pcg
 from peridyn.linalg.amg import amg_preconditioner, proxy_stiffness, rigid_fields
 from peridyn.linalg.block_operator import block_stiffness_operator
 from peridyn.linalg.dofs import free_dofs
+from peridyn.linalg.krylov import KrylovResult, RecycledDirections, pcg
 from peridyn.linalg.shift_invert import shifted_inverse
 from peridyn.linalg.stiffness import stiffness_operator, stiffness_parts
 from peridyn.physics.loads import Loading
@@ -61,7 +61,7 @@ FRESH_ITERATIONS = 1000
 #: ``auto`` factorises up to this many free dofs and uses AMG above (at the 0.5 mm dog-bone,
 #: 42 000 dofs, both take the same time; at 134 000 the factor's solves cost 10 V-cycles each).
 DIRECT_DOFS = 40_000
-#: Search directions of earlier solves kept to deflate the next ones (``fatigue.pcg``).
+#: Search directions of earlier solves kept to deflate the next ones (``linalg.krylov``).
 RECYCLE = 80
 #: Vectors per block product (bounds the (n_bonds, BLOCK) work arrays of ``linalg.block_operator``).
 BLOCK = 20
@@ -149,8 +149,14 @@ class LinearStatics:
         factorised = False
         if self.method == "cg":
             diagonal = self._diagonal()
-            result = deflated_pcg(
-                self._free_product, lambda r: r / diagonal, rhs, self._last, self.rtol, 20 * len(rhs)
+            result = pcg(
+                self._free_product,
+                lambda r: r / diagonal,
+                rhs,
+                self.rtol * np.linalg.norm(rhs),
+                20 * len(rhs),
+                x0=self._last,
+                keep_directions=True,
             )
         else:
             if self._preconditioner is None:
@@ -161,7 +167,7 @@ class LinearStatics:
                 self._build_preconditioner()
                 factorised = True
                 more = self._preconditioned_cg(rhs, result.x, True)
-                result = PCGResult(
+                result = KrylovResult(
                     more.x, result.iterations + more.iterations, more.converged, more.directions
                 )
             self.recycled.add(result.directions)
@@ -196,18 +202,19 @@ class LinearStatics:
             out[:, start : start + BLOCK] = self.block_stiffness.matmat(part) + self.shift * part
         return out
 
-    def _preconditioned_cg(self, rhs: np.ndarray, x0: np.ndarray | None, fresh: bool) -> PCGResult:
+    def _preconditioned_cg(self, rhs: np.ndarray, x0: np.ndarray | None, fresh: bool) -> KrylovResult:
         """CG with the kept preconditioner, deflated by the recycled directions; at most
         FRESH_ITERATIONS iterations when the preconditioner is ``fresh``, else refactor_iterations."""
         maxiter = FRESH_ITERATIONS if fresh else self.refactor_iterations
-        return deflated_pcg(
+        return pcg(
             self._free_product,
             self._preconditioner.matvec,
             rhs,
-            x0,
-            self.rtol,
+            self.rtol * np.linalg.norm(rhs),
             maxiter,
-            self.recycled.basis(self._free_block_product),
+            x0=x0,
+            deflation=self.recycled.basis(self._free_block_product),
+            keep_directions=True,
         )
 
     def _diagonal(self) -> np.ndarray:

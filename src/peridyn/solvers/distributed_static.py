@@ -20,9 +20,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from peridyn import interrupts
 from peridyn.errors import InputError
 from peridyn.linalg.distributed import RankDofs, RankStiffness
+from peridyn.linalg.krylov import pcg
 from peridyn.physics.loads import Loading
 from peridyn.solvers.static import RelaxationResult
 
@@ -85,28 +85,23 @@ def distributed_equilibrium(
 
 
 def conjugate_gradients(K, precond, dofs: RankDofs, rhs, target: float, volume, max_iterations: int):
-    """x with ||(rhs - K x) / volume|| <= ``target`` by preconditioned CG from zero, or the last
-    iterate after ``max_iterations``; returns (x, iterations) (collective).
+    """x with ||(rhs - K x) / volume|| <= ``target`` by preconditioned CG from zero
+    (``linalg.krylov.pcg``, inner products over every rank's dofs), or the last iterate after
+    ``max_iterations``; returns (x, iterations) (collective).
 
     ``rhs`` (n_free,) N, ``volume`` (n_free,) m^3 (the residual is compared as a force density,
     N/m^3, as the equilibrium criterion is)."""
-    x = np.zeros_like(rhs)
-    r = rhs.copy()
-    z = precond @ r
-    p = z.copy()
-    rz = float(dofs.domain.allsum(r @ z))
-    for it in range(1, max_iterations + 1):
-        interrupts.check(where="solving for equilibrium", agree=dofs.domain.max)
-        q = K @ p
-        alpha = rz / float(dofs.domain.allsum(p @ q))
-        x += alpha * p
-        r -= alpha * q
-        if float(dofs.column_norms((r / volume)[:, None])[0]) <= target:
-            return x, it
-        z = precond @ r
-        rz, rz_old = float(dofs.domain.allsum(r @ z)), rz
-        p = z + (rz / rz_old) * p
-    return x, max_iterations
+    result = pcg(
+        lambda p: K @ p,
+        lambda r: precond @ r,
+        rhs,
+        target,
+        max_iterations,
+        dot=lambda a, b: float(dofs.domain.allsum(a @ b)),
+        residual_norm=lambda r: float(dofs.column_norms((r / volume)[:, None])[0]),
+        agree=dofs.domain.max,
+    )
+    return result.x, result.iterations
 
 
 def _force(model, domain, u: np.ndarray) -> np.ndarray:

@@ -34,6 +34,7 @@ from scipy.sparse.linalg import splu
 from peridyn import interrupts
 from peridyn.errors import InputError, did_you_mean
 from peridyn.linalg.dofs import free_dofs
+from peridyn.linalg.krylov import solve_spd
 from peridyn.linalg.tangent import tangent_stiffness
 from peridyn.physics.damage import BondDamage
 from peridyn.physics.loads import Loading
@@ -245,34 +246,8 @@ def solve_held(k_ff: sp.spmatrix, rhs: np.ndarray, method: str = "lu") -> np.nda
     if method == "lu":
         x[active] = splu(k_aa.tocsc()).solve(rhs[active])
     else:
-        x[active] = _jacobi_cg(k_aa, rhs[active])
+        x[active] = solve_spd(k_aa, rhs[active], CG_RTOL, "jacobi")
     return x
-
-
-def _jacobi_cg(a: sp.csr_matrix, rhs: np.ndarray) -> np.ndarray:
-    """Conjugate gradients with the diagonal of ``a`` as preconditioner, to ``CG_RTOL``."""
-    inv_diag = 1.0 / a.diagonal()
-    x = np.zeros_like(rhs)
-    r = rhs.copy()
-    z = inv_diag * r
-    p = z.copy()
-    rz = r @ z
-    target = CG_RTOL * np.linalg.norm(rhs)
-    for _ in range(10 * len(rhs) + 1):
-        interrupts.check(where="solving for equilibrium")
-        if np.linalg.norm(r) <= target:
-            return x
-        ap = a @ p
-        step = rz / (p @ ap)
-        x += step * p
-        r -= step * ap
-        z = inv_diag * r
-        rz, rz_old = r @ z, rz
-        p = z + (rz / rz_old) * p
-    raise InputError(
-        f"conjugate gradients did not reach {CG_RTOL:g} in {10 * len(rhs)} "
-        "iterations (is the tangent indefinite?): use linear_solver 'lu'"
-    )
 
 
 def rigid_support(model: Model) -> np.ndarray:
