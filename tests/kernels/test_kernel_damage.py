@@ -12,6 +12,7 @@ from peridyn.kernels.reference import damage as ref
 pytestmark = pytest.mark.kernels
 
 
+@pytest.mark.bitwise
 @pytest.mark.parametrize("dtype", [np.float64, np.float32])
 def test_squared_length_keeps_its_roundings(rng, dtype):
     """Compiled without fast-math, the squared length is y0^2 + y1^2 + y2^2 rounded step by
@@ -36,6 +37,7 @@ def _stretch_inputs(rng, share_tested):
     return fam, u, limit, tested, points, moved
 
 
+@pytest.mark.bitwise
 @pytest.mark.parametrize("share_tested", [1.0, 0.5])
 @pytest.mark.parametrize("quantum", [2.015 * SPACING / damage.MAX_QUANTA, 1e-7], ids=["fine", "coarse"])
 def test_stretch_test_families(rng, share_tested, quantum):
