@@ -10,6 +10,7 @@ from peridyn.kernels.reference import deformed_component as deformed_reference
 pytestmark = pytest.mark.kernels
 
 
+@pytest.mark.bitwise
 @pytest.mark.parametrize("dtype", [np.float64, np.float32])
 def test_bond_differences(rng, dtype):
     """(xj - xi, uj - ui, xi_a + du_a), exactly: compiled without fast-math, its three
@@ -24,6 +25,7 @@ def test_bond_differences(rng, dtype):
     np.testing.assert_array_equal(swapped, -got)
 
 
+@pytest.mark.bitwise
 @pytest.mark.parametrize("dtype", [np.float64, np.float32])
 def test_deformed_component_from_a_stored_reference_vector(rng, dtype):
     """``xi + (uj - ui)`` exactly (its reference, in the dtype); with ``xi = xj - xi`` rounded as

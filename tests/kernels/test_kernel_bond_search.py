@@ -80,6 +80,7 @@ def test_box_fraction_in_ball(rng, q):
     assert np.any(expected == 0) and np.any((expected > 0) & (expected < 1))
 
 
+@pytest.mark.bitwise
 def test_initial_bond_vectors(rng):
     """x_j - x_i of every directed bond, exactly (one subtraction, as in the reference); the
     reverse bond's vector is its negative to the last bit (Newton's third law of the kernels
@@ -93,10 +94,11 @@ def test_initial_bond_vectors(rng):
     np.testing.assert_array_equal(got[reverse], -got)
 
 
+@pytest.mark.bitwise
 def test_family_sums_are_bincounts_to_the_bit(rng):
     """Per-family sums in each family's bond order, empty families included: bit for bit the
     ``np.bincount`` over the bonds' owners that the reference (and peridyn before the kernel)
-    computes."""
+    computes. Both add each family's values one after the other in bond order, with no fast-math."""
     sizes = rng.integers(0, 9, 60)
     sizes[[0, 17, -1]] = 0  # empty families first, inside and last
     offsets = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)

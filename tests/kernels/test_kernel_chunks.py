@@ -19,7 +19,11 @@ from peridyn.kernels.bond_search import initial_bond_vectors
 pytestmark = pytest.mark.kernels
 
 
+@pytest.mark.bitwise
 def test_chunks_sum_in_written_order(rng):
+    """Each chunked kernel gives the single-loop kernel's bits (module docstring): the same operations
+    in the same order, and the kernels are compiled without value-changing fast-math flags
+    (``peridyn.kernels.FASTMATH``), so this holds on every CPU."""
     fam = jittered_families(rng, shape=(5, 5, 4), horizon_factor=3.015)
     sizes = np.diff(fam.offsets)
     assert sizes.max() > 2 * CHUNK and np.any(sizes % CHUNK)  # several chunks, partial ones

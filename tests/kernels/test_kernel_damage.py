@@ -12,6 +12,7 @@ from peridyn.kernels.reference import damage as ref
 pytestmark = pytest.mark.kernels
 
 
+@pytest.mark.bitwise
 @pytest.mark.parametrize("dtype", [np.float64, np.float32])
 def test_squared_length_keeps_its_roundings(rng, dtype):
     """Compiled without fast-math, the squared length is y0^2 + y1^2 + y2^2 rounded step by
@@ -36,15 +37,17 @@ def _stretch_inputs(rng, share_tested):
     return fam, u, limit, tested, points, moved
 
 
+@pytest.mark.bitwise
 @pytest.mark.parametrize("share_tested", [1.0, 0.5])
 @pytest.mark.parametrize("quantum", [2.015 * SPACING / damage.MAX_QUANTA, 1e-7], ids=["fine", "coarse"])
 def test_stretch_test_families(rng, share_tested, quantum):
-    """Bonds broken (both copies where the other end is not tested) and their count: exact
-    (same squared lengths, same comparison). Margins: the same whole number of quanta, then
-    rounded to ~1e-16; the fast-math kernel may round a bond's room by an ulp otherwise than
-    NumPy, which changes its whole quanta only when it lies within an ulp of a whole number,
-    so at most one point in a hundred may be one quantum off. Entries of the points not
-    tested are left alone."""
+    """Bonds broken (both copies where the other end is not tested) and their count: exact (same
+    squared lengths, same comparison, and the kernels are compiled without value-changing
+    fast-math flags, ``peridyn.kernels.FASTMATH``: on every CPU). Margins: the same whole number
+    of quanta, then rounded to ~1e-16; the kernel multiplies a bond's room by 1 / quantum where
+    NumPy divides it by quantum, which may round it by an ulp otherwise and changes its whole
+    quanta only when it lies within an ulp of a whole number, so at most one point in a hundred
+    may be one quantum off. Entries of the points not tested are left alone."""
     fam, u, limit, tested, points, moved = _stretch_inputs(rng, share_tested)
     intact = fam.intact.copy()
     margin = np.full(fam.n, -1.0)

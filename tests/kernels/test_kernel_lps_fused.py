@@ -51,10 +51,15 @@ def _fused(fam, xi, u, w, dev, theta_coef, p_coef, parts, block_rows):
     return theta, p, f
 
 
+@pytest.mark.bitwise
 @pytest.mark.parametrize("block_rows", [1, 7, 10**9])
 @pytest.mark.parametrize("parts", [1, 2, 3, 200])
 @pytest.mark.parametrize("shape, horizon_factor", FAMILIES)
 def test_fused_force_is_the_two_passes_bit_for_bit(rng, shape, horizon_factor, parts, block_rows):
+    """The fused LPS force (dilatation, pressure and pair force in one sweep of the rows, in parts and
+    blocks of rows) gives the two passes' theta, p and force bit for bit: each row's sums are the same
+    operations in the same order, and the kernels are compiled without value-changing fast-math flags
+    (``peridyn.kernels.FASTMATH``), so this holds on every CPU."""
     inputs = _inputs(rng, shape, horizon_factor)
     for got, ref in zip(_fused(*inputs, parts, block_rows), _two_passes(*inputs), strict=True):
         assert np.array_equal(got, ref)
@@ -64,7 +69,8 @@ def test_fused_force_is_the_two_passes_bit_for_bit(rng, shape, horizon_factor, p
 @pytest.mark.parametrize("parts", [1, 2, 5, 200])
 def test_fused_plan_orders_the_rows_it_reads(rng, parts, block_rows):
     """Parts and blocks tile the rows in order; a part's inner rows are read by no row of another
-    part; a block's ``need`` is above its rows and every neighbour of them."""
+    part; a block's ``need`` is above its rows and every neighbour of them. Row indices: compared
+    exactly."""
     fam = jittered_families(rng, shape=(6, 3, 2), horizon_factor=3.015)
     plan = fused_plan(fam.offsets, fam.nbr, parts, block_rows)
     n = fam.n
@@ -85,10 +91,12 @@ def test_fused_plan_orders_the_rows_it_reads(rng, parts, block_rows):
         assert plan.need[k] > fam.nbr[rows].max(initial=-1)
 
 
+@pytest.mark.bitwise
 @pytest.mark.parametrize("dim", [2, 3])
 def test_lps_model_force_is_fused_and_the_two_passes(dim, rng):
     """``LPSModel.force`` (float64) takes the fused kernel on a small body, with the same bits as
-    the model's own two passes."""
+    the model's own two passes. Same operations in the same order, and the kernels are compiled without
+    value-changing fast-math flags (``peridyn.kernels.FASTMATH``), so this holds on every CPU."""
     model = small_model("lps", dim, n=8)
     b = model.bonds
     b.intact[rng.random(b.n_bonds) < 0.05] = False
@@ -102,12 +110,14 @@ def test_lps_model_force_is_fused_and_the_two_passes(dim, rng):
     assert np.array_equal(fused_theta, model._theta)
 
 
+@pytest.mark.bitwise
 @pytest.mark.parametrize("parts", [1, 2, 3])
 def test_fused_force_of_leading_rows_after_the_rest_is_the_two_passes(rng, parts):
     """An MPI rank's overlapped force (``LPSModel.force_overlapped``): the dilatation of the rows
     after ``rows`` first, then the fused force of the first ``rows`` rows on the plan of their
     families alone. Neighbours past ``rows`` order nothing (the plan's ``need`` stays within
-    ``rows``), and the leading rows' theta, p and force are the two passes' bits."""
+    ``rows``), and the leading rows' theta, p and force are the two passes' bits. The kernels are
+    compiled without value-changing fast-math flags (``peridyn.kernels.FASTMATH``): on every CPU."""
     fam, xi, u, w, dev, theta_coef, p_coef = _inputs(rng, (6, 3, 2), 3.015)
     rows = fam.n // 2
     offsets = fam.offsets[: rows + 1]

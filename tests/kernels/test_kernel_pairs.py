@@ -25,15 +25,19 @@ def _bonds(rng):
 
 
 def test_pair_row_counts(rng):
+    """Nonzeros per row of the pair matrix (int64): counts, compared exactly."""
     n, i, j, _, _ = _bonds(rng)
     counts = pairs.pair_row_counts(i, j, n)
     assert counts.dtype == np.int64
     np.testing.assert_array_equal(counts, ref.pair_row_counts(i, j, n))
 
 
+@pytest.mark.bitwise
 @pytest.mark.parametrize("rows", [(0, None), (7, 31)], ids=["all rows", "a middle chunk"])
 def test_pair_rows(rng, rows):
-    """All rows at once and a chunk of rows starting mid-point (row 7 = point 2, y)."""
+    """All rows at once and a chunk of rows starting mid-point (row 7 = point 2, y). Column indices
+    exactly, and the values bit for bit: each is the reference's products in the same order, in a kernel
+    compiled without fast-math."""
     n, i, j, n_vec, coef = _bonds(rng)
     start, stop = rows[0], 3 * n if rows[1] is None else rows[1]
     ends = np.cumsum(ref.pair_row_counts(i, j, n))

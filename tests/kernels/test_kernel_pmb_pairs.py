@@ -48,8 +48,15 @@ def _pair_force(pairs, u, intact):
     return f
 
 
+@pytest.mark.bitwise
 @pytest.mark.parametrize("n_blocks", [1, 2, 3, 5])
 def test_half_list_gives_the_block_order_bits(rng, n_blocks):
+    """The half-list PMB force (each bond pair computed once and added to both ends, row block by row
+    block) is the full-list kernel's force on the same row blocks, zero signs included, and its stored
+    bond vectors are the full list's (the same subtraction). Bit for bit: every point's sum adds the
+    same terms in the same order (``peridyn.discretization.pairs``), and the kernels are compiled
+    without value-changing fast-math flags (``peridyn.kernels.FASTMATH``), so this holds on every
+    CPU."""
     fam, bonds, u, k, xi, inv_len = _inputs(rng)
     bandwidth = index_bandwidth(fam.offsets, fam.nbr)
     assert fam.n >= 5 * bandwidth  # five blocks of at least the bandwidth fit
@@ -81,8 +88,11 @@ def test_block_order_matches_the_reference(rng):
     assert_close(got, expected, TOL64, scale)
 
 
+@pytest.mark.bitwise
 def test_row_bounds_keep_the_block_order(rng):
-    """An MPI rank's two row-bounded calls give the rows of one whole call."""
+    """An MPI rank's two row-bounded calls give the rows of one whole call. A row's sum is the same
+    operations in the same order whichever call computes it, and the kernels are compiled without
+    value-changing fast-math flags (``peridyn.kernels.FASTMATH``), so this holds on every CPU."""
     fam, bonds, u, k, xi, inv_len = _inputs(rng)
     split = block_split(fam.offsets, fam.nbr, row_blocks(fam.n, index_bandwidth(fam.offsets, fam.nbr)))
     args = (xi, u, fam.offsets, fam.nbr, inv_len, k, bonds.intact)

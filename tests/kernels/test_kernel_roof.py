@@ -9,6 +9,7 @@ from peridyn.kernels.roof import div_probe, sqrt_probe
 pytestmark = pytest.mark.kernels
 
 
+@pytest.mark.bitwise
 @pytest.mark.parametrize("dtype", [np.float64, np.float32])
 def test_sqrt_probe(rng, dtype):
     """Exactly NumPy's iterated sqrt(x + c): compiled without fast-math, each operation is rounded once."""
@@ -18,6 +19,7 @@ def test_sqrt_probe(rng, dtype):
     np.testing.assert_array_equal(sqrt_probe(buf, c, 3), expected)
 
 
+@pytest.mark.bitwise
 @pytest.mark.parametrize("dtype", [np.float64, np.float32])
 def test_div_probe(rng, dtype):
     """Exactly NumPy's iterated c / x: compiled without fast-math, IEEE division is correctly rounded."""

@@ -59,6 +59,7 @@ def _calls(rng):
     }
 
 
+@pytest.mark.bitwise
 @pytest.mark.parametrize(
     "name",
     [
@@ -71,6 +72,11 @@ def _calls(rng):
     ],
 )
 def test_bounded_rows_equal_the_full_call_and_others_stay(rng, name):
+    """A row-bounded call (an MPI rank's) computes the rows ``first .. stop - 1`` with the full call's
+    bits and leaves the other rows alone; two calls split at one row give the full call. A row's sums
+    are the same operations in the same order whichever call computes them, and the kernels are compiled
+    without value-changing fast-math flags (``peridyn.kernels.FASTMATH``), so this holds on every
+    CPU."""
     n, calls = _calls(rng)
     width, call = calls[name]
     dtype = np.float32 if name.endswith("_cf") else np.float64

@@ -9,6 +9,7 @@ from peridyn.kernels.triad import triad
 pytestmark = pytest.mark.kernels
 
 
+@pytest.mark.bitwise
 @pytest.mark.parametrize("dtype", [np.float64, np.float32])
 def test_triad(rng, dtype):
     """a = b + s c, exactly: compiled without fast-math, one product and one sum, each

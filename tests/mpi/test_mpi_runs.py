@@ -131,9 +131,16 @@ def _assert_same_snapshots(pieces_run: Path, serial_run: Path) -> None:
             assert got.dtype == value.dtype and np.array_equal(got[by_pieces], value[by_whole]), name
 
 
+@pytest.mark.bitwise
 @pytest.mark.parametrize("ranks", [2, 3])
 @pytest.mark.parametrize("case", list(CASES))
 def test_mpi_run_equals_the_serial_run_bit_for_bit(case, ranks, serial, tmp_path):
+    """Each case on 2 and 3 ranks writes the serial run's results.h5 (every dataset, dtypes and shapes
+    included) and VTU snapshots bit for bit, with halo traffic and per-rank metadata as expected. Bit
+    for bit: each rank computes its points with the serial operations in the serial order, and the
+    global sums are taken over the whole body in global point order on rank 0 (``Domain.reduce``); the
+    kernels are compiled without value-changing fast-math flags (``peridyn.kernels.FASTMATH``), so this
+    holds on every CPU."""
     done = _run(case, tmp_path / case, ranks)
     assert done.returncode == 0, done.stderr
     assert done.stderr.count("peridyn 0.1") <= 1  # only rank 0 speaks
@@ -189,14 +196,17 @@ def _assert_halo_traffic(summary: dict, case: str, ranks: int) -> None:
 def test_contact_acts_and_its_list_is_rebuilt_during_the_mpi_run(serial):
     """The contact comparison is not vacuous: the contact list was rebuilt after the first build
     (the rebuild and its new contact ghosts are covered) and the contact forces changed the
-    result (the same run without ``contact`` ends elsewhere)."""
+    result (the same run without ``contact`` ends elsewhere). (``array_equal`` only shows that the two
+    runs differ, by far more than rounding.)"""
     (with_contact, summary, _), without = serial["kalthoff_contact"], serial["kalthoff_winkler"][0]
     assert summary["contact_rebuilds"] >= 2
     assert not np.array_equal(with_contact["final/u"], without["final/u"])
 
 
+@pytest.mark.bitwise
 def test_contact_on_four_ranks_equals_the_serial_run_bit_for_bit(serial, tmp_path):
-    """Issue 20 asks for 1 to 4 ranks: contact, the case with the most collectives, on four."""
+    """Contact, the case with the most collectives, on four ranks: the serial run's datasets bit for
+    bit, for the reasons given in ``test_mpi_run_equals_the_serial_run_bit_for_bit``."""
     done = _run("kalthoff_contact", tmp_path / "run", 4)
     assert done.returncode == 0, done.stderr
     got, want = results_datasets(tmp_path / "run" / "results.h5"), serial["kalthoff_contact"][0]
@@ -274,11 +284,17 @@ def test_an_error_on_one_rank_inside_a_step_ends_every_rank_with_one_line(serial
     assert len(lines) == 1 and "out of memory (injected on one rank)" in lines[0], stderr
 
 
+@pytest.mark.bitwise
 def test_ctrl_c_stops_every_rank_at_one_step_with_a_checkpoint_and_restart_is_bit_for_bit(serial, tmp_path):
     """SIGINT to mpiexec's process group (Ctrl-C in a terminal; mpiexec forwards it to the ranks)
     after step 300 of plate2d_stretch on 2 ranks: the ranks agree on the step to stop after, the
     checkpoint holds that step, the status says it, the exit status is 130 (docs/user-guide.md);
-    ``--restart`` on 3 ranks then gives the serial run's datasets bit for bit."""
+    ``--restart`` on 3 ranks then gives the serial run's datasets bit for bit. The bits agree: the restart
+    continues from the checkpoint's exact state with the same operations in the same order, and each
+    rank computes its points with the serial operations in the serial order, and the global sums are
+    taken over the whole body in global point order on rank 0 (``Domain.reduce``); the kernels are
+    compiled without value-changing fast-math flags (``peridyn.kernels.FASTMATH``), so this holds on
+    every CPU."""
     out, mark = tmp_path / "run", tmp_path / "mark"
     run = _hooked(
         "plate2d_stretch",
@@ -311,11 +327,16 @@ def test_ctrl_c_stops_every_rank_at_one_step_with_a_checkpoint_and_restart_is_bi
     _assert_same_snapshots(out, serial["plate2d_stretch"][2])
 
 
+@pytest.mark.bitwise
 def test_restart_on_three_ranks_from_a_two_rank_checkpoint_equals_the_serial_run(serial, tmp_path):
     """Checkpoints hold the whole body in serial numbering: a 2-rank run stopped at 38 us (its
     last checkpoint at step 1500, after the crack has started: plate2d_stretch's crack history
     shows it by 35 us) and continued on 3 ranks to 40 us gives the serial 40 us run's datasets,
-    bonds broken and crack history bit for bit."""
+    bonds broken and crack history bit for bit. The bits agree: the restart continues from the checkpoint's
+    exact state with the same operations in the same order, and each rank computes its points with the
+    serial operations in the serial order, and the global sums are taken over the whole body in global
+    point order on rank 0 (``Domain.reduce``); the kernels are compiled without value-changing fast-math
+    flags (``peridyn.kernels.FASTMATH``), so this holds on every CPU."""
     out = tmp_path / "run"
     first = _run("plate2d_stretch", out, 2, "solver.time=38e-6", flags=["--checkpoint-every", "100"])
     assert first.returncode == 0, first.stderr

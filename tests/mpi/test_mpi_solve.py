@@ -75,6 +75,11 @@ def serial(tmp_path_factory):
 @pytest.mark.parametrize("ranks", [2, 3])
 @pytest.mark.parametrize("case", list(CASES))
 def test_mpi_modal_gives_the_serial_modes(case, ranks, serial, tmp_path):
+    """``peridyn modal`` on 2 and 3 ranks gives the serial modes: the same points, bonds and rigid
+    modes, elastic frequencies to 1e-6 (the eigensolver's tolerance), shapes with a MAC above 0.999 per
+    cluster, the same mode types where no frequencies are degenerate, residuals below 1e-6. The
+    rigid-mode flags are booleans, compared exactly: the rigid frequencies lie orders of magnitude below
+    the elastic ones."""
     want_summary, want = serial[case]
     summary = _modal(case, tmp_path / "run", ranks)
     got = _modes(tmp_path / "run")

@@ -140,9 +140,15 @@ def test_the_serial_runs_break_bonds_and_touch(serial):
     assert np.all(data["final/u"][:, 0] <= 0)  # pushed towards the clamp, not pulled apart
 
 
+@pytest.mark.bitwise
 @pytest.mark.parametrize("ranks", [2, 3])
 @pytest.mark.parametrize("case", list(CASES))
 def test_mpi_static_relaxation_is_the_serial_run(case, ranks, serial, tmp_path):
+    """A static case on 2 and 3 ranks gives the serial run's summary (but its folder, time and
+    memory) and datasets bit for bit: each rank computes its points with the serial operations in
+    the serial order, and the global sums are taken over the whole body in global point order on
+    rank 0 (``Domain.reduce``); the kernels are compiled without value-changing fast-math flags
+    (``peridyn.kernels.FASTMATH``), so this holds on every CPU."""
     want_summary, want = serial[case]
     summary = _run(case, tmp_path / "run", ranks)
     got = _datasets(tmp_path / "run")

@@ -49,6 +49,7 @@ def _arrays(path):
     return arrays
 
 
+@pytest.mark.bitwise
 @pytest.mark.parametrize(
     ("case", "sets"),
     [
@@ -62,6 +63,10 @@ def _arrays(path):
     ids=["lps-float64", "lps-float32", "pmb"],
 )
 def test_fresh_and_cached_kernels_give_the_same_run(tmp_path, case, sets):
+    """A run in a process that compiles the kernels (an empty numba cache) and one in a process that
+    loads them from that cache write the same floating-point datasets bit for bit: compiled without
+    value-changing fast-math flags (``peridyn.kernels.FASTMATH``), a kernel performs the IEEE operations
+    in its written order however it was built, on every CPU."""
     cache = tmp_path / "numba-cache"  # empty: the first run compiles and stores every kernel
     _run(case, tmp_path / "fresh", cache, sets)
     _run(case, tmp_path / "cached", cache, sets)

@@ -28,7 +28,10 @@ BAR = {
 }
 
 
+@pytest.mark.bitwise
 def test_exodus_geometry_gives_the_mesh_points_and_sets():
+    """A case on an Exodus mesh gets the points, volumes and node sets of ``mesh_points`` of that mesh,
+    exactly: the body is made by the same code from the same file."""
     body = build_body(validate_case(copy.deepcopy(BAR)))
     pts = mesh_points(read_exodus(MESH))
     np.testing.assert_array_equal(body.points, pts.points)
@@ -49,7 +52,7 @@ def test_unknown_mesh_set_is_named():
 def test_exodus_output_matches_results_h5(tmp_path):
     """results.e holds the snapshots (steps 0, 5, 10 and the last, 12): displacement equal to
     results.h5's field snapshots and, at the last step, to its final displacement, bit for bit;
-    velocity, damage and volume per point."""
+    velocity, damage and volume per point. Exactly: the same arrays stored in two files."""
     run_case(validate_case(copy.deepcopy(BAR)), tmp_path)
     out = read_exodus(tmp_path / "results.e")
     res = Results(tmp_path / "results.h5")
@@ -73,8 +76,12 @@ def test_exodus_output_matches_results_h5(tmp_path):
     assert np.all(v0[body.node_set("nodelist_1")] == -100.0)
 
 
+@pytest.mark.bitwise
 def test_exodus_output_survives_a_restart(tmp_path):
-    """Checkpoint at step 5, stop at 8, restart to 12: results.e as from one run."""
+    """Checkpoint at step 5, stop at 8, restart to 12: results.e as from one run. Bit for bit: the
+    restart continues from the checkpoint's exact state with the same operations in the same order, and
+    the kernels are compiled without value-changing fast-math flags (``peridyn.kernels.FASTMATH``), so
+    this holds on every CPU."""
     run_case(validate_case(copy.deepcopy(BAR)), tmp_path / "whole")
     short = copy.deepcopy(BAR)
     short["solver"]["steps"] = 8

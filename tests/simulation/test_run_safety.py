@@ -105,9 +105,13 @@ def test_an_earlier_run_is_left_alone(finished, kwargs, message):
     assert _digests(finished) == before
 
 
+@pytest.mark.bitwise
 def test_overwrite_replaces_and_restart_extends(finished, tmp_path):
     """--overwrite starts again; --restart with a longer run continues the checkpoint (the run
-    length is not part of the case hash) and equals the longer run made in one go."""
+    length is not part of the case hash) and equals the longer run made in one go. Bit for bit: the
+    restart continues from the checkpoint's exact state with the same operations in the same order, and
+    the kernels are compiled without value-changing fast-math flags (``peridyn.kernels.FASTMATH``), so
+    this holds on every CPU."""
     whole = run_case(_case(solver={"steps": 60}), tmp_path)
     again = run_case(_case(solver={"steps": 60}), tmp_path, overwrite=True)
     assert again["steps"] == 60

@@ -45,8 +45,12 @@ def _case(**changes):
     return validate_case(raw)
 
 
+@pytest.mark.bitwise
 def test_restart_reproduces_an_uninterrupted_run(tmp_path):
-    """Checkpoint at step 20, 'crash' at 30, restart to 40: identical to 40 steps in one go."""
+    """Checkpoint at step 20, 'crash' at 30, restart to 40: identical to 40 steps in one go. Bit for
+    bit: the restart continues from the checkpoint's exact state with the same operations in the same
+    order, and the kernels are compiled without value-changing fast-math flags
+    (``peridyn.kernels.FASTMATH``), so this holds on every CPU."""
     whole = run_case(_case(), tmp_path / "whole")
     run_case(_case(solver__steps=30), tmp_path / "split", checkpoint_every=20)
     resumed = run_case(_case(), tmp_path / "split", restart=True)

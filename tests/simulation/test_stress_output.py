@@ -36,7 +36,8 @@ def test_bar_stress_is_young_modulus_times_strain_at_the_centre(tmp_path):
     0.4%: what is left is the square lattice's fourth-moment anisotropy of the LPS deviatoric
     part (docs/user-guide.md), and the surfaces' stiffening 2.5 horizons away. The section's
     mean sigma_xx also balances the load, F / (W t), to 1e-4 (measured 1e-5): the partial
-    stress carries the force through the section."""
+    stress carries the force through the section. The snapshot's tensors are the final ones, stored in
+    another file: compared exactly."""
     run_case(validate_case(copy.deepcopy(BAR)), tmp_path)
     results = Results(tmp_path / "results.h5")
     x = results.array("geometry/points")

@@ -236,11 +236,13 @@ def test_blocks_of_a_text_mesh_by_their_sets(tmp_path):
     assert err.value.key == "blocks.right.set"
 
 
+@pytest.mark.bitwise
 def test_blocks_of_their_own_horizons():
     """docs/blocks.md: a bond between blocks exists within the smaller of its ends' horizons,
     and weighs its influence and partial volume with it. A point whose family lies in its own
     block has the family of the one-material body of its block's horizon (bit for bit), and
-    its PMB c0 is that of its horizon (Silling and Askari 2005: c0 = 18 K / (pi delta^4))."""
+    its PMB c0 is that of its horizon (Silling and Askari 2005: c0 = 18 K / (pi delta^4)). Bit for bit:
+    the same bond's coefficients are computed by the same code in the same order."""
     raw = _raw(materials={"steel": STEEL, "aluminium": STEEL})
     raw["geometry"]["size"] = [0.012, 0.006, 0.006]
     raw["discretization"]["partial_volumes"] = True

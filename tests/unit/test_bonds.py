@@ -41,6 +41,8 @@ def test_interior_family_size_2d():
 
 
 def test_families_are_symmetric_and_sorted():
+    """Each bond i->j has its reverse j->i (indices: compared exactly) with the same volume factor to
+    rounding, and each family is sorted by neighbour."""
     body = geometry.plate(0.008, 0.006, 0.002, spacing=1e-3, layers=3)
     bonds = find_bonds(body, 2.5e-3)
     rev = bonds.reverse()
@@ -55,7 +57,8 @@ def test_families_are_symmetric_and_sorted():
 
 def test_reverse_of_families_in_any_order():
     """``reverse`` pairs each bond i->j with j->i when the families are not sorted by neighbour
-    (as in a rank's part): the definition checked directly, and it is its own inverse."""
+    (as in a rank's part): the definition checked directly, and it is its own inverse. Indices: compared
+    exactly."""
     body = geometry.plate(0.008, 0.006, 0.002, spacing=1e-3, layers=3)
     bonds = find_bonds(body, 2.5e-3)
     order = np.concatenate(
@@ -144,6 +147,10 @@ def test_rectangle_precrack_cuts_exactly_the_crossing_bonds():
 
 
 def test_segment_precrack_2d():
+    """A 2D segment pre-crack cuts the bonds that cross it, found here by a direct intersection with the
+    line x = 5 mm. Booleans, compared exactly: both sides are NumPy elementwise arithmetic, correctly
+    rounded on every CPU; the four bonds through the segment's end (5, 4) mm land on it exactly on both
+    sides (y = 4 mm, a zero orientation) and are not cut."""
     body = geometry.rectangle(0.010, 0.010, 1e-3, thickness=1e-3)
     bonds = find_bonds(body, 2.015e-3, partial_volumes=False)
     cut = cut_bonds(body, bonds, lambda a, b: crossing_segment(a, b, (0.005, 0.0), (0.005, 0.004)))
@@ -157,7 +164,8 @@ def test_segment_precrack_2d():
 
 
 def test_family_sums_gives_zero_for_an_empty_family():
-    """An empty CSR family sums to 0 (np.add.reduceat would return the next family's first value)."""
+    """An empty CSR family sums to 0 (np.add.reduceat would return the next family's first value). Sums
+    of small whole numbers are exact: compared exactly."""
     from peridyn.discretization.bonds import family_sums
 
     offsets = np.array([0, 2, 2, 5])

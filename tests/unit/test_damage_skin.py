@@ -68,11 +68,14 @@ def run_pair(build, critical_stretch, n_steps, v0=None, no_damage_sets=()):
     return runs
 
 
+@pytest.mark.bitwise
 def test_skin_breaks_the_bonds_of_a_full_test_in_a_growing_crack():
     """Edge-cracked plate pulled apart: same bonds broken at every step, same displacements
     to the last bit, with the skin and with every bond tested at every step. The run must
     grow the crack (bonds broken beyond the pre-crack) and the skin must have skipped
-    many full tests, or the comparison proves nothing."""
+    many full tests, or the comparison proves nothing. Bit for bit: both test the bonds with the same
+    kernels and the same squared lengths, and the kernels are compiled without value-changing fast-math
+    flags (``peridyn.kernels.FASTMATH``), so this holds on every CPU."""
     runs = run_pair(edge_cracked_plate, 2e-3, 400, no_damage_sets=["grips"])
     (m1, skin, s1, broken1), (m2, full, s2, broken2) = runs
     assert broken1 == broken2
@@ -84,9 +87,12 @@ def test_skin_breaks_the_bonds_of_a_full_test_in_a_growing_crack():
     assert skin.partial_tests >= 200  # at most half the calls were full tests (116 here)
 
 
+@pytest.mark.bitwise
 def test_skin_breaks_the_bonds_of_a_full_test_when_bonds_break_everywhere():
     """Cube of the contact benchmark shaken by 2 m/s rms random velocities: bonds break here
-    and there all through it. Same broken bonds and displacements as full tests."""
+    and there all through it. Same broken bonds and displacements as full tests. Bit for bit: both test
+    the bonds with the same kernels and the same squared lengths, and the kernels are compiled without
+    value-changing fast-math flags (``peridyn.kernels.FASTMATH``), so this holds on every CPU."""
     rng = np.random.default_rng(3)
     v0 = rng.normal(scale=2.0 / np.sqrt(3), size=(12**3, 3))
     (m1, skin, s1, broken1), (m2, _, s2, broken2) = run_pair(shaken_cube, 1e-3, 60, v0)
@@ -193,7 +199,8 @@ def test_criteria_are_frozen_after_the_first_update_until_reset():
 
 def test_a_non_finite_displacement_falls_back_to_a_full_test():
     """An infinite displacement has no finite move to bound: ``update`` tests every bond, and
-    the infinitely stretched bonds of that point (both copies) break, as a full test breaks them."""
+    the infinitely stretched bonds of that point (both copies) break, as a full test breaks them.
+    Booleans: compared exactly."""
     model = line_model()
     b = model.bonds
     damage = BondDamage(model, critical_stretch=1e-3)

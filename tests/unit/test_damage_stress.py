@@ -26,7 +26,8 @@ def test_seed004_stress_is_critical_stretch_over_E():
 def test_bonds_break_exactly_when_uniaxial_stress_passes_the_ultimate():
     """A uniaxial strain eps along x stretches the x-bonds by eps: E eps is their bond stress.
     Just below 40 MPa no bond breaks, just above the bonds along x do (and only bonds whose
-    stretch E s exceeds 40 MPa)."""
+    stretch E s exceeds 40 MPa). Booleans, compared exactly: the bonds along x are 1% above the
+    threshold and every other bond well below it, far beyond rounding."""
     model = small_model()
     x = model.body.points
     for factor, expect_broken in ((0.99, False), (1.01, True)):
@@ -85,7 +86,8 @@ def test_case_key_and_errors():
 def test_breaking_kernel_breaks_exactly_the_bonds_a_direct_stretch_count_breaks():
     """Definition of critical-stretch breaking: bond i->j breaks iff |xi + u_j - u_i| / |xi| - 1
     exceeds s_c, both directed copies together, protected bonds never. Compared with numpy on
-    random displacements (bonds within 1e-9 of the threshold left out of the comparison)."""
+    random displacements (bonds within 1e-9 of the threshold left out of the comparison). Booleans,
+    compared exactly: the bonds compared are 1e-9 or more from the threshold, far beyond rounding."""
     model = small_model()
     b = model.bonds
     rng = np.random.default_rng(7)

@@ -192,9 +192,15 @@ def one_numba_thread():
     numba.set_num_threads(before)
 
 
+@pytest.mark.bitwise
 @pytest.mark.parametrize("ranks", [2, 3])
 @pytest.mark.parametrize("run", list(RUNS))
 def test_relaxation_on_simulated_ranks_is_the_serial_one(run, ranks):
+    """Dynamic relaxation on 2 and 3 simulated ranks gives the serial iterations, residual, broken
+    bonds, displacements and intact flags bit for bit: each rank computes its points with the serial
+    operations in the serial order, and the global sums are taken over the whole body in global point
+    order on rank 0 (``Domain.reduce``); the kernels are compiled without value-changing fast-math flags
+    (``peridyn.kernels.FASTMATH``), so this holds on every CPU."""
     case = load_case(CASES / "bar_tension_static.yaml", RUNS[run])
     whole = build(case, CASES)
     want = _relax(whole, case)

@@ -164,7 +164,8 @@ def test_relax_with_damage_leaves_every_intact_bond_within_its_critical_stretch(
     mid-length and a critical stretch of 8.5e-5 (below the elastic solution's 9.1e-5 at the crack
     tip): it converges with bonds broken beyond the pre-crack's, every intact bond's deformed
     length at the end within its critical length |xi| (1 + s_c) (bonds are tested at every
-    iterate), both copies of every broken bond broken, and ``broken_bonds`` the bonds it broke."""
+    iterate), both copies of every broken bond broken, and ``broken_bonds`` the bonds it broke. Intact
+    flags (booleans): compared exactly."""
     from peridyn.io.case import load_case
     from peridyn.jobs.build import build
     from peridyn.solvers.static import relax

@@ -85,7 +85,8 @@ def test_compliance_k_needs_increasing_crack_lengths():
 
 def test_straight_crack_cut_lengthens_a_2d_segment_precrack():
     """The pre-crack of a 2D case (a segment given by two coordinates) lengthened to a cuts the
-    bonds crossing y = H/2 at x < a (crack length from the low edge), and no others."""
+    bonds crossing y = H/2 at x < a (crack length from the low edge), and no others. Booleans, compared
+    exactly: no point lies on y = H/2 and no bond crosses it near x = 4.2 mm."""
     from peridyn.fatigue.specimen import straight_crack_cut
     from peridyn.io.case import Precrack
 

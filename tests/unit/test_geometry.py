@@ -40,6 +40,8 @@ def test_rectangle_is_2d_with_thickness():
 
 
 def test_hole_removal_reindexes_node_sets():
+    """Removing the points in a hole keeps each node set's points (their coordinates are copied:
+    compared exactly), and none is left in the hole."""
     body = geometry.plate(0.03, 0.02, 0.002, spacing=1e-3, layers=2)
     body = body.with_node_set("edge", geometry.face(body, "x+"))
     edge_points = body.points[body.node_set("edge")]
@@ -51,6 +53,8 @@ def test_hole_removal_reindexes_node_sets():
 
 
 def test_text_mesh_round_trip(tmp_path):
+    """A body written as a text mesh and read back: the same points (printed with 17 significant digits,
+    which read back to the same bits), its volumes to rounding and one block."""
     body = geometry.box((0.003, 0.002, 0.002), 1e-3)
     mesh_text.to_text_mesh(body, tmp_path / "m.txt")
     back = mesh_text.from_text_mesh(tmp_path / "m.txt")

@@ -83,7 +83,8 @@ def test_linear_lps_deck_breaks_bonds(tmp_path):
     """Compression_3x1x1 as a "Linear LPS" deck pulled apart (the end points' initial velocities
     outward) with a Critical Stretch of 1e-7: both bonds break (the deformed length's stretch,
     Peridigm's critical-stretch rule, for any material), after which no force acts: the last
-    two recorded velocities are equal and every point's damage is 1."""
+    two recorded velocities are equal and every point's damage is 1. The velocities are compared
+    exactly: with every bond broken the force is exactly zero, and a step adds exactly zero to them."""
     deck = read_deck(DATA / "Compression_3x1x1.yaml")
     deck["Materials"]["My Elastic Material"]["Material Model"] = "Linear LPS"
     deck["Blocks"]["My Group of Blocks"]["Damage Model"] = "Stretch"

@@ -76,7 +76,7 @@ def test_two_bond_aggregates_cover_every_free_dof_once_and_keep_points_whole():
     graph steps away, then joins each leftover point to an aggregate two steps from it, so a
     member is at most four short bonds (each at most one spacing along any axis on a grid)
     from its root: the extent along each axis is at most 8 spacings. Every aggregate has at
-    least 2 points."""
+    least 2 points. Sums of ones and indices: compared exactly."""
     model, dofs, _, _ = _system()
     aggregates = proxy_aggregates(model, dofs)
     assert aggregates.shape[0] == len(dofs)

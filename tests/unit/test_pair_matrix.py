@@ -24,8 +24,12 @@ def _bonds(model):
     return i, j, n_vec, model.body.volumes[i] * model.linearisation().pair[b.intact]
 
 
+@pytest.mark.bitwise
 @pytest.mark.parametrize("chunk", [2**25, 1000, 1], ids=["one chunk", "chunks", "a row per chunk"])
 def test_pair_matrix_is_scipys_coo_conversion(monkeypatch, chunk):
+    """The pair matrix assembled in chunks of any size is scipy's COO to CSR conversion of the same
+    entries: the structure exactly, and the values bit for bit: both sum each entry's duplicates in the
+    list's order, with the same products, and the kernels are compiled without fast-math."""
     model = small_model("lps", n=6)
     i, j, n_vec, coef = _bonds(model)
     n = model.body.n_points
@@ -39,10 +43,12 @@ def test_pair_matrix_is_scipys_coo_conversion(monkeypatch, chunk):
     np.testing.assert_array_equal(got.data, expected.data)  # exact: the same sums in the same order
 
 
+@pytest.mark.bitwise
 @pytest.mark.parametrize("chunk", [2**22, 1000, 1], ids=["one chunk", "chunks", "a row per chunk"])
 def test_zeros_dropped_chunk_by_chunk_are_the_whole_matrix_without_them(monkeypatch, chunk):
     """``drop_zeros`` (the AMG proxy's: an axis-parallel bond's block is mostly zeros, which a
-    whole matrix held all at once) gives the canonical matrix less its zero entries, same bits."""
+    whole matrix held all at once) gives the canonical matrix less its zero entries, same bits. The same
+    kernels and the same sums in the same order, with no fast-math."""
     model = small_model("pmb", n=6)  # a grid: most bonds along an axis or a face diagonal
     i, j, n_vec, coef = _bonds(model)
     n = model.body.n_points

@@ -49,7 +49,7 @@ def test_split_ends_each_family_where_its_neighbours_leave_earlier_blocks():
 
 def test_a_rank_part_gets_the_whole_bodys_split_from_its_global_rows():
     """Rows in another order (a rank's part): the split from the global row numbers is the
-    whole body's, row by row, and so is the bandwidth."""
+    whole body's, row by row, and so is the bandwidth. Indices: compared exactly."""
     body, bonds = _plate()
     blocks = row_blocks(body.n_points, index_bandwidth(bonds.offsets, bonds.neighbours))
     order = np.random.default_rng(0).permutation(body.n_points)
@@ -76,7 +76,12 @@ def test_families_out_of_order_get_one_chain_and_no_half_list():
     assert half_list(bonds, body.points, 1.0 / bonds.length, k, blocks) is not None
 
 
+@pytest.mark.bitwise
 def test_pmb_force_uses_the_half_list_and_gives_the_full_lists_bits():
+    """``PMBModel.force`` of a whole body takes the half list and gives the full-list kernel's force bit
+    for bit, on one thread and on any number: every point's sum adds the same terms in the same order,
+    and the kernels are compiled without value-changing fast-math flags (``peridyn.kernels.FASTMATH``),
+    so this holds on every CPU."""
     body, bonds = _plate((30, 6, 3))
     rng = np.random.default_rng(1)
     cut = rng.random(bonds.n_bonds) < 0.05

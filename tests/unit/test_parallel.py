@@ -35,6 +35,8 @@ CASES = Path(__file__).resolve().parents[2] / "cases"
 @pytest.mark.parametrize("dim", [2, 3])
 @pytest.mark.parametrize("parts", [1, 2, 3, 4, 7])
 def test_rcb_owns_every_point_once_balanced_and_deterministic(dim, parts):
+    """Recursive coordinate bisection gives each point one of ``parts`` ranks, balanced to a point per
+    level of cuts, and the same parts from a copy of the coordinates: rank numbers, compared exactly."""
     body = (
         geometry.box((0.013, 0.007, 0.005), 1e-3)
         if dim == 3
@@ -77,7 +79,9 @@ def _brute_ghosts(points, owned, reach, layers):
 @pytest.mark.parametrize("layers", [1, 2])
 @pytest.mark.parametrize("horizon", [2.015e-3, None])
 def test_ghosts_are_the_points_within_reach_not_owned(layers, horizon):
-    """Also at a reach of exactly two spacings (None), where grid points lie at the reach."""
+    """Also at a reach of exactly two spacings (None), where grid points lie at the reach. Point
+    indices, compared exactly with a brute-force search: both decide with IEEE distances computed by
+    scipy's compiled code, the same on every CPU."""
     body = geometry.rectangle(0.012, 0.009, 1e-3, thickness=1e-3)
     reach = 2e-3 if horizon is None else search_reach(body, horizon)
     part = rcb(body.points, 3)
@@ -101,6 +105,8 @@ class _Simulated:
 
 
 def test_halo_plans_send_each_ghost_from_its_owner_in_the_receiver_order():
+    """Each rank's halo plan receives each ghost from its owner, into the rows of the receiver's ghost
+    order: point indices, compared exactly."""
     body = geometry.box((0.010, 0.006, 0.004), 1e-3)
     size = 3
     part = rcb(body.points, size)
@@ -157,7 +163,7 @@ def test_launch_detection_reads_the_rank_count():
 
 def test_serial_gatherv_fills_recv_whatever_its_layout():
     """One process: the gather is a copy into ``recv``, also a non-contiguous view (a copy made
-    by a reshape would drop the values)."""
+    by a reshape would drop the values). A copy: compared exactly."""
     send = np.arange(6.0).reshape(3, 2)
     recv = np.zeros((2, 3)).T  # (3, 2), Fortran order
     SerialComm().gatherv(send, recv, [6])
@@ -190,12 +196,16 @@ PARTS = [
 ]
 
 
+@pytest.mark.bitwise
 @pytest.mark.parametrize(("name", "overrides"), PARTS)
 @pytest.mark.parametrize("size", [2, 3])
 def test_each_rank_part_matches_the_serial_build(name, overrides, size):
     """Owned families in serial order with identical coefficients, and the same force on the owned
     points from the same displacement (the kernels are unchanged: per-point arithmetic), also
-    when the force of the rows clear of the ghosts is computed before the ghosts' u arrives."""
+    when the force of the rows clear of the ghosts is computed before the ghosts' u arrives. Bit for
+    bit: a rank computes its points' coefficients and forces with the serial operations in the serial
+    order, and the kernels are compiled without value-changing fast-math flags
+    (``peridyn.kernels.FASTMATH``), so this holds on every CPU."""
     case = load_case(CASES / name, overrides)
     whole = build(case, CASES)
     m, b = whole.model, whole.bonds

@@ -69,6 +69,8 @@ def _ranks_last_root(domains):
 
 @pytest.mark.parametrize("size", [2, 3])
 def test_point_gather_places_the_owners_values_in_the_order_asked(size):
+    """A ``PointGather`` on simulated ranks places the owners' values of the asked points (repeats and
+    any order included) on rank 0: copied values, compared exactly."""
     body = geometry.box((0.010, 0.006, 0.004), 1e-3)
     n = body.n_points
     rng = np.random.default_rng(11)
@@ -96,6 +98,7 @@ def test_point_gather_refuses_a_point_no_rank_owns():
 
 
 def test_serial_point_gather_reads_the_points():
+    """In one process the gather reads the asked rows: copied values, compared exactly."""
     d = Domain.serial(20)
     a = np.arange(60.0).reshape(20, 3)
     (got,) = PointGather(d, np.array([4, 2, 4]))(a)
@@ -118,6 +121,8 @@ def _spec(body):
 
 
 def test_probe_state_records_equal_the_whole_state_records(tmp_path):
+    """The series recorded from a ``ProbeState`` (the probes' rows only) are those recorded from the
+    whole state: the same rows copied and stored, compared exactly."""
     body = geometry.box((0.010, 0.006, 0.005), 1e-3)
     spec = _spec(body)
     probes = Probes.of(body, spec)

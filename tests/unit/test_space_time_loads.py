@@ -15,7 +15,11 @@ from peridyn.physics.materials import make_model
 from peridyn.solvers import ExplicitSolver
 
 
+@pytest.mark.bitwise
 def test_expression_is_evaluated_per_point_and_time():
+    """An expression in x, y, z and t is evaluated per point with NumPy, in the written order: the same
+    operations as written here, so the same bits (NumPy's elementwise arithmetic and sqrt are correctly
+    rounded on every CPU)."""
     points = np.array([[0.0, 2.0, 0.0], [1.0, -1.0, 3.0]])
     np.testing.assert_array_equal(
         SpaceTime("0.001*y*t/1.0e-8").at(points, 2e-9), 0.001 * points[:, 1] * 2e-9 / 1e-8
@@ -50,9 +54,13 @@ def test_prescribed_expression_moves_the_set():
     np.testing.assert_allclose(state.u[left, 1], expected, rtol=1e-15)
 
 
+@pytest.mark.bitwise
 def test_difference_velocity_is_peridigms_and_leaves_the_motion():
     """The motion is the same bit for bit; the prescribed DOFs report (u(n+1) - u(n)) / dt +
-    dt/2 a with a the force acceleration f / rho (README of tests/data/peridigm), 0 at t = 0."""
+    dt/2 a with a the force acceleration f / rho (README of tests/data/peridigm), 0 at t = 0. Bit for
+    bit: the reported velocity of the prescribed DOFs does not enter the motion, which is computed by
+    the same operations in the same order, and the kernels are compiled without value-changing fast-math
+    flags (``peridyn.kernels.FASTMATH``), so this holds on every CPU."""
     body, model, rate = _bar("rate")
     _, _, difference = _bar("difference")
     a, b = rate.initial_state(), difference.initial_state()

@@ -48,7 +48,11 @@ def test_zip_and_list_blocks_combine_as_a_product(tmp_path):
     assert got == [(150e9, 7000, 0.25), (150e9, 7000, 0.3), (200e9, 8000, 0.25), (200e9, 8000, 0.3)]
 
 
+@pytest.mark.bitwise
 def test_random_block_is_seeded_and_within_its_distributions(tmp_path):
+    """A random block draws the same runs from the same seed, within its distributions. The uniform
+    draws are ``default_rng(seed).uniform`` called as here, the same bits; the log-uniform ones go
+    through ``np.exp`` and are compared to rounding."""
     spec = {
         "random": {
             "seed": 7,

@@ -75,9 +75,12 @@ def test_sign_convention_and_amplitude_on_a_bin():
     assert np.isclose(peak[0], -k, rtol=1e-6)
 
 
+@pytest.mark.bitwise
 def test_hann_window_is_scipy_periodic_hann_to_the_bit():
     """The Hann window computed without importing scipy.signal (0.65 s) is scipy.signal's
-    ``get_window("hann", n)`` (periodic: the DFT-even window of spectral analysis) bit for bit."""
+    ``get_window("hann", n)`` (periodic: the DFT-even window of spectral analysis) bit for bit. Both are
+    ``0.5 + 0.5 cos`` of the same ``np.linspace(-pi, pi, n + 1)`` values with NumPy's elementwise
+    functions, in one process: the same bits on any CPU."""
     from scipy.signal import get_window
 
     from peridyn.analysis.fk import _window

@@ -21,6 +21,9 @@ needs_sweep_extra = pytest.mark.skipif(
 
 @needs_sweep_extra
 def test_dataset_round_trip_with_types_and_padding(tmp_path):
+    """A sweep dataset written to netCDF and read back keeps its coordinates, table columns (types
+    included, a missing number as NaN), series padded with NaN to the longest, and attributes: stored
+    values, compared exactly."""
     rng = np.random.default_rng(0)
     a, b = rng.normal(size=(5, 2, 3)), rng.normal(size=(3, 2, 3))
     ds = build_dataset(

@@ -39,7 +39,8 @@ UNIT_HEX = np.array(
 
 def test_hex_mesh_of_elastic_bond_based_3d():
     """The deck's mesh: a 1 x 6 x 1 m box of 0.25 m hexes (4 x 24 x 4), three blocks along y
-    split at y = -1.5 and 1.5, one node set holding every node."""
+    split at y = -1.5 and 1.5, one node set holding every node. The coordinates' extremes are the file's
+    numbers and the block ids integers: compared exactly."""
     mesh = read_exodus(DATA / "ElasticBondBased3D.g")
     assert [(b.name, b.element_type, b.connectivity.shape) for b in mesh.blocks] == [
         ("block_1", "HEX8", (96, 8)),
@@ -86,7 +87,7 @@ def test_node_set_becomes_the_elements_touching_it():
     nodes at x = -15 mm are not shared with the next layer of elements (828 nodes = 22 planes
     of 6 x 6 + one duplicated plane), so the elements touching the set are the 3 layers left
     of x = -15 mm: 75 of the 21 x 5 x 5 elements of 2 mm. Checked against a plain loop over
-    the elements."""
+    the elements. Point indices: compared exactly."""
     mesh = read_exodus(DATA / "WaveInBar.g")
     assert len(mesh.coordinates) == 22 * 36 + 36 and mesh.n_elements == 21 * 5 * 5
     nodes = mesh.node_set("nodelist_1").nodes
@@ -104,7 +105,8 @@ def test_node_set_becomes_the_elements_touching_it():
 
 def test_node_set_rule_is_peridigms():
     """WaveInBar's deck gives the node set an initial velocity of -100 m/s in x: the points
-    moving at t = 0 in Peridigm's gold output are the points of our node set."""
+    moving at t = 0 in Peridigm's gold output are the points of our node set. Point indices: compared
+    exactly."""
     gold = read_exodus(DATA / "WaveInBar_gold.e")
     pts = mesh_points(read_exodus(DATA / "WaveInBar.g"))
     np.testing.assert_allclose(pts.points, gold.coordinates, rtol=0, atol=ULPS * 0.021)
@@ -128,7 +130,8 @@ def test_peridigm_results_file():
 
 
 def test_results_file_without_steps(tmp_path):
-    """A results file closed before its first step: variables declared, none recorded."""
+    """A results file closed before its first step: variables declared, none recorded. The coordinates
+    are the copied file's numbers: compared exactly."""
     gold = read_exodus(DATA / "Compression_2x1x1_gold.e")
     with scipy.io.netcdf_file(DATA / "Compression_2x1x1_gold.e", "r", mmap=False) as src:
         with scipy.io.netcdf_file(tmp_path / "empty.e", "w", version=2) as dst:
@@ -192,7 +195,8 @@ def _mesh(kind, conn, coordinates, attributes=None, node_sets=()):
 
 def test_tet_and_sphere_elements():
     """A TETRA4: volume 1/6 of the unit corner, centroid the vertex mean; a SPHERE element
-    keeps its node and takes the volume from its second attribute."""
+    keeps its node and takes the volume from its second attribute. A sphere's point and volume are the
+    file's numbers: compared exactly."""
     tet = mesh_points(_mesh("TETRA", [[0, 1, 2, 3]], [[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]]))
     np.testing.assert_allclose(tet.volumes, [1 / 6], rtol=1e-15)
     np.testing.assert_allclose(tet.points, [[0.25, 0.25, 0.25]], rtol=1e-15)
@@ -245,6 +249,8 @@ def _write_mesh(path):
 
 
 def test_blocks_sets_and_side_sets_from_a_file(tmp_path):
+    """A mesh file of named and unnamed blocks, node sets and side sets: names, ids, element types and
+    sides as written, volumes and centroids to rounding, and the block ids (integers) exactly."""
     _write_mesh(tmp_path / "m.g")
     mesh = read_exodus(tmp_path / "m.g")
     assert mesh.title == "two cubes and a tet"
@@ -286,7 +292,8 @@ def test_bad_meshes_are_refused(tmp_path):
 def test_sphere_volumes_written_read_back_and_one_layer_2d(tmp_path):
     """``ExodusWriter(volumes=...)`` writes Peridigm's sphere attributes (radius, volume) that
     ``body_from_exodus`` reads back as the points' volumes; a 2D body (Peridigm's 2D decks on a
-    one-layer mesh) takes cells of area volume / thickness and refuses points at two z."""
+    one-layer mesh) takes cells of area volume / thickness and refuses points at two z. The volumes read
+    back are the stored ones: compared exactly."""
     points = np.array([[0.0, 0.0, 0.1], [0.5, 0.0, 0.1], [0.0, 0.5, 0.1]])
     volumes = np.array([0.02, 0.03, 0.05])
     ExodusWriter(tmp_path / "flat.e", points, volumes=volumes).append(0.0)

@@ -89,7 +89,8 @@ def test_layout_is_exodus(tmp_path):
 
 
 def test_resume_drops_later_steps(tmp_path):
-    """A restart at t = 0.5 keeps the steps up to 0.5 and appends after them."""
+    """A restart at t = 0.5 keeps the steps up to 0.5 and appends after them. Stored values read back:
+    compared exactly."""
     writer, _ = _writer(tmp_path / "r.e")
     steps = _steps(4)
     for k, s in enumerate(steps):

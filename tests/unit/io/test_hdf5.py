@@ -36,6 +36,8 @@ def write_run(path, geometry, steps, mode="w", **kwargs):
 
 
 def test_geometry_and_series_round_trip(tmp_path, geometry):
+    """Series (steps, times, records) and geometry written to results.h5 read back as written, dtypes
+    included: stored values, compared exactly."""
     path = tmp_path / "run.h5"
     write_run(path, geometry, range(5))
     steps, times, data = Results(path).series("u")
@@ -73,6 +75,8 @@ def test_scalar_series(tmp_path, geometry):
 
 
 def test_float32_storage(tmp_path, geometry):
+    """A float32 series stores its records cast to float32 (one correctly rounded conversion, as
+    ``astype``): compared exactly."""
     path = tmp_path / "run.h5"
     values = np.linspace(0, 1, N * 2).reshape(N, 2)
     with HDF5Writer(path, *geometry, {}) as out:
@@ -84,6 +88,8 @@ def test_float32_storage(tmp_path, geometry):
 
 
 def test_provenance_round_trip(tmp_path, geometry):
+    """Provenance (numbers, booleans, None, nested mappings, lists and an array) reads back as written,
+    types included: stored values, compared exactly."""
     path = tmp_path / "run.h5"
     provenance = {
         "version": "0.1.0",
@@ -110,6 +116,8 @@ def test_provenance_rejects_unstorable_value(tmp_path, geometry):
 
 
 def test_chunked_reading_equals_whole_reading(tmp_path, geometry):
+    """A series read in chunks of 5 records is the series read whole: the same stored values, compared
+    exactly."""
     path = tmp_path / "run.h5"
     write_run(path, geometry, range(0, 23, 1))
     _, times, data = Results(path).series("u")
@@ -120,6 +128,8 @@ def test_chunked_reading_equals_whole_reading(tmp_path, geometry):
 
 
 def test_data_written_before_an_exception_is_readable(tmp_path, geometry):
+    """Records appended before an exception inside the writer's ``with`` block are readable after it, as
+    written: stored values, compared exactly."""
     path = tmp_path / "run.h5"
     with pytest.raises(RuntimeError, match="solver blew up"):
         with HDF5Writer(path, *geometry, {}) as out:
@@ -133,6 +143,8 @@ def test_data_written_before_an_exception_is_readable(tmp_path, geometry):
 
 
 def test_data_survives_a_process_killed_without_closing(tmp_path):
+    """Records appended by a process that exits without closing the file are readable, as written
+    (stored values, compared exactly), and so is the provenance."""
     path = tmp_path / "run.h5"
     script = textwrap.dedent(
         f"""
@@ -156,6 +168,8 @@ def test_data_survives_a_process_killed_without_closing(tmp_path):
 
 
 def test_append_mode_continues_series(tmp_path, geometry):
+    """A writer in mode "a" continues the series after its last record; the records read back as written
+    (stored values, compared exactly)."""
     path = tmp_path / "run.h5"
     write_run(path, geometry, range(3))
     write_run(path, geometry, range(3, 5), mode="a")
@@ -165,6 +179,8 @@ def test_append_mode_continues_series(tmp_path, geometry):
 
 
 def test_truncate_drops_records_after_checkpoint_step(tmp_path, geometry):
+    """``truncate`` drops the records after the checkpoint step in every series, the records appended
+    after it follow, and the provenance is merged; stored values, compared exactly."""
     path = tmp_path / "run.h5"
     with HDF5Writer(path, *geometry, {"case": "bar"}) as out:
         out.create_series("u", (N, 2))
@@ -224,6 +240,8 @@ def test_flush_every_batches_flushes(tmp_path, geometry):
 
 
 def test_write_array_replaces_and_keeps_attrs(tmp_path, geometry):
+    """``write_array`` replaces an array and stores its attributes, and refuses paths outside its
+    groups; the array reads back as written (stored values, compared exactly)."""
     path = tmp_path / "run.h5"
     with HDF5Writer(path, *geometry, {}) as out:
         out.write_array("final/damage", np.zeros(N))
@@ -249,6 +267,8 @@ def test_readers_name_missing_file_and_series(tmp_path, geometry):
 
 
 def test_append_mode_drops_a_half_written_record(tmp_path, geometry):
+    """A record whose data and time were written but not its step (a crash in between) is not read, and
+    appending replaces it; the records read back as written (stored values, compared exactly)."""
     path = tmp_path / "run.h5"
     write_run(path, geometry, range(3))
     with h5py.File(path, "a") as f:  # a crash after writing data and time, before step

@@ -14,6 +14,8 @@ def write(tmp_path, text, name="mesh.txt"):
 
 
 def test_round_trip_is_exact(tmp_path):
+    """Points, block ids and volumes written as text and read back are the same numbers, dtypes and
+    shapes: the floats are printed with 17 significant digits, which read back to the same bits."""
     rng = np.random.default_rng(0)
     points = rng.normal(size=(50, 3)) * 1e-3
     block_ids = rng.integers(1, 4, size=50)
@@ -29,6 +31,7 @@ def test_round_trip_is_exact(tmp_path):
 
 
 def test_write_pads_2d_points_with_zero_z(tmp_path):
+    """2D points are written with z = 0 and read back exactly (numbers printed to round-trip)."""
     path = tmp_path / "mesh.txt"
     write_text_mesh(path, [[1.0, 2.0], [3.0, 4.0]], [1, 2], [0.5, 0.25])
     p, b, v = read_text_mesh(path)
@@ -37,6 +40,8 @@ def test_write_pads_2d_points_with_zero_z(tmp_path):
 
 
 def test_comments_blank_lines_and_whitespace(tmp_path):
+    """Comments, blank lines, tabs and non-ASCII text are skipped; each number parses to the float of
+    the same decimal literal (correctly rounded): compared exactly."""
     text = (
         "# x y z block_id volume, spacing 1 µm — ünïcode comment\n"
         "\n"

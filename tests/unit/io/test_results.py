@@ -27,7 +27,8 @@ def path(tmp_path):
 
 def test_round_trip_of_everything_the_writer_stores(path):
     """What the writer was given comes back: series, attributes, arrays, provenance, summary
-    (numpy scalars stored as numbers), and the schema version of this peridyn."""
+    (numpy scalars stored as numbers), and the schema version of this peridyn. Stored values read back:
+    compared exactly."""
     results = Results(path)
     assert results.schema_version == SCHEMA_VERSION
     steps, times, data = results.series("u")

@@ -42,6 +42,8 @@ def _series(path, name):
 
 @pytest.mark.parametrize("dtype", ["float64", "float32"])
 def test_block_append_writes_what_single_appends_write(tmp_path, geometry, dtype):
+    """``append_block`` of several records writes the file that one ``append`` per record writes: the
+    same stored values and dtypes (float32: the same cast), compared exactly."""
     values = records(5)
     steps, times = [0, 2, 3, 7, 9], [0.0, 2e-7, 3e-7, 7e-7, 9e-7]
     for name, blocks in (("single", [[i] for i in range(5)]), ("block", [[0, 1], [2, 3, 4]])):
@@ -77,6 +79,8 @@ def test_block_append_checks_every_record_and_writes_nothing_on_error(tmp_path, 
 
 
 def test_buffered_records_equal_direct_appends(tmp_path, geometry):
+    """Records held by a ``SeriesBuffer`` and written in blocks give the file of direct appends: the
+    same stored values, compared exactly."""
     values = records(11, seed=1)
     for name in ("direct", "buffered"):
         with HDF5Writer(tmp_path / f"{name}.h5", *geometry, {}, flush_every=None) as out:
@@ -98,7 +102,7 @@ def test_buffered_records_equal_direct_appends(tmp_path, geometry):
 def test_records_given_by_rows_are_those_rows(tmp_path, geometry, dtype):
     """``append(..., values, rows)`` holds ``values[rows]`` (an index array is taken straight
     into the buffer, a slice is viewed), cast to the series' dtype: the file of direct appends
-    of ``values[rows]``."""
+    of ``values[rows]``. Stored values: compared exactly."""
     fields = records(10, seed=2).reshape(5, 2 * N, 3)  # five records of 2 N points
     picks = {"spread": np.array([7, 0, 11, 3, 3, 5]), "layer": slice(1, 2 * N, 2)}
     for name in ("direct", "buffered"):
@@ -141,7 +145,8 @@ def test_buffer_holds_at_most_max_bytes_or_max_records_per_series(tmp_path, geom
 
 
 def test_a_killed_process_keeps_the_flushed_blocks_only(tmp_path):
-    """Records held in memory die with the process; the blocks written before stay readable."""
+    """Records held in memory die with the process; the blocks written before stay readable. Stored
+    values: compared exactly."""
     path = tmp_path / "run.h5"
     script = textwrap.dedent(
         f"""

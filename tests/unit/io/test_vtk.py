@@ -12,6 +12,9 @@ from peridyn.io.vtk import PVDCollection, read_pvtu_pieces, write_pvtu, write_vt
 
 @pytest.mark.parametrize("compression", ["none", "zlib"])
 def test_vtu_round_trip_3d(tmp_path, compression):
+    """Points, vertex cells and point fields (float64, int64, float32) written to a VTU file,
+    uncompressed or zlib, read back by meshio as written, dtypes included: stored values, compared
+    exactly."""
     rng = np.random.default_rng(2)
     points = rng.random((8, 3))
     fields = {
@@ -34,6 +37,8 @@ def test_vtu_round_trip_3d(tmp_path, compression):
 
 
 def test_vtu_pads_2d_points_and_vectors(tmp_path):
+    """2D points and vectors are padded with a zero z and booleans stored as 0 and 1: stored values,
+    compared exactly."""
     points = np.array([[0.0, 0.0], [1e-3, 0.0], [0.0, 1e-3]])
     velocity = np.array([[1.0, 2.0], [3.0, 4.0], [5.0, 6.0]])
     path = tmp_path / "out.vtu"
