@@ -80,15 +80,26 @@ from numba.extending import intrinsic, overload
 CHUNK = 32
 CHUNK_BUFFER = 4 * CHUNK
 
-#: Fast-math flags used by the force kernels: fused multiply-adds, no signed zeros, reciprocal
-#: divisions; NaN/inf semantics are kept so blow-ups are still detected. Not "reassoc": with it
-#: a parallel kernel's sums rounded differently when numba compiled it afresh and when it loaded
-#: it from its on-disk cache (the parallel loop's body is optimised once more when cached), so a
-#: run in a process that compiled the kernels differed in the last bits from one in a process
-#: that loaded them (a sweep's serial and process-pool datasets, a run and its restart). The
-#: per-point sums keep their written order; the force throughput is unchanged (``peridyn bench``,
-#: 50k points: within 1%). numba's cache does not notice a change here (see ``bond_differences``).
-FASTMATH = {"contract", "nsz", "arcp"}
+#: Fast-math flags of the force kernels: "nsz" only (the sign of a zero result may differ). No
+#: other flag may change a value, so every compiled kernel performs the IEEE operations of its
+#: source in the written order, and the bits of a result do not depend on the instructions
+#: numba picks for the CPU at hand (SSE2, AVX2, AVX-512; vectorised or scalar; a kernel compiled
+#: afresh or loaded from numba's on-disk cache). Two code paths that perform the same operations
+#: in the same order (fused and two-pass LPS, half and full PMB lists, row bounds, MPI ranks,
+#: restarts) therefore give the same bits on every x86-64 CPU. Left out on purpose:
+#:
+#: - "contract" (fused multiply-adds): LLVM fuses a product into a sum where it sees fit, and
+#:   what it sees depends on the target and on the code around the sum: on AVX2 targets a
+#:   kernel loaded from the cache rounded unlike the same kernel compiled afresh, and the fused
+#:   LPS force unlike its two passes;
+#: - "arcp" (reciprocals): lets LLVM replace a division or an inverse square root by a
+#:   reciprocal (an estimate and a Newton step where the target has one): a float32 kernel's
+#:   vectorised and scalar loops rounded differently under it (``lps_pair_force_cf``);
+#: - "reassoc": reorders sums (and rounded differently after the cache's second optimisation).
+#:
+#: The force throughput without them: ``benchmarks/RESULTS.md``. numba's cache does not notice a
+#: change here (see ``bond_differences``).
+FASTMATH = {"nsz"}
 
 
 def exact_helper(signature: str):
