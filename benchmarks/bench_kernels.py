@@ -1,7 +1,7 @@
 """Force-kernel throughput benchmark; writes ``bench_kernels.json`` next to this script.
 
 Same measurement as ``peridyn bench`` (``peridyn.jobs.bench``), plus the machine, the
-command line and the UTC date in the JSON, for ``RESULTS.md``::
+command line and the UTC date in the JSON, for ``RESULTS.md`` and ``HISTORY.md``::
 
     python benchmarks/bench_kernels.py                      # 46^3 grid, no partial volumes
     python benchmarks/bench_kernels.py --partial-volumes -o benchmarks/bench_kernels_pv.json

@@ -9,7 +9,7 @@ fixed tree at the end of the family): faster on its own, but it changes the orde
 point's sum, hence the last bits. Each pair is timed by ``kernel_candidates.compare``
 (interleaved calls on the same inputs: the before / candidate ratio of the best wall and CPU
 times and the median of the rounds' ratios, and the largest force difference). Results in
-RESULTS.md.
+HISTORY.md, "Stored bond vectors, the fused LPS force, ..." (2026-11-28).
 
     PYTHONPATH=src python benchmarks/kernel_bond_vectors.py --side 49 --rounds 10
 """

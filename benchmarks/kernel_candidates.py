@@ -12,7 +12,8 @@ the candidate's (best of ``--rounds`` interleaved calls on the same inputs, any 
 layout conversion included; wall clock and process CPU time, the latter less sensitive to
 other jobs on a shared machine), the median of the rounds' ratios (steadier than the best
 when the load moves during a run), and the largest force difference relative to the
-largest force (0 = the same bits). Results in RESULTS.md.
+largest force (0 = the same bits). Results in HISTORY.md ("Force kernels: chunks, candidates, roofs
+and LAMMPS PERI", "Stored bond vectors, the fused LPS force, ...").
 
     PYTHONPATH=src python benchmarks/kernel_candidates.py --side 49 --rounds 15
     PYTHONPATH=src python benchmarks/kernel_candidates.py --case cases/lamb_plate.yaml --rounds 40

@@ -10,7 +10,8 @@ and CPU times, and the largest force difference):
 - the block order / the half list (``PMBModel.force``): the same bits, ``max |df|`` 0;
 - one chain / the half list: the speed-up of ``peridyn bench``'s PMB float64 row.
 
-With and without 5 % of the bonds broken (in both directions). Results in RESULTS.md.
+With and without 5 % of the bonds broken (in both directions). Results in HISTORY.md, "Each bond pair
+once: the PMB float64 half list; ..." (2026-11-28); the current figures in RESULTS.md.
 
     PYTHONPATH=src python benchmarks/kernel_half_pairs.py --side 49 --rounds 15
 """

@@ -15,10 +15,10 @@ shared machine hits both alike. Rates are directed bond updates per second, best
 Threads are bound on both sides, like for like: Open MPI's ``mpirun`` binds each LAMMPS rank to
 a core (``--report-bindings`` shows it for 2 ranks), and the script sets ``OMP_PROC_BIND``
 (``--thread-binding``, default ``spread``) before peridyn's first kernel, which binds numba's
-threads to cores. On the 2-core VM of ``RESULTS.md`` binding did not change peridyn's rate; about
-one process in ten, bound or not, ran at 0.8 of the others' (``thread_binding.py``), so a round
-whose peridyn rates are low is worth repeating. LAMMPS is started with the CPU set the script
-started with, not the core its bound main thread then holds.
+threads to cores. On the 2-core VM of ``HISTORY.md`` ("Chunks of 32, slow processes, ...") binding
+did not change peridyn's rate; about one process in ten, bound or not, ran at 0.8 of the others'
+(``thread_binding.py``), so a round whose peridyn rates are low is worth repeating. LAMMPS is
+started with the CPU set the script started with, not the core its bound main thread then holds.
 
 Writes ``benchmarks/lammps_vs_peridyn.json`` (command, machine, date, load averages)::
 

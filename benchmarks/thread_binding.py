@@ -9,7 +9,8 @@ for its whole life, so it takes many processes, not many calls, to see it::
 
     PYTHONPATH=src python benchmarks/thread_binding.py --processes 10
 
-Results in ``benchmarks/RESULTS.md``; the user guide's "Threads" says when to bind.
+Results in ``benchmarks/HISTORY.md`` ("Chunks of 32, slow processes, ...", 2026-11-28); the user
+guide's "Threads" says when to bind.
 """
 
 from __future__ import annotations

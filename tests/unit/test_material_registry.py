@@ -41,8 +41,8 @@ def test_unknown_material_names_the_choices():
 
 
 def test_float64_lps_reads_the_bonds_lengths_without_a_copy():
-    """8 B a bond less (``benchmarks/RESULTS.md``): the float64 model's ``length`` is the bonds'
-    array; float32 keeps its own rounded copy."""
+    """8 B a bond less (``benchmarks/HISTORY.md``, "What the PMB float64 kernel waits on; ..."): the
+    float64 model's ``length`` is the bonds' array; float32 keeps its own rounded copy."""
     body = small_body(3, None, n=4)
     bonds = find_bonds(body, 3.015 * body.spacing)
     lps64, lps32 = (

@@ -30,7 +30,7 @@ def write_vtu(path: str | os.PathLike, points, point_data: dict, compression: st
     compression : {"none", "zlib"}
         The data arrays' compression (``VTU_COMPRESSIONS``). zlib makes a snapshot of
         displacements and velocities about 0.7 times the size and takes 8 times as long to
-        write (125 000 points: 0.33 s against 0.04 s, benchmarks/RESULTS.md).
+        write (125 000 points: 0.33 s against 0.04 s, benchmarks/RESULTS.md, "Output and I/O").
 
     Raises
     ------

@@ -19,9 +19,10 @@ Timing: every row is called once first (JIT compilation or cache load, excluded)
 ``repeat`` rounds each call every row once, in turn, and a row's time is its best
 round. Interleaving the rows makes their ratios robust to a machine whose load drifts.
 The result records ``omp_proc_bind``, the ``OMP_PROC_BIND`` of the process's environment
-(``None``: numba's threads unbound). On the 2-core VM of ``benchmarks/RESULTS.md`` about one
-process in ten ran the kernels at 0.8 of the others' rate for its whole life, bound or not (see
-the user guide's "Threads"): compare rows within one result, or results of several processes.
+(``None``: numba's threads unbound). On the 2-core VM of ``benchmarks/HISTORY.md`` ("Chunks of
+32, slow processes, ...") about one process in ten ran the kernels at 0.8 of the others' rate for
+its whole life, bound or not (see the user guide's "Threads"): compare rows within one result, or
+results of several processes.
 
 Memory bandwidth: a STREAM-like triad ``a[:] = b + s c`` (numba ``prange``, float64
 arrays of ``triad_elements`` items, 128 MiB each by default, far beyond any L3),

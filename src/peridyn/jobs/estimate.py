@@ -12,7 +12,7 @@ Peak bytes are ``BASE_BYTES + points * per_point + bonds * per_bond`` with per-j
 coefficients (``COSTS``) counted from the arrays each solver holds at its peak (see their
 comments), plus the sparse factor of a shift-invert modal run
 (``linalg.ordering.estimated_factor_entries``, as ``jobs.modal`` chooses it).
-benchmarks/RESULTS.md compares them with measured peaks.
+benchmarks/RESULTS.md ("Memory per bond and the estimate") compares them with measured peaks.
 """
 
 from __future__ import annotations
@@ -30,7 +30,8 @@ from peridyn.io.case import Case
 
 #: Resident bytes of the interpreter with numpy, scipy, numba (and its loaded kernels), h5py
 #: and peridyn imported, before the first array: measured with ``/usr/bin/time -v`` on a
-#: 2 500-point case (bar_pulse at 2 mm: 310 MB; benchmarks/RESULTS.md).
+#: 2 500-point case (bar_pulse at 2 mm: 310 MB; benchmarks/HISTORY.md, "Memory estimate against
+#: measured peaks").
 BASE_BYTES = 300e6
 
 
@@ -55,7 +56,8 @@ class Costs:
 #: indices per bond, COO then CSR) and the bond vectors of the force: about 424 B.
 #: ``fatigue``: statics by AMG-preconditioned CG (or a factor) and modal analyses before and after:
 #: 2 400 B per bond, fitted to one measured run (dog-bone at 0.33 mm, 795 k directed bonds,
-#: 2.05 GiB peak) and 7-11 % high on the SEN strip at 132 k-1.24 M bonds (benchmarks/RESULTS.md).
+#: 2.05 GiB peak) and 7-11 % high on the SEN strip at 132 k-1.24 M bonds (benchmarks/HISTORY.md,
+#: "Memory estimate against measured peaks").
 #: ``modal``: + the stiffness parts P and G (LPS) in COO and CSR and the augmented matrix:
 #: about 500 B; per point the mode shapes are small (n_modes x 24 B) next to the bonds.
 COSTS = {

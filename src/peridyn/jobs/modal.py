@@ -25,7 +25,7 @@ from peridyn.solvers.modal import ModalResult, modal_analysis
 #: Share of the machine's memory the factorisation may take.
 MEMORY_SHARE = 0.7
 #: ``auto`` factorises (shift-invert) only below this estimated factor size, bytes; above
-#: it LOBPCG is faster as well as smaller (benchmarks/RESULTS.md, modal section).
+#: it LOBPCG is faster as well as smaller (benchmarks/HISTORY.md, "Modal: LOBPCG without a factor").
 FACTOR_BUDGET = 2**30
 
 

@@ -21,7 +21,8 @@ time with the JIT off (the kernels then run as plain Python, which also gives co
 and a debugger):
 ``NUMBA_DISABLE_JIT=1 PYTHONPATH=src python -m pytest -m kernels -q -p no:cacheprovider``.
 
-How the force kernels are written (what makes them fast, see ``benchmarks/RESULTS.md``):
+How the force kernels are written (what makes them fast, see ``benchmarks/HISTORY.md``, "What made the
+difference" and the later kernel sections; current rates in ``benchmarks/RESULTS.md``):
 
 - the family of point ``i`` is taken in chunks of ``CHUNK`` bonds, each as slices
   ``nbr[c:c + m]``, ``k[c:c + m]``... indexed from 0, and the neighbour index is read as
@@ -46,8 +47,9 @@ How the force kernels are written (what makes them fast, see ``benchmarks/RESULT
 - the float64 force kernels read each bond's reference vector ``xi = x_j - x_i`` from a
   stored (n_bonds, 3) array (``bond_search.initial_bond_vectors``, the same subtraction, so
   the same bits) and gather only ``u_j``: three gathers a bond instead of six, which is
-  what the force loop waits on (1.16-1.20x on AMD Zen 4, ``benchmarks/RESULTS.md``). The
-  deformed vector is :func:`deformed_component`, also exact;
+  what the force loop waits on (1.16-1.20x on AMD Zen 4, ``benchmarks/HISTORY.md``, "Stored bond
+  vectors, the fused LPS force, ..."). The deformed vector is :func:`deformed_component`, also
+  exact;
 - the PMB float64 force of a whole body computes each bond pair once and adds it to both
   ends (``pmb.pmb_pair_force``; per pair it streams 53 bytes where the full list streams
   2 x 45), row block by row block so that every sum keeps an order that the full-list kernel
@@ -75,7 +77,7 @@ from numba.extending import intrinsic, overload
 #: kernel holds 4 values per bond of a chunk (``CHUNK_BUFFER``). 32 bonds give the vector loop
 #: four independent 8-lane iterations to overlap with each other and with the previous chunk's
 #: sums; 16 gave it two (our reading of timings, this VM has no hardware counters). Measured
-#: (``benchmarks/RESULTS.md``): PMB float64 1.06-1.07x over 16, float32 1.15x, LPS
+#: (``benchmarks/HISTORY.md``, "Chunks of 32, ..."): PMB float64 1.06-1.07x over 16, float32 1.15x, LPS
 #: 1.04-1.07x; 24, 48 and 64 in between or below. The chunk size does not change the bits.
 CHUNK = 32
 CHUNK_BUFFER = 4 * CHUNK

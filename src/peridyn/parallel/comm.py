@@ -143,7 +143,7 @@ class MPIComm:
         """Every rank's contiguous array ``send`` into ``recv`` on ``root``, in rank order:
         ``counts`` (one per rank) values each, on ``root``; ``recv`` and ``counts`` are ignored
         elsewhere. No pickling: on 2 ranks a 21 000 x 3 float64 part took 0.32 ms against 0.84
-        ms for ``gather`` (``benchmarks/RESULTS.md``)."""
+        ms for ``gather`` (``benchmarks/HISTORY.md``, "Chunks of 32, ..., a cheaper recorder")."""
         spec = [recv, list(counts)] if self.rank == root else None
         self._timed(self._comm.Gatherv, send, spec, root=root)
 

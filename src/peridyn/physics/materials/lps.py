@@ -60,7 +60,8 @@ from peridyn.physics.materials.registry import register_material
 SURFACE_CORRECTIONS = ("none", "shear-factor", "energy")
 
 #: Rows a block of the fused float64 force (``kernels.lps.lps_force_fused``; 256 measured as
-#: fast as 1024 and faster than 64 or 2048 on the seed Lamb plate, benchmarks/RESULTS.md).
+#: fast as 1024 and faster than 64 or 2048 on the seed Lamb plate, benchmarks/HISTORY.md, "Stored
+#: bond vectors, the fused LPS force, ...").
 FUSED_BLOCK_ROWS = 256
 #: The fused force is used when each thread's ring holds at most this many bonds (32 B each:
 #: 8 MiB), i.e. when the point order's index bandwidth keeps a block's bonds in the cache
