@@ -168,8 +168,10 @@ class Domain:
         return self.reduce(np.sum, a)
 
     def dot(self, a: np.ndarray, b: np.ndarray) -> float:
-        """``np.dot`` of two per-point arrays over the whole body, as in serial, on every rank."""
-        return self.reduce(np.dot, a, b)
+        """The dot product of two per-point (n,) arrays over the whole body, as in serial, on
+        every rank: ``np.sum(a * b)``, NumPy's pairwise sum in a fixed order, not ``np.dot``,
+        whose BLAS may split the sum over threads as the cores it sees allow."""
+        return self.reduce(lambda x, y: np.sum(x * y), a, b)
 
     def allsum(self, value):
         """The sum of every rank's ``value`` (a number or an array, element by element) by one

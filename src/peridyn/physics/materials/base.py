@@ -174,8 +174,8 @@ class Model:
         raise NotImplementedError
 
     def strain_energy(self, u: np.ndarray) -> float:
-        """Total strain energy, J."""
-        return float(np.dot(self.energy_density(u), self.body.volumes))
+        """Total strain energy, J (a pairwise sum in a fixed order, as ``Domain.dot``)."""
+        return float(np.sum(self.energy_density(u) * self.body.volumes))
 
     def stiffness_bound(self) -> np.ndarray:
         """(n_points,) N/m^4: an upper bound of each point's block row sum of the stiffness per volume.
