@@ -1,0 +1,123 @@
+"""Shipped explicit cases, shortened, on the GPU backend (Warp's CPU device in CI) against the
+same runs on the CPU backend: every recorded series within 1e-10 of its largest value, the same
+bonds broken. The two backends sum each family in another order (the numba float64 kernels in
+row blocks, ``peridyn.discretization.pairs``), so they differ by roundings of ~1e-16 of each
+bond's force, which the wave carries along: the measured differences are 1e-14 to 2e-11.
+"""
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from peridyn.cli import main
+from peridyn.errors import InputError
+from peridyn.io.case import load_case
+from peridyn.io.results import Results
+from peridyn.jobs.build import build
+from peridyn.solvers.explicit_gpu import GPUExplicitSolver
+from peridyn.solvers.gpu_force import device_bytes
+
+pytestmark = pytest.mark.gpu
+
+CASES = Path(__file__).resolve().parents[2] / "cases"
+#: relative agreement of every series (docs/gpu.md)
+SERIES_TOL = 1e-10
+#: the bar pulse at 2.5 mm (1280 points, LPS, displacement-driven end, sensors and a line)
+BAR = ["--set", "discretization.spacing=2.5e-3", "--set", "solver.time=10e-6"]
+#: the pre-cracked plate at 1 mm (1600 points, PMB in 2D, velocity-driven edges), with a
+#: fracture energy low enough that 9860 directed bonds break in 68 steps
+PLATE = [
+    "--set",
+    "discretization.spacing=1e-3",
+    "--set",
+    "solver.time=12e-6",
+    "--set",
+    "material.damage.fracture_energy=20",
+    "--set",
+    "output.every=5",
+]
+
+
+def _run(case: str, extra: list[str], out: Path, capsys) -> dict:
+    args = ["run", str(CASES / case), *extra, "--json", "--no-progress", "-o", str(out)]
+    assert main([*args, "--set", "output.plots=false"]) == 0
+    return json.loads(capsys.readouterr().out)
+
+
+@pytest.mark.parametrize(
+    "case, extra, dtype",
+    [
+        ("bar_pulse.yaml", BAR, "float64"),
+        ("bar_pulse.yaml", BAR, "float32"),
+        ("plate2d_precrack_pull.yaml", PLATE, "float64"),
+    ],
+    ids=["bar_pulse-lps", "bar_pulse-lps-float32", "precrack_pull-pmb-damage"],
+)
+def test_gpu_run_matches_cpu_run(case, extra, dtype, tmp_path, capsys):
+    """Same files (series, steps, times), every series within ``SERIES_TOL`` of the CPU run's
+    largest value (float32: 1e-5, its kernels' unit roundoff carried by the wave), the same
+    number of broken bonds and the same largest damage."""
+    extra = [*extra, "--set", f"solver.dtype={dtype}"]
+    cpu = _run(case, extra, tmp_path / "cpu", capsys)
+    gpu = _run(case, [*extra, "--backend", "gpu"], tmp_path / "gpu", capsys)
+    assert gpu["steps"] == cpu["steps"] and gpu["dt_s"] == cpu["dt_s"]
+    assert gpu["broken_bonds"] == cpu["broken_bonds"]
+    assert gpu["max_damage"] == cpu["max_damage"]
+    if "damage" in case:
+        assert cpu["broken_bonds"] > 1000  # the comparison covers fracture
+    tol = SERIES_TOL if dtype == "float64" else 1e-5
+    c, g = Results(tmp_path / "cpu" / "results.h5"), Results(tmp_path / "gpu" / "results.h5")
+    assert g.series_names() == c.series_names()
+    for name in c.series_names():
+        steps, times, values = c.series(name)
+        g_steps, g_times, g_values = g.series(name)
+        np.testing.assert_array_equal(g_steps, steps)
+        np.testing.assert_array_equal(g_times, times)
+        scale = np.max(np.abs(values))
+        assert np.max(np.abs(g_values - values)) <= tol * scale, name
+    assert sorted(p.name for p in (tmp_path / "gpu").rglob("*")) == sorted(
+        p.name for p in (tmp_path / "cpu").rglob("*")
+    )
+
+
+def test_no_gpu_is_a_one_line_error(monkeypatch, tmp_path, capsys):
+    """Without a CUDA device and without PERIDYN_GPU_ON_CPU, --backend gpu fails with one line."""
+    import warp
+
+    if warp.get_cuda_device_count() > 0:
+        pytest.skip("this machine has a CUDA device: --backend gpu runs")
+    monkeypatch.delenv("PERIDYN_GPU_ON_CPU", raising=False)
+    args = ["run", str(CASES / "bar_pulse.yaml"), *BAR, "--backend", "gpu", "-o", str(tmp_path), "--no-progress"]
+    assert main(args) != 0
+    err = [line for line in capsys.readouterr().err.splitlines() if line.startswith("peridyn run: error")]
+    assert len(err) == 1 and "no CUDA device" in err[0] and "PERIDYN_GPU_ON_CPU=1" in err[0]
+
+
+@pytest.fixture(scope="module")
+def bar_setup():
+    case = load_case(CASES / "bar_pulse.yaml", ["discretization.spacing=5e-3"])
+    return build(case, CASES)
+
+
+def test_contact_and_mpi_refused(bar_setup):
+    """Contact and MPI ranks are named in the refusal (they are not on the GPU backend yet)."""
+    with pytest.raises(InputError, match="contact"):
+        GPUExplicitSolver(bar_setup.model, bar_setup.loading, contact=object())
+
+    class TwoRanks:
+        size = 2
+
+    with pytest.raises(InputError, match="MPI ranks"):
+        GPUExplicitSolver(bar_setup.model, bar_setup.loading, domain=TwoRanks())
+
+
+def test_memory_estimate_counts_the_device_arrays(bar_setup):
+    """The estimate made before allocating is within 10 % above the bytes the solver's device
+    arrays take once allocated (bonds and points of an LPS float64 model without damage)."""
+    solver = GPUExplicitSolver(bar_setup.model, bar_setup.loading)
+    arrays = [*vars(solver).values(), *vars(solver.force_on_device).values(), *solver.force_on_device.xi]
+    allocated = sum(a.capacity for a in arrays if isinstance(a, solver.wp.array))
+    estimate = device_bytes(bar_setup.model, damage=False)["total"]
+    assert allocated <= estimate <= 1.1 * allocated
