@@ -89,7 +89,16 @@ def test_no_gpu_is_a_one_line_error(monkeypatch, tmp_path, capsys):
     if warp.get_cuda_device_count() > 0:
         pytest.skip("this machine has a CUDA device: --backend gpu runs")
     monkeypatch.delenv("PERIDYN_GPU_ON_CPU", raising=False)
-    args = ["run", str(CASES / "bar_pulse.yaml"), *BAR, "--backend", "gpu", "-o", str(tmp_path), "--no-progress"]
+    args = [
+        "run",
+        str(CASES / "bar_pulse.yaml"),
+        *BAR,
+        "--backend",
+        "gpu",
+        "-o",
+        str(tmp_path),
+        "--no-progress",
+    ]
     assert main(args) != 0
     err = [line for line in capsys.readouterr().err.splitlines() if line.startswith("peridyn run: error")]
     assert len(err) == 1 and "no CUDA device" in err[0] and "PERIDYN_GPU_ON_CPU=1" in err[0]
