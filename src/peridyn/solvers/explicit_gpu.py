@@ -42,34 +42,41 @@ from peridyn.solvers.stepping import advance
 
 class DeviceState:
     """The state an observer sees during a GPU run: ``time`` and ``step``, and ``u``, ``v``, ``a``
-    ((n_points, 3) float64 host arrays) copied from the device on first use at each step."""
+    ((n_points, 3) float64 host arrays), each copied from the device when first read at a step
+    (a series record reads u and v, a step without a record nothing)."""
 
     def __init__(self, solver: GPUExplicitSolver, host: State):
         self._solver = solver
         self._host = host
         self.time = host.time
         self.step = host.step
-        self._copied = None  # the step whose values are in ``_host``
+        self._copied = {}  # field -> the step whose values are in ``_host``
+
+    def _field(self, name: str) -> np.ndarray:
+        target = getattr(self._host, name)
+        if self._copied.get(name) != self.step:
+            target[:] = self._solver.device_array(name).numpy()
+            self._copied[name] = self.step
+        return target
 
     def sync(self) -> State:
-        """The host state, its arrays copied from the device if not yet at this step."""
-        if self._copied != self.step:
-            self._solver.download(self._host)
-            self._copied = self.step
+        """The host state with every field copied from the device at this step."""
+        for name in ("u", "v", "a"):
+            self._field(name)
         self._host.time, self._host.step = self.time, self.step
         return self._host
 
     @property
     def u(self) -> np.ndarray:
-        return self.sync().u
+        return self._field("u")
 
     @property
     def v(self) -> np.ndarray:
-        return self.sync().v
+        return self._field("v")
 
     @property
     def a(self) -> np.ndarray:
-        return self.sync().a
+        return self._field("a")
 
 
 class _DeviceBound:
@@ -184,11 +191,9 @@ class GPUExplicitSolver(ExplicitSolver):
         fd = self.force_on_device
         fd.intact.assign(fd.slots.to_ell(self.model.bonds.intact, np.uint8))
 
-    def download(self, state: State) -> None:
-        """Copy u, v, a from the device into ``state``'s arrays."""
-        state.u[:] = self._u.numpy()
-        state.v[:] = self._v.numpy()
-        state.a[:] = self._a.numpy()
+    def device_array(self, name: str):
+        """The device's ``"u"``, ``"v"`` or ``"a"`` (a Warp (n_points, 3) float64 array)."""
+        return {"u": self._u, "v": self._v, "a": self._a}[name]
 
     def initial_state(self) -> State:
         state = State.zeros(self.model.body.n_points)
