@@ -16,6 +16,7 @@ from peridyn.errors import InputError
 from peridyn.io.case import load_case
 from peridyn.io.results import Results
 from peridyn.jobs.build import build
+from peridyn.kernels.gpu import unavailable
 from peridyn.solvers.explicit_gpu import GPUExplicitSolver
 from peridyn.solvers.gpu_force import device_bytes
 
@@ -115,6 +116,9 @@ def test_no_gpu_is_a_one_line_error(monkeypatch, tmp_path, capsys):
     assert main(args) != 0
     err = [line for line in capsys.readouterr().err.splitlines() if line.startswith("peridyn run: error")]
     assert len(err) == 1 and "no CUDA device" in err[0] and "PERIDYN_GPU_ON_CPU=1" in err[0]
+    assert "no CUDA device" in unavailable()  # what the gallery example reports when it falls back
+    monkeypatch.setenv("PERIDYN_GPU_ON_CPU", "1")
+    assert unavailable() is None
 
 
 @pytest.fixture(scope="module")

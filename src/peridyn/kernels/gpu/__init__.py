@@ -61,6 +61,15 @@ def device() -> str:
     return "cuda:0"
 
 
+def unavailable() -> str | None:
+    """Why the GPU backend cannot run here (the one-line error of :func:`device`), or None when it can."""
+    try:
+        device()
+    except InputError as exc:
+        return str(exc)
+    return None
+
+
 def device_description(name: str) -> str:
     """A device's name as Warp reports it, e.g. ``"NVIDIA H200"`` or ``"CPU"``."""
     return str(warp().get_device(name).name)
