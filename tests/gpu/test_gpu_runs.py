@@ -16,6 +16,7 @@ from peridyn.errors import InputError
 from peridyn.io.case import load_case
 from peridyn.io.results import Results
 from peridyn.jobs.build import build
+from peridyn.jobs.run import run_case
 from peridyn.kernels.gpu import unavailable
 from peridyn.solvers.explicit_gpu import GPUExplicitSolver
 from peridyn.solvers.gpu_force import device_bytes
@@ -147,3 +148,22 @@ def test_memory_estimate_counts_the_device_arrays(bar_setup):
     allocated = sum(a.capacity for a in arrays if isinstance(a, solver.wp.array))
     estimate = device_bytes(bar_setup.model, damage=False)["total"]
     assert allocated <= estimate <= 1.1 * allocated
+
+
+def test_series_records_copy_the_probe_points_only(tmp_path, monkeypatch):
+    """A series-only step copies no whole field from the device (the probe points' values are
+    gathered there): over the shortened bar pulse's 64 steps and 33 series records, whole u, v
+    or a come back only for the final snapshot and the end of the run (at most 3 + 3)."""
+    copies = []
+    original = GPUExplicitSolver.device_array
+
+    def counted(self, name):
+        copies.append(name)
+        return original(self, name)
+
+    monkeypatch.setattr(GPUExplicitSolver, "device_array", counted)
+    case = load_case(CASES / "bar_pulse.yaml", [*BAR[1::2], "solver.backend=gpu", "output.plots=false"])
+    summary = run_case(case, tmp_path, overwrite=True)
+    steps, _, _ = Results(tmp_path / "results.h5").series("sensor_u")
+    assert summary["steps"] == 64 and len(steps) == 33
+    assert len(copies) <= 6

@@ -121,7 +121,8 @@ def run_case_benchmark(
     Returns
     -------
     dict
-        ``case``, ``points``, ``bonds`` (directed), ``steps``, ``dt`` (s), ``seconds`` (the timed
+        ``case``, ``backend`` (``solver.backend``: cpu or gpu, whose force kernel is timed),
+        ``points``, ``bonds`` (directed), ``steps``, ``dt`` (s), ``seconds`` (the timed
         steps), ``kernel_seconds`` (best force evaluation), ``kernel_bond_updates_per_s``,
         ``step_bond_updates_per_s``, ``step_share``, ``parts`` (s: force, damage, contact,
         observers, rest; damage and contact only when the case has them), ``observer_calls``,

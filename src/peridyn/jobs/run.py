@@ -504,9 +504,10 @@ def _run_explicit(
         traffic = d.comm.traffic.copy()
         loop_start = time.perf_counter()
         try:
-            gathered.attach(
-                watched, due, prepare, damage_due, (spec.series_due, probes.u_points, probes.v_points, record)
-            )
+            series = (spec.series_due, probes.u_points, probes.v_points, record)
+            # the GPU backend's state is on the device: a series-only step reads the probe points only
+            device_probes = solver.probe_values if isinstance(solver, GPUExplicitSolver) else None
+            gathered.attach(watched, due, prepare, damage_due, series, device_probes)
             solver.run(state, remaining, observers, bar)
         finally:
             gathered.detach()

@@ -12,7 +12,9 @@ the bonds' intact mask on a Warp device (``peridyn.kernels.gpu``; ``solvers.gpu_
   bonds that cannot break yet: the same bonds break); the count of bonds broken is read each
   step, and the intact mask copied back to ``bonds.intact`` at the steps where bonds broke;
 - the observers (recorders, checkpoints) get a state whose ``u``, ``v``, ``a`` are copied from
-  the device when first read at a step: nothing is copied at a step where nothing is recorded.
+  the device when first read at a step: nothing is copied at a step where nothing is recorded;
+  at a step where only a recorder's series are due, the state is checked on the device and only
+  the probe points' u and v come back (:meth:`GPUExplicitSolver.probe_values`).
 
 Contact and MPI ranks are refused (InputError naming them), as is Peridigm's differenced
 prescribed velocity.
@@ -29,6 +31,7 @@ from peridyn.errors import InputError
 from peridyn.kernels.gpu import device, device_description
 from peridyn.kernels.gpu.update import (
     acceleration_kernel,
+    gather_rows_kernel,
     kick_drift_kernel,
     prescribe_kernel,
     stretch_break_kernel,
@@ -253,15 +256,30 @@ class GPUExplicitSolver(ExplicitSolver):
             self.bonds_broken += broken
         return broken
 
-    def _check(self, state) -> None:
-        """Count the unsound points on the device; when there is one, the host check names it."""
+    def probe_values(self, state, u_points: np.ndarray, v_points: np.ndarray, limit: float):
+        """u at the points ``u_points`` (k,) and v at ``v_points`` (s,) of the device state, (k, 3)
+        and (s, 3) float64, after checking the whole state on the device against the runaway
+        ``limit`` (m; InstabilityError naming the point, from the host check, when unsound)."""
+        self._check(state, limit)
+        values = []
+        for field, points in ((self._u, u_points), (self._v, v_points)):
+            out = self.wp.zeros((len(points), 3), dtype=self.wp.float64, device=self.device)
+            if len(points):
+                index = self._put(np.asarray(points, dtype=np.int32))
+                self._launch(gather_rows_kernel(), (len(points), 3), [field, index, out])
+            values.append(out.numpy())
+        return values[0], values[1]
+
+    def _check(self, state, limit: float | None = None) -> None:
+        """Count the unsound points on the device (``limit``: the runaway displacement, m; None:
+        the solver's); when there is one, the host check names it."""
+        limit = self.max_displacement if limit is None else limit
         self._counter.zero_()
-        inputs = [self._u, self._v, float(self.max_displacement), self._counter]
-        self._launch(unsound_kernel(), self.model.body.n_points, inputs)
+        self._launch(
+            unsound_kernel(), self.model.body.n_points, [self._u, self._v, float(limit), self._counter]
+        )
         if int(self._counter.numpy()[0]):
-            self.domain.check_state(
-                state.sync() if isinstance(state, DeviceState) else state, self.max_displacement
-            )
+            self.domain.check_state(state.sync() if isinstance(state, DeviceState) else state, limit)
 
     def run(self, state: State, n_steps: int, observers: Sequence = (), progress=None) -> State:
         """Advance the host ``state`` by ``n_steps`` steps on the device (uploaded first, copied

@@ -166,3 +166,18 @@ def unsound_kernel():
             wp.atomic_add(bad, 0, 1)
 
     return unsound
+
+
+@functools.cache
+def gather_rows_kernel():
+    """``out[r] = values[index[r]]``: the rows (n_points, 3) float64 of ``index`` (k,) int32 into
+    ``out`` (k, 3) (a recorder's probe points)."""
+    wp = warp()
+    A2 = wp.array2d(dtype=wp.float64)
+
+    @wp.kernel(module="unique")
+    def gather_rows(values: A2, index: wp.array(dtype=wp.int32), out: A2):
+        r, c = wp.tid()
+        out[r, c] = values[index[r], c]
+
+    return gather_rows
