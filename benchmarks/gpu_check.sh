@@ -24,10 +24,10 @@ nvidia-smi --query-gpu=name,memory.total,driver_version --format=csv,noheader ||
 date -u
 
 echo "== GPU tests on the device"
-timeout 150 python -m pytest -q -p no:cacheprovider tests/gpu
+timeout 200 python -m pytest -q -p no:cacheprovider tests/gpu
 
 echo "== kernel bench on the device"
-timeout 150 peridyn bench --backend gpu --json > benchmarks/gpu_bench.json
+timeout 100 peridyn bench --backend gpu --json > benchmarks/gpu_bench.json
 python - <<'PY'
 import json
 from peridyn.jobs.bench_gpu import format_gpu_table
@@ -38,5 +38,5 @@ echo "== $case_file on both backends"
 rm -rf "$out"
 common=(--json --no-progress --overwrite --set output.plots=false --set output.vtu=false)
 timeout 200 peridyn run "$case_file" "${common[@]}" -o "$out/cpu" > "$out-cpu.json"
-timeout 90 peridyn run "$case_file" --backend gpu "${common[@]}" -o "$out/gpu" > "$out-gpu.json"
+timeout 80 peridyn run "$case_file" --backend gpu "${common[@]}" -o "$out/gpu" > "$out-gpu.json"
 python benchmarks/gpu_compare.py "$out/cpu" "$out/gpu"

@@ -19,6 +19,7 @@ from peridyn.jobs.build import build
 from peridyn.jobs.run import run_case
 from peridyn.kernels.gpu import unavailable
 from peridyn.solvers.explicit_gpu import GPUExplicitSolver
+from peridyn.solvers import gpu_force
 from peridyn.solvers.gpu_force import device_bytes
 
 pytestmark = pytest.mark.gpu
@@ -167,3 +168,27 @@ def test_series_records_copy_the_probe_points_only(tmp_path, monkeypatch):
     steps, _, _ = Results(tmp_path / "results.h5").series("sensor_u")
     assert summary["steps"] == 64 and len(steps) == 33
     assert len(copies) <= 6
+
+
+def test_a_model_larger_than_the_device_is_refused_with_the_numbers(bar_setup, monkeypatch):
+    """The estimate is compared with the CUDA device's free memory before anything is allocated:
+    above it, one error giving both (in GiB) and the parts (bonds, points)."""
+
+    class SmallDevice:
+        is_cuda, name, free_memory = True, "a 100 kB GPU", 100_000
+
+    class FakeWarp:
+        @staticmethod
+        def get_device(name):
+            return SmallDevice()
+
+    monkeypatch.setattr(gpu_force, "warp", lambda: FakeWarp())
+    need = device_bytes(bar_setup.model, damage=False)["total"]
+    assert need > SmallDevice.free_memory  # 160 points: about 190 kB
+    with pytest.raises(InputError) as info:
+        gpu_force.check_fits(bar_setup.model, False, "cuda:0")
+    message = str(info.value)
+    assert "does not fit on a 100 kB GPU" in message and f"{need / 2**30:.2f} GiB" in message
+    assert "0.00 GiB free" in message and "bonds in the ELL layout" in message
+    SmallDevice.free_memory = need
+    assert gpu_force.check_fits(bar_setup.model, False, "cuda:0")["total"] == need
