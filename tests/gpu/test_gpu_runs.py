@@ -18,8 +18,8 @@ from peridyn.io.results import Results
 from peridyn.jobs.build import build
 from peridyn.jobs.run import run_case
 from peridyn.kernels.gpu import unavailable
-from peridyn.solvers.explicit_gpu import GPUExplicitSolver
 from peridyn.solvers import gpu_force
+from peridyn.solvers.explicit_gpu import GPUExplicitSolver
 from peridyn.solvers.gpu_force import device_bytes
 
 pytestmark = pytest.mark.gpu
