@@ -230,7 +230,7 @@ def test_verlet_updates(rng, dtype, damping):
     e.launch(
         update.acceleration_kernel(scalar),
         (n, 3),
-        [F, e.point(b), e.point(inv_rho), e.point(damping), V, con, A2, 1, 0.5 * dt],
+        [F, e.point(b), e.point(inv_rho), e.point(damping), V, con, A2, 1, 0.5 * dt, 0, e.out((1, 3))],
     )
     a_ref, v2_ref = verlet_ref.acceleration(f, b, inv_rho, damping, v_ref, constrained, True, 0.5 * dt)
     a_numba, v_numba = np.empty((n, 3)), v_ref.copy()

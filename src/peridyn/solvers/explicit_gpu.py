@@ -16,8 +16,7 @@ the bonds' intact mask on a Warp device (``peridyn.kernels.gpu``; ``solvers.gpu_
   at a step where only a recorder's series are due, the state is checked on the device and only
   the probe points' u and v come back (:meth:`GPUExplicitSolver.probe_values`).
 
-Contact and MPI ranks are refused (InputError naming them), as is Peridigm's differenced
-prescribed velocity.
+Contact and MPI ranks are refused (InputError naming them).
 """
 
 from __future__ import annotations
@@ -31,6 +30,7 @@ from peridyn.errors import InputError
 from peridyn.kernels.gpu import device, device_description
 from peridyn.kernels.gpu.update import (
     acceleration_kernel,
+    difference_velocity_kernel,
     gather_rows_kernel,
     kick_drift_kernel,
     prescribe_kernel,
@@ -141,13 +141,14 @@ class GPUExplicitSolver(ExplicitSolver):
             for what, present in (
                 ("contact", contact is not None),
                 ("MPI ranks", domain is not None and domain.size > 1),
-                ("solver.prescribed_velocity: difference", prescribed_velocity == "difference"),
             )
             if present
         ]
         if refused:
             raise InputError(f"the GPU backend does not run {', '.join(refused)} yet: use --backend cpu")
-        super().__init__(model, loading, dt, safety, damping, damage, check_every, None, domain)
+        super().__init__(
+            model, loading, dt, safety, damping, damage, check_every, None, domain, prescribed_velocity
+        )
         self.device = device_name or device()
         self.memory = check_fits(model, damage is not None, self.device)
         self.force_on_device = DeviceForce(model, self.device)
@@ -164,6 +165,13 @@ class GPUExplicitSolver(ExplicitSolver):
         self._velocity = [_DeviceBound(b, self._put) for b in ld.velocity]
         self._body_force = [_DeviceBound(b, self._put) for b in ld.body_force]
         self._counter = wp.zeros(1, dtype=wp.int32, device=self.device)
+        # Peridigm's differenced velocity: the DOFs, u before the step and their force acceleration
+        self._diff_mask = self._u_before = None
+        self._free_d = wp.zeros((1, 3), dtype=wp.float64, device=self.device)  # unused without it
+        if self._differenced is not None:
+            self._diff_mask = self._put(self._differenced.astype(np.uint8))
+            self._u_before = wp.zeros((n, 3), dtype=wp.float64, device=self.device)
+            self._free_d = wp.zeros((n, 3), dtype=wp.float64, device=self.device)
         self._limit = None
         if damage is not None:
             self._limit = self.force_on_device.per_bond(damage.critical_lengths(), np.inf)
@@ -200,7 +208,7 @@ class GPUExplicitSolver(ExplicitSolver):
 
     def initial_state(self) -> State:
         state = State.zeros(self.model.body.n_points)
-        self.loading.apply_start(self.dt, state.u, state.v)
+        self.loading.apply_start(self.dt, state.u, state.v, rates=self._differenced is None)
         self.upload(state)
         self._device_acceleration(0.0, kick=False)
         state.a[:] = self._a.numpy()
@@ -219,26 +227,33 @@ class GPUExplicitSolver(ExplicitSolver):
             self._prescribe(self._body_force, self._b, [db.value(time) for db in self._body_force], 1)
         inputs = [f, self._b, self._inv_rho_d, self._damping_d, self._v, self._constrained, self._a]
         n = self.model.body.n_points
-        self._launch(
-            acceleration_kernel(self.force_on_device.scalar), (n, 3), [*inputs, int(kick), 0.5 * self.dt]
-        )
+        keep = int(self._differenced is not None)
+        inputs = [*inputs, int(kick), 0.5 * self.dt, keep, self._free_d]
+        self._launch(acceleration_kernel(self.force_on_device.scalar), (n, 3), inputs)
 
     def step(self, state) -> int:
         """Advance the device state by one step (``state``: the :class:`DeviceState` of
         :meth:`run`, whose time and step are advanced); returns the number of bonds broken."""
         dt = self.dt
         n = self.model.body.n_points
+        differenced = self._differenced is not None
+        if differenced:
+            self.wp.copy(self._u_before, self._u)
         self._launch(kick_drift_kernel(), (n, 3), [self._u, self._v, self._a, 0.5 * dt, dt])
         state.time += dt
         state.step += 1
         t = state.time
         if self._displacement:
             self._prescribe(self._displacement, self._u, [db.value(t) for db in self._displacement], 0)
-            self._prescribe(self._displacement, self._v, [db.rate(t, dt) for db in self._displacement], 0)
+            if not differenced:
+                self._prescribe(self._displacement, self._v, [db.rate(t, dt) for db in self._displacement], 0)
         broken = self._break_bonds() if self._limit is not None else 0
         self._device_acceleration(t, kick=True)
         if self._velocity:
             self._prescribe(self._velocity, self._v, [db.value(t) for db in self._velocity], 0)
+        if differenced:
+            inputs = [self._u, self._u_before, self._free_d, self._diff_mask, dt, 0.5 * dt, self._v]
+            self._launch(difference_velocity_kernel(), (n, 3), inputs)
         if state.step % self.check_every == 0:
             self._check(state)
         return broken

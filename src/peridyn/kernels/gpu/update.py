@@ -28,7 +28,9 @@ def kick_drift_kernel():
 def acceleration_kernel(scalar):
     """``a = (f + b) * inv_rho``, ``a -= damping * v``, ``a = 0`` where ``constrained``, and with
     ``kick`` ``v += half_dt * a`` (``verlet.acceleration``): ``f`` (n, 3) of ``scalar``, taken as
-    float64; ``damping`` (0,), (1,) or (n,) 1/s; ``constrained`` (n, 3) uint8."""
+    float64; ``damping`` (0,), (1,) or (n,) 1/s; ``constrained`` (n, 3) uint8. With ``keep_free``
+    1, ``free`` (OUT, (n, 3)) gets ``a`` before the constraint zeroes it (the force acceleration
+    of Peridigm's differenced velocity, ``solvers.explicit``)."""
     wp = warp()
     A1 = wp.array(dtype=wp.float64)
     A2 = wp.array2d(dtype=wp.float64)
@@ -44,6 +46,8 @@ def acceleration_kernel(scalar):
         a: A2,
         kick: wp.int32,
         half_dt: wp.float64,
+        keep_free: wp.int32,
+        free: A2,
     ):
         i, k = wp.tid()
         n_damping = damping.shape[0]
@@ -52,6 +56,8 @@ def acceleration_kernel(scalar):
             ak = ak - damping[0] * v[i, k]
         elif n_damping > 1:
             ak = ak - damping[i] * v[i, k]
+        if keep_free != 0:
+            free[i, k] = ak
         if constrained[i, k] != wp.uint8(0):
             ak = wp.float64(0.0)
         a[i, k] = ak
@@ -59,6 +65,31 @@ def acceleration_kernel(scalar):
             v[i, k] = v[i, k] + half_dt * ak
 
     return acceleration
+
+
+@functools.cache
+def difference_velocity_kernel():
+    """Peridigm's velocity of the DOFs with a prescribed displacement (``mask`` (n, 3) uint8):
+    ``v = (u - u_before) / dt + half_dt * free`` (``solvers.explicit``, ``prescribed_velocity:
+    difference``); the other DOFs are left as they are."""
+    wp = warp()
+    A2 = wp.array2d(dtype=wp.float64)
+
+    @wp.kernel(module="unique")
+    def difference_velocity(
+        u: A2,
+        u_before: A2,
+        free: A2,
+        mask: wp.array2d(dtype=wp.uint8),
+        dt: wp.float64,
+        half_dt: wp.float64,
+        v: A2,
+    ):
+        i, k = wp.tid()
+        if mask[i, k] != wp.uint8(0):
+            v[i, k] = (u[i, k] - u_before[i, k]) / dt + half_dt * free[i, k]
+
+    return difference_velocity
 
 
 @functools.cache
