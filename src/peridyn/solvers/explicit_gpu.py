@@ -175,6 +175,7 @@ class GPUExplicitSolver(ExplicitSolver):
         self._limit = None
         if damage is not None:
             self._limit = self.force_on_device.per_bond(damage.critical_lengths(), np.inf)
+        self._probes = {}  # id -> (probe points, their device indices, output buffer)
         #: directed bonds broken on the device so far
         self.bonds_broken = 0
 
@@ -278,12 +279,21 @@ class GPUExplicitSolver(ExplicitSolver):
         self._check(state, limit)
         values = []
         for field, points in ((self._u, u_points), (self._v, v_points)):
-            out = self.wp.zeros((len(points), 3), dtype=self.wp.float64, device=self.device)
+            index, out = self._probe_buffers(points)
             if len(points):
-                index = self._put(np.asarray(points, dtype=np.int32))
                 self._launch(gather_rows_kernel(), (len(points), 3), [field, index, out])
             values.append(out.numpy())
         return values[0], values[1]
+
+    def _probe_buffers(self, points: np.ndarray):
+        """The device copy of the probe indices ``points`` (k,) and a (k, 3) output buffer, made on
+        the first call with these points (a run's recorder asks for the same ones every time)."""
+        key = id(points)
+        if key not in self._probes or self._probes[key][0] is not points:
+            index = self._put(np.asarray(points, dtype=np.int32))
+            out = self.wp.zeros((len(points), 3), dtype=self.wp.float64, device=self.device)
+            self._probes[key] = (points, index, out)
+        return self._probes[key][1:]
 
     def _check(self, state, limit: float | None = None) -> None:
         """Count the unsound points on the device (``limit``: the runaway displacement, m; None:

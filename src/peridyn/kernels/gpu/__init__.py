@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import functools
 import os
+import sys
 
 from peridyn.errors import InputError
 
@@ -43,8 +44,23 @@ def warp():
     wp.config.quiet = True  # no banner, and no line per compiled module (stdout may carry JSON)
     if hasattr(wp, "LOG_WARNING"):
         wp.config.log_level = wp.LOG_WARNING
-    wp.init()
+    _init_without_driver_warning(wp)
     return wp
+
+
+def _init_without_driver_warning(wp) -> None:
+    """``wp.init()`` with the process's stderr closed: Warp's native library prints a warning there
+    on a machine without the CUDA driver, which :func:`device` reports in its own one-line error."""
+    if sys.stderr is not None:
+        sys.stderr.flush()
+    saved = os.dup(2)
+    try:
+        with open(os.devnull, "w") as null:
+            os.dup2(null.fileno(), 2)
+            wp.init()
+    finally:
+        os.dup2(saved, 2)
+        os.close(saved)
 
 
 def device() -> str:
