@@ -15,7 +15,7 @@ unset PERIDYN_GPU_ON_CPU
 
 if ! python -c "import warp" 2>/dev/null; then
     if [ -d benchmarks/wheels ]; then
-        python -m pip install --no-index --find-links benchmarks/wheels "warp-lang>=1.5"
+        python -m pip install --no-index --find-links benchmarks/wheels "warp-lang>=1.19"
     else
         python -m pip install -e ".[gpu]"
     fi
