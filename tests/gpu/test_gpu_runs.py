@@ -228,3 +228,19 @@ def test_peridigm_decks_write_the_same_exodus_file(deck, tmp_path, capsys):
     for name, values in cpu.nodal_variables.items():
         scale = np.max(np.abs(values))
         assert np.max(np.abs(gpu.nodal_variables[name] - values)) <= SERIES_TOL * scale, name
+
+
+def test_a_driver_older_than_warps_cuda_is_named(monkeypatch):
+    """A machine whose NVIDIA driver predates the CUDA of the Warp wheel has no usable device: the
+    error says so with both versions instead of 'no CUDA device'."""
+    import peridyn.kernels.gpu as kgpu
+
+    class OldDriver:
+        get_cuda_device_count = staticmethod(lambda: 0)
+        get_cuda_driver_version = staticmethod(lambda: (12, 4))
+        get_cuda_toolkit_version = staticmethod(lambda: (13, 0))
+
+    monkeypatch.delenv("PERIDYN_GPU_ON_CPU", raising=False)
+    monkeypatch.setattr(kgpu, "warp", lambda: OldDriver())
+    with pytest.raises(InputError, match=r"driver supports CUDA 12\.4, older than the CUDA 13\.0"):
+        kgpu.device()

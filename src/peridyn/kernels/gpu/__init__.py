@@ -70,9 +70,16 @@ def device() -> str:
     if on_cpu():
         return "cpu"
     if wp.get_cuda_device_count() == 0:
+        driver, toolkit = wp.get_cuda_driver_version(), wp.get_cuda_toolkit_version()
+        if driver is not None and toolkit is not None and driver[0] < toolkit[0]:
+            raise InputError(
+                f"--backend gpu: the NVIDIA driver supports CUDA {driver[0]}.{driver[1]}, older than "
+                f"the CUDA {toolkit[0]}.{toolkit[1]} of this Warp build: update the driver or install "
+                f"a warp-lang build for CUDA {driver[0]} (docs/gpu.md)"
+            )
         raise InputError(
-            f"--backend gpu: no CUDA device found (set {ON_CPU_VARIABLE}=1 to run the GPU "
-            "kernels on the CPU, or use --backend cpu)"
+            f"--backend gpu: no CUDA device found (set {ON_CPU_VARIABLE}=1 to run the GPU kernels "
+            "on the CPU, or use --backend cpu)"
         )
     return "cuda:0"
 
