@@ -25,6 +25,7 @@ TINY = [
 ]
 KEYS = {
     "case",
+    "backend",
     "points",
     "bonds",
     "steps",

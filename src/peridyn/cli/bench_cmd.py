@@ -14,6 +14,11 @@ snapshots, written to a temporary folder deleted afterwards) against the force
 evaluation alone on the same bonds (best of --repeat): the whole-step and kernel
 rates, the step's share of the kernel rate and where the step time goes. See
 peridyn.jobs.bench_case.
+
+With --backend gpu: the same on the GPU backend (a CUDA device through NVIDIA Warp, or
+Warp's CPU device with PERIDYN_GPU_ON_CPU=1): the PMB and LPS rows in float64 and float32
+against the device's memory roof from a measured copy (peridyn.jobs.bench_gpu), or with
+--case the case's whole steps on the device against its device force kernel.
 """
 
 from __future__ import annotations
@@ -63,6 +68,12 @@ def register(sub) -> None:
         metavar="N",
         help="with --case: timed steps (default: the case's step count, at most 200)",
     )
+    p.add_argument(
+        "--backend",
+        choices=("cpu", "gpu"),
+        default="cpu",
+        help="the numba CPU kernels (default) or the GPU backend (docs/gpu.md)",
+    )
     add_common_flags(p)
     p.set_defaults(func=run)
 
@@ -77,6 +88,14 @@ def run(args) -> dict:
         return _run_case(args, log)
     if args.steps is not None or args.overrides:
         raise InputError("--steps and --set apply to a case: give --case CASE.yaml")
+    if args.backend == "gpu":
+        from peridyn.jobs.bench_gpu import format_gpu_table, run_gpu_benchmark
+
+        points = args.points if args.points is not None else DEFAULT_POINTS
+        result = run_gpu_benchmark(points, args.repeat, args.partial_volumes, log=log)
+        if not args.json:
+            print(format_gpu_table(result))
+        return result
     result = run_benchmark(
         points=args.points if args.points is not None else DEFAULT_POINTS,
         repeat=args.repeat,
@@ -95,7 +114,8 @@ def _run_case(args, log) -> dict:
 
     if args.points is not None or args.partial_volumes:
         raise InputError("--points and --partial-volumes set the benchmark grid, not a --case run")
-    case = load_case(args.case, args.overrides)
+    backend = [f"solver.backend={args.backend}"] if args.backend == "gpu" else []
+    case = load_case(args.case, [*args.overrides, *backend])
     result = run_case_benchmark(
         case, Path(args.case).parent, args.case, steps=args.steps, repeat=args.repeat, log=log
     )

@@ -37,6 +37,13 @@ def register(sub) -> None:
         help="write a checkpoint every N steps",
     )
     p.add_argument("--restart", action="store_true", help="continue from the output folder's checkpoint.h5")
+    p.add_argument(
+        "--backend",
+        choices=("cpu", "gpu"),
+        default=None,
+        help="where an explicit run's time loop runs (default: the case's solver.backend, cpu): "
+        "gpu needs a CUDA device and pip install peridyn[gpu] (docs/gpu.md)",
+    )
     add_progress_flags(p)
     add_common_flags(p)
     add_max_memory(p)
@@ -55,7 +62,9 @@ def run(args) -> dict:
     from peridyn.jobs.estimate import check_memory
     from peridyn.jobs.run import run_case
 
-    case = load_case_or_deck(args.case, args.overrides)
+    backend = getattr(args, "backend", None)  # demo: no flag
+    overrides = [*args.overrides, *([f"solver.backend={backend}"] if backend else [])]
+    case = load_case_or_deck(args.case, overrides)
     check_memory(case, getattr(args, "max_memory", None), Path(args.case).parent)  # demo: no flag
     info = provenance()
     print(

@@ -507,6 +507,15 @@ class Solver(Strict):
     #: modal: ``shift-invert`` (factorised), ``lobpcg`` (matrix-free) or ``auto`` (by the
     #: estimated factor size, ``jobs.modal.choose_eigensolver``).
     eigensolver: Literal["auto", "shift-invert", "lobpcg"] = "auto"
+    #: explicit: where the time loop runs, ``cpu`` (numba kernels) or ``gpu`` (a CUDA device
+    #: through NVIDIA Warp, ``pip install peridyn[gpu]``; docs/gpu.md)
+    backend: Literal["cpu", "gpu"] = "cpu"
+
+    @model_validator(mode="after")
+    def _backend(self):
+        if self.backend == "gpu" and self.type != "explicit":
+            raise ValueError(f"backend gpu runs explicit solvers only, not {self.type}: use backend cpu")
+        return self
 
     @model_validator(mode="after")
     def _newmark(self):

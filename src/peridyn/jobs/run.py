@@ -39,6 +39,7 @@ from peridyn.physics.damage import damage_field
 from peridyn.physics.deformation import strain_field
 from peridyn.physics.transducers import pzt_sensor_weights
 from peridyn.solvers import ExplicitSolver, relax
+from peridyn.solvers.explicit_gpu import GPUExplicitSolver
 
 #: The results file in a run's output folder.
 RESULTS = "results.h5"
@@ -388,8 +389,9 @@ def time_stepper(case, setup):
     if np.ndim(damping):  # per point: the rank's points
         damping = damping[setup.domain.global_ids]
     peridigm_dt = s.dt is None and s.step_rule == "peridigm"
+    solver_class = GPUExplicitSolver if s.backend == "gpu" else ExplicitSolver
     try:
-        return ExplicitSolver(
+        return solver_class(
             setup.model,
             setup.loading,
             dt=s.safety * peridigm_stable_step(case, setup) if peridigm_dt else s.dt,
@@ -502,9 +504,10 @@ def _run_explicit(
         traffic = d.comm.traffic.copy()
         loop_start = time.perf_counter()
         try:
-            gathered.attach(
-                watched, due, prepare, damage_due, (spec.series_due, probes.u_points, probes.v_points, record)
-            )
+            series = (spec.series_due, probes.u_points, probes.v_points, record)
+            # the GPU backend's state is on the device: a series-only step reads the probe points only
+            device_probes = solver.probe_values if isinstance(solver, GPUExplicitSolver) else None
+            gathered.attach(watched, due, prepare, damage_due, series, device_probes)
             solver.run(state, remaining, observers, bar)
         finally:
             gathered.detach()

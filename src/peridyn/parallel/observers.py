@@ -15,6 +15,7 @@ asked.
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable, Sequence
 
 import numpy as np
@@ -53,6 +54,7 @@ class RootObservers:
         self._damage: np.ndarray | None = None
         self._tensors: dict = {}
         self._series = None  # (due, PointGather, record, runaway limit) under MPI
+        self._device_probes = False  # the series come from ``attach``'s ``device_probes``
 
     def attach(
         self,
@@ -61,6 +63,7 @@ class RootObservers:
         prepare=(),
         damage_due=None,
         series=None,
+        device_probes=None,
     ) -> None:
         """Watch with ``observers`` (objects with ``observe(state, solver)``, used on rank 0 only:
         None elsewhere) at the steps where one of ``due`` (callables step -> bool, known on every
@@ -76,16 +79,24 @@ class RootObservers:
         u at the global points ``u_points`` (k,) and v at ``v_points`` (s,) only, and rank 0
         calls ``record`` (a callable, None elsewhere) with that ``ProbeState``: a recorder's
         ``record_series`` with its ``Probes``. Collective; several ranks only (in one process
-        the observers see the state itself)."""
+        the observers see the state itself), or in one process with ``device_probes``: a
+        callable ``(state, u_points, v_points, limit) -> (u, v)`` that checks the state where it
+        lives and returns the probe points' values (the GPU backend's ``probe_values``), so that
+        a series-only step reads those points only."""
         self.observers = list(observers) if self.domain.is_root else []
         self.due = list(due)
         self.prepare = list(prepare)
         self.damage_due = None if damage_due is None else list(damage_due)
         self._series = None
-        if series is not None and self.domain.size > 1:
+        self._device_probes = device_probes is not None and self.domain.size == 1
+        if series is not None and (self.domain.size > 1 or self._device_probes):
             series_due, u_points, v_points, record = series
             limit = self.domain.runaway_limit(self.model.body.points)
-            self._series = series_due, PointGather(self.domain, u_points, v_points), record, limit
+            if self._device_probes:
+                gather = functools.partial(device_probes, u_points=u_points, v_points=v_points, limit=limit)
+            else:
+                gather = PointGather(self.domain, u_points, v_points)
+            self._series = series_due, gather, record, limit
 
     def detach(self) -> None:
         """Forget ``attach``'s observers. Observers hold this object's ``damage``: until they are
@@ -109,7 +120,8 @@ class RootObservers:
         """Gather and call the observers when one is due (every rank calls it); in one process,
         call them at every step (nothing to gather). At a step with only the series due, gather
         the probe points' values and record them (``attach``'s ``series``)."""
-        if self.domain.size == 1 or any(due(state.step) for due in self.due):
+        serial = self.domain.size == 1 and self._series is None
+        if serial or any(due(state.step) for due in self.due):
             for due, prepare in self.prepare:
                 if due(state.step):
                     prepare(state)
@@ -123,8 +135,11 @@ class RootObservers:
     def record_probes(self, state: State) -> None:
         """The series record of ``attach``'s ``series`` at ``state`` (collective)."""
         _, gather, record, limit = self._series
-        self.domain.check_state(state, limit)
-        values = gather(state.u, state.v)
+        if self._device_probes:  # checked where the state lives
+            values = gather(state)
+        else:
+            self.domain.check_state(state, limit)
+            values = gather(state.u, state.v)
         probe = None if values is None else ProbeState(*values, state.time, state.step)
         self.domain.on_root(record, probe)
 

@@ -210,6 +210,14 @@ class BondDamage:
         self.full_tests = int(saved["full_tests"])
         self.partial_tests = int(saved["partial_tests"])
 
+    def critical_lengths(self) -> np.ndarray:
+        """(n_bonds,) m: the deformed length past which each bond breaks, ``|xi| (1 + s_c)`` (inf
+        where it may not break); from the first call on, ``critical_stretch`` and ``breakable``
+        are read-only (see the class)."""
+        if self._limit is None:
+            self._freeze_limit()
+        return self._limit
+
     def _freeze_limit(self) -> None:
         """Compute the critical lengths and make their inputs read-only."""
         self._limit = np.where(

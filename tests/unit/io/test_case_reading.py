@@ -130,3 +130,11 @@ def test_a_tagged_value_of_the_wrong_type_names_it_and_its_line(tmp_path, text, 
 
 def test_valid_tagged_scalars_are_still_read():
     assert parse_yaml("[!!int 1_000, !!float 2, !!bool yes, 1.5e3]") == [1000, 2.0, True, 1500.0]
+
+
+def test_the_gpu_backend_is_refused_for_a_solver_other_than_explicit():
+    """``solver.backend: gpu`` runs explicit solvers only: a modal case with it is one error
+    naming the solver type (docs/gpu.md); an explicit case takes it."""
+    with pytest.raises(CaseFileError, match="backend gpu runs explicit solvers only, not modal"):
+        load_case(BAR, ["solver.type=modal", "solver.backend=gpu"])
+    assert load_case(BAR, ["solver.backend=gpu"]).solver.backend == "gpu"

@@ -1,0 +1,21 @@
+"""The GPU-backend tests run Warp's kernels on its CPU device (``PERIDYN_GPU_ON_CPU=1``), or on
+the GPU when one is there and the variable is not set (``benchmarks/gpu_check.sh``); they are
+skipped, with the reason, where Warp is not installed."""
+
+import os
+import sys
+from pathlib import Path
+
+import pytest
+
+pytest.importorskip("warp", reason="the GPU backend's tests need NVIDIA Warp (pip install -e '.[gpu]')")
+
+if "PERIDYN_GPU_ON_CPU" not in os.environ:
+    import warp
+
+    warp.config.quiet = True
+    if warp.get_cuda_device_count() == 0:
+        os.environ["PERIDYN_GPU_ON_CPU"] = "1"
+
+# the small random families of the numba kernel tests
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "kernels"))
