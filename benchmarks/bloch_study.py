@@ -11,7 +11,7 @@ from __future__ import annotations
 import sys
 import time
 
-from peridyn.analysis.bloch import Discretisation
+from peridyn.analysis.bloch import BlochLattice
 from peridyn.analysis.bloch_study import format_study, predict, study
 from peridyn.io.case import load_case
 
@@ -19,16 +19,16 @@ FREQUENCIES = (110e3, 150e3, 185e3, 225e3)
 
 
 def main() -> None:
-    disc = Discretisation.from_case(load_case("cases/lamb_plate_converged.yaml"))
+    disc = BlochLattice.from_case(load_case("cases/lamb_plate_converged.yaml"))
     predict(disc, [150e3])  # compile the numba kernels once
     start = time.perf_counter()
-    predict(Discretisation.from_case(load_case("cases/lamb_plate_converged.yaml")), [110e3, 150e3, 225e3])
+    predict(BlochLattice.from_case(load_case("cases/lamb_plate_converged.yaml")), [110e3, 150e3, 225e3])
     print(
         f"prediction at three frequencies (converged preset): {time.perf_counter() - start:.2f} s",
         file=sys.stderr,
     )
     start = time.perf_counter()
-    seed = Discretisation.from_case(load_case("cases/lamb_plate.yaml"))
+    seed = BlochLattice.from_case(load_case("cases/lamb_plate.yaml"))
     predict(seed, [110e3, 150e3, 225e3])
     print(
         f"prediction at three frequencies (seed case): {time.perf_counter() - start:.2f} s", file=sys.stderr

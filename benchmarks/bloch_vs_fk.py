@@ -34,7 +34,7 @@ import json
 import numpy as np
 from scipy.special import hankel1
 
-from peridyn.analysis.bloch import Discretisation, bloch_cell, plate_basis, zone_edge
+from peridyn.analysis.bloch import BlochLattice, bloch_cell, plate_basis, zone_edge
 from peridyn.analysis.bloch_study import predict
 from peridyn.analysis.fk import fk_transform, line_mode_wavenumbers, phase_wavenumber, pick_wavenumbers
 from peridyn.analysis.lamb import lamb_modes
@@ -103,7 +103,7 @@ def main() -> None:
     args = parser.parse_args()
     r_range = tuple(float(v) for v in args.r_range.split(","))
     case = load_case(args.case)
-    disc = Discretisation.from_case(case)
+    disc = BlochLattice.from_case(case)
     cell = bloch_cell(disc)
     f0 = centre_frequency(case)
     fk = case.analysis.fk

@@ -10,13 +10,13 @@ and shear-horizontal branches of the periodic point lattice, against Rayleigh-La
 
 from pathlib import Path
 
-from peridyn.analysis.bloch import Discretisation
+from peridyn.analysis.bloch import BlochLattice
 from peridyn.analysis.bloch_study import predict
 from peridyn.plotting.bloch import plot_bloch
 
 out = Path("peridyn-out/gallery/bloch")
 out.mkdir(parents=True, exist_ok=True)
-plate = Discretisation(
+plate = BlochLattice(
     spacing=1.2e-3,
     horizon=3.015 * 1.2e-3,
     model="lps",

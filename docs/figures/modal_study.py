@@ -175,7 +175,7 @@ def lattice() -> str:
     """Long-wave stiffness of an interior point against the continuum, in %, from the Bloch
     cell of this plate's material at each horizon: shear modulus from cS^2 and P-wave modulus
     M = K + 4 mu / 3 from cL^2, along [100] and [111]."""
-    from peridyn.analysis.bloch import Discretisation, bloch_cell
+    from peridyn.analysis.bloch import BlochLattice, bloch_cell
 
     young, nu, rho = 5.35e9, 0.33, 1200.0
     mu = young / (2 * (1 + nu))
@@ -187,7 +187,7 @@ def lattice() -> str:
     for horizon in (1.4143, 2.001, 3.001, 4.001):
         for correction in ("none", "shear-factor"):
             cell = bloch_cell(
-                Discretisation(
+                BlochLattice(
                     spacing=1e-3,
                     horizon=horizon * 1e-3,
                     model="lps",

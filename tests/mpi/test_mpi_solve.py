@@ -116,14 +116,14 @@ def _static(out: Path, ranks: int, *extra: str) -> dict:
 def test_mpi_static_reaches_the_serial_equilibrium(material, ranks, tmp_path):
     """The MPI static run (modified Newton + CG) stops at an equilibrium that meets the serial
     criterion: the serial model's out-of-balance force at the MPI displacement, relative to the
-    larger of load and reactions (``solvers.static``), is below the case's tolerance; and the
+    larger of load and reactions (``solvers.relaxation``), is below the case's tolerance; and the
     serial run (dynamic relaxation) meets the same criterion."""
     if shutil.which("mpiexec") is None:
         pytest.skip("mpiexec not installed")
     pytest.importorskip("mpi4py")
     from peridyn.io.case import load_case
     from peridyn.jobs.build import build
-    from peridyn.solvers.static import _relative_residual
+    from peridyn.solvers.relaxation import _relative_residual
 
     extra = [f"material.model={material}"]
     runs = {r: _static(tmp_path / f"r{r}", r, *extra) for r in (1, ranks)}

@@ -1,5 +1,5 @@
 """``mpiexec -n 2`` and ``-n 3 peridyn run`` of static cases with bond breaking or contact (issue
-20 item 5: dynamic relaxation on each rank's part, ``solvers.static.relax`` with a ``Domain``)
+20 item 5: dynamic relaxation on each rank's part, ``solvers.relaxation.relax`` with a ``Domain``)
 give the serial run bit for bit: every dataset under ``final/`` and ``series/`` of results.h5
 equal, and every value of the summary (bonds broken, relaxation iterations, residual, strain
 energy, crack paths, contact rebuilds) but the run's own (folder, seconds, memory).

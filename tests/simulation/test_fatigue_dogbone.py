@@ -5,8 +5,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from peridyn.fatigue.loop import run_fatigue
 from peridyn.fatigue.mapping import CycleMapping
-from peridyn.fatigue.run import run_fatigue
 from peridyn.io.case import FatigueTip, load_case
 from peridyn.jobs.build import build
 from peridyn.jobs.fatigue import fatigue_parameters, run_fatigue_case

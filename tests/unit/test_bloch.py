@@ -2,7 +2,7 @@
 
 Sources: closed-form long-wave speeds of an isotropic solid (cL = sqrt((K + 4 mu / 3) / rho),
 cS = sqrt(mu / rho), S0 plate velocity sqrt(E / (rho (1 - nu^2)))); VALIDATION.md
-"Discretisation facts" and V2 (Bloch facts of the seed 000 plate); Rayleigh-Lamb roots of
+"BlochLattice facts" and V2 (Bloch facts of the seed 000 plate); Rayleigh-Lamb roots of
 ``analysis.lamb`` (checked against V1 in its own tests).
 """
 
@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from peridyn.analysis.bloch import Discretisation, bloch_cell, plate_basis, tiled_model
+from peridyn.analysis.bloch import BlochLattice, bloch_cell, plate_basis, tiled_model
 from peridyn.analysis.bloch_study import format_study, predict, study
 from peridyn.cli import main
 from peridyn.linalg.stiffness import assemble_stiffness
@@ -52,8 +52,8 @@ CONVERGED = dict(
 )
 
 
-def steel_lattice(horizon_dx: float, partial_volumes: bool) -> Discretisation:
-    return Discretisation(
+def steel_lattice(horizon_dx: float, partial_volumes: bool) -> BlochLattice:
+    return BlochLattice(
         spacing=1e-3,
         horizon=horizon_dx * 1e-3,
         model="lps",
@@ -89,7 +89,7 @@ def test_18_neighbour_lps_long_wave_speeds_are_classical():
     ],
 )
 def test_discretisation_facts_long_wave_limits(horizon_dx, partial, p_percent, s_percent):
-    """VALIDATION.md "Discretisation facts": P and S along x off by the tabulated percentages
+    """VALIDATION.md "BlochLattice facts": P and S along x off by the tabulated percentages
     (printed to 0.1 %), within 0.2 percentage points."""
     speeds = bloch_cell(steel_lattice(horizon_dx, partial)).long_wave_speeds((1, 0, 0))
     assert 100 * (speeds[2] / CL_STEEL - 1) == pytest.approx(p_percent, abs=0.2)
@@ -123,7 +123,7 @@ def test_periodic_supercell_eigenvalues_equal_bloch(kwargs):
     own stiffness (``assemble_stiffness`` of the central cells' energy, folded onto the
     supercell, no phases), has the Bloch eigenvalues omega^2 at k = 2 pi n / (N dx),
     n = 0..N-1, to 1e-10 of the largest."""
-    disc = Discretisation(
+    disc = BlochLattice(
         spacing=1e-3,
         horizon=2.015e-3,
         E=E_AL,
@@ -153,7 +153,7 @@ def test_periodic_supercell_eigenvalues_equal_bloch(kwargs):
 def test_plate_mirror_separates_s_a_and_sh():
     """The mid-plane and y mirrors leave D(k) invariant: S, A and SH bases span all dofs and
     D couples none of them to another (off-block part below 1e-12 of the norm)."""
-    cell = bloch_cell(Discretisation(**CONVERGED))
+    cell = bloch_cell(BlochLattice(**CONVERGED))
     bases = [
         plate_basis(cell, "S"),
         plate_basis(cell, "A"),
@@ -177,7 +177,7 @@ def test_thick_plate_s0_long_wave_velocity(layers, correction):
     is sqrt(E / (rho (1 - nu^2))) within 1 % (k t = 0.02, where S0 dispersion is 1e-5)."""
     dx = THICK / layers
     cell = bloch_cell(
-        Discretisation(
+        BlochLattice(
             spacing=dx,
             horizon=1.4143 * dx,
             model="lps",
@@ -199,7 +199,7 @@ def test_thick_plate_s0_long_wave_velocity(layers, correction):
 def test_v2_seed_plain_lps_waves_too_fast():
     """V2: plain LPS at the seed discretisation is about 13 % (S0) and 8 % (A0) off at
     150 kHz, waves too fast (wavenumbers too small); checked to 1 percentage point."""
-    modes = by_mode(predict(Discretisation(**SEED), [150e3]))
+    modes = by_mode(predict(BlochLattice(**SEED), [150e3]))
     assert 100 * modes[("S0", 150e3)]["error"] == pytest.approx(-13.0, abs=1.0)
     assert 100 * modes[("A0", 150e3)]["error"] == pytest.approx(-8.0, abs=1.0)
 
@@ -207,7 +207,7 @@ def test_v2_seed_plain_lps_waves_too_fast():
 def test_v2_seed_shear_factor():
     """V2: LPS + shear-correction factor at the seed discretisation is within 2 % at 150 kHz
     but about 11 % off for A0 at 225 kHz (checked to 1 percentage point)."""
-    modes = by_mode(predict(Discretisation(**dict(SEED, surface_correction="shear-factor")), [150e3, 225e3]))
+    modes = by_mode(predict(BlochLattice(**dict(SEED, surface_correction="shear-factor")), [150e3, 225e3]))
     assert abs(modes[("S0", 150e3)]["error"]) < 0.02
     assert abs(modes[("A0", 150e3)]["error"]) < 0.02
     assert 100 * abs(modes[("A0", 225e3)]["error"]) == pytest.approx(11.0, abs=1.0)
@@ -216,7 +216,7 @@ def test_v2_seed_shear_factor():
 def test_v2_converged_preset_within_1_5_percent():
     """V2: 5 layers, 0.4 mm, 1.5 dx, LPS + shear factor: S0 and A0 within 1.5 % of
     Rayleigh-Lamb from 110 to 225 kHz; SH0 (non-dispersive, k = omega / cT) too."""
-    modes = predict(Discretisation(**CONVERGED), [110e3, 150e3, 185e3, 225e3])
+    modes = predict(BlochLattice(**CONVERGED), [110e3, 150e3, 185e3, 225e3])
     assert len(modes) == 12
     for m in modes:
         assert abs(m["error"]) < 0.015, m
@@ -224,7 +224,7 @@ def test_v2_converged_preset_within_1_5_percent():
 
 def test_theory_of_the_prediction_is_v1():
     """The theory column is Rayleigh-Lamb of V1 (S0 176.34, A0 612.41 rad/m at 150 kHz)."""
-    modes = by_mode(predict(Discretisation(**CONVERGED), [150e3]))
+    modes = by_mode(predict(BlochLattice(**CONVERGED), [150e3]))
     assert modes[("S0", 150e3)]["theory_wavenumber_rad_m"] == pytest.approx(176.34, abs=0.01)
     assert modes[("A0", 150e3)]["theory_wavenumber_rad_m"] == pytest.approx(612.41, abs=0.01)
 
@@ -242,7 +242,7 @@ def test_study_rows_and_table():
     layers / dx^2; bonds per point counted by hand at 1.5 dx = 0.6 mm: 5 layers (dz = dx):
     18 inside, 13 on the faces, mean 16; 4 layers (dz = 0.5 mm): 8 in-plane + 2 (1 on the
     faces), mean 9.5. The best row of this small sweep is the converged preset's."""
-    base = Discretisation(**SEED)
+    base = BlochLattice(**SEED)
     rows = study(
         base,
         [150e3],

@@ -6,7 +6,7 @@ import copy
 import numpy as np
 import pytest
 
-from peridyn.analysis.bloch import Discretisation
+from peridyn.analysis.bloch import BlochLattice
 from peridyn.errors import CaseFileError, InputError
 from peridyn.io.case import validate_case
 from peridyn.io.mesh_text import to_text_mesh
@@ -202,7 +202,7 @@ def test_features_without_blocks_refuse_them():
     blocks: tests/mpi/test_mpi_decks.py)."""
     case = validate_case(_raw())
     with pytest.raises(InputError, match="body of one material"):
-        Discretisation.from_case(case)
+        BlochLattice.from_case(case)
 
 
 def test_assign_blocks_and_per_point_constants_errors():

@@ -1,4 +1,4 @@
-"""Dynamic relaxation over simulated MPI ranks in one process (``solvers.static.relax`` with a
+"""Dynamic relaxation over simulated MPI ranks in one process (``solvers.relaxation.relax`` with a
 ``Domain``, issue 20 item 5): the ranks are threads that take turns, joined by a communicator
 with MPI's semantics (``ThreadComm``: collectives and point-to-point messages, objects copied),
 so the whole distributed path (the rank's part as ``jobs.build`` makes it, the halo exchange,
@@ -24,7 +24,7 @@ import pytest
 from peridyn.io.case import load_case
 from peridyn.jobs.build import build
 from peridyn.parallel.comm import Traffic
-from peridyn.solvers.static import relax
+from peridyn.solvers.relaxation import relax
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 

@@ -93,7 +93,7 @@ def test_distributed_lobpcg_gives_the_serial_modes(plate, clamped):
 def test_distributed_equilibrium_meets_the_serial_criterion(material):
     """Modified Newton with CG (solvers.distributed_static) on the clamped bar of
     cases/bar_tension_static.yaml at 2 mm: the serial model's out-of-balance force at its
-    displacement, relative to the larger of load and reactions (solvers.static), is below the
+    displacement, relative to the larger of load and reactions (solvers.relaxation), is below the
     case's tolerance, as dynamic relaxation's; and the end displacements agree to 100 times that
     tolerance (1e-7): both solves are within the tolerance of the same equilibrium (measured:
     2.6e-7 PMB, 2.0e-7 LPS apart, and the CG one within 1.2e-9 of a relaxation to 1e-9)."""
@@ -101,7 +101,7 @@ def test_distributed_equilibrium_meets_the_serial_criterion(material):
     from peridyn.jobs.build import build
     from peridyn.linalg.distributed import rank_preconditioner
     from peridyn.solvers.distributed_static import distributed_equilibrium
-    from peridyn.solvers.static import _relative_residual, relax
+    from peridyn.solvers.relaxation import _relative_residual, relax
 
     root = Path(__file__).resolve().parents[2] / "cases"
     case = load_case(
@@ -159,7 +159,7 @@ def test_static_mpi_runs_with_damage_or_contact_are_accepted(case_file, override
 
 
 def test_relax_with_damage_leaves_every_intact_bond_within_its_critical_stretch():
-    """Dynamic relaxation with bond breaking (solvers.static.relax, the code every MPI rank runs)
+    """Dynamic relaxation with bond breaking (solvers.relaxation.relax, the code every MPI rank runs)
     on the clamped bar of cases/bar_tension_static.yaml at 2 mm with a pre-crack to mid-height at
     mid-length and a critical stretch of 8.5e-5 (below the elastic solution's 9.1e-5 at the crack
     tip): it converges with bonds broken beyond the pre-crack's, every intact bond's deformed
@@ -168,7 +168,7 @@ def test_relax_with_damage_leaves_every_intact_bond_within_its_critical_stretch(
     flags (booleans): compared exactly."""
     from peridyn.io.case import load_case
     from peridyn.jobs.build import build
-    from peridyn.solvers.static import relax
+    from peridyn.solvers.relaxation import relax
 
     root = Path(__file__).resolve().parents[2] / "cases"
     precrack = (

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from peridyn.fatigue.calibration import stress_intensity
-from peridyn.fatigue.run import FatigueResult
+from peridyn.fatigue.loop import FatigueResult
 from peridyn.io.case import load_case
 from peridyn.jobs.fatigue import paris_rates, paris_slope
 

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from conftest import small_model
 
-from peridyn.analysis.bloch import Discretisation, bloch_cell
+from peridyn.analysis.bloch import BlochLattice, bloch_cell
 from peridyn.discretization import geometry
 from peridyn.discretization.bonds import find_bonds
 from peridyn.errors import InputError
@@ -190,7 +190,7 @@ def test_bloch_cell_long_waves_become_classical_on_anisotropic_lattices(horizon_
     nu = (3 * bulk - 2 * shear) / (2 * (3 * bulk + shear))
     c_l, c_s = np.sqrt((bulk + 4 * shear / 3) / rho), np.sqrt(shear / rho)
     cell = bloch_cell(
-        Discretisation(
+        BlochLattice(
             spacing=1e-3,
             horizon=horizon_dx * 1e-3,
             model="lps",

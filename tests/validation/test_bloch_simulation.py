@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from peridyn.analysis.bloch import Discretisation
+from peridyn.analysis.bloch import BlochLattice
 from peridyn.analysis.bloch_study import predict
 from peridyn.analysis.fk import line_mode_wavenumbers
 from peridyn.io.case import load_case
@@ -52,7 +52,7 @@ def test_run_wavenumbers_match_bloch(case_file, tmp_path):
     converged S0 moves by 1-2 % with the fit range, docs/bloch.md)."""
     case = load_case(CASES / case_file, ["output.plots=false"])
     run_case(case, tmp_path)
-    bloch = {m["mode"]: m["wavenumber_rad_m"] for m in predict(Discretisation.from_case(case), [150e3])}
+    bloch = {m["mode"]: m["wavenumber_rad_m"] for m in predict(BlochLattice.from_case(case), [150e3])}
     line = case.output.lines["x_axis"]
     x = np.linspace(line.start[0], line.end[0], line.points)
     found = line_mode_wavenumbers(

@@ -42,7 +42,7 @@ _SCAN_POINTS = 64
 
 
 @dataclass(frozen=True)
-class Discretisation:
+class BlochLattice:
     """What the Bloch cell needs of a case: grid, horizon, material.
 
     spacing : in-plane grid spacing dx = dy, m
@@ -67,7 +67,7 @@ class Discretisation:
     layer_placement: str = "cell"
 
     @classmethod
-    def from_case(cls, case) -> Discretisation:
+    def from_case(cls, case) -> BlochLattice:
         """The discretisation of a validated ``io.case.Case`` (``box`` or ``plate`` geometry)."""
         g, d, mat = case.geometry, case.discretization, case.material
         if mat is None:
@@ -214,7 +214,7 @@ class BlochCell:
         return np.sqrt(np.clip(lam, 0.0, None) / self.mass[0])
 
 
-def _tiles(disc: Discretisation) -> int:
+def _tiles(disc: BlochLattice) -> int:
     """Tiles on each side of the central one so that its points' families are complete."""
     reach = disc.horizon * (1 + 1e-9)
     if disc.partial_volumes:
@@ -222,7 +222,7 @@ def _tiles(disc: Discretisation) -> int:
     return int(math.ceil(reach / disc.spacing))
 
 
-def tiled_model(disc: Discretisation, repeat: int = 1):
+def tiled_model(disc: BlochLattice, repeat: int = 1):
     """The solver's model on enough tiles around a central row of ``repeat`` cells along x.
 
     Returns (model, central, cell_index): ``central`` ((n,) bool) marks the points of the
@@ -261,7 +261,7 @@ def tiled_model(disc: Discretisation, repeat: int = 1):
     return model, central, cell_index
 
 
-def bloch_cell(disc: Discretisation) -> BlochCell:
+def bloch_cell(disc: BlochLattice) -> BlochCell:
     """The periodic cell of ``disc`` built with the solver's own model (module docstring)."""
     model, central, cell_index = tiled_model(disc)
     k_c = assemble_stiffness(model, energy_of=central).tocoo()
@@ -292,7 +292,7 @@ def bloch_cell(disc: Discretisation) -> BlochCell:
     )
 
 
-def _check(disc: Discretisation) -> None:
+def _check(disc: BlochLattice) -> None:
     if not (disc.spacing > 0 and disc.horizon > 0):
         raise InputError(
             f"spacing and horizon must be positive, got {disc.spacing!r} m and {disc.horizon!r} m"

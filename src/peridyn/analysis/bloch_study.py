@@ -15,7 +15,7 @@ import numpy as np
 
 from peridyn.analysis.bloch import (
     BlochCell,
-    Discretisation,
+    BlochLattice,
     bloch_cell,
     block_wavenumbers,
     plate_wavenumbers,
@@ -24,7 +24,7 @@ from peridyn.analysis.lamb import bulk_speeds, lamb_modes
 from peridyn.errors import InputError
 
 
-def theory_wavenumbers(disc: Discretisation, frequencies) -> dict[tuple[str, float], float]:
+def theory_wavenumbers(disc: BlochLattice, frequencies) -> dict[tuple[str, float], float]:
     """{(mode, frequency_hz): k (rad/m)} of the continuum for the modes Bloch reports."""
     nu = 0.25 if disc.nu is None else disc.nu
     cl, ct = bulk_speeds(disc.E, nu, disc.density)
@@ -42,7 +42,7 @@ def theory_wavenumbers(disc: Discretisation, frequencies) -> dict[tuple[str, flo
     return out
 
 
-def predict(disc: Discretisation, frequencies, cell: BlochCell | None = None) -> list[dict]:
+def predict(disc: BlochLattice, frequencies, cell: BlochCell | None = None) -> list[dict]:
     """Discrete and theoretical wavenumbers of each mode at each frequency (Hz).
 
     Returns dicts with mode, frequency_hz, wavenumber_rad_m, theory_wavenumber_rad_m and
@@ -75,7 +75,7 @@ STUDY_CORRECTIONS = ("none", "shear-factor")
 
 
 def study(
-    base: Discretisation,
+    base: BlochLattice,
     frequencies,
     layers=STUDY_LAYERS,
     spacings=STUDY_SPACINGS,

@@ -108,7 +108,7 @@ __all__ = [
 
 #: Branch names, in the order of the polarisation basis (longitudinal first).
 BRANCHES = ("longitudinal", "shear_1", "shear_2")
-MODELS = ("pmb", "lps")
+DISPERSION_MODELS = ("pmb", "lps")
 #: Wavenumber (times the horizon) of the long-wave limit: D(k)/k^2 is exact to O((k delta)^2).
 _LONG_WAVE_K_DELTA = 1e-6
 #: Group velocities below this fraction of the long-wave speed count as negative
@@ -251,8 +251,8 @@ class LinearModel:
 
 def linear_model(model: str, family: Family, medium: Medium, plane: str = "stress") -> LinearModel:
     """The linearised ``model`` ("pmb" or "lps") of ``medium`` on ``family``."""
-    if model not in MODELS:
-        raise InputError(f"model must be one of {MODELS}, got {model!r}")
+    if model not in DISPERSION_MODELS:
+        raise InputError(f"model must be one of {DISPERSION_MODELS}, got {model!r}")
     length, dim = family.length, family.dim
     w = family.influence * family.volume
     if model == "pmb":

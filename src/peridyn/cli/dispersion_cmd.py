@@ -8,7 +8,7 @@ import sys
 
 import numpy as np
 
-from peridyn.analysis.dispersion import MODELS, Medium, dispersion_relation, parse_direction
+from peridyn.analysis.dispersion import DISPERSION_MODELS, Medium, dispersion_relation, parse_direction
 from peridyn.cli.errors import writing
 from peridyn.cli.options import add_common_flags, add_set_flag
 from peridyn.discretization.bonds import INFLUENCE_FUNCTIONS
@@ -40,7 +40,7 @@ def register(subparsers) -> None:
     add_set_flag(
         parser, "with a case: override a case entry, e.g. discretization.spacing=0.0004 (repeatable)"
     )
-    parser.add_argument("--model", help=f"material model: {' or '.join(MODELS)}")
+    parser.add_argument("--model", help=f"material model: {' or '.join(DISPERSION_MODELS)}")
     parser.add_argument("--rho", help="density, kg/m^3")
     parser.add_argument("--bulk-modulus", help="bulk modulus K, Pa (with --shear-modulus)")
     parser.add_argument("--shear-modulus", help="shear modulus G, Pa (with --bulk-modulus)")
@@ -83,7 +83,7 @@ def run(args: argparse.Namespace) -> dict:
         return run_case_file(args)
     dim = _choice("--dimension", args.dimension, ("1", "2", "3"))
     relation = dispersion_relation(
-        _choice("--model", args.model, MODELS),
+        _choice("--model", args.model, DISPERSION_MODELS),
         medium_from_args(args),
         horizon=_positive("--horizon", args.horizon),
         spacing=_positive("--spacing", args.spacing),
@@ -111,7 +111,7 @@ def run(args: argparse.Namespace) -> dict:
 def run_case_file(args: argparse.Namespace) -> dict:
     """Bloch-wave wavenumbers of a case's discrete model against theory (``{"modes": [...]}``)."""
     from peridyn.analysis.bloch import (
-        Discretisation,
+        BlochLattice,
         bloch_cell,
         negative_group_velocity_from,
         zone_edge,
@@ -123,7 +123,7 @@ def run_case_file(args: argparse.Namespace) -> dict:
         raise InputError("--frequencies is required with a case file, e.g. --frequencies 150e3")
     freqs = [_positive("--frequencies", item) for item in args.frequencies.split(",")]
     case = load_case(args.case, args.overrides)
-    disc = Discretisation.from_case(case)
+    disc = BlochLattice.from_case(case)
     cell = bloch_cell(disc)
     summary = {"case": case.name, "modes": predict(disc, freqs, cell), "zone_edge_rad_m": zone_edge(cell)}
     if disc.kind == "block":  # one-point lattice: exact long-wave limits along x

@@ -5,9 +5,9 @@
 the parameter fits from strain-life and Paris-law data.
 """
 
+from peridyn.fatigue.loop import FatigueResult, run_fatigue
 from peridyn.fatigue.mapping import CycleMapping
 from peridyn.fatigue.model import FatigueParameters, RemainingLife, cyclic_bond_strain, scale_A_II
-from peridyn.fatigue.run import FatigueResult, run_fatigue
 from peridyn.fatigue.tip import crack_tip
 
 __all__ = [

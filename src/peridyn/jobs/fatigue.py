@@ -7,7 +7,7 @@ the cycles),
 and ``fatigue.json`` (the summary).
 
 Under ``mpiexec -n N`` (N > 1) each rank builds its part of the body and runs the fatigue loop on
-it (``fatigue.run``: the distributed CG for the equilibrium); the modal analyses before and after
+it (``fatigue.loop``: the distributed CG for the equilibrium); the modal analyses before and after
 run on the parts too (``jobs.modal.case_modes``: the distributed LOBPCG, after the cycles with the
 bonds each rank's loop broke); rank 0 writes the same files as a serial run. The compliance K of
 the Paris fit and the serial solvers are not distributed: they are refused by their case keys
@@ -27,9 +27,9 @@ import numpy as np
 from peridyn import interrupts
 from peridyn.errors import CaseFileError, did_you_mean
 from peridyn.fatigue.calibration import growth_rates, paris_fit, stress_intensity
+from peridyn.fatigue.loop import FatigueResult, run_fatigue
 from peridyn.fatigue.mapping import CycleMapping
 from peridyn.fatigue.model import FatigueParameters, scale_A_II
-from peridyn.fatigue.run import FatigueResult, run_fatigue
 from peridyn.fatigue.specimen import compliance_energy, compliance_stress_intensity, straight_crack_cut
 from peridyn.fatigue.tip import AXES
 from peridyn.io.case import Case, FatigueModal

@@ -119,11 +119,11 @@ def _job(task: RunTask) -> dict:
 def bloch_prediction(case, frequencies) -> dict:
     """``{mode: {"<f>": {"wavenumber_rad_m", "theory_rad_m", "error"}}}`` of the Bloch analysis
     of the case's discretisation at ``frequencies`` (Hz) (None where a branch stays below f)."""
-    from peridyn.analysis.bloch import Discretisation
+    from peridyn.analysis.bloch import BlochLattice
     from peridyn.analysis.bloch_study import predict
 
     out: dict = {}
-    for row in predict(Discretisation.from_case(case), list(frequencies)):
+    for row in predict(BlochLattice.from_case(case), list(frequencies)):
         out.setdefault(row["mode"], {})[f"{row['frequency_hz']:g}"] = {
             "wavenumber_rad_m": row["wavenumber_rad_m"],
             "theory_rad_m": row["theory_wavenumber_rad_m"],

@@ -8,14 +8,14 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from peridyn.analysis.bloch import Discretisation, bloch_cell, plate_basis
+from peridyn.analysis.bloch import BlochLattice, bloch_cell, plate_basis
 from peridyn.analysis.bloch_study import theory_wavenumbers
 
 #: Wavenumbers drawn per discrete branch.
 _POINTS = 120
 
 
-def plot_bloch(disc: Discretisation, path=None, frequencies=(), f_max: float | None = None) -> Figure:
+def plot_bloch(disc: BlochLattice, path=None, frequencies=(), f_max: float | None = None) -> Figure:
     """Frequency (kHz) against wavenumber (rad/m): discrete branches solid, theory dashed.
 
     Plates: the lowest S, A and SH (even) branches and Rayleigh-Lamb S0, A0 and SH0;
@@ -24,7 +24,7 @@ def plot_bloch(disc: Discretisation, path=None, frequencies=(), f_max: float | N
 
     Parameters
     ----------
-    disc : Discretisation
+    disc : BlochLattice
     path : str or os.PathLike, optional
         Where to save the figure as PNG.
     frequencies : sequence of float, Hz

@@ -4,6 +4,6 @@ implicit quasi-statics (Newton-Raphson) and dynamics (Newmark)."""
 from peridyn.solvers.explicit import ExplicitSolver, State
 from peridyn.solvers.newmark import NewmarkSolver
 from peridyn.solvers.newton import NewtonResult, newton
-from peridyn.solvers.static import RelaxationResult, relax
+from peridyn.solvers.relaxation import RelaxationResult, relax
 
 __all__ = ["ExplicitSolver", "RelaxationResult", "State", "relax", "NewmarkSolver", "NewtonResult", "newton"]

@@ -1,6 +1,6 @@
 """Static equilibrium over MPI ranks: modified Newton steps, each solved by preconditioned CG.
 
-A serial static run relaxes dynamically (``solvers.static``). Under MPI the same equilibrium,
+A serial static run relaxes dynamically (``solvers.relaxation``). Under MPI the same equilibrium,
 to the same criterion (the out-of-balance force on the free dofs below ``tolerance`` times the
 larger of the applied load and the reactions, ``static._relative_residual``), is found by
 
@@ -24,7 +24,7 @@ from peridyn.errors import InputError
 from peridyn.linalg.distributed import RankDofs, RankStiffness
 from peridyn.linalg.krylov import pcg
 from peridyn.physics.loads import Loading
-from peridyn.solvers.static import RelaxationResult
+from peridyn.solvers.relaxation import RelaxationResult
 
 #: Share of the allowed out-of-balance force that each CG solve leaves.
 INNER_SHARE = 1.0 / 3.0

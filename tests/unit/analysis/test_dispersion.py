@@ -124,7 +124,7 @@ def test_discrete_limits_within_1p5_percent_at_3_dx():
 @pytest.mark.parametrize(
     ("factor", "partial", "p_error", "s_error"),
     [
-        # VALIDATION.md, "Discretisation facts" (P along x and S, percent).
+        # VALIDATION.md, "BlochLattice facts" (P along x and S, percent).
         (1.4143, False, 0.0, 0.0),
         (2.015, False, 3.4, -5.3),
         (2.015, True, 0.7, -1.1),
