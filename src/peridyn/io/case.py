@@ -385,12 +385,15 @@ class BoundaryConditionSpec(Strict):
     """A condition on node set ``set``: kind, components ("x", "xy", ...) and a value
     (a number, a time function mapping, see ``peridyn.physics.timefunctions.from_spec``, or
     ``{type: expression, text: ...}``, an expression in x, y, z and t evaluated on the set's
-    points, see ``peridyn.physics.expressions``)."""
+    points, see ``peridyn.physics.expressions``). ``where_prescribed`` (a force): ``error`` if
+    another condition prescribes the motion of one of its components, or ``yield``: the prescribed
+    motion wins, the force still counting in the point's acceleration (Peridigm's convention)."""
 
     set: str
     kind: Literal["displacement", "velocity", "force", "body_force"]
     components: str | list[str] = "xyz"
     value: Finite | dict = 0.0
+    where_prescribed: Literal["error", "yield"] = "error"
 
 
 class InitialConditionSpec(Strict):
@@ -537,12 +540,17 @@ class SetSum(Strict):
 class ExodusOutput(Strict):
     """Exodus II output as Peridigm writes it: the ``variables`` named as Peridigm names them
     (``peridyn.io.exodus_write.PERIDIGM_VARIABLES``) and the global ``sums`` (name ->
-    ``SetSum``) in ``file`` (in the output folder), at every ``every``-th step from step 0."""
+    ``SetSum``) in ``file`` (in the output folder), at every ``every``-th step from step 0;
+    ``point_order``: the body's (``peridyn``) or ``grid`` (x fastest, then y, then z, as
+    Peridigm numbers a PdQuickGrid); ``three_d``: a 2D body written with three coordinates and
+    vector components (z = 0), as Peridigm writes it."""
 
     file: Annotated[str, Field(pattern=r"^[^/\\]+$")] = "results.e"
     every: Annotated[int, NotBool, Field(ge=1)] = 1
     variables: Annotated[list[str], Field(min_length=1)]
     sums: dict[str, SetSum] = {}
+    point_order: Literal["peridyn", "grid"] = "peridyn"
+    three_d: bool = False
 
     @model_validator(mode="after")
     def _known(self):

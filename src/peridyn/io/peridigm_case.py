@@ -58,6 +58,9 @@ SECTIONS = {
     "Compute Class Parameters",
     "Damage Models",
 }
+#: Material parameters that change how Peridigm computes, not what: its tangent by automatic
+#: differentiation or by finite differences gives the same equilibrium.
+IGNORED_MATERIAL = {"Apply Automatic Differentiation Jacobian"}
 #: Initial-condition kinds of the deck's boundary conditions.
 INITIAL = {"Initial Displacement": "displacement", "Initial Velocity": "velocity"}
 #: Boundary-condition kinds of the deck's boundary conditions.
@@ -144,7 +147,7 @@ def deck_case(params: dict, name: str, source: str = "<deck>", deck_dir=".") -> 
         **materials,
         "solver": solver,
     }
-    first_id = 0 if older_form(deck) else 1
+    first_id = 0 if older_form(deck) or _lists_node_zero(deck) else 1
     sets, bcs, ics = _conditions(deck, deck_dir, grid, geometry["type"] == "exodus", first_id)
     if sets:
         case["node_sets"] = sets
@@ -154,6 +157,9 @@ def deck_case(params: dict, name: str, source: str = "<deck>", deck_dir=".") -> 
         case["initial_conditions"] = ics
     model = (case.get("material") or next(iter(case["materials"].values())))["model"]
     case["output"] = _output(deck, model, _compute_classes(deck))
+    if "exodus" in case["output"]:  # Peridigm's numbering of a grid; three components in 2D
+        case["output"]["exodus"]["point_order"] = "grid" if grid is not None else "peridyn"
+        case["output"]["exodus"]["three_d"] = plane is not None
     return case
 
 
@@ -303,6 +309,7 @@ def _material(deck: _Deck, name: str) -> dict:
     bulk = deck.get(f"{where}.Bulk Modulus", float)
     known = {"Material Model", "Density", "Bulk Modulus", "Shear Modulus", "Apply Shear Correction Factor"}
     known |= {"Influence Function", "Plane Stress", "Plane Strain", "Height"}
+    known |= IGNORED_MATERIAL
     for key in deck.get(where, dict):
         if key not in known:
             raise deck.error(f"{where}.{key}", None, f"only the parameters {sorted(known)}", False)
@@ -384,8 +391,8 @@ def _solver(deck: _Deck) -> dict:
     final = deck.get("Solver.Final Time", float)
     solver = deck.get("Solver", dict)
     kinds = [k for k in solver if isinstance(solver[k], dict)]
-    if kinds == ["QuasiStatic"]:
-        return _quasi_static(deck, final)
+    if kinds in (["QuasiStatic"], ["NOXQuasiStatic"]):
+        return _quasi_static(deck, final, kinds[0])
     if kinds != ["Verlet"]:
         raise deck.error(
             "Solver", kinds, "one 'Verlet' or 'QuasiStatic' solver list (others are not supported yet)"
@@ -426,27 +433,28 @@ def _verlet(deck: _Deck, final: float) -> dict:
     return {"type": "explicit", "dt": dt, "steps": steps, "prescribed_velocity": "difference"}
 
 
-#: QuasiStatic parameters read: deck name -> newton solver key.
-QUASI_STATIC = {
-    "Number of Load Steps": "load_steps",
-    "Absolute Tolerance": "absolute_tolerance",
-    "Maximum Solver Iterations": "newton_iterations",
-}
+#: NOXQuasiStatic's parameters of how Trilinos' NOX finds the equilibrium (its nonlinear solver,
+#: line search, preconditioner, Jacobian operator), not of the equilibrium found: not read.
+NOX_IGNORED = {"Nonlinear Solver", "Max Age Of Prec", "Direction", "Line Search"}
 
 
-def _quasi_static(deck: _Deck, final: float) -> dict:
-    """Peridigm's QuasiStatic solver as Newton load steps to the final time, converged on the
-    absolute residual (N), velocities the change of u over a load step's time."""
-    where = "Solver.QuasiStatic"
+def _quasi_static(deck: _Deck, final: float, kind: str = "QuasiStatic") -> dict:
+    """Peridigm's QuasiStatic (or NOXQuasiStatic) solver as Newton load steps to the final
+    time, converged on the absolute residual (N), velocities the change of u over a load
+    step's time."""
+    where = f"Solver.{kind}"
+    nox = kind == "NOXQuasiStatic"
+    iterations_key = "Max Solver Iterations" if nox else "Maximum Solver Iterations"
+    known = {"Number of Load Steps", "Absolute Tolerance", iterations_key} | (NOX_IGNORED if nox else set())
     for key in deck.get(where, dict):
-        if key not in QUASI_STATIC:
-            raise deck.error(f"{where}.{key}", None, f"only the parameters {sorted(QUASI_STATIC)}", False)
+        if key not in known:
+            raise deck.error(f"{where}.{key}", None, f"only the parameters {sorted(known)}", False)
     if not final > 0:
         raise deck.error("Solver.Final Time", final, "a positive time (s)")
     steps = deck.get(f"{where}.Number of Load Steps", int)
-    iterations = deck.get(f"{where}.Maximum Solver Iterations", int, 10)
+    iterations = deck.get(f"{where}.{iterations_key}", int, 10)
     tolerance = deck.get(f"{where}.Absolute Tolerance", float)
-    for key, value in (("Number of Load Steps", steps), ("Maximum Solver Iterations", iterations)):
+    for key, value in (("Number of Load Steps", steps), (iterations_key, iterations)):
         if value < 1:
             raise deck.error(f"{where}.{key}", value, "at least 1")
     if not tolerance > 0:
@@ -489,15 +497,30 @@ def _conditions(deck: _Deck, deck_dir: Path, grid, mesh_sets: bool, first_id: in
         if kind in INITIAL:
             ics.append({"set": set_name, "kind": INITIAL[kind], "components": axis, "value": value})
         elif kind in BOUNDARY:
-            bcs.append({"set": set_name, "kind": BOUNDARY[kind], "components": axis, "value": value})
+            bc = {"set": set_name, "kind": BOUNDARY[kind], "components": axis, "value": value}
+            if kind == "Body Force":  # on a prescribed component, the prescribed motion wins
+                bc["where_prescribed"] = "yield"
+            bcs.append(bc)
         else:
             raise deck.error(f"{where}.Type", kind, f"one of {sorted(INITIAL) + sorted(BOUNDARY)}")
     return sets, bcs, ics
 
 
+def _lists_node_zero(deck: _Deck) -> bool:
+    """True when an inline node set of ``Boundary Conditions`` lists node 0: the deck's ids
+    then count from 0 (as the older form's do)."""
+    section = deck.get("Boundary Conditions", dict, {})
+    for value in section.values():
+        words = value.split() if isinstance(value, str) else []
+        if words and all(w.isdigit() for w in words) and min(int(w) for w in words) == 0:
+            return True
+    return False
+
+
 def _value(deck: _Deck, key: str):
-    """A condition's value: a number, or an expression in x, y, z and t (checked now)."""
-    text = deck.get(key, str)
+    """A condition's value: a number, or an expression in x, y, z and t (checked now); ``^``
+    is a power, as in Peridigm's expression parser."""
+    text = deck.get(key, str).replace("^", "**")
     try:
         return float(text)
     except ValueError:

@@ -95,6 +95,12 @@ class RecorderSpec:
         their values from the recorder's ``fields``; empty: ``snapshot_exodus``'s fields.
     exodus_sums : dict of name -> (variable, node set name)
         Global vector variables written with the named ones: a nodal variable's sum over a set.
+    exodus_order : {"peridyn", "grid"}
+        The named variables' point order: the body's, or ``grid_order`` (x fastest, then y,
+        then z: PdQuickGrid's numbering).
+    exodus_three_d : bool
+        Write a 2D body's named variables with three coordinates and vector components (z 0),
+        as Peridigm does.
     """
 
     every: int = 1
@@ -112,6 +118,8 @@ class RecorderSpec:
     exodus_every: int | None = None
     exodus_variables: tuple = ()
     exodus_sums: dict = field(default_factory=dict)
+    exodus_order: str = "peridyn"
+    exodus_three_d: bool = False
     stress: bool = False
     strain: bool = False
 
@@ -243,9 +251,16 @@ class Recorder:
         self.fields = fields
         self._exodus_step = None  # the step of the last Exodus record
         self.exodus = None
+        self._rows = grid_order(body.points) if spec.exodus_order == "grid" else None
+        self._dim = 3 if spec.exodus_three_d else body.dim
         if spec.exodus and spec.exodus_variables:
             self.exodus = variables_exodus(
-                body, self.directory / spec.exodus_file, spec.exodus_variables, spec.exodus_sums
+                body,
+                self.directory / spec.exodus_file,
+                spec.exodus_variables,
+                spec.exodus_sums,
+                rows=self._rows,
+                dim=self._dim,
             )
         elif spec.exodus:
             self.exodus = snapshot_exodus(body, self.directory / spec.exodus_file, damage is not None)
@@ -339,7 +354,7 @@ class Recorder:
             return
         self._exodus_step = state.step
         if self.spec.exodus_variables:
-            self.exodus.append(state.time, **self.fields(state))
+            self.exodus.append(state.time, **arranged(self.fields(state), self._rows, self._dim))
         else:
             self.exodus.append(state.time, **exodus_fields(self.body, state, self.damage))
 
@@ -471,22 +486,58 @@ def snapshot_exodus(body: Body, path, damage: bool = False) -> ExodusWriter:
     )
 
 
-def variables_exodus(body: Body, path, variables, sums=None) -> ExodusWriter:
+def grid_order(points: np.ndarray) -> np.ndarray:
+    """(n,) indices of ``points`` ((n, 3), m) ordered x fastest, then y, then z: a grid's
+    points as PdQuickGrid numbers them."""
+    return np.lexsort((points[:, 0], points[:, 1], points[:, 2]))
+
+
+#: Variables that number the file's points: they count in the file's order, not the body's.
+POSITIONAL = ("Element_Id", "ID")
+
+
+def arranged(values: dict, rows: np.ndarray | None, dim: int) -> dict:
+    """``ExodusWriter.append``'s keyword arguments ``values`` (``variable_values``'s) with the
+    per-point arrays in the order ``rows`` ((n,) body indices, or None: the body's; the
+    ``POSITIONAL`` ones stay) and vectors padded with zero components to ``dim``."""
+    out = {}
+    for placement, fields in values.items():
+        out[placement] = {}
+        for name, array in fields.items():
+            array = np.asarray(array)
+            if rows is not None and placement != "global_" and name not in POSITIONAL:
+                array = array[rows]
+            if array.ndim >= 1 and placement == "global_" and array.shape[-1] < dim:
+                array = np.concatenate([array, np.zeros(dim - array.shape[-1])])
+            elif array.ndim == 2 and array.shape[1] < dim:
+                array = np.hstack([array, np.zeros((len(array), dim - array.shape[1]))])
+            out[placement][name] = array
+    return out
+
+
+def variables_exodus(body: Body, path, variables, sums=None, rows=None, dim=None) -> ExodusWriter:
     """An Exodus writer of Peridigm's named ``variables`` (``PERIDIGM_VARIABLES`` gives each one's
     placement, nodal or element, and size) and global vectors named by ``sums``' keys, one
-    block, the body's node sets."""
+    block, the body's node sets; the points in the order ``rows`` ((n,) body indices, None:
+    the body's), with ``dim`` coordinates (default the body's; 3 in 2D: z = 0)."""
+    dim = body.dim if dim is None else dim
     fields = {"nodal": {}, "element": {}}
     for name in variables:
         placement, vector = PERIDIGM_VARIABLES[name]
-        fields[placement][name] = body.dim if vector else 1
-    sets = {k: v for k, v in body.node_sets.items() if len(v)}
+        fields[placement][name] = dim if vector else 1
+    position = np.arange(body.n_points)
+    if rows is not None:
+        position[rows] = np.arange(body.n_points)
+    sets = {k: np.sort(position[v]) for k, v in body.node_sets.items() if len(v)}
+    points = np.zeros((body.n_points, dim))
+    points[:, : body.dim] = body.points[:, : body.dim]
     return ExodusWriter(
         path,
-        body.points[:, : body.dim],
+        points if rows is None else points[rows],
         node_sets=sets,
         nodal=fields["nodal"],
         element=fields["element"],
-        global_=dict.fromkeys(sums or {}, body.dim),
+        global_=dict.fromkeys(sums or {}, dim),
     )
 
 

@@ -254,7 +254,11 @@ def build_loading(case: Case, body: Body, extra=()) -> Loading:
     """Boundary and initial conditions of the case (plus ``extra`` ones), checked for conflicts."""
     bcs = [
         BoundaryCondition(
-            bc.set, bc.kind, bc.components, value_function(bc.value, f"boundary_conditions[{k}]")
+            bc.set,
+            bc.kind,
+            bc.components,
+            value_function(bc.value, f"boundary_conditions[{k}]"),
+            where_prescribed=bc.where_prescribed,
         )
         for k, bc in enumerate(case.boundary_conditions)
     ]
