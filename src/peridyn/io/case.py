@@ -220,6 +220,20 @@ class Geometry(Strict):
         return 2 if self.type == "rectangle" or (self.type == "mesh" and self.dimension == 2) else 3
 
 
+class BondFilter(Strict):
+    """Bonds meeting a finite plane leave the families (``finite_plane``: Peridigm's
+    "Rectangular_Plane" bond filter, ``peridyn.discretization.bonds.crossing_finite_plane``):
+    the plane through ``corner`` (m) of ``normal``, ``bottom_length`` (m) along ``bottom`` and
+    ``side_length`` (m) along bottom x normal; a bond touching it at an end counts."""
+
+    type: Literal["finite_plane"] = "finite_plane"
+    corner: Vector3
+    normal: Vector3
+    bottom: Vector3
+    bottom_length: Positive
+    side_length: Positive
+
+
 class Discretization(Strict):
     """Spacing (m, one value or one per axis for a box), horizon as a multiple of the spacing
     (``horizon``) or in metres (``horizon_m``), influence function and partial volumes."""
@@ -232,6 +246,10 @@ class Discretization(Strict):
     #: ``sphere``: |xi| <= horizon; ``box`` (a box geometry, no partial volumes): the points
     #: within round(horizon / spacing) cells along each axis, Peridigm's PdQuickGrid families
     neighbourhood: Literal["sphere", "box"] = "sphere"
+    #: bonds taken out of the families (Peridigm's bond filters; a pre-crack breaks them instead)
+    bond_filters: list[BondFilter] = []
+    #: False: no bond joins two blocks (Peridigm's "Omit Bonds Between Blocks: All")
+    bonds_between_blocks: bool = True
 
     @model_validator(mode="after")
     def _one_horizon(self):
@@ -486,9 +504,13 @@ class Solver(Strict):
     breaking_rounds: Annotated[int, NotBool, Field(ge=1)] = 100
     displacement_tolerance: Positive = 1e-10
     #: newton: converged when the residual force's norm (N) is below it, instead of the
-    #: relative ``tolerance`` (Peridigm's "Absolute Tolerance")
+    #: relative ``tolerance``; newmark: instead of ``displacement_tolerance`` (Peridigm's
+    #: "Absolute Tolerance")
     absolute_tolerance: Positive | None = None
     linear_solver: Literal["lu", "cg"] = "lu"
+    #: newmark: the acceleration at t = 0, ``balance`` (of the initial forces) or ``zero``
+    #: (Peridigm's implicit solver)
+    initial_acceleration: Literal["balance", "zero"] = "balance"
     #: explicit: the reported velocity of a DOF with a prescribed displacement, ``rate`` (its
     #: time function's derivative) or ``difference`` (Peridigm's, see ``ExplicitSolver``)
     prescribed_velocity: Literal["rate", "difference"] = "rate"

@@ -37,6 +37,16 @@ MATERIALS = {
     "Linear LPS": "linear_lps",
     "Linear Elastic": "lps",
 }
+#: Words of Peridigm's material model names -> the feature peridyn lacks to run them.
+LACKING = {
+    "correspondence": "correspondence (non-ordinary state-based) models",
+    "plastic": "plasticity",
+    "thermal": "thermal models",
+    "diffusion": "thermal models",
+    "viscoelastic": "viscoelasticity",
+    "viscoplastic": "viscoplasticity",
+    "pals": "position-aware linear solid models",
+}
 #: Peridigm's partial-volume models, refused with ``PARTIAL_VOLUME_DIFFERS``.
 PARTIAL_VOLUME = ("Elastic Partial Volume", "Linear LPS Partial Volume")
 PARTIAL_VOLUME_DIFFERS = (
@@ -266,7 +276,7 @@ def _discretization(deck: _Deck, deck_dir: Path, horizon: float) -> tuple[dict, 
     """Geometry and discretisation sections, and the PdQuickGrid's (nx, ny, nz) (None for a mesh)."""
     kind = deck.get("Discretization.Type", str)
     neighbourhood = deck.get("Discretization.NeighborhoodType", str, "")
-    discretization = {"horizon_m": horizon, "partial_volumes": False}
+    discretization = {"horizon_m": horizon, "partial_volumes": False, **_bond_options(deck)}
     if kind == "PdQuickGrid":
         where = "Discretization.TensorProduct3DMeshGenerator"
         deck.get(where, dict)
@@ -297,19 +307,84 @@ def _discretization(deck: _Deck, deck_dir: Path, horizon: float) -> tuple[dict, 
     return geometry, discretization, None
 
 
+#: Discretization parameters read.
+DISCRETIZATION = {
+    "Type",
+    "Input Mesh File",
+    "NeighborhoodType",
+    "TensorProduct3DMeshGenerator",
+    "Horizon",
+    "Bond Filters",
+    "Omit Bonds Between Blocks",
+}
+#: A Rectangular_Plane bond filter's parameters: deck name (X, Y, Z of a vector) -> case key.
+PLANE_FILTER = {
+    "Lower_Left_Corner": "corner",
+    "Normal": "normal",
+    "Bottom_Unit_Vector": "bottom",
+}
+
+
+def _bond_options(deck: _Deck) -> dict:
+    """``bond_filters`` of ``Discretization.Bond Filters`` (each "Rectangular_Plane" a
+    ``finite_plane``) and ``bonds_between_blocks`` of ``Omit Bonds Between Blocks`` ("All":
+    false; "None": true)."""
+    for key in deck.get("Discretization", dict):
+        if key not in DISCRETIZATION:
+            if key == "Compute Element-Horizon Intersections":
+                raise deck.error(f"Discretization.{key}", True, PARTIAL_VOLUME_DIFFERS)
+            raise deck.error(
+                f"Discretization.{key}", None, f"only the parameters {sorted(DISCRETIZATION)}", False
+            )
+    out = {}
+    filters = []
+    for name in deck.get("Discretization.Bond Filters", dict, {}):
+        where = f"Discretization.Bond Filters.{name}"
+        kind = deck.get(f"{where}.Type", str)
+        if kind != "Rectangular_Plane":
+            raise deck.error(f"{where}.Type", kind, "'Rectangular_Plane' (the bond filter peridyn has)")
+        spec = {"type": "finite_plane"}
+        for prefix, key in PLANE_FILTER.items():
+            spec[key] = [deck.get(f"{where}.{prefix}_{a}", float) for a in "XYZ"]
+        spec["bottom_length"] = deck.get(f"{where}.Bottom_Length", float)
+        spec["side_length"] = deck.get(f"{where}.Side_Length", float)
+        known = {f"{p}_{a}" for p in PLANE_FILTER for a in "XYZ"} | {"Type", "Bottom_Length", "Side_Length"}
+        for key in deck.get(where, dict):
+            if key not in known:
+                raise deck.error(f"{where}.{key}", None, f"only the parameters {sorted(known)}", False)
+        filters.append(spec)
+    if filters:
+        out["bond_filters"] = filters
+    omit = deck.get("Discretization.Omit Bonds Between Blocks", str, "None")
+    if omit not in ("All", "None"):
+        raise deck.error("Discretization.Omit Bonds Between Blocks", omit, "'All' or 'None'")
+    if omit == "All":
+        if len(deck.get("Blocks", dict)) < 2:
+            raise deck.error("Discretization.Omit Bonds Between Blocks", omit, "'None' with one block group")
+        out["bonds_between_blocks"] = False
+    return out
+
+
 def _material(deck: _Deck, name: str) -> dict:
     where = f"Materials.{name}"
     deck.get(where, dict)
     model = deck.get(f"{where}.Material Model", str)
     if model in PARTIAL_VOLUME:
         raise deck.error(f"{where}.Material Model", model, PARTIAL_VOLUME_DIFFERS)
-    if model not in MATERIALS:
-        raise deck.error(f"{where}.Material Model", model, f"one of {sorted(MATERIALS)}")
+    if model == "Elastic Plastic" and deck.get(f"{where}.Disable Plasticity", bool, False):
+        model = "Elastic"  # Peridigm's elastic-plastic model without plasticity: its elastic one
+    elif model not in MATERIALS:
+        lacking = next((f for k, f in LACKING.items() if k in model.lower()), "this material model")
+        raise deck.error(
+            f"{where}.Material Model", model, f"one of {sorted(MATERIALS)} (peridyn lacks {lacking})"
+        )
     density = deck.get(f"{where}.Density", float)
     bulk = deck.get(f"{where}.Bulk Modulus", float)
     known = {"Material Model", "Density", "Bulk Modulus", "Shear Modulus", "Apply Shear Correction Factor"}
     known |= {"Influence Function", "Plane Stress", "Plane Strain", "Height"}
     known |= IGNORED_MATERIAL
+    if deck.get(f"{where}.Material Model", str) == "Elastic Plastic":  # plasticity disabled
+        known |= {"Disable Plasticity", "Yield Stress"}
     for key in deck.get(where, dict):
         if key not in known:
             raise deck.error(f"{where}.{key}", None, f"only the parameters {sorted(known)}", False)
@@ -393,11 +468,54 @@ def _solver(deck: _Deck) -> dict:
     kinds = [k for k in solver if isinstance(solver[k], dict)]
     if kinds in (["QuasiStatic"], ["NOXQuasiStatic"]):
         return _quasi_static(deck, final, kinds[0])
+    if kinds == ["Implicit"]:
+        return _implicit(deck, final)
     if kinds != ["Verlet"]:
         raise deck.error(
-            "Solver", kinds, "one 'Verlet' or 'QuasiStatic' solver list (others are not supported yet)"
+            "Solver",
+            kinds,
+            "one 'Verlet', 'QuasiStatic', 'NOXQuasiStatic' or 'Implicit' solver list",
         )
     return _verlet(deck, final)
+
+
+#: Implicit parameters read.
+IMPLICIT = {"Fixed dt", "Beta", "Gamma", "Absolute Tolerance", "Maximum Solver Iterations"}
+
+
+def _implicit(deck: _Deck, final: float) -> dict:
+    """Peridigm's Implicit solver (Newmark with Newton) as ``newmark``: average acceleration
+    (Beta 1/4, Gamma 1/2, the one peridyn has), ``Fixed dt``, floor(final / dt) steps, Newton
+    converged on the residual's norm (``Absolute Tolerance``, N), starting from a = 0 as
+    Peridigm's does."""
+    where = "Solver.Implicit"
+    for key in deck.get(where, dict):
+        if key not in IMPLICIT:
+            raise deck.error(f"{where}.{key}", None, f"only the parameters {sorted(IMPLICIT)}", False)
+    for key, value in (("Beta", 0.25), ("Gamma", 0.5)):
+        given = deck.get(f"{where}.{key}", float, value)
+        if given != value:
+            raise deck.error(f"{where}.{key}", given, f"{value} (average acceleration, peridyn's Newmark)")
+    dt = deck.get(f"{where}.Fixed dt", float)
+    if not dt > 0:
+        raise deck.error(f"{where}.Fixed dt", dt, "a positive time step (s)")
+    steps = math.floor(final / dt)
+    if steps < 1:
+        raise deck.error("Solver.Final Time", final, f"at least one step of {dt:g} s")
+    tolerance = deck.get(f"{where}.Absolute Tolerance", float)
+    if not tolerance > 0:
+        raise deck.error(f"{where}.Absolute Tolerance", tolerance, "a positive tolerance (N)")
+    iterations = deck.get(f"{where}.Maximum Solver Iterations", int, 10)
+    if iterations < 1:
+        raise deck.error(f"{where}.Maximum Solver Iterations", iterations, "at least 1")
+    return {
+        "type": "newmark",
+        "dt": dt,
+        "steps": steps,
+        "absolute_tolerance": tolerance,
+        "newton_iterations": iterations,
+        "initial_acceleration": "zero",
+    }
 
 
 def _verlet(deck: _Deck, final: float) -> dict:

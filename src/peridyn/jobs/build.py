@@ -16,12 +16,15 @@ from peridyn.discretization.body import Body, in_box, in_cylinder, in_sphere
 from peridyn.discretization.bonds import (
     HORIZON_RTOL,
     Bonds,
+    crossing_finite_plane,
+    crossing_mask,
     crossing_rectangle,
     crossing_segment,
     cut_bonds,
     find_bonds,
     reorder_bonds,
     search_reach,
+    without_bonds,
 )
 from peridyn.discretization.pairs import index_bandwidth, row_blocks
 from peridyn.errors import CaseFileError, InputError
@@ -223,7 +226,24 @@ def build_bonds(case: Case, body: Body, required=None, of_block=None) -> Bonds:
                 return crossing_segment(a, b, c.start, c.end)
 
         cut_bonds(body, bonds, crossing)
-    return bonds
+    return filtered(case, body, bonds, of_block)
+
+
+def filtered(case: Case, body: Body, bonds: Bonds, of_block=None) -> Bonds:
+    """``bonds`` less those the case's bond filters take out, and those between blocks when
+    ``discretization.bonds_between_blocks`` is false (``of_block`` as ``block_horizons``'s)."""
+    d = case.discretization
+    mask = np.zeros(bonds.n_bonds, dtype=bool)
+    for f in d.bond_filters:
+
+        def meets(a, b, f=f):
+            return crossing_finite_plane(a, b, f.corner, f.normal, f.bottom, f.bottom_length, f.side_length)
+
+        mask |= crossing_mask(body, bonds, meets)
+    if not d.bonds_between_blocks and case.blocks:
+        blocks = block_index(case, body) if of_block is None else of_block
+        mask |= blocks[bonds.owners()] != blocks[bonds.neighbours]
+    return without_bonds(bonds, mask) if mask.any() else bonds
 
 
 def add_actuators(case: Case, body: Body) -> tuple[Body, list[BoundaryCondition]]:

@@ -24,13 +24,15 @@ def check_variables(case_name: str, model: Model, variables) -> None:
             )
 
 
-def variable_values(model: Model, variables, sums=None):
+def variable_values(model: Model, variables, sums=None, loading=None):
     """A function of a state (u, v, a: (n_points, 3)) giving the ``variables``' values as
     ``ExodusWriter.append`` takes them: ``{"nodal": {...}, "element": {...}, "global_":
     {...}}``, vectors (n_points, dim), scalars (n_points,), and per ``sums`` entry (name ->
     (nodal variable, node set name)) that variable's sum over the set, (dim,). Force density
     is the internal force density (N/m^3) at u, force that times the point's volume (N);
-    acceleration the solver's."""
+    acceleration the solver's; external force density the body-force density (N/m^3) of
+    ``loading`` (a ``Loading``, needed for it) at the state's time; ``Lambda`` Peridigm's
+    plastic multiplier, zero (peridyn's materials are elastic)."""
     sums = sums or {}
     needed = set(variables) | {variable for variable, _ in sums.values()}
     body = model.body
@@ -42,6 +44,10 @@ def variable_values(model: Model, variables, sums=None):
             "Displacement": lambda: state.u[:, :dim],
             "Velocity": lambda: state.v[:, :dim],
             "Acceleration": lambda: state.a[:, :dim],
+            "External_Force_Density": lambda: loading.body_force_density(
+                state.time, np.zeros((body.n_points, 3))
+            )[:, :dim],
+            "Lambda": lambda: np.zeros(body.n_points),
             "Force_Density": lambda: force_density,
             "Force": lambda: force_density * body.volumes[:, None],
             "Element_Id": lambda: np.arange(1.0, body.n_points + 1.0),
@@ -85,13 +91,15 @@ class GatheredVariables:
         Name -> (nodal variable, node set name), as ``variable_values``.
     whole_body : Body
         The case's body (its node sets name the sums' points).
+    loading : Loading or None
+        The rank's part of the loading (for ``External_Force_Density``).
     """
 
-    def __init__(self, domain, model: Model, variables, sums, whole_body):
+    def __init__(self, domain, model: Model, variables, sums, whole_body, loading=None):
         self.domain, self.whole_body = domain, whole_body
         self.variables, self.sums = list(variables), dict(sums or {})
         needed = self.variables + [v for v, _ in self.sums.values() if v not in self.variables]
-        self._local = variable_values(model, needed)
+        self._local = variable_values(model, needed, loading=loading)
         self._values: dict | None = None
         self._step: int | None = None
 

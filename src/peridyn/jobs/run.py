@@ -236,9 +236,14 @@ def exodus_values(case: Case, setup: Setup, spec: RecorderSpec):
     check_variables(case.name, setup.model, spec.exodus_variables)
     if setup.domain.size > 1:  # each rank's owned values, gathered on rank 0 (``collect``)
         return GatheredVariables(
-            setup.domain, setup.model, spec.exodus_variables, spec.exodus_sums, setup.whole_body
+            setup.domain,
+            setup.model,
+            spec.exodus_variables,
+            spec.exodus_sums,
+            setup.whole_body,
+            setup.loading,
         )
-    return variable_values(setup.model, spec.exodus_variables, spec.exodus_sums)
+    return variable_values(setup.model, spec.exodus_variables, spec.exodus_sums, setup.loading)
 
 
 def step_count(case: Case, solver) -> int:
@@ -765,6 +770,8 @@ def _newmark_solver(case, setup):
         damping=s.damping,
         damage=setup.damage,
         linear_solver=s.linear_solver,
+        residual_tolerance=s.absolute_tolerance,
+        initial_acceleration=s.initial_acceleration,
     )
 
 
