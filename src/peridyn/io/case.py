@@ -552,11 +552,21 @@ class LineSpec(Strict):
 
 
 class SetSum(Strict):
-    """A global output variable: the sum of the nodal vector ``variable`` over node set ``set``
-    (Peridigm's "Block_Data" compute class with "Calculation Type: Sum")."""
+    """A global output variable: the sum (``calculation``: or the largest or smallest value,
+    per component) of the output variable ``variable`` (``PERIDIGM_VARIABLES``) over node set
+    ``set`` (Peridigm's "Block_Data" and "Node_Set_Data" compute classes)."""
 
-    variable: Literal["Displacement", "Velocity", "Force", "Force_Density", "Acceleration"]
+    variable: str
     set: str
+    calculation: Literal["sum", "maximum", "minimum"] = "sum"
+
+    @model_validator(mode="after")
+    def _known(self):
+        if self.variable not in PERIDIGM_VARIABLES:
+            raise ValueError(
+                f"variable: unknown output variable {self.variable!r}; known: {sorted(PERIDIGM_VARIABLES)}"
+            )
+        return self
 
 
 class ExodusOutput(Strict):

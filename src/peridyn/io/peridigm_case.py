@@ -16,14 +16,16 @@ from __future__ import annotations
 
 import math
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
 
 from peridyn.errors import CaseFileError, InputError
 from peridyn.io.case import Case, apply_override, load_case, validate_case
+from peridyn.io.exodus import read_exodus
 from peridyn.io.exodus_write import PERIDIGM_VARIABLES
+from peridyn.io.mesh_text import read_text_mesh
 from peridyn.io.peridigm_deck import is_peridigm_deck, read_deck
 from peridyn.physics.expressions import SpaceTime
 
@@ -128,7 +130,9 @@ def deck_case(params: dict, name: str, source: str = "<deck>", deck_dir=".") -> 
     for key in params:
         if key not in SECTIONS and not key.startswith("Output"):
             raise deck.error(key, None, f"one of the sections peridyn reads: {sorted(SECTIONS)}", False)
-    groups = _groups(deck)
+    for group in deck.get("Blocks", dict):  # the material models first: what peridyn lacks
+        _material(deck, deck.get(f"Blocks.{group}.Material", str))
+    groups = _with_default(deck, _groups(deck), deck_dir)
     horizon = max(g.horizon for g in groups)
     if len(groups) == 1:  # materials and solver first: their refusals before a missing mesh's
         (group,) = groups
@@ -173,21 +177,32 @@ def deck_case(params: dict, name: str, source: str = "<deck>", deck_dir=".") -> 
     return case
 
 
+#: Peridigm's compute classes of a variable over a set: class -> the parameter naming the set.
+COMPUTE_CLASSES = {"Block_Data": "Block", "Node_Set_Data": "Node Set"}
+#: Their calculation types: deck name -> ``SetSum.calculation``.
+CALCULATIONS = {"Sum": "sum", "Maximum": "maximum", "Minimum": "minimum"}
+
+
 def _compute_classes(deck: _Deck) -> dict:
-    """Output label -> ``{variable, set}`` of each "Block_Data" sum of ``Compute Class Parameters``."""
+    """Output label -> ``{variable, set, calculation}`` of each "Block_Data" or "Node_Set_Data"
+    of ``Compute Class Parameters``: a variable's sum, maximum or minimum over a block or a
+    node set."""
     out = {}
     for name in deck.get("Compute Class Parameters", dict, {}):
         where = f"Compute Class Parameters.{name}"
-        for key, expected in (("Compute Class", "Block_Data"), ("Calculation Type", "Sum")):
-            value = deck.get(f"{where}.{key}", str)
-            if value != expected:
-                raise deck.error(f"{where}.{key}", value, f"{expected!r} (the one compute class peridyn has)")
+        kind = deck.get(f"{where}.Compute Class", str)
+        if kind not in COMPUTE_CLASSES:
+            raise deck.error(f"{where}.Compute Class", kind, f"one of {sorted(COMPUTE_CLASSES)}")
+        calculation = deck.get(f"{where}.Calculation Type", str)
+        if calculation not in CALCULATIONS:
+            raise deck.error(f"{where}.Calculation Type", calculation, f"one of {sorted(CALCULATIONS)}")
         variable = deck.get(f"{where}.Variable", str)
-        if PERIDIGM_VARIABLES.get(variable) != ("nodal", True):
-            raise deck.error(f"{where}.Variable", variable, "a nodal vector variable, e.g. Force")
+        if variable not in PERIDIGM_VARIABLES:
+            raise deck.error(f"{where}.Variable", variable, f"one of {sorted(PERIDIGM_VARIABLES)}")
         out[deck.get(f"{where}.Output Label", str)] = {
             "variable": variable,
-            "set": deck.get(f"{where}.Block", str),
+            "set": deck.get(f"{where}.{COMPUTE_CLASSES[kind]}", str),
+            "calculation": CALCULATIONS[calculation],
         }
     return out
 
@@ -227,7 +242,7 @@ def _groups(deck: _Deck) -> list[_Group]:
                 f"{where}.Horizon", deck.get(f"{where}.Horizon"), "no block horizon: Discretization.Horizon"
             )
         key = "Discretization.Horizon" if shared else f"{where}.Horizon"
-        horizon = deck.get(key, float)
+        horizon = _horizon(deck, key)
         if not horizon > 0:
             raise deck.error(key, horizon, "a positive horizon (m)")
         blocks = tuple(deck.get(f"{where}.Block Names", str).split())
@@ -239,6 +254,45 @@ def _groups(deck: _Deck) -> list[_Group]:
     if not groups:
         raise deck.error("Blocks", {}, "at least one block group")
     return groups
+
+
+def _horizon(deck: _Deck, key: str) -> float:
+    """A horizon (m): a number, or a string holding one (Peridigm reads both)."""
+    value = deck.get(key)
+    if isinstance(value, str):
+        try:
+            return float(value)
+        except ValueError:
+            raise deck.error(
+                key, value, "a number (m): horizons varying in space are not supported"
+            ) from None
+    return deck.get(key, float)
+
+
+def _with_default(deck: _Deck, groups: list[_Group], deck_dir: Path) -> list[_Group]:
+    """``groups`` with the block name ``default`` replaced by the mesh's blocks that no group
+    names (Peridigm's default block); a single group keeps it (it takes every block)."""
+    if len(groups) < 2 or not any("default" in g.block_names for g in groups):
+        return groups
+    named = {b for g in groups for b in g.block_names if b != "default"}
+    rest = tuple(b for b in _mesh_blocks(deck, deck_dir) if b not in named)
+    return [
+        replace(g, block_names=tuple(b for b in g.block_names if b != "default") + rest)
+        if "default" in g.block_names
+        else g
+        for g in groups
+    ]
+
+
+def _mesh_blocks(deck: _Deck, deck_dir: Path) -> list[str]:
+    """Names of the blocks of the deck's mesh (an Exodus mesh's, ``block_<id>`` of a text mesh)."""
+    kind = deck.get("Discretization.Type", str)
+    mesh = deck_dir / deck.get("Discretization.Input Mesh File", str, "")
+    if kind not in ("Exodus", "Text File") or not mesh.is_file():
+        raise deck.error("Blocks", "default", "a mesh whose blocks the default block takes")
+    if kind == "Exodus":
+        return [b.name for b in read_exodus(mesh).blocks]
+    return [f"block_{i}" for i in np.unique(read_text_mesh(mesh)[1])]
 
 
 def _block_materials(deck: _Deck, groups: list[_Group], horizon: float) -> tuple[dict, dict]:
@@ -379,8 +433,7 @@ def _material(deck: _Deck, name: str) -> dict:
             f"{where}.Material Model", model, f"one of {sorted(MATERIALS)} (peridyn lacks {lacking})"
         )
     density = deck.get(f"{where}.Density", float)
-    bulk = deck.get(f"{where}.Bulk Modulus", float)
-    known = {"Material Model", "Density", "Bulk Modulus", "Shear Modulus", "Apply Shear Correction Factor"}
+    known = {"Material Model", "Density", "Apply Shear Correction Factor", *ELASTIC_CONSTANTS}
     known |= {"Influence Function", "Plane Stress", "Plane Strain", "Height"}
     known |= IGNORED_MATERIAL
     if deck.get(f"{where}.Material Model", str) == "Elastic Plastic":  # plasticity disabled
@@ -392,6 +445,7 @@ def _material(deck: _Deck, name: str) -> dict:
     if influence not in INFLUENCE:
         raise deck.error(f"{where}.Influence Function", influence, f"one of {sorted(INFLUENCE)}")
     plane = _plane(deck, name)
+    bulk, E, nu = _elastic_constants(deck, where, MATERIALS[model] == "pmb")
     if MATERIALS[model] == "pmb":
         # c = 18 K / (pi delta^4) from K alone: peridyn's PMB has nu = 1/4, so K = E / 1.5; in
         # 2D Peridigm's c = 12 K / (pi h delta^3) is peridyn's 12 kappa / (pi t delta^3) of
@@ -401,10 +455,6 @@ def _material(deck: _Deck, name: str) -> dict:
         raise deck.error(
             f"{where}.Plane {plane[0].capitalize()}", True, "3D, or the Elastic Bond Based model in 2D"
         )
-    shear = deck.get(f"{where}.Shear Modulus", float)
-    # E and nu of the bulk and shear moduli (LPS turns them back into K and mu)
-    E = 9.0 * bulk * shear / (3.0 * bulk + shear)
-    nu = (3.0 * bulk - 2.0 * shear) / (2.0 * (3.0 * bulk + shear))
     material = {"model": MATERIALS[model], "E": E, "nu": nu, "density": density}
     if deck.get(f"{where}.Apply Shear Correction Factor", bool, False):
         if model != "Elastic":
@@ -413,6 +463,30 @@ def _material(deck: _Deck, name: str) -> dict:
             )
         material["surface_correction"] = "shear-factor"
     return material
+
+
+#: Elastic constants a deck may give, two of them (one, the bulk modulus, for bond-based).
+ELASTIC_CONSTANTS = ("Bulk Modulus", "Shear Modulus", "Young's Modulus", "Poisson's Ratio")
+
+
+def _elastic_constants(deck: _Deck, where: str, bond_based: bool) -> tuple[float, float, float]:
+    """(K, E, nu) of the material at ``where`` from the two constants it gives (Pa, Pa, -):
+    the bulk and shear moduli, or Young's modulus and Poisson's ratio, as Peridigm reads them
+    (a bond-based material: the bulk modulus alone, or E and nu; its E and nu are then unused)."""
+    given = {k: deck.get(f"{where}.{k}", float) for k in ELASTIC_CONSTANTS if k in deck.get(where, dict)}
+    if bond_based and set(given) == {"Bulk Modulus"}:
+        return given["Bulk Modulus"], math.nan, math.nan
+    if set(given) == {"Bulk Modulus", "Shear Modulus"}:
+        bulk, shear = given["Bulk Modulus"], given["Shear Modulus"]
+        # E and nu of the bulk and shear moduli (LPS turns them back into K and mu)
+        E = 9.0 * bulk * shear / (3.0 * bulk + shear)
+        return bulk, E, (3.0 * bulk - 2.0 * shear) / (2.0 * (3.0 * bulk + shear))
+    if set(given) == {"Young's Modulus", "Poisson's Ratio"}:
+        E, nu = given["Young's Modulus"], given["Poisson's Ratio"]
+        return E / (3.0 * (1.0 - 2.0 * nu)), E, nu
+    raise deck.error(
+        where, sorted(given), "Bulk Modulus and Shear Modulus, or Young's Modulus and Poisson's Ratio"
+    )
 
 
 #: E / K of peridyn's 2D bond-based model whose plane bulk modulus is K: kappa = E / (2 (1 - nu))

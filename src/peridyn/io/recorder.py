@@ -93,8 +93,9 @@ class RecorderSpec:
     exodus_variables : tuple of str
         Peridigm's names of the variables written (``peridyn.io.exodus_write.PERIDIGM_VARIABLES``),
         their values from the recorder's ``fields``; empty: ``snapshot_exodus``'s fields.
-    exodus_sums : dict of name -> (variable, node set name)
-        Global vector variables written with the named ones: a nodal variable's sum over a set.
+    exodus_sums : dict of name -> (variable, node set name, calculation)
+        Global variables written with the named ones: a variable's sum, maximum or minimum
+        over a set.
     exodus_order : {"peridyn", "grid"}
         The named variables' point order: the body's, or ``grid_order`` (x fastest, then y,
         then z: PdQuickGrid's numbering).
@@ -537,7 +538,7 @@ def variables_exodus(body: Body, path, variables, sums=None, rows=None, dim=None
         node_sets=sets,
         nodal=fields["nodal"],
         element=fields["element"],
-        global_=dict.fromkeys(sums or {}, dim),
+        global_={k: dim if PERIDIGM_VARIABLES[v[0]][1] else 1 for k, v in (sums or {}).items()},
     )
 
 

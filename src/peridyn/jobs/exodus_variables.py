@@ -11,6 +11,8 @@ from peridyn.io.exodus_write import PERIDIGM_VARIABLES
 from peridyn.physics.damage import damage_field
 from peridyn.physics.materials.base import Model
 
+#: Global variables of a variable over a set: its sum, largest or smallest value (per component).
+REDUCTIONS = {"sum": np.sum, "maximum": np.max, "minimum": np.min}
 #: Variables that only a state-based material has (its per-point dilatation and weighted volume).
 STATE_BASED = ("Dilatation", "Weighted_Volume")
 
@@ -28,13 +30,14 @@ def variable_values(model: Model, variables, sums=None, loading=None):
     """A function of a state (u, v, a: (n_points, 3)) giving the ``variables``' values as
     ``ExodusWriter.append`` takes them: ``{"nodal": {...}, "element": {...}, "global_":
     {...}}``, vectors (n_points, dim), scalars (n_points,), and per ``sums`` entry (name ->
-    (nodal variable, node set name)) that variable's sum over the set, (dim,). Force density
+    (variable, node set name[, "sum" | "maximum" | "minimum"])) that variable's sum (or
+    extreme) over the set, (dim,) or a scalar. Force density
     is the internal force density (N/m^3) at u, force that times the point's volume (N);
     acceleration the solver's; external force density the body-force density (N/m^3) of
     ``loading`` (a ``Loading``, needed for it) at the state's time; ``Lambda`` Peridigm's
     plastic multiplier, zero (peridyn's materials are elastic)."""
     sums = sums or {}
-    needed = set(variables) | {variable for variable, _ in sums.values()}
+    needed = set(variables) | {variable for variable, *_ in sums.values()}
     body = model.body
     dim = body.dim
 
@@ -63,8 +66,9 @@ def variable_values(model: Model, variables, sums=None, loading=None):
         out = {"nodal": {}, "element": {}, "global_": {}}
         for name in variables:
             out[PERIDIGM_VARIABLES[name][0]][name] = computed[name]()
-        for name, (variable, set_name) in sums.items():
-            out["global_"][name] = computed[variable]()[body.node_set(set_name)].sum(axis=0)
+        for name, (variable, set_name, *calculation) in sums.items():
+            reduce = REDUCTIONS[calculation[0] if calculation else "sum"]
+            out["global_"][name] = reduce(computed[variable]()[body.node_set(set_name)], axis=0)
         return out
 
     return values
@@ -98,7 +102,7 @@ class GatheredVariables:
     def __init__(self, domain, model: Model, variables, sums, whole_body, loading=None):
         self.domain, self.whole_body = domain, whole_body
         self.variables, self.sums = list(variables), dict(sums or {})
-        needed = self.variables + [v for v, _ in self.sums.values() if v not in self.variables]
+        needed = self.variables + [v for v, *_ in self.sums.values() if v not in self.variables]
         self._local = variable_values(model, needed, loading=loading)
         self._values: dict | None = None
         self._step: int | None = None
@@ -121,8 +125,9 @@ class GatheredVariables:
         out = {"nodal": {}, "element": {}, "global_": {}}
         for name in self.variables:
             out[PERIDIGM_VARIABLES[name][0]][name] = whole[name]
-        for name, (variable, set_name) in self.sums.items():
-            out["global_"][name] = whole[variable][self.whole_body.node_set(set_name)].sum(axis=0)
+        for name, (variable, set_name, *calculation) in self.sums.items():
+            reduce = REDUCTIONS[calculation[0] if calculation else "sum"]
+            out["global_"][name] = reduce(whole[variable][self.whole_body.node_set(set_name)], axis=0)
         self._values = out
 
     def __call__(self, state: State) -> dict:

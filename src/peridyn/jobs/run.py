@@ -74,7 +74,7 @@ def exodus_spec(exodus) -> dict:
         "exodus_file": exodus.file,
         "exodus_every": exodus.every,
         "exodus_variables": tuple(exodus.variables),
-        "exodus_sums": {k: (v.variable, v.set) for k, v in exodus.sums.items()},
+        "exodus_sums": {k: (v.variable, v.set, v.calculation) for k, v in exodus.sums.items()},
         "exodus_order": exodus.point_order,
         "exodus_three_d": exodus.three_d,
     }
