@@ -301,7 +301,9 @@ class Damage(Strict):
     ``critical_bond_stress`` (Pa; bond stress E s, see ``peridyn.physics.damage``), and node sets
     where bonds never break."""
 
-    critical_stretch: Positive | None = None
+    #: a number, or a time function (a mapping, ``peridyn.physics.timefunctions.from_spec``;
+    #: a body of one material): s_c(t), Peridigm's "Time Dependent Critical Stretch"
+    critical_stretch: Positive | dict | None = None
     fracture_energy: Positive | None = None
     critical_bond_stress: Positive | None = None
     no_damage_sets: list[str] = []

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -515,22 +516,56 @@ def _plane(deck: _Deck, name: str) -> tuple[str, float] | None:
 
 def _damage(deck: _Deck, key: str) -> dict:
     """``{"damage": {"critical_stretch": s_c}}`` of the block's "Critical Stretch" damage model
-    (a bond breaks once (|y| - |xi|) / |xi| exceeds s_c, as in peridyn), or {} without one."""
+    (a bond breaks once (|y| - |xi|) / |xi| exceeds s_c, as in peridyn), or of its "Time
+    Dependent Critical Stretch" (s_c a time function, ``_stretch_in_time``), or {} without one."""
     name = deck.get(key, str, None)
     if name is None:
         return {}
     where = f"Damage Models.{name}"
     deck.get(where, dict)
-    for param in deck.get(where, dict):
-        if param not in ("Damage Model", "Critical Stretch"):
-            raise deck.error(f"{where}.{param}", None, "Damage Model and Critical Stretch only", False)
     model = deck.get(f"{where}.Damage Model", str)
-    if model != "Critical Stretch":
-        raise deck.error(f"{where}.Damage Model", model, "'Critical Stretch'")
+    if model not in ("Critical Stretch", "Time Dependent Critical Stretch"):
+        raise deck.error(
+            f"{where}.Damage Model", model, "'Critical Stretch' or 'Time Dependent Critical Stretch'"
+        )
+    for param in deck.get(where, dict):
+        if param not in ("Damage Model", model):
+            raise deck.error(f"{where}.{param}", None, f"Damage Model and {model} only", False)
+    if model == "Time Dependent Critical Stretch":
+        return {"damage": {"critical_stretch": _stretch_in_time(deck, f"{where}.{model}")}}
     stretch = deck.get(f"{where}.Critical Stretch", float)
     if not stretch > 0:
         raise deck.error(f"{where}.Critical Stretch", stretch, "a positive stretch")
     return {"damage": {"critical_stretch": stretch}}
+
+
+#: Peridigm's time-dependent critical stretch of two values: "if(t <= T){ value = A; } else{
+#: value = B; }" (its expression parser's form), with ``<=`` or ``<``.
+STEP_IN_TIME = re.compile(
+    r"^\s*if\s*\(\s*t\s*(<=|<)\s*(\S+?)\s*\)\s*\\?\{\s*value\s*=\s*(\S+?)\s*;\s*\\?\}"
+    r"\s*else\s*\\?\{\s*value\s*=\s*(\S+?)\s*;\s*\\?\}\s*$"
+)
+
+
+def _stretch_in_time(deck: _Deck, key: str) -> dict:
+    """A critical stretch in time as a peridyn time function: a number, or the two-valued
+    form of ``STEP_IN_TIME`` as a ``step``."""
+    text = deck.get(key, str)
+    match = STEP_IN_TIME.match(text)
+    try:
+        if match is None:
+            return {"type": "constant", "value": float(text)}
+        operator, time, before, after = match.groups()
+        step = {"time": float(time), "before": float(before), "after": float(after)}
+    except ValueError:
+        match = None
+    if match is None:
+        raise deck.error(key, text.strip(), "a number, or 'if(t <= T){ value = A; } else{ value = B; }'")
+    if not (step["before"] > 0 and step["after"] > 0):
+        raise deck.error(key, text.strip(), "positive stretches")
+    if operator == "<":  # t < T is t <= the float below T
+        step["time"] = math.nextafter(step["time"], -math.inf)
+    return {"type": "step", **step}
 
 
 def _solver(deck: _Deck) -> dict:

@@ -546,13 +546,15 @@ def build_damage(case: Case, model: Model, protected=None, of_block=None) -> Bon
     d = case.material.damage
     if d is None:
         return None
+    timed = isinstance(d.critical_stretch, dict)
     return BondDamage(
         model,
-        d.critical_stretch,
+        None if timed else d.critical_stretch,
         d.fracture_energy,
         d.no_damage_sets if protected is None else (),
         critical_bond_stress=d.critical_bond_stress,
         protected=protected,
+        schedule=from_spec(d.critical_stretch, "material.damage.critical_stretch") if timed else None,
     )
 
 
@@ -571,6 +573,11 @@ def block_damage(case: Case, model: Model, protected=None, of_block=None) -> Bon
         if d is None:
             continue
         mine = of_point == k
+        if isinstance(d.critical_stretch, dict):
+            raise InputError(
+                f"materials.{block.material}.damage.critical_stretch: a number (a critical "
+                "stretch in time is for a body of one material)"
+            )
         if d.critical_stretch is not None:
             stretch[mine] = d.critical_stretch
         elif d.fracture_energy is not None:

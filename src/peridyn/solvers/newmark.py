@@ -172,7 +172,7 @@ class NewmarkSolver:
         state.step += 1
         # bonds broken here act from the next step on: the stored acceleration is the
         # converged one of this step (a lag of one step; the explicit solver breaks first)
-        broken = self.damage.update(state.u) if self.damage is not None else 0
+        broken = self.damage.update(state.u, state.time) if self.damage is not None else 0
         check_state(state)
         return broken
 
