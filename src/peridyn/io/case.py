@@ -615,10 +615,22 @@ class Output(Strict):
     #: the VTU snapshots' data arrays: "none" (the default: written 8 times as fast) or "zlib"
     vtu_compression: Literal["none", "zlib"] = "none"
     exodus: bool | ExodusOutput = False
+    #: more Exodus files of named variables (Peridigm's Output1, Output2, ...), each at its own
+    #: frequency; ``exodus`` must then be a mapping too
+    exodus_more: list[ExodusOutput] = []
     plots: bool = True
     #: per-point partial stress and Green-Lagrange strain in the final fields and VTU snapshots
     stress: bool = False
     strain: bool = False
+
+    @model_validator(mode="after")
+    def _more_files(self):
+        if self.exodus_more and isinstance(self.exodus, bool):
+            raise ValueError("exodus_more: give exodus as a mapping (file, every, variables) too")
+        files = [e.file for e in [self.exodus, *self.exodus_more] if not isinstance(e, bool)]
+        if len(set(files)) != len(files):
+            raise ValueError(f"exodus and exodus_more: one file each, got {files}")
+        return self
 
 
 class ContactSpec(Strict):
@@ -751,6 +763,8 @@ class Case(Strict):
         used += [(f"output.planes.{k}", v) for k, v in self.output.planes.items()]
         if not isinstance(self.output.exodus, bool):
             used += [(f"output.exodus.sums.{k}.set", v.set) for k, v in self.output.exodus.sums.items()]
+        for n, more in enumerate(self.output.exodus_more):
+            used += [(f"output.exodus_more[{n}].sums.{k}.set", v.set) for k, v in more.sums.items()]
         used += [(f"blocks.{k}.set", b.set) for k, b in self.blocks.items() if b.set is not None]
         for key, mat in self.block_materials().items():
             if key != "material":

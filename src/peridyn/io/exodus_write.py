@@ -39,7 +39,7 @@ COMPONENTS = "XYZ"
 #: external (body) force density (N/m^3); element scalars: 1-based id, 0-based id (``ID``, the
 #: older decks' name), rank, volume (m^3), dilatation, weighted volume (m^5), stored elastic
 #: energy (J, energy density times volume), number of neighbours, damage and the plastic
-#: multiplier (``Lambda``: 0, elastic materials).
+#: multiplier (``Lambda``: 0, elastic materials); global: the kinetic energy (J).
 PERIDIGM_VARIABLES = {
     "Displacement": ("nodal", True),
     "Velocity": ("nodal", True),
@@ -57,6 +57,7 @@ PERIDIGM_VARIABLES = {
     "Number_Of_Neighbors": ("element", False),
     "Damage": ("element", False),
     "Lambda": ("element", False),
+    "Global_Kinetic_Energy": ("global", False),
 }
 
 

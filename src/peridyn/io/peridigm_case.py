@@ -172,9 +172,10 @@ def deck_case(params: dict, name: str, source: str = "<deck>", deck_dir=".") -> 
         case["initial_conditions"] = ics
     model = (case.get("material") or next(iter(case["materials"].values())))["model"]
     case["output"] = _output(deck, model, _compute_classes(deck))
-    if "exodus" in case["output"]:  # Peridigm's numbering of a grid; three components in 2D
-        case["output"]["exodus"]["point_order"] = "grid" if grid is not None else "peridyn"
-        case["output"]["exodus"]["three_d"] = plane is not None
+    for exodus in [case["output"].get("exodus"), *case["output"].get("exodus_more", [])]:
+        if exodus is not None:  # Peridigm's numbering of a grid; three components in 2D
+            exodus["point_order"] = "grid" if grid is not None else "peridyn"
+            exodus["three_d"] = plane is not None
     return case
 
 
@@ -787,37 +788,61 @@ def _set_indices(deck: _Deck, key: str, deck_dir: Path, grid, first_id: int) -> 
     return sorted(int(p) for p in index)
 
 
+#: Output list parameters read (``Output Format`` and ``Parallel Write`` change how, not what).
+OUTPUT = {"Output File Type", "Output Format", "Output Filename", "Output Frequency", "Parallel Write"}
+
+
 def _output(deck: _Deck, model: str, sums: dict) -> dict:
-    """The output section: plots and VTU off, the deck's Exodus file and variables."""
+    """The output section: plots and VTU off, an Exodus file of each output list (``Output``,
+    ``Output1``, ``Output2``, ...: the first as ``exodus``, the others ``exodus_more``), each
+    with its file, frequency, variables and compute classes."""
     outputs = [k for k in deck.params if k.startswith("Output")]
-    if not outputs:
-        return {"plots": False, "vtu": False}
-    first = outputs[0]
-    fmt = deck.get(f"{first}.Output File Type", str, "ExodusII")
+    out = {"plots": False, "vtu": False}
+    files = [_exodus_file(deck, where, model, sums) for where in outputs]
+    merged = []
+    for where, exodus in zip(outputs, files, strict=True):  # lists of one file: one output
+        same = next((m for m in merged if m["file"] == exodus["file"]), None)
+        if same is None:
+            merged.append(exodus)
+            continue
+        if same["every"] != exodus["every"]:
+            raise deck.error(
+                f"{where}.Output Frequency", exodus["every"], f"{same['every']}, as the file's other list"
+            )
+        same["variables"] += [v for v in exodus["variables"] if v not in same["variables"]]
+        same.setdefault("sums", {}).update(exodus.get("sums", {}))
+    if merged:
+        out["exodus"] = merged[0]
+    if len(merged) > 1:
+        out["exodus_more"] = merged[1:]
+    return out
+
+
+def _exodus_file(deck: _Deck, where: str, model: str, sums: dict) -> dict:
+    """``ExodusOutput`` of one output list."""
+    for key in deck.get(where, dict):
+        if key not in OUTPUT and key != "Output Variables":
+            raise deck.error(f"{where}.{key}", None, f"only the parameters {sorted(OUTPUT)}", False)
+    fmt = deck.get(f"{where}.Output File Type", str, "ExodusII")
     if fmt != "ExodusII":
-        raise deck.error(f"{first}.Output File Type", fmt, "ExodusII")
-    names = [k for k, on in deck.get(f"{first}.Output Variables", dict).items() if on is True]
-    for k in outputs[1:]:  # more output lists: the same file, variables and frequency only
-        for key in ("Output Filename", "Output Frequency"):
-            if deck.get(f"{k}.{key}", default=None) != deck.get(f"{first}.{key}", default=None):
-                raise deck.error(f"{k}.{key}", deck.get(f"{k}.{key}", default=None), f"as in {first}")
-        extra = [v for v, on in deck.get(f"{k}.Output Variables", dict).items() if on and v not in names]
-        if extra:
-            raise deck.error(f"{k}.Output Variables", extra, f"variables that {first} writes")
+        raise deck.error(f"{where}.Output File Type", fmt, "ExodusII")
+    names = [k for k, on in deck.get(f"{where}.Output Variables", dict).items() if on is True]
     asked_sums = {name: sums[name] for name in names if name in sums}
     names = [name for name in names if name not in sums]
     for name in names:
         if name not in PERIDIGM_VARIABLES:
-            raise deck.error(f"{first}.Output Variables.{name}", True, f"one of {sorted(PERIDIGM_VARIABLES)}")
+            raise deck.error(f"{where}.Output Variables.{name}", True, f"one of {sorted(PERIDIGM_VARIABLES)}")
         if model == "pmb" and name in ("Dilatation", "Weighted_Volume"):
-            raise deck.error(f"{first}.Output Variables.{name}", True, "a state-based material's variable")
-    every = deck.get(f"{first}.Output Frequency", int, 1)
+            raise deck.error(f"{where}.Output Variables.{name}", True, "a state-based material's variable")
+    every = deck.get(f"{where}.Output Frequency", int, 1)
     if every < 1:
-        raise deck.error(f"{first}.Output Frequency", every, "at least 1 step")
-    exodus = {"file": deck.get(f"{first}.Output Filename", str) + ".e", "every": every, "variables": names}
+        raise deck.error(f"{where}.Output Frequency", every, "at least 1 step")
+    history = all(PERIDIGM_VARIABLES[n][0] == "global" for n in names)  # Peridigm's ".h" file
+    suffix = ".h" if history else ".e"
+    exodus = {"file": deck.get(f"{where}.Output Filename", str) + suffix, "every": every, "variables": names}
     if asked_sums:
         exodus["sums"] = asked_sums
-    return {"plots": False, "vtu": False, "exodus": exodus}
+    return exodus
 
 
 def convert_deck(path) -> dict:

@@ -102,6 +102,9 @@ class RecorderSpec:
     exodus_three_d : bool
         Write a 2D body's named variables with three coordinates and vector components (z 0),
         as Peridigm does.
+    exodus_more : tuple of dict
+        More Exodus files of named variables, each a dict of the ``exodus_*`` settings above
+        (``exodus_file``, ``exodus_every``, ``exodus_variables``, ...), written at its own steps.
     """
 
     every: int = 1
@@ -121,6 +124,7 @@ class RecorderSpec:
     exodus_sums: dict = field(default_factory=dict)
     exodus_order: str = "peridyn"
     exodus_three_d: bool = False
+    exodus_more: tuple = ()
     stress: bool = False
     strain: bool = False
 
@@ -133,10 +137,24 @@ class RecorderSpec:
         return bool(self.snapshot_every and step % self.snapshot_every == 0) or step in self.snapshot_steps
 
     def exodus_due(self, step: int) -> bool:
-        """True when the Exodus file gets a record at ``step``."""
+        """True when an Exodus file gets a record at ``step``."""
+        if any(step % more["exodus_every"] == 0 for more in self.exodus_more):
+            return True
+        return self.main_exodus_due(step)
+
+    def main_exodus_due(self, step: int) -> bool:
+        """True when the first Exodus file (``exodus_file``) gets a record at ``step``."""
         if not self.exodus:
             return False
         return self.snapshot_due(step) if self.exodus_every is None else step % self.exodus_every == 0
+
+    def all_exodus_variables(self) -> tuple[list, dict]:
+        """The named variables and global sums of every Exodus file, each once."""
+        variables, sums = list(self.exodus_variables), dict(self.exodus_sums)
+        for more in self.exodus_more:
+            variables += [v for v in more["exodus_variables"] if v not in variables]
+            sums |= more["exodus_sums"]
+        return variables, sums
 
     def whole_due(self, step: int) -> bool:
         """True when something that reads the whole body (a snapshot, an Exodus record) is
@@ -265,12 +283,28 @@ class Recorder:
             )
         elif spec.exodus:
             self.exodus = snapshot_exodus(body, self.directory / spec.exodus_file, damage is not None)
+        self._more = [
+            (
+                more,
+                variables_exodus(
+                    body,
+                    self.directory / more["exodus_file"],
+                    more["exodus_variables"],
+                    more["exodus_sums"],
+                    rows=self._rows,
+                    dim=self._dim,
+                ),
+            )
+            for more in spec.exodus_more
+        ]
         if resume is not None:
             self.h5.truncate(resume[0])
             if self.pvd is not None:
                 self.pvd.truncate(resume[1])
             if self.exodus is not None:
                 self.exodus.resume(resume[1])
+            for _, writer in self._more:
+                writer.resume(resume[1])
 
     def _create_series(self) -> None:
         h5, spec = self.h5, self.spec
@@ -334,7 +368,7 @@ class Recorder:
         check_state(state, self.max_displacement)
         self.series.append("field_u", state.step, state.time, state.u)
         if self.exodus is not None and (self.spec.exodus_every is None or self.spec.exodus_due(state.step)):
-            self.write_exodus(state)
+            self.write_exodus(state, at_snapshot=True)
         if self.pvd is None:
             return
         if self.vtu_pieces:  # written by the ranks (peridyn.io.vtu_pieces)
@@ -348,16 +382,29 @@ class Recorder:
         )
         self.pvd.add(state.time, name)
 
-    def write_exodus(self, state: State) -> None:
-        """Append ``state`` to the Exodus file (once per step: the end-of-run snapshot of a
-        step already written adds nothing)."""
+    def write_exodus(self, state: State, at_snapshot: bool = False) -> None:
+        """Append ``state`` to the Exodus files due at its step (once per step: the end-of-run
+        snapshot of a step already written adds nothing); the first file, without a frequency
+        of its own, at the snapshots (``at_snapshot``)."""
         if state.step == self._exodus_step:
             return
         self._exodus_step = state.step
-        if self.spec.exodus_variables:
-            self.exodus.append(state.time, **arranged(self.fields(state), self._rows, self._dim))
-        else:
-            self.exodus.append(state.time, **exodus_fields(self.body, state, self.damage))
+        spec = self.spec
+        main = spec.main_exodus_due(state.step) if spec.exodus_every is not None else at_snapshot
+        if not spec.exodus_variables:
+            if main:
+                self.exodus.append(state.time, **exodus_fields(self.body, state, self.damage))
+            return
+        values = self.fields(state)
+        if main:
+            self.exodus.append(
+                state.time,
+                **arranged(chosen(values, spec.exodus_variables, spec.exodus_sums), self._rows, self._dim),
+            )
+        for more, writer in self._more:
+            if state.step % more["exodus_every"] == 0:
+                picked = chosen(values, more["exodus_variables"], more["exodus_sums"])
+                writer.append(state.time, **arranged(picked, self._rows, self._dim))
 
     def flush(self) -> None:
         """Write the series records held in memory and flush the file (before a checkpoint)."""
@@ -516,16 +563,34 @@ def arranged(values: dict, rows: np.ndarray | None, dim: int) -> dict:
     return out
 
 
+def chosen(values: dict, variables, sums) -> dict:
+    """The part of ``values`` (``ExodusWriter.append``'s keyword arguments) that one file
+    writes: its ``variables`` and its global ``sums``."""
+    return {
+        placement: {
+            k: v for k, v in fields.items() if k in variables or (placement == "global_" and k in sums)
+        }
+        for placement, fields in values.items()
+    }
+
+
 def variables_exodus(body: Body, path, variables, sums=None, rows=None, dim=None) -> ExodusWriter:
     """An Exodus writer of Peridigm's named ``variables`` (``PERIDIGM_VARIABLES`` gives each one's
     placement, nodal or element, and size) and global vectors named by ``sums``' keys, one
     block, the body's node sets; the points in the order ``rows`` ((n,) body indices, None:
-    the body's), with ``dim`` coordinates (default the body's; 3 in 2D: z = 0)."""
+    the body's), with ``dim`` coordinates (default the body's; 3 in 2D: z = 0). Of global
+    variables only, the file is a history file, as Peridigm writes one: a single point at the
+    origin."""
     dim = body.dim if dim is None else dim
-    fields = {"nodal": {}, "element": {}}
+    fields = {"nodal": {}, "element": {}, "global": {}}
     for name in variables:
         placement, vector = PERIDIGM_VARIABLES[name]
         fields[placement][name] = dim if vector else 1
+    global_ = fields["global"] | {
+        k: dim if PERIDIGM_VARIABLES[v[0]][1] else 1 for k, v in (sums or {}).items()
+    }
+    if not fields["nodal"] and not fields["element"]:  # global variables only: a history file
+        return ExodusWriter(path, np.zeros((1, dim)), global_=global_)
     position = np.arange(body.n_points)
     if rows is not None:
         position[rows] = np.arange(body.n_points)
@@ -538,7 +603,7 @@ def variables_exodus(body: Body, path, variables, sums=None, rows=None, dim=None
         node_sets=sets,
         nodal=fields["nodal"],
         element=fields["element"],
-        global_={k: dim if PERIDIGM_VARIABLES[v[0]][1] else 1 for k, v in (sums or {}).items()},
+        global_=global_,
     )
 
 

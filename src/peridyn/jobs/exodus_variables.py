@@ -51,6 +51,9 @@ def variable_values(model: Model, variables, sums=None, loading=None):
                 state.time, np.zeros((body.n_points, 3))
             )[:, :dim],
             "Lambda": lambda: np.zeros(body.n_points),
+            "Global_Kinetic_Energy": lambda: (
+                0.5 * np.sum(model.density * body.volumes * np.sum(state.v**2, axis=1))
+            ),
             "Force_Density": lambda: force_density,
             "Force": lambda: force_density * body.volumes[:, None],
             "Element_Id": lambda: np.arange(1.0, body.n_points + 1.0),
@@ -65,7 +68,8 @@ def variable_values(model: Model, variables, sums=None, loading=None):
         }
         out = {"nodal": {}, "element": {}, "global_": {}}
         for name in variables:
-            out[PERIDIGM_VARIABLES[name][0]][name] = computed[name]()
+            placement = PERIDIGM_VARIABLES[name][0]
+            out["global_" if placement == "global" else placement][name] = computed[name]()
         for name, (variable, set_name, *calculation) in sums.items():
             reduce = REDUCTIONS[calculation[0] if calculation else "sum"]
             out["global_"][name] = reduce(computed[variable]()[body.node_set(set_name)], axis=0)
@@ -102,6 +106,11 @@ class GatheredVariables:
     def __init__(self, domain, model: Model, variables, sums, whole_body, loading=None):
         self.domain, self.whole_body = domain, whole_body
         self.variables, self.sums = list(variables), dict(sums or {})
+        whole = [v for v in self.variables if PERIDIGM_VARIABLES[v][0] == "global"]
+        if whole:
+            raise CaseFileError(
+                "<case>", "output.exodus.variables", whole[0], "a per-point variable under MPI"
+            )
         needed = self.variables + [v for v, *_ in self.sums.values() if v not in self.variables]
         self._local = variable_values(model, needed, loading=loading)
         self._values: dict | None = None

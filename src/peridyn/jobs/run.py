@@ -62,6 +62,7 @@ def recorder_spec(case: Case, body: Body, dt: float) -> RecorderSpec:
         stress=out.stress,
         strain=out.strain,
         **exodus_spec(out.exodus),
+        exodus_more=tuple(exodus_spec(more) for more in out.exodus_more),
     )
 
 
@@ -233,17 +234,11 @@ def exodus_values(case: Case, setup: Setup, spec: RecorderSpec):
     ``collect`` every rank calls at the states recorded."""
     if not spec.exodus_variables:
         return None
-    check_variables(case.name, setup.model, spec.exodus_variables)
+    variables, sums = spec.all_exodus_variables()
+    check_variables(case.name, setup.model, variables)
     if setup.domain.size > 1:  # each rank's owned values, gathered on rank 0 (``collect``)
-        return GatheredVariables(
-            setup.domain,
-            setup.model,
-            spec.exodus_variables,
-            spec.exodus_sums,
-            setup.whole_body,
-            setup.loading,
-        )
-    return variable_values(setup.model, spec.exodus_variables, spec.exodus_sums, setup.loading)
+        return GatheredVariables(setup.domain, setup.model, variables, sums, setup.whole_body, setup.loading)
+    return variable_values(setup.model, variables, sums, setup.loading)
 
 
 def step_count(case: Case, solver) -> int:
