@@ -581,13 +581,15 @@ class ExodusOutput(Strict):
 
     file: Annotated[str, Field(pattern=r"^[^/\\]+$")] = "results.e"
     every: Annotated[int, NotBool, Field(ge=1)] = 1
-    variables: Annotated[list[str], Field(min_length=1)]
+    variables: list[str]
     sums: dict[str, SetSum] = {}
     point_order: Literal["peridyn", "grid"] = "peridyn"
     three_d: bool = False
 
     @model_validator(mode="after")
     def _known(self):
+        if not self.variables and not self.sums:
+            raise ValueError("variables: at least one variable or sum to write")
         for name in self.variables:
             if name not in PERIDIGM_VARIABLES:
                 raise ValueError(

@@ -811,6 +811,9 @@ def _output(deck: _Deck, model: str, sums: dict) -> dict:
             )
         same["variables"] += [v for v in exodus["variables"] if v not in same["variables"]]
         same.setdefault("sums", {}).update(exodus.get("sums", {}))
+    for exodus in merged:  # of global variables only, Peridigm writes a history file, ".h"
+        history = all(PERIDIGM_VARIABLES[n][0] == "global" for n in exodus["variables"])
+        exodus["file"] += ".h" if history else ".e"
     if merged:
         out["exodus"] = merged[0]
     if len(merged) > 1:
@@ -837,9 +840,7 @@ def _exodus_file(deck: _Deck, where: str, model: str, sums: dict) -> dict:
     every = deck.get(f"{where}.Output Frequency", int, 1)
     if every < 1:
         raise deck.error(f"{where}.Output Frequency", every, "at least 1 step")
-    history = all(PERIDIGM_VARIABLES[n][0] == "global" for n in names)  # Peridigm's ".h" file
-    suffix = ".h" if history else ".e"
-    exodus = {"file": deck.get(f"{where}.Output Filename", str) + suffix, "every": every, "variables": names}
+    exodus = {"file": deck.get(f"{where}.Output Filename", str), "every": every, "variables": names}
     if asked_sums:
         exodus["sums"] = asked_sums
     return exodus

@@ -102,6 +102,9 @@ class RecorderSpec:
     exodus_three_d : bool
         Write a 2D body's named variables with three coordinates and vector components (z 0),
         as Peridigm does.
+    exodus_named : bool
+        The Exodus file holds the named variables and sums (``output.exodus`` as a mapping),
+        not ``snapshot_exodus``'s fields.
     exodus_more : tuple of dict
         More Exodus files of named variables, each a dict of the ``exodus_*`` settings above
         (``exodus_file``, ``exodus_every``, ``exodus_variables``, ...), written at its own steps.
@@ -125,6 +128,7 @@ class RecorderSpec:
     exodus_order: str = "peridyn"
     exodus_three_d: bool = False
     exodus_more: tuple = ()
+    exodus_named: bool = False
     stress: bool = False
     strain: bool = False
 
@@ -265,14 +269,14 @@ class Recorder:
         if spec.vtu:
             (self.directory / "snapshots").mkdir(exist_ok=True)
             self.pvd = PVDCollection(self.directory / "snapshots.pvd", mode=mode)
-        if spec.exodus_variables and fields is None:
+        if spec.exodus_named and fields is None:
             raise InputError("named Exodus variables need a fields function: the recorder has none")
         self.fields = fields
         self._exodus_step = None  # the step of the last Exodus record
         self.exodus = None
         self._rows = grid_order(body.points) if spec.exodus_order == "grid" else None
         self._dim = 3 if spec.exodus_three_d else body.dim
-        if spec.exodus and spec.exodus_variables:
+        if spec.exodus and spec.exodus_named:
             self.exodus = variables_exodus(
                 body,
                 self.directory / spec.exodus_file,
@@ -391,7 +395,7 @@ class Recorder:
         self._exodus_step = state.step
         spec = self.spec
         main = spec.main_exodus_due(state.step) if spec.exodus_every is not None else at_snapshot
-        if not spec.exodus_variables:
+        if not spec.exodus_named:
             if main:
                 self.exodus.append(state.time, **exodus_fields(self.body, state, self.damage))
             return

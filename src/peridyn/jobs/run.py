@@ -78,6 +78,7 @@ def exodus_spec(exodus) -> dict:
         "exodus_sums": {k: (v.variable, v.set, v.calculation) for k, v in exodus.sums.items()},
         "exodus_order": exodus.point_order,
         "exodus_three_d": exodus.three_d,
+        "exodus_named": True,
     }
 
 
@@ -232,7 +233,7 @@ def exodus_values(case: Case, setup: Setup, spec: RecorderSpec):
     """The recorder's ``fields``: the values of the named Exodus variables (``output.exodus``
     as a mapping) at a state, or None without them; under MPI a ``GatheredVariables``, whose
     ``collect`` every rank calls at the states recorded."""
-    if not spec.exodus_variables:
+    if not spec.exodus_named:
         return None
     variables, sums = spec.all_exodus_variables()
     check_variables(case.name, setup.model, variables)
