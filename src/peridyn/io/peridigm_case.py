@@ -70,6 +70,7 @@ SECTIONS = {
     "Output",
     "Compute Class Parameters",
     "Damage Models",
+    "Contact",
 }
 #: Material parameters that change how Peridigm computes, not what: its tangent by automatic
 #: differentiation or by finite differences gives the same equilibrium.
@@ -170,6 +171,8 @@ def deck_case(params: dict, name: str, source: str = "<deck>", deck_dir=".") -> 
         case["boundary_conditions"] = bcs
     if ics:
         case["initial_conditions"] = ics
+    if "Contact" in params:
+        case["contact"] = _contact(deck, groups, case.get("material") or case["materials"])
     model = (case.get("material") or next(iter(case["materials"].values())))["model"]
     case["output"] = _output(deck, model, _compute_classes(deck))
     for exodus in [case["output"].get("exodus"), *case["output"].get("exodus_more", [])]:
@@ -734,6 +737,60 @@ def _conditions(deck: _Deck, deck_dir: Path, grid, mesh_sets: bool, first_id: in
     return sets, bcs, ics
 
 
+def _contact(deck: _Deck, groups: list[_Group], materials: dict) -> dict:
+    """``contact`` of the deck's ``Contact`` section: one "Short Range Force" model between
+    every pair of blocks (``General Contact``, or interactions naming every pair), its
+    ``Contact Radius`` (m) and ``Spring Constant`` (Pa): Peridigm's short-range constant is
+    18 K_s / (pi delta^4), the PMB micromodulus of the bulk modulus K_s, so peridyn's
+    ``stiffness_factor`` (a multiple of the micromodulus of the material, K = E / 1.5) is
+    1.5 K_s / E. ``Search Radius`` and ``Search Frequency`` say how Peridigm finds the pairs
+    (peridyn's list is kept complete), not which; they are not read."""
+    where = "Contact"
+    for key in deck.get(where, dict):
+        if key not in ("Verbose", "Search Radius", "Search Frequency", "Models", "Interactions"):
+            raise deck.error(
+                f"{where}.{key}", None, "Search Radius, Search Frequency, Models, Interactions", False
+            )
+    models = deck.get(f"{where}.Models", dict)
+    if len(models) != 1:
+        raise deck.error(f"{where}.Models", sorted(models), "one contact model")
+    (name,) = models
+    at = f"{where}.Models.{name}"
+    kind = deck.get(f"{at}.Contact Model", str)
+    if kind != "Short Range Force":
+        raise deck.error(f"{at}.Contact Model", kind, "'Short Range Force'")
+    for key in deck.get(at, dict):
+        if key not in ("Contact Model", "Contact Radius", "Spring Constant"):
+            raise deck.error(f"{at}.{key}", None, "Contact Model, Contact Radius, Spring Constant", False)
+    radius, spring = deck.get(f"{at}.Contact Radius", float), deck.get(f"{at}.Spring Constant", float)
+    for key, value in (("Contact Radius", radius), ("Spring Constant", spring)):
+        if not value > 0:
+            raise deck.error(f"{at}.{key}", value, "a positive value")
+    blocks = sorted({b for g in groups for b in g.block_names})
+    needed = {frozenset((a, b)) for a in blocks for b in blocks}
+    for label in deck.get(f"{where}.Interactions", dict):
+        at = f"{where}.Interactions.{label}"
+        if deck.get(f"{at}.Contact Model", str) != name:
+            raise deck.error(f"{at}.Contact Model", deck.get(f"{at}.Contact Model"), repr(name))
+        if label == "General Contact":
+            needed = set()
+        else:
+            needed.discard(
+                frozenset((deck.get(f"{at}.First Block", str), deck.get(f"{at}.Second Block", str)))
+            )
+    if needed:
+        pairs = sorted(" with ".join(sorted(p)) if len(p) > 1 else f"{min(p)} with itself" for p in needed)
+        raise deck.error(
+            f"{where}.Interactions", pairs, "contact between every pair of blocks (General Contact)"
+        )
+    moduli = {m["E"] for m in ([materials] if "model" in materials else materials.values())}
+    if len(moduli) > 1:
+        raise deck.error(
+            where, sorted(moduli), "materials of one Young's modulus (the contact constant's reference)"
+        )
+    return {"radius_m": radius, "stiffness_factor": 1.5 * spring / moduli.pop()}
+
+
 def _lists_node_zero(deck: _Deck) -> bool:
     """True when an inline node set of ``Boundary Conditions`` lists node 0: the deck's ids
     then count from 0 (as the older form's do)."""
@@ -811,9 +868,6 @@ def _output(deck: _Deck, model: str, sums: dict) -> dict:
             )
         same["variables"] += [v for v in exodus["variables"] if v not in same["variables"]]
         same.setdefault("sums", {}).update(exodus.get("sums", {}))
-    for exodus in merged:  # of global variables only, Peridigm writes a history file, ".h"
-        history = all(PERIDIGM_VARIABLES[n][0] == "global" for n in exodus["variables"])
-        exodus["file"] += ".h" if history else ".e"
     if merged:
         out["exodus"] = merged[0]
     if len(merged) > 1:
@@ -822,7 +876,8 @@ def _output(deck: _Deck, model: str, sums: dict) -> dict:
 
 
 def _exodus_file(deck: _Deck, where: str, model: str, sums: dict) -> dict:
-    """``ExodusOutput`` of one output list."""
+    """``ExodusOutput`` of one output list: ``<Output Filename>.e``, or of global variables and
+    compute classes only a history file, ``.h``, as Peridigm names them."""
     for key in deck.get(where, dict):
         if key not in OUTPUT and key != "Output Variables":
             raise deck.error(f"{where}.{key}", None, f"only the parameters {sorted(OUTPUT)}", False)
@@ -840,7 +895,9 @@ def _exodus_file(deck: _Deck, where: str, model: str, sums: dict) -> dict:
     every = deck.get(f"{where}.Output Frequency", int, 1)
     if every < 1:
         raise deck.error(f"{where}.Output Frequency", every, "at least 1 step")
-    exodus = {"file": deck.get(f"{where}.Output Filename", str), "every": every, "variables": names}
+    history = all(PERIDIGM_VARIABLES[n][0] == "global" for n in names)  # Peridigm's ".h" file
+    suffix = ".h" if history else ".e"
+    exodus = {"file": deck.get(f"{where}.Output Filename", str) + suffix, "every": every, "variables": names}
     if asked_sums:
         exodus["sums"] = asked_sums
     return exodus
