@@ -32,6 +32,7 @@ class Tolerance:
         if self.floor > 0:
             diff = np.where((np.abs(gold) < self.floor) & (np.abs(mine) < self.floor), 0.0, diff)
         scale = np.maximum(np.abs(gold), np.abs(mine)) if self.kind == "relative" else 1.0
+        scale = np.where(scale == 0, 1.0, scale)  # two zeros: no difference to scale
         return float(np.max(diff / (self.value * scale), initial=0.0)) - 1.0
 
 

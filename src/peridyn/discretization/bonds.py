@@ -504,6 +504,38 @@ def crossing_finite_plane(
     return meets & inside
 
 
+def crossing_triangles(x_from: np.ndarray, x_to: np.ndarray, triangles: np.ndarray, tolerance: float = 1e-15):
+    """Mask of segments ``x_from -> x_to`` ((n, 3), m) that meet any of ``triangles`` ((m, 3, 3),
+    m: the corners v1, v2, v3 of each), as Peridigm's triangle bond filter finds them: the line
+    meets the triangle's plane at t in [0, 1] (not when parallel to it, |(x_to - x_from) . n| <
+    1e-14 |n|), at a point of barycentric coordinates alpha (along v3 - v1), beta (along
+    v2 - v1) with alpha > -tol, beta > -tol and alpha + beta < 1 + 2 tol."""
+    out = np.zeros(len(x_from), dtype=bool)
+    low, high = np.minimum(x_from, x_to), np.maximum(x_from, x_to)
+    for v1, v2, v3 in np.asarray(triangles, dtype=float):
+        near = np.all(
+            (low <= np.maximum(np.maximum(v1, v2), v3)) & (high >= np.minimum(np.minimum(v1, v2), v3)), axis=1
+        )
+        idx = np.flatnonzero(near & ~out)
+        if len(idx) == 0:
+            continue
+        p0, p1 = x_from[idx], x_to[idx]
+        a, b = v3 - v1, v2 - v1
+        n = np.cross(b, a)
+        denominator = (p1 - p0) @ n
+        parallel = np.abs(denominator) < 1e-14 * np.linalg.norm(n)
+        t = ((v1 - p0) @ n) / np.where(parallel, 1.0, denominator)
+        c = p0 + t[:, None] * (p1 - p0) - v1
+        d00, d01, d11 = a @ a, a @ b, b @ b
+        d02, d12 = c @ a, c @ b
+        det = d00 * d11 - d01 * d01
+        alpha = (d11 * d02 - d01 * d12) / det
+        beta = (d00 * d12 - d01 * d02) / det
+        inside = (alpha > -tolerance) & (beta > -tolerance) & (alpha + beta < 1.0 + 2.0 * tolerance)
+        out[idx] = ~parallel & (t >= 0.0) & (t <= 1.0) & inside
+    return out
+
+
 CUT_CHUNK = 1_000_000  # bonds tested at a time: bounds the (chunk, 3) temporaries of ``crossing``
 
 

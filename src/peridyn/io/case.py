@@ -382,10 +382,15 @@ class Block(Strict):
 
 
 class Precrack(Strict):
-    """Bonds crossing a planar rectangle (origin, edge_u, edge_v; 3D) or a segment
-    (start, end; 2D) are cut."""
+    """Bonds crossing a planar rectangle (origin, edge_u, edge_v; 3D), a segment (start, end;
+    2D) or a surface (``file``: an Exodus mesh of triangles, e.g. shells, relative to the case
+    file; Peridigm's "Exodus Mesh" bond filter of an initial damage model) are cut."""
 
-    type: Literal["rectangle", "segment"]
+    type: Literal["rectangle", "segment", "surface"]
+    file: str | None = None
+    #: the cut bonds still count in LPS's weighted volumes (Peridigm's initial damage breaks
+    #: them after its weighted volumes are computed); false: the family is the intact bonds
+    in_weighted_volume: bool = False
     origin: Vector3 | None = None
     edge_u: Vector3 | None = None
     edge_v: Vector3 | None = None
@@ -394,7 +399,11 @@ class Precrack(Strict):
 
     @model_validator(mode="after")
     def _complete(self):
-        keys = ("origin", "edge_u", "edge_v") if self.type == "rectangle" else ("start", "end")
+        keys = {
+            "rectangle": ("origin", "edge_u", "edge_v"),
+            "segment": ("start", "end"),
+            "surface": ("file",),
+        }[self.type]
         missing = [k for k in keys if getattr(self, k) is None]
         if missing:
             raise ValueError(f"a {self.type} pre-crack needs {', '.join(missing)}")

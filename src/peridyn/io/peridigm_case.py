@@ -171,6 +171,9 @@ def deck_case(params: dict, name: str, source: str = "<deck>", deck_dir=".") -> 
         case["boundary_conditions"] = bcs
     if ics:
         case["initial_conditions"] = ics
+    cracks = _initial_damage(deck, groups, deck_dir)
+    if cracks:
+        case["precracks"] = cracks
     if "Contact" in params:
         case["contact"] = _contact(deck, groups, case.get("material") or case["materials"])
     model = (case.get("material") or next(iter(case["materials"].values())))["model"]
@@ -528,6 +531,8 @@ def _damage(deck: _Deck, key: str) -> dict:
     where = f"Damage Models.{name}"
     deck.get(where, dict)
     model = deck.get(f"{where}.Damage Model", str)
+    if model == "Initial Damage":
+        return {}  # its bonds are broken by the case's pre-cracks (``_initial_damage``)
     if model not in ("Critical Stretch", "Time Dependent Critical Stretch"):
         raise deck.error(
             f"{where}.Damage Model", model, "'Critical Stretch' or 'Time Dependent Critical Stretch'"
@@ -735,6 +740,35 @@ def _conditions(deck: _Deck, deck_dir: Path, grid, mesh_sets: bool, first_id: in
         else:
             raise deck.error(f"{where}.Type", kind, f"one of {sorted(INITIAL) + sorted(BOUNDARY)}")
     return sets, bcs, ics
+
+
+def _initial_damage(deck: _Deck, groups: list[_Group], deck_dir: Path) -> list[dict]:
+    """Pre-cracks of the blocks' "Initial Damage" models: each "Exodus Mesh" bond filter a
+    ``surface`` (its triangles; bonds crossing them start broken, Peridigm's bond damage 1,
+    still counting in the weighted volumes, which Peridigm computes before)."""
+    cracks = []
+    for group in groups:
+        name = deck.get(group.damage_key, str, None)
+        where = f"Damage Models.{name}"
+        if name is None or deck.get(f"{where}.Damage Model", str) != "Initial Damage":
+            continue
+        if len(groups) > 1:
+            raise deck.error(
+                f"{where}.Damage Model", "Initial Damage", "one block group (the pre-cracks cut every block)"
+            )
+        for key in deck.get(where, dict):
+            if key not in ("Damage Model", "Bond Filters"):
+                raise deck.error(f"{where}.{key}", None, "Damage Model and Bond Filters only", False)
+        for label in deck.get(f"{where}.Bond Filters", dict):
+            at = f"{where}.Bond Filters.{label}"
+            kind = deck.get(f"{at}.Type", str)
+            if kind != "Exodus Mesh":
+                raise deck.error(f"{at}.Type", kind, "'Exodus Mesh' (a surface of triangles)")
+            path = deck_dir / deck.get(f"{at}.File Name", str)
+            if not path.is_file():
+                raise deck.error(f"{at}.File Name", str(path), "an existing Exodus file")
+            cracks.append({"type": "surface", "file": str(path.resolve()), "in_weighted_volume": True})
+    return cracks
 
 
 def _contact(deck: _Deck, groups: list[_Group], materials: dict) -> dict:

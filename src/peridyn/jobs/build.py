@@ -20,6 +20,7 @@ from peridyn.discretization.bonds import (
     crossing_mask,
     crossing_rectangle,
     crossing_segment,
+    crossing_triangles,
     cut_bonds,
     find_bonds,
     reorder_bonds,
@@ -215,18 +216,48 @@ def build_bonds(case: Case, body: Body, required=None, of_block=None) -> Bonds:
     bonds = find_bonds(
         body, horizon, d.influence, d.partial_volumes, required=required, box=box, point_horizon=point_horizon
     )
+    cut_precracks(case, body, bonds, in_weighted_volume=False)
+    return filtered(case, body, bonds, of_block)
+
+
+def cut_precracks(case: Case, body: Body, bonds: Bonds, in_weighted_volume: bool) -> None:
+    """Break the bonds of the case's pre-cracks whose ``in_weighted_volume`` is the one given:
+    those not counting in LPS's weighted volumes before the model is made (``build_bonds``),
+    those counting in them after (``build_model``'s callers)."""
     for crack in case.precracks:
+        if crack.in_weighted_volume != in_weighted_volume:
+            continue
         if crack.type == "rectangle":
 
             def crossing(a, b, c=crack):
                 return crossing_rectangle(a, b, c.origin, c.edge_u, c.edge_v)
+        elif crack.type == "surface":
+            triangles = surface_triangles(crack.file)
+
+            def crossing(a, b, tris=triangles):
+                return crossing_triangles(a, b, tris)
         else:
 
             def crossing(a, b, c=crack):
                 return crossing_segment(a, b, c.start, c.end)
 
         cut_bonds(body, bonds, crossing)
-    return filtered(case, body, bonds, of_block)
+
+
+def surface_triangles(path) -> np.ndarray:
+    """(m, 3, 3) corners (m) of the triangles of an Exodus surface mesh (3-node elements, or
+    4-node ones split into two triangles by their first diagonal)."""
+    mesh = exodus.read_exodus(path)
+    triangles = []
+    for block in mesh.blocks:
+        nodes = mesh.coordinates[block.connectivity]
+        if nodes.shape[1] == 3:
+            triangles.append(nodes)
+        elif nodes.shape[1] == 4:
+            triangles += [nodes[:, [0, 1, 2]], nodes[:, [0, 2, 3]]]
+        else:
+            raise InputError(f"{path}: block {block.name!r} of {nodes.shape[1]}-node elements, not a surface")
+    return np.concatenate(triangles)
 
 
 def filtered(case: Case, body: Body, bonds: Bonds, of_block=None) -> Bonds:
@@ -380,6 +411,7 @@ def build(case: Case, base_dir=".", comm=None) -> Setup:
     bonds = build_bonds(case, body)
     interrupts.check(where=BUILDING)
     model = build_model(case, body, bonds)
+    cut_precracks(case, body, bonds, in_weighted_volume=True)
     damage = build_damage(case, model)
     interrupts.check(where=BUILDING)
     loading = build_loading(case, body, actuation)
@@ -451,6 +483,7 @@ def _build_part(case: Case, comm, base_dir):
     part = body.subset(local_ids)
     part_blocks = None if of_block is None else of_block[local_ids]
     model = build_model(case, part, bonds, part_blocks)
+    cut_precracks(case, part, bonds, in_weighted_volume=True)
     materials = case.block_materials().values()
     no_damage = sorted({name for m in materials if m.damage is not None for name in m.damage.no_damage_sets})
     protected = protected_points(body, no_damage)[local_ids]
