@@ -129,6 +129,11 @@ def deck_case(params: dict, name: str, source: str = "<deck>", deck_dir=".") -> 
     """
     deck = _Deck(params, source)
     deck_dir = Path(deck_dir)
+    sequence = [k for k in params if re.fullmatch(r"Solver\d+", k)]
+    if sequence:
+        raise deck.error(
+            sequence[0], None, "one Solver list (peridyn does not run a sequence of solvers)", False
+        )
     for key in params:
         if key not in SECTIONS and not key.startswith("Output"):
             raise deck.error(key, None, f"one of the sections peridyn reads: {sorted(SECTIONS)}", False)
