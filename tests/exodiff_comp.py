@@ -1,7 +1,8 @@
 """A small exodiff for tests: compare an Exodus result with a gold file under the tolerances of
 an exodiff command file (``*.comp``, as Peridigm's test suite writes them).
 
-The subset read: ``DEFAULT TOLERANCE``, ``COORDINATES``, ``TIME STEPS``, and the sections
+The subset read: ``DEFAULT TOLERANCE`` (coordinates and times without their own line take it),
+``COORDINATES``, ``TIME STEPS``, and the sections
 ``NODAL VARIABLES``, ``ELEMENT VARIABLES``, ``GLOBAL VARIABLES`` whose indented lines name a
 variable and its tolerance (``absolute T`` or ``relative T``, optionally ``floor F``: values
 below F in magnitude count as equal). As in exodiff, a section compares the variables it lists.
@@ -31,6 +32,7 @@ class Tolerance:
         if self.floor > 0:
             diff = np.where((np.abs(gold) < self.floor) & (np.abs(mine) < self.floor), 0.0, diff)
         scale = np.maximum(np.abs(gold), np.abs(mine)) if self.kind == "relative" else 1.0
+        scale = np.where(scale == 0, 1.0, scale)  # two zeros: no difference to scale
         return float(np.max(diff / (self.value * scale), initial=0.0)) - 1.0
 
 
@@ -61,6 +63,9 @@ def read_comp(path) -> dict:
             out["times"] = _tolerance(words[2:])
         elif head in ("NODAL VARIABLES", "ELEMENT VARIABLES", "GLOBAL VARIABLES"):
             section = words[0].lower()
+    default = out.get("default", Tolerance("relative", 1e-6))  # exodiff's own default
+    out.setdefault("coordinates", default)
+    out.setdefault("times", default)
     return out
 
 

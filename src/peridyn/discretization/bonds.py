@@ -8,7 +8,7 @@ MPI, by the neighbours' global index: ``peridyn.parallel``).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import NamedTuple
 
 import numpy as np
@@ -480,6 +480,71 @@ def crossing_segment(x_from: np.ndarray, x_to: np.ndarray, start, end) -> np.nda
     return (s1 * s2 < 0) & (s3 * s4 < 0)
 
 
+def crossing_finite_plane(
+    x_from: np.ndarray,
+    x_to: np.ndarray,
+    corner,
+    normal,
+    bottom,
+    bottom_length: float,
+    side_length: float,
+    tolerance: float = 1e-15,
+) -> np.ndarray:
+    """Mask of segments ``x_from -> x_to`` ((n, 3), m) that meet a finite plane as Peridigm's
+    "Rectangular_Plane" bond filter finds them (its ``PdBondFilter::FinitePlane``): the line
+    meets the plane through ``corner`` of ``normal`` at t in [0, 1] (a segment touching it at
+    an end counts; one parallel to it, |(x_to - x_from) . n| < 1e-14, does not), at a point
+    whose coordinates a = (x - corner) . (bottom x normal) and b = (x - corner) . bottom
+    satisfy -tol < a < (1 + tol) ``side_length`` and -tol < b < (1 + tol) ``bottom_length``
+    (Peridigm's tolerance, 1e-15). ``normal`` and ``bottom`` are taken as given (Peridigm does
+    not normalise them). A bond that meets an edge exactly is decided by the rounding of its
+    points' coordinates."""
+    r0, n, ub = (np.asarray(v, float) for v in (corner, normal, bottom))
+    ua = np.cross(ub, n)
+    numerator = (r0 - x_from) @ n
+    denominator = (x_to - x_from) @ n
+    parallel = np.abs(denominator) < 1e-14
+    t = np.where(parallel, np.inf, numerator / np.where(parallel, 1.0, denominator))
+    meets = (t >= 0.0) & (t <= 1.0)
+    hit = x_from + np.where(meets, t, 0.0)[:, None] * (x_to - x_from) - r0
+    a, b = hit @ ua, hit @ ub
+    inside = (-tolerance < a) & (a / side_length < 1 + tolerance)
+    inside &= (-tolerance < b) & (b / bottom_length < 1 + tolerance)
+    return meets & inside
+
+
+def crossing_triangles(x_from: np.ndarray, x_to: np.ndarray, triangles: np.ndarray, tolerance: float = 1e-15):
+    """Mask of segments ``x_from -> x_to`` ((n, 3), m) that meet any of ``triangles`` ((m, 3, 3),
+    m: the corners v1, v2, v3 of each), as Peridigm's triangle bond filter finds them: the line
+    meets the triangle's plane at t in [0, 1] (not when parallel to it, |(x_to - x_from) . n| <
+    1e-14 |n|), at a point of barycentric coordinates alpha (along v3 - v1), beta (along
+    v2 - v1) with alpha > -tol, beta > -tol and alpha + beta < 1 + 2 tol."""
+    out = np.zeros(len(x_from), dtype=bool)
+    low, high = np.minimum(x_from, x_to), np.maximum(x_from, x_to)
+    for v1, v2, v3 in np.asarray(triangles, dtype=float):
+        near = np.all(
+            (low <= np.maximum(np.maximum(v1, v2), v3)) & (high >= np.minimum(np.minimum(v1, v2), v3)), axis=1
+        )
+        idx = np.flatnonzero(near & ~out)
+        if len(idx) == 0:
+            continue
+        p0, p1 = x_from[idx], x_to[idx]
+        a, b = v3 - v1, v2 - v1
+        n = np.cross(b, a)
+        denominator = (p1 - p0) @ n
+        parallel = np.abs(denominator) < 1e-14 * np.linalg.norm(n)
+        t = ((v1 - p0) @ n) / np.where(parallel, 1.0, denominator)
+        c = p0 + t[:, None] * (p1 - p0) - v1
+        d00, d01, d11 = a @ a, a @ b, b @ b
+        d02, d12 = c @ a, c @ b
+        det = d00 * d11 - d01 * d01
+        alpha = (d11 * d02 - d01 * d12) / det
+        beta = (d00 * d12 - d01 * d02) / det
+        inside = (alpha > -tolerance) & (beta > -tolerance) & (alpha + beta < 1.0 + 2.0 * tolerance)
+        out[idx] = ~parallel & (t >= 0.0) & (t <= 1.0) & inside
+    return out
+
+
 CUT_CHUNK = 1_000_000  # bonds tested at a time: bounds the (chunk, 3) temporaries of ``crossing``
 
 
@@ -489,14 +554,37 @@ def cut_bonds(body: Body, bonds: Bonds, crossing) -> int:
     ``crossing`` is e.g. ``lambda a, b: crossing_rectangle(a, b, o, u, v)``; it is called on
     CUT_CHUNK bonds at a time.
     """
+    mask = crossing_mask(body, bonds, crossing)
+    bonds.intact[mask] = False
+    return int(mask.sum())
+
+
+def crossing_mask(body: Body, bonds: Bonds, crossing) -> np.ndarray:
+    """(n_bonds,) bool: ``crossing(x_i, x_j)`` of every bond, on both copies of a bond where
+    either has it (``both_copies``), CUT_CHUNK bonds at a time."""
     owners = bonds.owners()
     mask = np.zeros(bonds.n_bonds, dtype=bool)
     for start in range(0, bonds.n_bonds, CUT_CHUNK):
         chunk = slice(start, start + CUT_CHUNK)
         mask[chunk] = crossing(body.points[owners[chunk]], body.points[bonds.neighbours[chunk]])
-    mask = both_copies(mask, bonds.reverse())
-    bonds.intact[mask] = False
-    return int(mask.sum())
+    return both_copies(mask, bonds.reverse())
+
+
+def without_bonds(bonds: Bonds, mask: np.ndarray) -> Bonds:
+    """``bonds`` less the directed bonds of ``mask`` ((n_bonds,) bool, both copies of a bond
+    set): they leave the families, as Peridigm's bond filters take them out of its neighbour
+    lists (no neighbour, no weighted volume, no damage), where a cut bond stays a broken one."""
+    keep = ~np.asarray(mask, dtype=bool)
+    counts = np.bincount(bonds.owners()[keep], minlength=len(bonds.offsets) - 1)
+    return replace(
+        bonds,
+        offsets=np.concatenate([[0], np.cumsum(counts)]).astype(bonds.offsets.dtype),
+        neighbours=bonds.neighbours[keep],
+        length=bonds.length[keep],
+        influence=bonds.influence[keep],
+        volume_factor=bonds.volume_factor[keep],
+        intact=bonds.intact[keep],
+    )
 
 
 def both_copies(mask: np.ndarray, reverse: np.ndarray) -> np.ndarray:

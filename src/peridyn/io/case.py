@@ -221,6 +221,20 @@ class Geometry(Strict):
         return 2 if self.type == "rectangle" or (self.type == "mesh" and self.dimension == 2) else 3
 
 
+class BondFilter(Strict):
+    """Bonds meeting a finite plane leave the families (``finite_plane``: Peridigm's
+    "Rectangular_Plane" bond filter, ``peridyn.discretization.bonds.crossing_finite_plane``):
+    the plane through ``corner`` (m) of ``normal``, ``bottom_length`` (m) along ``bottom`` and
+    ``side_length`` (m) along bottom x normal; a bond touching it at an end counts."""
+
+    type: Literal["finite_plane"] = "finite_plane"
+    corner: Vector3
+    normal: Vector3
+    bottom: Vector3
+    bottom_length: Positive
+    side_length: Positive
+
+
 class Discretization(Strict):
     """Spacing (m, one value or one per axis for a box), horizon as a multiple of the spacing
     (``horizon``) or in metres (``horizon_m``), influence function and partial volumes."""
@@ -233,6 +247,10 @@ class Discretization(Strict):
     #: ``sphere``: |xi| <= horizon; ``box`` (a box geometry, no partial volumes): the points
     #: within round(horizon / spacing) cells along each axis, Peridigm's PdQuickGrid families
     neighbourhood: Literal["sphere", "box"] = "sphere"
+    #: bonds taken out of the families (Peridigm's bond filters; a pre-crack breaks them instead)
+    bond_filters: list[BondFilter] = []
+    #: False: no bond joins two blocks (Peridigm's "Omit Bonds Between Blocks: All")
+    bonds_between_blocks: bool = True
 
     def horizon_metres(self, spacing: float) -> float:
         """The horizon (m) on a grid of ``spacing`` (m): ``horizon_m``, or ``horizon`` spacings."""
@@ -288,7 +306,9 @@ class Damage(Strict):
     ``critical_bond_stress`` (Pa; bond stress E s, see ``peridyn.physics.damage``), and node sets
     where bonds never break."""
 
-    critical_stretch: Positive | None = None
+    #: a number, or a time function (a mapping, ``peridyn.physics.timefunctions.from_spec``;
+    #: a body of one material): s_c(t), Peridigm's "Time Dependent Critical Stretch"
+    critical_stretch: Positive | dict | None = None
     fracture_energy: Positive | None = None
     critical_bond_stress: Positive | None = None
     no_damage_sets: list[str] = []
@@ -373,10 +393,15 @@ class Block(Strict):
 
 
 class Precrack(Strict):
-    """Bonds crossing a planar rectangle (origin, edge_u, edge_v; 3D) or a segment
-    (start, end; 2D) are cut."""
+    """Bonds crossing a planar rectangle (origin, edge_u, edge_v; 3D), a segment (start, end;
+    2D) or a surface (``file``: an Exodus mesh of triangles, e.g. shells, relative to the case
+    file; Peridigm's "Exodus Mesh" bond filter of an initial damage model) are cut."""
 
-    type: Literal["rectangle", "segment"]
+    type: Literal["rectangle", "segment", "surface"]
+    file: str | None = None
+    #: the cut bonds still count in LPS's weighted volumes (Peridigm's initial damage breaks
+    #: them after its weighted volumes are computed); false: the family is the intact bonds
+    in_weighted_volume: bool = False
     origin: Vector3 | None = None
     edge_u: Vector3 | None = None
     edge_v: Vector3 | None = None
@@ -385,7 +410,11 @@ class Precrack(Strict):
 
     @model_validator(mode="after")
     def _complete(self):
-        keys = ("origin", "edge_u", "edge_v") if self.type == "rectangle" else ("start", "end")
+        keys = {
+            "rectangle": ("origin", "edge_u", "edge_v"),
+            "segment": ("start", "end"),
+            "surface": ("file",),
+        }[self.type]
         missing = [k for k in keys if getattr(self, k) is None]
         if missing:
             raise ValueError(f"a {self.type} pre-crack needs {', '.join(missing)}")
@@ -396,12 +425,15 @@ class BoundaryConditionSpec(Strict):
     """A condition on node set ``set``: kind, components ("x", "xy", ...) and a value
     (a number, a time function mapping, see ``peridyn.physics.timefunctions.from_spec``, or
     ``{type: expression, text: ...}``, an expression in x, y, z and t evaluated on the set's
-    points, see ``peridyn.physics.expressions``)."""
+    points, see ``peridyn.physics.expressions``). ``where_prescribed`` (a force): ``error`` if
+    another condition prescribes the motion of one of its components, or ``yield``: the prescribed
+    motion wins, the force still counting in the point's acceleration (Peridigm's convention)."""
 
     set: str
     kind: Literal["displacement", "velocity", "force", "body_force"]
     components: str | list[str] = "xyz"
     value: Finite | dict = 0.0
+    where_prescribed: Literal["error", "yield"] = "error"
 
 
 class InitialConditionSpec(Strict):
@@ -494,9 +526,13 @@ class Solver(Strict):
     breaking_rounds: Annotated[int, NotBool, Field(ge=1)] = 100
     displacement_tolerance: Positive = 1e-10
     #: newton: converged when the residual force's norm (N) is below it, instead of the
-    #: relative ``tolerance`` (Peridigm's "Absolute Tolerance")
+    #: relative ``tolerance``; newmark: instead of ``displacement_tolerance`` (Peridigm's
+    #: "Absolute Tolerance")
     absolute_tolerance: Positive | None = None
     linear_solver: Literal["lu", "cg"] = "lu"
+    #: newmark: the acceleration at t = 0, ``balance`` (of the initial forces) or ``zero``
+    #: (Peridigm's implicit solver)
+    initial_acceleration: Literal["balance", "zero"] = "balance"
     #: explicit: the reported velocity of a DOF with a prescribed displacement, ``rate`` (its
     #: time function's derivative) or ``difference`` (Peridigm's, see ``ExplicitSolver``)
     prescribed_velocity: Literal["rate", "difference"] = "rate"
@@ -547,25 +583,42 @@ class LineSpec(Strict):
 
 
 class SetSum(Strict):
-    """A global output variable: the sum of the nodal vector ``variable`` over node set ``set``
-    (Peridigm's "Block_Data" compute class with "Calculation Type: Sum")."""
+    """A global output variable: the sum (``calculation``: or the largest or smallest value,
+    per component) of the output variable ``variable`` (``PERIDIGM_VARIABLES``) over node set
+    ``set`` (Peridigm's "Block_Data" and "Node_Set_Data" compute classes)."""
 
-    variable: Literal["Displacement", "Velocity", "Force", "Force_Density", "Acceleration"]
+    variable: str
     set: str
+    calculation: Literal["sum", "maximum", "minimum"] = "sum"
+
+    @model_validator(mode="after")
+    def _known(self):
+        if self.variable not in PERIDIGM_VARIABLES:
+            raise ValueError(
+                f"variable: unknown output variable {self.variable!r}; known: {sorted(PERIDIGM_VARIABLES)}"
+            )
+        return self
 
 
 class ExodusOutput(Strict):
     """Exodus II output as Peridigm writes it: the ``variables`` named as Peridigm names them
     (``peridyn.io.exodus_write.PERIDIGM_VARIABLES``) and the global ``sums`` (name ->
-    ``SetSum``) in ``file`` (in the output folder), at every ``every``-th step from step 0."""
+    ``SetSum``) in ``file`` (in the output folder), at every ``every``-th step from step 0;
+    ``point_order``: the body's (``peridyn``) or ``grid`` (x fastest, then y, then z, as
+    Peridigm numbers a PdQuickGrid); ``three_d``: a 2D body written with three coordinates and
+    vector components (z = 0), as Peridigm writes it."""
 
     file: Annotated[str, Field(pattern=r"^[^/\\]+$")] = "results.e"
     every: Annotated[int, NotBool, Field(ge=1)] = 1
-    variables: Annotated[list[str], Field(min_length=1)]
+    variables: list[str]
     sums: dict[str, SetSum] = {}
+    point_order: Literal["peridyn", "grid"] = "peridyn"
+    three_d: bool = False
 
     @model_validator(mode="after")
     def _known(self):
+        if not self.variables and not self.sums:
+            raise ValueError("variables: at least one variable or sum to write")
         for name in self.variables:
             if name not in PERIDIGM_VARIABLES:
                 raise ValueError(
@@ -593,10 +646,22 @@ class Output(Strict):
     #: the VTU snapshots' data arrays: "none" (the default: written 8 times as fast) or "zlib"
     vtu_compression: Literal["none", "zlib"] = "none"
     exodus: bool | ExodusOutput = False
+    #: more Exodus files of named variables (Peridigm's Output1, Output2, ...), each at its own
+    #: frequency; ``exodus`` must then be a mapping too
+    exodus_more: list[ExodusOutput] = []
     plots: bool = True
     #: per-point partial stress and Green-Lagrange strain in the final fields and VTU snapshots
     stress: bool = False
     strain: bool = False
+
+    @model_validator(mode="after")
+    def _more_files(self):
+        if self.exodus_more and isinstance(self.exodus, bool):
+            raise ValueError("exodus_more: give exodus as a mapping (file, every, variables) too")
+        files = [e.file for e in [self.exodus, *self.exodus_more] if not isinstance(e, bool)]
+        if len(set(files)) != len(files):
+            raise ValueError(f"exodus and exodus_more: one file each, got {files}")
+        return self
 
 
 class ContactSpec(Strict):
@@ -729,6 +794,8 @@ class Case(Strict):
         used += [(f"output.planes.{k}", v) for k, v in self.output.planes.items()]
         if not isinstance(self.output.exodus, bool):
             used += [(f"output.exodus.sums.{k}.set", v.set) for k, v in self.output.exodus.sums.items()]
+        for n, more in enumerate(self.output.exodus_more):
+            used += [(f"output.exodus_more[{n}].sums.{k}.set", v.set) for k, v in more.sums.items()]
         used += [(f"blocks.{k}.set", b.set) for k, b in self.blocks.items() if b.set is not None]
         for key, mat in self.block_materials().items():
             if key != "material":

@@ -35,16 +35,18 @@ NUMRECS_OFFSET = 4
 MAX_NAME = 255
 COMPONENTS = "XYZ"
 #: Peridigm's output variables that peridyn writes: name -> (placement, vector). Nodal vectors:
-#: displacement (m), velocity (m/s), force (N), force density (N/m^3), acceleration (m/s^2);
-#: element scalars: 1-based id, 0-based id (``ID``, the older decks' name), rank, volume (m^3),
-#: dilatation, weighted volume (m^5), stored elastic energy (J, energy density times volume),
-#: number of neighbours and damage.
+#: displacement (m), velocity (m/s), force (N), force density (N/m^3), acceleration (m/s^2),
+#: external (body) force density (N/m^3); element scalars: 1-based id, 0-based id (``ID``, the
+#: older decks' name), rank, volume (m^3), dilatation, weighted volume (m^5), stored elastic
+#: energy (J, energy density times volume), number of neighbours, damage and the plastic
+#: multiplier (``Lambda``: 0, elastic materials); global: the kinetic energy (J).
 PERIDIGM_VARIABLES = {
     "Displacement": ("nodal", True),
     "Velocity": ("nodal", True),
     "Force": ("nodal", True),
     "Force_Density": ("nodal", True),
     "Acceleration": ("nodal", True),
+    "External_Force_Density": ("nodal", True),
     "Element_Id": ("element", False),
     "ID": ("element", False),
     "Proc_Num": ("element", False),
@@ -54,6 +56,8 @@ PERIDIGM_VARIABLES = {
     "Stored_Elastic_Energy": ("element", False),
     "Number_Of_Neighbors": ("element", False),
     "Damage": ("element", False),
+    "Lambda": ("element", False),
+    "Global_Kinetic_Energy": ("global", False),
 }
 
 

@@ -16,14 +16,17 @@ from __future__ import annotations
 
 import math
 import os
-from dataclasses import dataclass
+import re
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
 
 from peridyn.errors import CaseFileError, InputError
 from peridyn.io.case import Case, apply_override, load_case, validate_case
+from peridyn.io.exodus import read_exodus
 from peridyn.io.exodus_write import PERIDIGM_VARIABLES
+from peridyn.io.mesh_text import read_text_mesh
 from peridyn.io.peridigm_deck import is_peridigm_deck, read_deck
 from peridyn.physics.expressions import SpaceTime
 
@@ -36,6 +39,16 @@ MATERIALS = {
     "Elastic Bond Based": "pmb",
     "Linear LPS": "linear_lps",
     "Linear Elastic": "lps",
+}
+#: Words of Peridigm's material model names -> the feature peridyn lacks to run them.
+LACKING = {
+    "correspondence": "correspondence (non-ordinary state-based) models",
+    "plastic": "plasticity",
+    "thermal": "thermal models",
+    "diffusion": "thermal models",
+    "viscoelastic": "viscoelasticity",
+    "viscoplastic": "viscoplasticity",
+    "pals": "position-aware linear solid models",
 }
 #: Peridigm's partial-volume models, refused with ``PARTIAL_VOLUME_DIFFERS``.
 PARTIAL_VOLUME = ("Elastic Partial Volume", "Linear LPS Partial Volume")
@@ -57,7 +70,11 @@ SECTIONS = {
     "Output",
     "Compute Class Parameters",
     "Damage Models",
+    "Contact",
 }
+#: Material parameters that change how Peridigm computes, not what: its tangent by automatic
+#: differentiation or by finite differences gives the same equilibrium.
+IGNORED_MATERIAL = {"Apply Automatic Differentiation Jacobian"}
 #: Initial-condition kinds of the deck's boundary conditions.
 INITIAL = {"Initial Displacement": "displacement", "Initial Velocity": "velocity"}
 #: Boundary-condition kinds of the deck's boundary conditions.
@@ -112,10 +129,17 @@ def deck_case(params: dict, name: str, source: str = "<deck>", deck_dir=".") -> 
     """
     deck = _Deck(params, source)
     deck_dir = Path(deck_dir)
+    sequence = [k for k in params if re.fullmatch(r"Solver\d+", k)]
+    if sequence:
+        raise deck.error(
+            sequence[0], None, "one Solver list (peridyn does not run a sequence of solvers)", False
+        )
     for key in params:
         if key not in SECTIONS and not key.startswith("Output"):
             raise deck.error(key, None, f"one of the sections peridyn reads: {sorted(SECTIONS)}", False)
-    groups = _groups(deck)
+    for group in deck.get("Blocks", dict):  # the material models first: what peridyn lacks
+        _material(deck, deck.get(f"Blocks.{group}.Material", str))
+    groups = _with_default(deck, _groups(deck), deck_dir)
     horizon = max(g.horizon for g in groups)
     if len(groups) == 1:  # materials and solver first: their refusals before a missing mesh's
         (group,) = groups
@@ -144,7 +168,7 @@ def deck_case(params: dict, name: str, source: str = "<deck>", deck_dir=".") -> 
         **materials,
         "solver": solver,
     }
-    first_id = 0 if older_form(deck) else 1
+    first_id = 0 if older_form(deck) or _lists_node_zero(deck) else 1
     sets, bcs, ics = _conditions(deck, deck_dir, grid, geometry["type"] == "exodus", first_id)
     if sets:
         case["node_sets"] = sets
@@ -152,26 +176,46 @@ def deck_case(params: dict, name: str, source: str = "<deck>", deck_dir=".") -> 
         case["boundary_conditions"] = bcs
     if ics:
         case["initial_conditions"] = ics
+    cracks = _initial_damage(deck, groups, deck_dir)
+    if cracks:
+        case["precracks"] = cracks
+    if "Contact" in params:
+        case["contact"] = _contact(deck, groups, case.get("material") or case["materials"])
     model = (case.get("material") or next(iter(case["materials"].values())))["model"]
     case["output"] = _output(deck, model, _compute_classes(deck))
+    for exodus in [case["output"].get("exodus"), *case["output"].get("exodus_more", [])]:
+        if exodus is not None:  # Peridigm's numbering of a grid; three components in 2D
+            exodus["point_order"] = "grid" if grid is not None else "peridyn"
+            exodus["three_d"] = plane is not None
     return case
 
 
+#: Peridigm's compute classes of a variable over a set: class -> the parameter naming the set.
+COMPUTE_CLASSES = {"Block_Data": "Block", "Node_Set_Data": "Node Set"}
+#: Their calculation types: deck name -> ``SetSum.calculation``.
+CALCULATIONS = {"Sum": "sum", "Maximum": "maximum", "Minimum": "minimum"}
+
+
 def _compute_classes(deck: _Deck) -> dict:
-    """Output label -> ``{variable, set}`` of each "Block_Data" sum of ``Compute Class Parameters``."""
+    """Output label -> ``{variable, set, calculation}`` of each "Block_Data" or "Node_Set_Data"
+    of ``Compute Class Parameters``: a variable's sum, maximum or minimum over a block or a
+    node set."""
     out = {}
     for name in deck.get("Compute Class Parameters", dict, {}):
         where = f"Compute Class Parameters.{name}"
-        for key, expected in (("Compute Class", "Block_Data"), ("Calculation Type", "Sum")):
-            value = deck.get(f"{where}.{key}", str)
-            if value != expected:
-                raise deck.error(f"{where}.{key}", value, f"{expected!r} (the one compute class peridyn has)")
+        kind = deck.get(f"{where}.Compute Class", str)
+        if kind not in COMPUTE_CLASSES:
+            raise deck.error(f"{where}.Compute Class", kind, f"one of {sorted(COMPUTE_CLASSES)}")
+        calculation = deck.get(f"{where}.Calculation Type", str)
+        if calculation not in CALCULATIONS:
+            raise deck.error(f"{where}.Calculation Type", calculation, f"one of {sorted(CALCULATIONS)}")
         variable = deck.get(f"{where}.Variable", str)
-        if PERIDIGM_VARIABLES.get(variable) != ("nodal", True):
-            raise deck.error(f"{where}.Variable", variable, "a nodal vector variable, e.g. Force")
+        if variable not in PERIDIGM_VARIABLES:
+            raise deck.error(f"{where}.Variable", variable, f"one of {sorted(PERIDIGM_VARIABLES)}")
         out[deck.get(f"{where}.Output Label", str)] = {
             "variable": variable,
-            "set": deck.get(f"{where}.Block", str),
+            "set": deck.get(f"{where}.{COMPUTE_CLASSES[kind]}", str),
+            "calculation": CALCULATIONS[calculation],
         }
     return out
 
@@ -211,7 +255,7 @@ def _groups(deck: _Deck) -> list[_Group]:
                 f"{where}.Horizon", deck.get(f"{where}.Horizon"), "no block horizon: Discretization.Horizon"
             )
         key = "Discretization.Horizon" if shared else f"{where}.Horizon"
-        horizon = deck.get(key, float)
+        horizon = _horizon(deck, key)
         if not horizon > 0:
             raise deck.error(key, horizon, "a positive horizon (m)")
         blocks = tuple(deck.get(f"{where}.Block Names", str).split())
@@ -223,6 +267,45 @@ def _groups(deck: _Deck) -> list[_Group]:
     if not groups:
         raise deck.error("Blocks", {}, "at least one block group")
     return groups
+
+
+def _horizon(deck: _Deck, key: str) -> float:
+    """A horizon (m): a number, or a string holding one (Peridigm reads both)."""
+    value = deck.get(key)
+    if isinstance(value, str):
+        try:
+            return float(value)
+        except ValueError:
+            raise deck.error(
+                key, value, "a number (m): horizons varying in space are not supported"
+            ) from None
+    return deck.get(key, float)
+
+
+def _with_default(deck: _Deck, groups: list[_Group], deck_dir: Path) -> list[_Group]:
+    """``groups`` with the block name ``default`` replaced by the mesh's blocks that no group
+    names (Peridigm's default block); a single group keeps it (it takes every block)."""
+    if len(groups) < 2 or not any("default" in g.block_names for g in groups):
+        return groups
+    named = {b for g in groups for b in g.block_names if b != "default"}
+    rest = tuple(b for b in _mesh_blocks(deck, deck_dir) if b not in named)
+    return [
+        replace(g, block_names=tuple(b for b in g.block_names if b != "default") + rest)
+        if "default" in g.block_names
+        else g
+        for g in groups
+    ]
+
+
+def _mesh_blocks(deck: _Deck, deck_dir: Path) -> list[str]:
+    """Names of the blocks of the deck's mesh (an Exodus mesh's, ``block_<id>`` of a text mesh)."""
+    kind = deck.get("Discretization.Type", str)
+    mesh = deck_dir / deck.get("Discretization.Input Mesh File", str, "")
+    if kind not in ("Exodus", "Text File") or not mesh.is_file():
+        raise deck.error("Blocks", "default", "a mesh whose blocks the default block takes")
+    if kind == "Exodus":
+        return [b.name for b in read_exodus(mesh).blocks]
+    return [f"block_{i}" for i in np.unique(read_text_mesh(mesh)[1])]
 
 
 def _block_materials(deck: _Deck, groups: list[_Group], horizon: float) -> tuple[dict, dict]:
@@ -260,7 +343,7 @@ def _discretization(deck: _Deck, deck_dir: Path, horizon: float) -> tuple[dict, 
     """Geometry and discretisation sections, and the PdQuickGrid's (nx, ny, nz) (None for a mesh)."""
     kind = deck.get("Discretization.Type", str)
     neighbourhood = deck.get("Discretization.NeighborhoodType", str, "")
-    discretization = {"horizon_m": horizon, "partial_volumes": False}
+    discretization = {"horizon_m": horizon, "partial_volumes": False, **_bond_options(deck)}
     if kind == "PdQuickGrid":
         where = "Discretization.TensorProduct3DMeshGenerator"
         deck.get(where, dict)
@@ -291,18 +374,83 @@ def _discretization(deck: _Deck, deck_dir: Path, horizon: float) -> tuple[dict, 
     return geometry, discretization, None
 
 
+#: Discretization parameters read.
+DISCRETIZATION = {
+    "Type",
+    "Input Mesh File",
+    "NeighborhoodType",
+    "TensorProduct3DMeshGenerator",
+    "Horizon",
+    "Bond Filters",
+    "Omit Bonds Between Blocks",
+}
+#: A Rectangular_Plane bond filter's parameters: deck name (X, Y, Z of a vector) -> case key.
+PLANE_FILTER = {
+    "Lower_Left_Corner": "corner",
+    "Normal": "normal",
+    "Bottom_Unit_Vector": "bottom",
+}
+
+
+def _bond_options(deck: _Deck) -> dict:
+    """``bond_filters`` of ``Discretization.Bond Filters`` (each "Rectangular_Plane" a
+    ``finite_plane``) and ``bonds_between_blocks`` of ``Omit Bonds Between Blocks`` ("All":
+    false; "None": true)."""
+    for key in deck.get("Discretization", dict):
+        if key not in DISCRETIZATION:
+            if key == "Compute Element-Horizon Intersections":
+                raise deck.error(f"Discretization.{key}", True, PARTIAL_VOLUME_DIFFERS)
+            raise deck.error(
+                f"Discretization.{key}", None, f"only the parameters {sorted(DISCRETIZATION)}", False
+            )
+    out = {}
+    filters = []
+    for name in deck.get("Discretization.Bond Filters", dict, {}):
+        where = f"Discretization.Bond Filters.{name}"
+        kind = deck.get(f"{where}.Type", str)
+        if kind != "Rectangular_Plane":
+            raise deck.error(f"{where}.Type", kind, "'Rectangular_Plane' (the bond filter peridyn has)")
+        spec = {"type": "finite_plane"}
+        for prefix, key in PLANE_FILTER.items():
+            spec[key] = [deck.get(f"{where}.{prefix}_{a}", float) for a in "XYZ"]
+        spec["bottom_length"] = deck.get(f"{where}.Bottom_Length", float)
+        spec["side_length"] = deck.get(f"{where}.Side_Length", float)
+        known = {f"{p}_{a}" for p in PLANE_FILTER for a in "XYZ"} | {"Type", "Bottom_Length", "Side_Length"}
+        for key in deck.get(where, dict):
+            if key not in known:
+                raise deck.error(f"{where}.{key}", None, f"only the parameters {sorted(known)}", False)
+        filters.append(spec)
+    if filters:
+        out["bond_filters"] = filters
+    omit = deck.get("Discretization.Omit Bonds Between Blocks", str, "None")
+    if omit not in ("All", "None"):
+        raise deck.error("Discretization.Omit Bonds Between Blocks", omit, "'All' or 'None'")
+    if omit == "All":
+        if len(deck.get("Blocks", dict)) < 2:
+            raise deck.error("Discretization.Omit Bonds Between Blocks", omit, "'None' with one block group")
+        out["bonds_between_blocks"] = False
+    return out
+
+
 def _material(deck: _Deck, name: str) -> dict:
     where = f"Materials.{name}"
     deck.get(where, dict)
     model = deck.get(f"{where}.Material Model", str)
     if model in PARTIAL_VOLUME:
         raise deck.error(f"{where}.Material Model", model, PARTIAL_VOLUME_DIFFERS)
-    if model not in MATERIALS:
-        raise deck.error(f"{where}.Material Model", model, f"one of {sorted(MATERIALS)}")
+    if model == "Elastic Plastic" and deck.get(f"{where}.Disable Plasticity", bool, False):
+        model = "Elastic"  # Peridigm's elastic-plastic model without plasticity: its elastic one
+    elif model not in MATERIALS:
+        lacking = next((f for k, f in LACKING.items() if k in model.lower()), "this material model")
+        raise deck.error(
+            f"{where}.Material Model", model, f"one of {sorted(MATERIALS)} (peridyn lacks {lacking})"
+        )
     density = deck.get(f"{where}.Density", float)
-    bulk = deck.get(f"{where}.Bulk Modulus", float)
-    known = {"Material Model", "Density", "Bulk Modulus", "Shear Modulus", "Apply Shear Correction Factor"}
+    known = {"Material Model", "Density", "Apply Shear Correction Factor", *ELASTIC_CONSTANTS}
     known |= {"Influence Function", "Plane Stress", "Plane Strain", "Height"}
+    known |= IGNORED_MATERIAL
+    if deck.get(f"{where}.Material Model", str) == "Elastic Plastic":  # plasticity disabled
+        known |= {"Disable Plasticity", "Yield Stress"}
     for key in deck.get(where, dict):
         if key not in known:
             raise deck.error(f"{where}.{key}", None, f"only the parameters {sorted(known)}", False)
@@ -310,6 +458,7 @@ def _material(deck: _Deck, name: str) -> dict:
     if influence not in INFLUENCE:
         raise deck.error(f"{where}.Influence Function", influence, f"one of {sorted(INFLUENCE)}")
     plane = _plane(deck, name)
+    bulk, E, nu = _elastic_constants(deck, where, MATERIALS[model] == "pmb")
     if MATERIALS[model] == "pmb":
         # c = 18 K / (pi delta^4) from K alone: peridyn's PMB has nu = 1/4, so K = E / 1.5; in
         # 2D Peridigm's c = 12 K / (pi h delta^3) is peridyn's 12 kappa / (pi t delta^3) of
@@ -319,10 +468,6 @@ def _material(deck: _Deck, name: str) -> dict:
         raise deck.error(
             f"{where}.Plane {plane[0].capitalize()}", True, "3D, or the Elastic Bond Based model in 2D"
         )
-    shear = deck.get(f"{where}.Shear Modulus", float)
-    # E and nu of the bulk and shear moduli (LPS turns them back into K and mu)
-    E = 9.0 * bulk * shear / (3.0 * bulk + shear)
-    nu = (3.0 * bulk - 2.0 * shear) / (2.0 * (3.0 * bulk + shear))
     material = {"model": MATERIALS[model], "E": E, "nu": nu, "density": density}
     if deck.get(f"{where}.Apply Shear Correction Factor", bool, False):
         if model != "Elastic":
@@ -331,6 +476,30 @@ def _material(deck: _Deck, name: str) -> dict:
             )
         material["surface_correction"] = "shear-factor"
     return material
+
+
+#: Elastic constants a deck may give, two of them (one, the bulk modulus, for bond-based).
+ELASTIC_CONSTANTS = ("Bulk Modulus", "Shear Modulus", "Young's Modulus", "Poisson's Ratio")
+
+
+def _elastic_constants(deck: _Deck, where: str, bond_based: bool) -> tuple[float, float, float]:
+    """(K, E, nu) of the material at ``where`` from the two constants it gives (Pa, Pa, -):
+    the bulk and shear moduli, or Young's modulus and Poisson's ratio, as Peridigm reads them
+    (a bond-based material: the bulk modulus alone, or E and nu; its E and nu are then unused)."""
+    given = {k: deck.get(f"{where}.{k}", float) for k in ELASTIC_CONSTANTS if k in deck.get(where, dict)}
+    if bond_based and set(given) == {"Bulk Modulus"}:
+        return given["Bulk Modulus"], math.nan, math.nan
+    if set(given) == {"Bulk Modulus", "Shear Modulus"}:
+        bulk, shear = given["Bulk Modulus"], given["Shear Modulus"]
+        # E and nu of the bulk and shear moduli (LPS turns them back into K and mu)
+        E = 9.0 * bulk * shear / (3.0 * bulk + shear)
+        return bulk, E, (3.0 * bulk - 2.0 * shear) / (2.0 * (3.0 * bulk + shear))
+    if set(given) == {"Young's Modulus", "Poisson's Ratio"}:
+        E, nu = given["Young's Modulus"], given["Poisson's Ratio"]
+        return E / (3.0 * (1.0 - 2.0 * nu)), E, nu
+    raise deck.error(
+        where, sorted(given), "Bulk Modulus and Shear Modulus, or Young's Modulus and Poisson's Ratio"
+    )
 
 
 #: E / K of peridyn's 2D bond-based model whose plane bulk modulus is K: kappa = E / (2 (1 - nu))
@@ -359,22 +528,58 @@ def _plane(deck: _Deck, name: str) -> tuple[str, float] | None:
 
 def _damage(deck: _Deck, key: str) -> dict:
     """``{"damage": {"critical_stretch": s_c}}`` of the block's "Critical Stretch" damage model
-    (a bond breaks once (|y| - |xi|) / |xi| exceeds s_c, as in peridyn), or {} without one."""
+    (a bond breaks once (|y| - |xi|) / |xi| exceeds s_c, as in peridyn), or of its "Time
+    Dependent Critical Stretch" (s_c a time function, ``_stretch_in_time``), or {} without one."""
     name = deck.get(key, str, None)
     if name is None:
         return {}
     where = f"Damage Models.{name}"
     deck.get(where, dict)
-    for param in deck.get(where, dict):
-        if param not in ("Damage Model", "Critical Stretch"):
-            raise deck.error(f"{where}.{param}", None, "Damage Model and Critical Stretch only", False)
     model = deck.get(f"{where}.Damage Model", str)
-    if model != "Critical Stretch":
-        raise deck.error(f"{where}.Damage Model", model, "'Critical Stretch'")
+    if model == "Initial Damage":
+        return {}  # its bonds are broken by the case's pre-cracks (``_initial_damage``)
+    if model not in ("Critical Stretch", "Time Dependent Critical Stretch"):
+        raise deck.error(
+            f"{where}.Damage Model", model, "'Critical Stretch' or 'Time Dependent Critical Stretch'"
+        )
+    for param in deck.get(where, dict):
+        if param not in ("Damage Model", model):
+            raise deck.error(f"{where}.{param}", None, f"Damage Model and {model} only", False)
+    if model == "Time Dependent Critical Stretch":
+        return {"damage": {"critical_stretch": _stretch_in_time(deck, f"{where}.{model}")}}
     stretch = deck.get(f"{where}.Critical Stretch", float)
     if not stretch > 0:
         raise deck.error(f"{where}.Critical Stretch", stretch, "a positive stretch")
     return {"damage": {"critical_stretch": stretch}}
+
+
+#: Peridigm's time-dependent critical stretch of two values: "if(t <= T){ value = A; } else{
+#: value = B; }" (its expression parser's form), with ``<=`` or ``<``.
+STEP_IN_TIME = re.compile(
+    r"^\s*if\s*\(\s*t\s*(<=|<)\s*(\S+?)\s*\)\s*\\?\{\s*value\s*=\s*(\S+?)\s*;\s*\\?\}"
+    r"\s*else\s*\\?\{\s*value\s*=\s*(\S+?)\s*;\s*\\?\}\s*$"
+)
+
+
+def _stretch_in_time(deck: _Deck, key: str) -> dict:
+    """A critical stretch in time as a peridyn time function: a number, or the two-valued
+    form of ``STEP_IN_TIME`` as a ``step``."""
+    text = deck.get(key, str)
+    match = STEP_IN_TIME.match(text)
+    try:
+        if match is None:
+            return {"type": "constant", "value": float(text)}
+        operator, time, before, after = match.groups()
+        step = {"time": float(time), "before": float(before), "after": float(after)}
+    except ValueError:
+        match = None
+    if match is None:
+        raise deck.error(key, text.strip(), "a number, or 'if(t <= T){ value = A; } else{ value = B; }'")
+    if not (step["before"] > 0 and step["after"] > 0):
+        raise deck.error(key, text.strip(), "positive stretches")
+    if operator == "<":  # t < T is t <= the float below T
+        step["time"] = math.nextafter(step["time"], -math.inf)
+    return {"type": "step", **step}
 
 
 def _solver(deck: _Deck) -> dict:
@@ -384,13 +589,56 @@ def _solver(deck: _Deck) -> dict:
     final = deck.get("Solver.Final Time", float)
     solver = deck.get("Solver", dict)
     kinds = [k for k in solver if isinstance(solver[k], dict)]
-    if kinds == ["QuasiStatic"]:
-        return _quasi_static(deck, final)
+    if kinds in (["QuasiStatic"], ["NOXQuasiStatic"]):
+        return _quasi_static(deck, final, kinds[0])
+    if kinds == ["Implicit"]:
+        return _implicit(deck, final)
     if kinds != ["Verlet"]:
         raise deck.error(
-            "Solver", kinds, "one 'Verlet' or 'QuasiStatic' solver list (others are not supported yet)"
+            "Solver",
+            kinds,
+            "one 'Verlet', 'QuasiStatic', 'NOXQuasiStatic' or 'Implicit' solver list",
         )
     return _verlet(deck, final)
+
+
+#: Implicit parameters read.
+IMPLICIT = {"Fixed dt", "Beta", "Gamma", "Absolute Tolerance", "Maximum Solver Iterations"}
+
+
+def _implicit(deck: _Deck, final: float) -> dict:
+    """Peridigm's Implicit solver (Newmark with Newton) as ``newmark``: average acceleration
+    (Beta 1/4, Gamma 1/2, the one peridyn has), ``Fixed dt``, floor(final / dt) steps, Newton
+    converged on the residual's norm (``Absolute Tolerance``, N), starting from a = 0 as
+    Peridigm's does."""
+    where = "Solver.Implicit"
+    for key in deck.get(where, dict):
+        if key not in IMPLICIT:
+            raise deck.error(f"{where}.{key}", None, f"only the parameters {sorted(IMPLICIT)}", False)
+    for key, value in (("Beta", 0.25), ("Gamma", 0.5)):
+        given = deck.get(f"{where}.{key}", float, value)
+        if given != value:
+            raise deck.error(f"{where}.{key}", given, f"{value} (average acceleration, peridyn's Newmark)")
+    dt = deck.get(f"{where}.Fixed dt", float)
+    if not dt > 0:
+        raise deck.error(f"{where}.Fixed dt", dt, "a positive time step (s)")
+    steps = math.floor(final / dt)
+    if steps < 1:
+        raise deck.error("Solver.Final Time", final, f"at least one step of {dt:g} s")
+    tolerance = deck.get(f"{where}.Absolute Tolerance", float)
+    if not tolerance > 0:
+        raise deck.error(f"{where}.Absolute Tolerance", tolerance, "a positive tolerance (N)")
+    iterations = deck.get(f"{where}.Maximum Solver Iterations", int, 10)
+    if iterations < 1:
+        raise deck.error(f"{where}.Maximum Solver Iterations", iterations, "at least 1")
+    return {
+        "type": "newmark",
+        "dt": dt,
+        "steps": steps,
+        "absolute_tolerance": tolerance,
+        "newton_iterations": iterations,
+        "initial_acceleration": "zero",
+    }
 
 
 def _verlet(deck: _Deck, final: float) -> dict:
@@ -426,27 +674,28 @@ def _verlet(deck: _Deck, final: float) -> dict:
     return {"type": "explicit", "dt": dt, "steps": steps, "prescribed_velocity": "difference"}
 
 
-#: QuasiStatic parameters read: deck name -> newton solver key.
-QUASI_STATIC = {
-    "Number of Load Steps": "load_steps",
-    "Absolute Tolerance": "absolute_tolerance",
-    "Maximum Solver Iterations": "newton_iterations",
-}
+#: NOXQuasiStatic's parameters of how Trilinos' NOX finds the equilibrium (its nonlinear solver,
+#: line search, preconditioner, Jacobian operator), not of the equilibrium found: not read.
+NOX_IGNORED = {"Nonlinear Solver", "Max Age Of Prec", "Direction", "Line Search"}
 
 
-def _quasi_static(deck: _Deck, final: float) -> dict:
-    """Peridigm's QuasiStatic solver as Newton load steps to the final time, converged on the
-    absolute residual (N), velocities the change of u over a load step's time."""
-    where = "Solver.QuasiStatic"
+def _quasi_static(deck: _Deck, final: float, kind: str = "QuasiStatic") -> dict:
+    """Peridigm's QuasiStatic (or NOXQuasiStatic) solver as Newton load steps to the final
+    time, converged on the absolute residual (N), velocities the change of u over a load
+    step's time."""
+    where = f"Solver.{kind}"
+    nox = kind == "NOXQuasiStatic"
+    iterations_key = "Max Solver Iterations" if nox else "Maximum Solver Iterations"
+    known = {"Number of Load Steps", "Absolute Tolerance", iterations_key} | (NOX_IGNORED if nox else set())
     for key in deck.get(where, dict):
-        if key not in QUASI_STATIC:
-            raise deck.error(f"{where}.{key}", None, f"only the parameters {sorted(QUASI_STATIC)}", False)
+        if key not in known:
+            raise deck.error(f"{where}.{key}", None, f"only the parameters {sorted(known)}", False)
     if not final > 0:
         raise deck.error("Solver.Final Time", final, "a positive time (s)")
     steps = deck.get(f"{where}.Number of Load Steps", int)
-    iterations = deck.get(f"{where}.Maximum Solver Iterations", int, 10)
+    iterations = deck.get(f"{where}.{iterations_key}", int, 10)
     tolerance = deck.get(f"{where}.Absolute Tolerance", float)
-    for key, value in (("Number of Load Steps", steps), ("Maximum Solver Iterations", iterations)):
+    for key, value in (("Number of Load Steps", steps), (iterations_key, iterations)):
         if value < 1:
             raise deck.error(f"{where}.{key}", value, "at least 1")
     if not tolerance > 0:
@@ -489,15 +738,113 @@ def _conditions(deck: _Deck, deck_dir: Path, grid, mesh_sets: bool, first_id: in
         if kind in INITIAL:
             ics.append({"set": set_name, "kind": INITIAL[kind], "components": axis, "value": value})
         elif kind in BOUNDARY:
-            bcs.append({"set": set_name, "kind": BOUNDARY[kind], "components": axis, "value": value})
+            bc = {"set": set_name, "kind": BOUNDARY[kind], "components": axis, "value": value}
+            if kind == "Body Force":  # on a prescribed component, the prescribed motion wins
+                bc["where_prescribed"] = "yield"
+            bcs.append(bc)
         else:
             raise deck.error(f"{where}.Type", kind, f"one of {sorted(INITIAL) + sorted(BOUNDARY)}")
     return sets, bcs, ics
 
 
+def _initial_damage(deck: _Deck, groups: list[_Group], deck_dir: Path) -> list[dict]:
+    """Pre-cracks of the blocks' "Initial Damage" models: each "Exodus Mesh" bond filter a
+    ``surface`` (its triangles; bonds crossing them start broken, Peridigm's bond damage 1,
+    still counting in the weighted volumes, which Peridigm computes before)."""
+    cracks = []
+    for group in groups:
+        name = deck.get(group.damage_key, str, None)
+        where = f"Damage Models.{name}"
+        if name is None or deck.get(f"{where}.Damage Model", str) != "Initial Damage":
+            continue
+        if len(groups) > 1:
+            raise deck.error(
+                f"{where}.Damage Model", "Initial Damage", "one block group (the pre-cracks cut every block)"
+            )
+        for key in deck.get(where, dict):
+            if key not in ("Damage Model", "Bond Filters"):
+                raise deck.error(f"{where}.{key}", None, "Damage Model and Bond Filters only", False)
+        for label in deck.get(f"{where}.Bond Filters", dict):
+            at = f"{where}.Bond Filters.{label}"
+            kind = deck.get(f"{at}.Type", str)
+            if kind != "Exodus Mesh":
+                raise deck.error(f"{at}.Type", kind, "'Exodus Mesh' (a surface of triangles)")
+            path = deck_dir / deck.get(f"{at}.File Name", str)
+            if not path.is_file():
+                raise deck.error(f"{at}.File Name", str(path), "an existing Exodus file")
+            cracks.append({"type": "surface", "file": str(path.resolve()), "in_weighted_volume": True})
+    return cracks
+
+
+def _contact(deck: _Deck, groups: list[_Group], materials: dict) -> dict:
+    """``contact`` of the deck's ``Contact`` section: one "Short Range Force" model between
+    every pair of blocks (``General Contact``, or interactions naming every pair), its
+    ``Contact Radius`` (m) and ``Spring Constant`` (Pa): Peridigm's short-range constant is
+    18 K_s / (pi delta^4), the PMB micromodulus of the bulk modulus K_s, so peridyn's
+    ``stiffness_factor`` (a multiple of the micromodulus of the material, K = E / 1.5) is
+    1.5 K_s / E. ``Search Radius`` and ``Search Frequency`` say how Peridigm finds the pairs
+    (peridyn's list is kept complete), not which; they are not read."""
+    where = "Contact"
+    for key in deck.get(where, dict):
+        if key not in ("Verbose", "Search Radius", "Search Frequency", "Models", "Interactions"):
+            raise deck.error(
+                f"{where}.{key}", None, "Search Radius, Search Frequency, Models, Interactions", False
+            )
+    models = deck.get(f"{where}.Models", dict)
+    if len(models) != 1:
+        raise deck.error(f"{where}.Models", sorted(models), "one contact model")
+    (name,) = models
+    at = f"{where}.Models.{name}"
+    kind = deck.get(f"{at}.Contact Model", str)
+    if kind != "Short Range Force":
+        raise deck.error(f"{at}.Contact Model", kind, "'Short Range Force'")
+    for key in deck.get(at, dict):
+        if key not in ("Contact Model", "Contact Radius", "Spring Constant"):
+            raise deck.error(f"{at}.{key}", None, "Contact Model, Contact Radius, Spring Constant", False)
+    radius, spring = deck.get(f"{at}.Contact Radius", float), deck.get(f"{at}.Spring Constant", float)
+    for key, value in (("Contact Radius", radius), ("Spring Constant", spring)):
+        if not value > 0:
+            raise deck.error(f"{at}.{key}", value, "a positive value")
+    blocks = sorted({b for g in groups for b in g.block_names})
+    needed = {frozenset((a, b)) for a in blocks for b in blocks}
+    for label in deck.get(f"{where}.Interactions", dict):
+        at = f"{where}.Interactions.{label}"
+        if deck.get(f"{at}.Contact Model", str) != name:
+            raise deck.error(f"{at}.Contact Model", deck.get(f"{at}.Contact Model"), repr(name))
+        if label == "General Contact":
+            needed = set()
+        else:
+            needed.discard(
+                frozenset((deck.get(f"{at}.First Block", str), deck.get(f"{at}.Second Block", str)))
+            )
+    if needed:
+        pairs = sorted(" with ".join(sorted(p)) if len(p) > 1 else f"{min(p)} with itself" for p in needed)
+        raise deck.error(
+            f"{where}.Interactions", pairs, "contact between every pair of blocks (General Contact)"
+        )
+    moduli = {m["E"] for m in ([materials] if "model" in materials else materials.values())}
+    if len(moduli) > 1:
+        raise deck.error(
+            where, sorted(moduli), "materials of one Young's modulus (the contact constant's reference)"
+        )
+    return {"radius_m": radius, "stiffness_factor": 1.5 * spring / moduli.pop()}
+
+
+def _lists_node_zero(deck: _Deck) -> bool:
+    """True when an inline node set of ``Boundary Conditions`` lists node 0: the deck's ids
+    then count from 0 (as the older form's do)."""
+    section = deck.get("Boundary Conditions", dict, {})
+    for value in section.values():
+        words = value.split() if isinstance(value, str) else []
+        if words and all(w.isdigit() for w in words) and min(int(w) for w in words) == 0:
+            return True
+    return False
+
+
 def _value(deck: _Deck, key: str):
-    """A condition's value: a number, or an expression in x, y, z and t (checked now)."""
-    text = deck.get(key, str)
+    """A condition's value: a number, or an expression in x, y, z and t (checked now); ``^``
+    is a power, as in Peridigm's expression parser."""
+    text = deck.get(key, str).replace("^", "**")
     try:
         return float(text)
     except ValueError:
@@ -537,37 +884,62 @@ def _set_indices(deck: _Deck, key: str, deck_dir: Path, grid, first_id: int) -> 
     return sorted(int(p) for p in index)
 
 
+#: Output list parameters read (``Output Format`` and ``Parallel Write`` change how, not what).
+OUTPUT = {"Output File Type", "Output Format", "Output Filename", "Output Frequency", "Parallel Write"}
+
+
 def _output(deck: _Deck, model: str, sums: dict) -> dict:
-    """The output section: plots and VTU off, the deck's Exodus file and variables."""
+    """The output section: plots and VTU off, an Exodus file of each output list (``Output``,
+    ``Output1``, ``Output2``, ...: the first as ``exodus``, the others ``exodus_more``), each
+    with its file, frequency, variables and compute classes."""
     outputs = [k for k in deck.params if k.startswith("Output")]
-    if not outputs:
-        return {"plots": False, "vtu": False}
-    first = outputs[0]
-    fmt = deck.get(f"{first}.Output File Type", str, "ExodusII")
+    out = {"plots": False, "vtu": False}
+    files = [_exodus_file(deck, where, model, sums) for where in outputs]
+    merged = []
+    for where, exodus in zip(outputs, files, strict=True):  # lists of one file: one output
+        same = next((m for m in merged if m["file"] == exodus["file"]), None)
+        if same is None:
+            merged.append(exodus)
+            continue
+        if same["every"] != exodus["every"]:
+            raise deck.error(
+                f"{where}.Output Frequency", exodus["every"], f"{same['every']}, as the file's other list"
+            )
+        same["variables"] += [v for v in exodus["variables"] if v not in same["variables"]]
+        same.setdefault("sums", {}).update(exodus.get("sums", {}))
+    if merged:
+        out["exodus"] = merged[0]
+    if len(merged) > 1:
+        out["exodus_more"] = merged[1:]
+    return out
+
+
+def _exodus_file(deck: _Deck, where: str, model: str, sums: dict) -> dict:
+    """``ExodusOutput`` of one output list: ``<Output Filename>.e``, or of global variables and
+    compute classes only a history file, ``.h``, as Peridigm names them."""
+    for key in deck.get(where, dict):
+        if key not in OUTPUT and key != "Output Variables":
+            raise deck.error(f"{where}.{key}", None, f"only the parameters {sorted(OUTPUT)}", False)
+    fmt = deck.get(f"{where}.Output File Type", str, "ExodusII")
     if fmt != "ExodusII":
-        raise deck.error(f"{first}.Output File Type", fmt, "ExodusII")
-    names = [k for k, on in deck.get(f"{first}.Output Variables", dict).items() if on is True]
-    for k in outputs[1:]:  # more output lists: the same file, variables and frequency only
-        for key in ("Output Filename", "Output Frequency"):
-            if deck.get(f"{k}.{key}", default=None) != deck.get(f"{first}.{key}", default=None):
-                raise deck.error(f"{k}.{key}", deck.get(f"{k}.{key}", default=None), f"as in {first}")
-        extra = [v for v, on in deck.get(f"{k}.Output Variables", dict).items() if on and v not in names]
-        if extra:
-            raise deck.error(f"{k}.Output Variables", extra, f"variables that {first} writes")
+        raise deck.error(f"{where}.Output File Type", fmt, "ExodusII")
+    names = [k for k, on in deck.get(f"{where}.Output Variables", dict).items() if on is True]
     asked_sums = {name: sums[name] for name in names if name in sums}
     names = [name for name in names if name not in sums]
     for name in names:
         if name not in PERIDIGM_VARIABLES:
-            raise deck.error(f"{first}.Output Variables.{name}", True, f"one of {sorted(PERIDIGM_VARIABLES)}")
+            raise deck.error(f"{where}.Output Variables.{name}", True, f"one of {sorted(PERIDIGM_VARIABLES)}")
         if model == "pmb" and name in ("Dilatation", "Weighted_Volume"):
-            raise deck.error(f"{first}.Output Variables.{name}", True, "a state-based material's variable")
-    every = deck.get(f"{first}.Output Frequency", int, 1)
+            raise deck.error(f"{where}.Output Variables.{name}", True, "a state-based material's variable")
+    every = deck.get(f"{where}.Output Frequency", int, 1)
     if every < 1:
-        raise deck.error(f"{first}.Output Frequency", every, "at least 1 step")
-    exodus = {"file": deck.get(f"{first}.Output Filename", str) + ".e", "every": every, "variables": names}
+        raise deck.error(f"{where}.Output Frequency", every, "at least 1 step")
+    history = all(PERIDIGM_VARIABLES[n][0] == "global" for n in names)  # Peridigm's ".h" file
+    suffix = ".h" if history else ".e"
+    exodus = {"file": deck.get(f"{where}.Output Filename", str) + suffix, "every": every, "variables": names}
     if asked_sums:
         exodus["sums"] = asked_sums
-    return {"plots": False, "vtu": False, "exodus": exodus}
+    return exodus
 
 
 def convert_deck(path) -> dict:

@@ -3,8 +3,9 @@
 one nested dict of the deck's parameters (``read_deck``).
 
 XML types: ``string``, ``double``, ``int``, ``bool`` (``true``/``false``, any case); a
-``<ParameterList name>`` is a nested dict. A parameter given twice in one list, an unknown
-type or a value that does not read as its type is a ``CaseFileError`` naming the parameter.
+``<ParameterList name>`` is a nested dict. A list given twice in one list, an unknown
+type or a value that does not read as its type is a ``CaseFileError`` naming the parameter; a
+parameter repeated in its list must repeat its value (Peridigm's own decks do so).
 """
 
 from __future__ import annotations
@@ -91,9 +92,9 @@ def _parameter_list(element, source: str, where: str) -> dict:
             raise CaseFileError(source, key, child.tag, "a <Parameter> or <ParameterList> element")
         if name is None:
             raise CaseFileError(source, where or "<root>", child.tag, "a name attribute on every element")
-        if name in out:
-            raise CaseFileError(source, key, None, "a parameter given once in its list", has_value=False)
         if child.tag == "ParameterList":
+            if name in out:
+                raise CaseFileError(source, key, None, "a list given once in its list", has_value=False)
             out[name] = _parameter_list(child, source, key)
             continue
         kind, value = child.get("type"), child.get("value")
@@ -102,7 +103,10 @@ def _parameter_list(element, source: str, where: str) -> dict:
         if value is None:
             raise CaseFileError(source, key, None, "a value attribute", has_value=False)
         try:
-            out[name] = XML_TYPES[kind](value)
+            parsed = XML_TYPES[kind](value)
         except ValueError:
             raise CaseFileError(source, key, value, f"a value of type {kind}") from None
+        if name in out and out[name] != parsed:  # Peridigm's decks repeat some, with one value
+            raise CaseFileError(source, key, value, f"the value it has above ({out[name]!r})")
+        out[name] = parsed
     return out

@@ -93,8 +93,21 @@ class RecorderSpec:
     exodus_variables : tuple of str
         Peridigm's names of the variables written (``peridyn.io.exodus_write.PERIDIGM_VARIABLES``),
         their values from the recorder's ``fields``; empty: ``snapshot_exodus``'s fields.
-    exodus_sums : dict of name -> (variable, node set name)
-        Global vector variables written with the named ones: a nodal variable's sum over a set.
+    exodus_sums : dict of name -> (variable, node set name, calculation)
+        Global variables written with the named ones: a variable's sum, maximum or minimum
+        over a set.
+    exodus_order : {"peridyn", "grid"}
+        The named variables' point order: the body's, or ``grid_order`` (x fastest, then y,
+        then z: PdQuickGrid's numbering).
+    exodus_three_d : bool
+        Write a 2D body's named variables with three coordinates and vector components (z 0),
+        as Peridigm does.
+    exodus_named : bool
+        The Exodus file holds the named variables and sums (``output.exodus`` as a mapping),
+        not ``snapshot_exodus``'s fields.
+    exodus_more : tuple of dict
+        More Exodus files of named variables, each a dict of the ``exodus_*`` settings above
+        (``exodus_file``, ``exodus_every``, ``exodus_variables``, ...), written at its own steps.
     """
 
     every: int = 1
@@ -112,6 +125,10 @@ class RecorderSpec:
     exodus_every: int | None = None
     exodus_variables: tuple = ()
     exodus_sums: dict = field(default_factory=dict)
+    exodus_order: str = "peridyn"
+    exodus_three_d: bool = False
+    exodus_more: tuple = ()
+    exodus_named: bool = False
     stress: bool = False
     strain: bool = False
 
@@ -124,10 +141,24 @@ class RecorderSpec:
         return bool(self.snapshot_every and step % self.snapshot_every == 0) or step in self.snapshot_steps
 
     def exodus_due(self, step: int) -> bool:
-        """True when the Exodus file gets a record at ``step``."""
+        """True when an Exodus file gets a record at ``step``."""
+        if any(step % more["exodus_every"] == 0 for more in self.exodus_more):
+            return True
+        return self.main_exodus_due(step)
+
+    def main_exodus_due(self, step: int) -> bool:
+        """True when the first Exodus file (``exodus_file``) gets a record at ``step``."""
         if not self.exodus:
             return False
         return self.snapshot_due(step) if self.exodus_every is None else step % self.exodus_every == 0
+
+    def all_exodus_variables(self) -> tuple[list, dict]:
+        """The named variables and global sums of every Exodus file, each once."""
+        variables, sums = list(self.exodus_variables), dict(self.exodus_sums)
+        for more in self.exodus_more:
+            variables += [v for v in more["exodus_variables"] if v not in variables]
+            sums |= more["exodus_sums"]
+        return variables, sums
 
     def whole_due(self, step: int) -> bool:
         """True when something that reads the whole body (a snapshot, an Exodus record) is
@@ -238,23 +269,46 @@ class Recorder:
         if spec.vtu:
             (self.directory / "snapshots").mkdir(exist_ok=True)
             self.pvd = PVDCollection(self.directory / "snapshots.pvd", mode=mode)
-        if spec.exodus_variables and fields is None:
+        if spec.exodus_named and fields is None:
             raise InputError("named Exodus variables need a fields function: the recorder has none")
         self.fields = fields
         self._exodus_step = None  # the step of the last Exodus record
         self.exodus = None
-        if spec.exodus and spec.exodus_variables:
+        self._rows = grid_order(body.points) if spec.exodus_order == "grid" else None
+        self._dim = 3 if spec.exodus_three_d else body.dim
+        if spec.exodus and spec.exodus_named:
             self.exodus = variables_exodus(
-                body, self.directory / spec.exodus_file, spec.exodus_variables, spec.exodus_sums
+                body,
+                self.directory / spec.exodus_file,
+                spec.exodus_variables,
+                spec.exodus_sums,
+                rows=self._rows,
+                dim=self._dim,
             )
         elif spec.exodus:
             self.exodus = snapshot_exodus(body, self.directory / spec.exodus_file, damage is not None)
+        self._more = [
+            (
+                more,
+                variables_exodus(
+                    body,
+                    self.directory / more["exodus_file"],
+                    more["exodus_variables"],
+                    more["exodus_sums"],
+                    rows=self._rows,
+                    dim=self._dim,
+                ),
+            )
+            for more in spec.exodus_more
+        ]
         if resume is not None:
             self.h5.truncate(resume[0])
             if self.pvd is not None:
                 self.pvd.truncate(resume[1])
             if self.exodus is not None:
                 self.exodus.resume(resume[1])
+            for _, writer in self._more:
+                writer.resume(resume[1])
 
     def _create_series(self) -> None:
         h5, spec = self.h5, self.spec
@@ -318,7 +372,7 @@ class Recorder:
         check_state(state, self.max_displacement)
         self.series.append("field_u", state.step, state.time, state.u)
         if self.exodus is not None and (self.spec.exodus_every is None or self.spec.exodus_due(state.step)):
-            self.write_exodus(state)
+            self.write_exodus(state, at_snapshot=True)
         if self.pvd is None:
             return
         if self.vtu_pieces:  # written by the ranks (peridyn.io.vtu_pieces)
@@ -332,16 +386,29 @@ class Recorder:
         )
         self.pvd.add(state.time, name)
 
-    def write_exodus(self, state: State) -> None:
-        """Append ``state`` to the Exodus file (once per step: the end-of-run snapshot of a
-        step already written adds nothing)."""
+    def write_exodus(self, state: State, at_snapshot: bool = False) -> None:
+        """Append ``state`` to the Exodus files due at its step (once per step: the end-of-run
+        snapshot of a step already written adds nothing); the first file, without a frequency
+        of its own, at the snapshots (``at_snapshot``)."""
         if state.step == self._exodus_step:
             return
         self._exodus_step = state.step
-        if self.spec.exodus_variables:
-            self.exodus.append(state.time, **self.fields(state))
-        else:
-            self.exodus.append(state.time, **exodus_fields(self.body, state, self.damage))
+        spec = self.spec
+        main = spec.main_exodus_due(state.step) if spec.exodus_every is not None else at_snapshot
+        if not spec.exodus_named:
+            if main:
+                self.exodus.append(state.time, **exodus_fields(self.body, state, self.damage))
+            return
+        values = self.fields(state)
+        if main:
+            self.exodus.append(
+                state.time,
+                **arranged(chosen(values, spec.exodus_variables, spec.exodus_sums), self._rows, self._dim),
+            )
+        for more, writer in self._more:
+            if state.step % more["exodus_every"] == 0:
+                picked = chosen(values, more["exodus_variables"], more["exodus_sums"])
+                writer.append(state.time, **arranged(picked, self._rows, self._dim))
 
     def flush(self) -> None:
         """Write the series records held in memory and flush the file (before a checkpoint)."""
@@ -471,22 +538,76 @@ def snapshot_exodus(body: Body, path, damage: bool = False) -> ExodusWriter:
     )
 
 
-def variables_exodus(body: Body, path, variables, sums=None) -> ExodusWriter:
+def grid_order(points: np.ndarray) -> np.ndarray:
+    """(n,) indices of ``points`` ((n, 3), m) ordered x fastest, then y, then z: a grid's
+    points as PdQuickGrid numbers them."""
+    return np.lexsort((points[:, 0], points[:, 1], points[:, 2]))
+
+
+#: Variables that number the file's points: they count in the file's order, not the body's.
+POSITIONAL = ("Element_Id", "ID")
+
+
+def arranged(values: dict, rows: np.ndarray | None, dim: int) -> dict:
+    """``ExodusWriter.append``'s keyword arguments ``values`` (``variable_values``'s) with the
+    per-point arrays in the order ``rows`` ((n,) body indices, or None: the body's; the
+    ``POSITIONAL`` ones stay) and vectors padded with zero components to ``dim``."""
+    out = {}
+    for placement, fields in values.items():
+        out[placement] = {}
+        for name, array in fields.items():
+            array = np.asarray(array)
+            if rows is not None and placement != "global_" and name not in POSITIONAL:
+                array = array[rows]
+            if array.ndim >= 1 and placement == "global_" and array.shape[-1] < dim:
+                array = np.concatenate([array, np.zeros(dim - array.shape[-1])])
+            elif array.ndim == 2 and array.shape[1] < dim:
+                array = np.hstack([array, np.zeros((len(array), dim - array.shape[1]))])
+            out[placement][name] = array
+    return out
+
+
+def chosen(values: dict, variables, sums) -> dict:
+    """The part of ``values`` (``ExodusWriter.append``'s keyword arguments) that one file
+    writes: its ``variables`` and its global ``sums``."""
+    return {
+        placement: {
+            k: v for k, v in fields.items() if k in variables or (placement == "global_" and k in sums)
+        }
+        for placement, fields in values.items()
+    }
+
+
+def variables_exodus(body: Body, path, variables, sums=None, rows=None, dim=None) -> ExodusWriter:
     """An Exodus writer of Peridigm's named ``variables`` (``PERIDIGM_VARIABLES`` gives each one's
     placement, nodal or element, and size) and global vectors named by ``sums``' keys, one
-    block, the body's node sets."""
-    fields = {"nodal": {}, "element": {}}
+    block, the body's node sets; the points in the order ``rows`` ((n,) body indices, None:
+    the body's), with ``dim`` coordinates (default the body's; 3 in 2D: z = 0). Of global
+    variables only, the file is a history file, as Peridigm writes one: a single point at the
+    origin."""
+    dim = body.dim if dim is None else dim
+    fields = {"nodal": {}, "element": {}, "global": {}}
     for name in variables:
         placement, vector = PERIDIGM_VARIABLES[name]
-        fields[placement][name] = body.dim if vector else 1
-    sets = {k: v for k, v in body.node_sets.items() if len(v)}
+        fields[placement][name] = dim if vector else 1
+    global_ = fields["global"] | {
+        k: dim if PERIDIGM_VARIABLES[v[0]][1] else 1 for k, v in (sums or {}).items()
+    }
+    if not fields["nodal"] and not fields["element"]:  # global variables only: a history file
+        return ExodusWriter(path, np.zeros((1, dim)), global_=global_)
+    position = np.arange(body.n_points)
+    if rows is not None:
+        position[rows] = np.arange(body.n_points)
+    sets = {k: np.sort(position[v]) for k, v in body.node_sets.items() if len(v)}
+    points = np.zeros((body.n_points, dim))
+    points[:, : body.dim] = body.points[:, : body.dim]
     return ExodusWriter(
         path,
-        body.points[:, : body.dim],
+        points if rows is None else points[rows],
         node_sets=sets,
         nodal=fields["nodal"],
         element=fields["element"],
-        global_=dict.fromkeys(sums or {}, body.dim),
+        global_=global_,
     )
 
 

@@ -16,12 +16,16 @@ from peridyn.discretization.body import Body, in_box, in_cylinder, in_sphere
 from peridyn.discretization.bonds import (
     HORIZON_RTOL,
     Bonds,
+    crossing_finite_plane,
+    crossing_mask,
     crossing_rectangle,
     crossing_segment,
+    crossing_triangles,
     cut_bonds,
     find_bonds,
     reorder_bonds,
     search_reach,
+    without_bonds,
 )
 from peridyn.discretization.pairs import index_bandwidth, row_blocks
 from peridyn.errors import CaseFileError, InputError
@@ -202,18 +206,65 @@ def build_bonds(case: Case, body: Body, required=None, of_block=None) -> Bonds:
     bonds = find_bonds(
         body, horizon, d.influence, d.partial_volumes, required=required, box=box, point_horizon=point_horizon
     )
+    cut_precracks(case, body, bonds, in_weighted_volume=False)
+    return filtered(case, body, bonds, of_block)
+
+
+def cut_precracks(case: Case, body: Body, bonds: Bonds, in_weighted_volume: bool) -> None:
+    """Break the bonds of the case's pre-cracks whose ``in_weighted_volume`` is the one given:
+    those not counting in LPS's weighted volumes before the model is made (``build_bonds``),
+    those counting in them after (``build_model``'s callers)."""
     for crack in case.precracks:
+        if crack.in_weighted_volume != in_weighted_volume:
+            continue
         if crack.type == "rectangle":
 
             def crossing(a, b, c=crack):
                 return crossing_rectangle(a, b, c.origin, c.edge_u, c.edge_v)
+        elif crack.type == "surface":
+            triangles = surface_triangles(crack.file)
+
+            def crossing(a, b, tris=triangles):
+                return crossing_triangles(a, b, tris)
         else:
 
             def crossing(a, b, c=crack):
                 return crossing_segment(a, b, c.start, c.end)
 
         cut_bonds(body, bonds, crossing)
-    return bonds
+
+
+def surface_triangles(path) -> np.ndarray:
+    """(m, 3, 3) corners (m) of the triangles of an Exodus surface mesh (3-node elements, or
+    4-node ones split into two triangles by their first diagonal)."""
+    mesh = exodus.read_exodus(path)
+    triangles = []
+    for block in mesh.blocks:
+        nodes = mesh.coordinates[block.connectivity]
+        if nodes.shape[1] == 3:
+            triangles.append(nodes)
+        elif nodes.shape[1] == 4:
+            triangles += [nodes[:, [0, 1, 2]], nodes[:, [0, 2, 3]]]
+        else:
+            raise InputError(f"{path}: block {block.name!r} of {nodes.shape[1]}-node elements, not a surface")
+    return np.concatenate(triangles)
+
+
+def filtered(case: Case, body: Body, bonds: Bonds, of_block=None) -> Bonds:
+    """``bonds`` less those the case's bond filters take out, and those between blocks when
+    ``discretization.bonds_between_blocks`` is false (``of_block`` as ``block_horizons``'s)."""
+    d = case.discretization
+    mask = np.zeros(bonds.n_bonds, dtype=bool)
+    for f in d.bond_filters:
+
+        def meets(a, b, f=f):
+            return crossing_finite_plane(a, b, f.corner, f.normal, f.bottom, f.bottom_length, f.side_length)
+
+        mask |= crossing_mask(body, bonds, meets)
+    if not d.bonds_between_blocks and case.blocks:
+        blocks = block_index(case, body) if of_block is None else of_block
+        mask |= blocks[bonds.owners()] != blocks[bonds.neighbours]
+    return without_bonds(bonds, mask) if mask.any() else bonds
 
 
 def add_actuators(case: Case, body: Body) -> tuple[Body, list[BoundaryCondition]]:
@@ -244,7 +295,11 @@ def build_loading(case: Case, body: Body, extra=()) -> Loading:
     """Boundary and initial conditions of the case (plus ``extra`` ones), checked for conflicts."""
     bcs = [
         BoundaryCondition(
-            bc.set, bc.kind, bc.components, value_function(bc.value, f"boundary_conditions[{k}]")
+            bc.set,
+            bc.kind,
+            bc.components,
+            value_function(bc.value, f"boundary_conditions[{k}]"),
+            where_prescribed=bc.where_prescribed,
         )
         for k, bc in enumerate(case.boundary_conditions)
     ]
@@ -346,6 +401,7 @@ def build(case: Case, base_dir=".", comm=None) -> Setup:
     bonds = build_bonds(case, body)
     interrupts.check(where=BUILDING)
     model = build_model(case, body, bonds)
+    cut_precracks(case, body, bonds, in_weighted_volume=True)
     damage = build_damage(case, model)
     interrupts.check(where=BUILDING)
     loading = build_loading(case, body, actuation)
@@ -417,6 +473,7 @@ def _build_part(case: Case, comm, base_dir):
     part = body.subset(local_ids)
     part_blocks = None if of_block is None else of_block[local_ids]
     model = build_model(case, part, bonds, part_blocks)
+    cut_precracks(case, part, bonds, in_weighted_volume=True)
     materials = case.block_materials().values()
     no_damage = sorted({name for m in materials if m.damage is not None for name in m.damage.no_damage_sets})
     protected = protected_points(body, no_damage)[local_ids]
@@ -512,13 +569,15 @@ def build_damage(case: Case, model: Model, protected=None, of_block=None) -> Bon
     d = case.material.damage
     if d is None:
         return None
+    timed = isinstance(d.critical_stretch, dict)
     return BondDamage(
         model,
-        d.critical_stretch,
+        None if timed else d.critical_stretch,
         d.fracture_energy,
         d.no_damage_sets if protected is None else (),
         critical_bond_stress=d.critical_bond_stress,
         protected=protected,
+        schedule=from_spec(d.critical_stretch, "material.damage.critical_stretch") if timed else None,
     )
 
 
@@ -537,6 +596,11 @@ def block_damage(case: Case, model: Model, protected=None, of_block=None) -> Bon
         if d is None:
             continue
         mine = of_point == k
+        if isinstance(d.critical_stretch, dict):
+            raise InputError(
+                f"materials.{block.material}.damage.critical_stretch: a number (a critical "
+                "stretch in time is for a body of one material)"
+            )
         if d.critical_stretch is not None:
             stretch[mine] = d.critical_stretch
         elif d.fracture_energy is not None:

@@ -11,6 +11,8 @@ from peridyn.io.exodus_write import PERIDIGM_VARIABLES
 from peridyn.physics.damage import damage_field
 from peridyn.physics.materials.base import Model
 
+#: Global variables of a variable over a set: its sum, largest or smallest value (per component).
+REDUCTIONS = {"sum": np.sum, "maximum": np.max, "minimum": np.min}
 #: Variables that only a state-based material has (its per-point dilatation and weighted volume).
 STATE_BASED = ("Dilatation", "Weighted_Volume")
 
@@ -24,15 +26,18 @@ def check_variables(case_name: str, model: Model, variables) -> None:
             )
 
 
-def variable_values(model: Model, variables, sums=None):
+def variable_values(model: Model, variables, sums=None, loading=None):
     """A function of a state (u, v, a: (n_points, 3)) giving the ``variables``' values as
     ``ExodusWriter.append`` takes them: ``{"nodal": {...}, "element": {...}, "global_":
     {...}}``, vectors (n_points, dim), scalars (n_points,), and per ``sums`` entry (name ->
-    (nodal variable, node set name)) that variable's sum over the set, (dim,). Force density
+    (variable, node set name[, "sum" | "maximum" | "minimum"])) that variable's sum (or
+    extreme) over the set, (dim,) or a scalar. Force density
     is the internal force density (N/m^3) at u, force that times the point's volume (N);
-    acceleration the solver's."""
+    acceleration the solver's; external force density the body-force density (N/m^3) of
+    ``loading`` (a ``Loading``, needed for it) at the state's time; ``Lambda`` Peridigm's
+    plastic multiplier, zero (peridyn's materials are elastic)."""
     sums = sums or {}
-    needed = set(variables) | {variable for variable, _ in sums.values()}
+    needed = set(variables) | {variable for variable, *_ in sums.values()}
     body = model.body
     dim = body.dim
 
@@ -42,6 +47,13 @@ def variable_values(model: Model, variables, sums=None):
             "Displacement": lambda: state.u[:, :dim],
             "Velocity": lambda: state.v[:, :dim],
             "Acceleration": lambda: state.a[:, :dim],
+            "External_Force_Density": lambda: loading.body_force_density(
+                state.time, np.zeros((body.n_points, 3))
+            )[:, :dim],
+            "Lambda": lambda: np.zeros(body.n_points),
+            "Global_Kinetic_Energy": lambda: (
+                0.5 * np.sum(model.density * body.volumes * np.sum(state.v**2, axis=1))
+            ),
             "Force_Density": lambda: force_density,
             "Force": lambda: force_density * body.volumes[:, None],
             "Element_Id": lambda: np.arange(1.0, body.n_points + 1.0),
@@ -56,9 +68,11 @@ def variable_values(model: Model, variables, sums=None):
         }
         out = {"nodal": {}, "element": {}, "global_": {}}
         for name in variables:
-            out[PERIDIGM_VARIABLES[name][0]][name] = computed[name]()
-        for name, (variable, set_name) in sums.items():
-            out["global_"][name] = computed[variable]()[body.node_set(set_name)].sum(axis=0)
+            placement = PERIDIGM_VARIABLES[name][0]
+            out["global_" if placement == "global" else placement][name] = computed[name]()
+        for name, (variable, set_name, *calculation) in sums.items():
+            reduce = REDUCTIONS[calculation[0] if calculation else "sum"]
+            out["global_"][name] = reduce(computed[variable]()[body.node_set(set_name)], axis=0)
         return out
 
     return values
@@ -85,13 +99,20 @@ class GatheredVariables:
         Name -> (nodal variable, node set name), as ``variable_values``.
     whole_body : Body
         The case's body (its node sets name the sums' points).
+    loading : Loading or None
+        The rank's part of the loading (for ``External_Force_Density``).
     """
 
-    def __init__(self, domain, model: Model, variables, sums, whole_body):
+    def __init__(self, domain, model: Model, variables, sums, whole_body, loading=None):
         self.domain, self.whole_body = domain, whole_body
         self.variables, self.sums = list(variables), dict(sums or {})
-        needed = self.variables + [v for v, _ in self.sums.values() if v not in self.variables]
-        self._local = variable_values(model, needed)
+        whole = [v for v in self.variables if PERIDIGM_VARIABLES[v][0] == "global"]
+        if whole:
+            raise CaseFileError(
+                "<case>", "output.exodus.variables", whole[0], "a per-point variable under MPI"
+            )
+        needed = self.variables + [v for v, *_ in self.sums.values() if v not in self.variables]
+        self._local = variable_values(model, needed, loading=loading)
         self._values: dict | None = None
         self._step: int | None = None
 
@@ -113,8 +134,9 @@ class GatheredVariables:
         out = {"nodal": {}, "element": {}, "global_": {}}
         for name in self.variables:
             out[PERIDIGM_VARIABLES[name][0]][name] = whole[name]
-        for name, (variable, set_name) in self.sums.items():
-            out["global_"][name] = whole[variable][self.whole_body.node_set(set_name)].sum(axis=0)
+        for name, (variable, set_name, *calculation) in self.sums.items():
+            reduce = REDUCTIONS[calculation[0] if calculation else "sum"]
+            out["global_"][name] = reduce(whole[variable][self.whole_body.node_set(set_name)], axis=0)
         self._values = out
 
     def __call__(self, state: State) -> dict:

@@ -63,6 +63,7 @@ def recorder_spec(case: Case, body: Body, dt: float) -> RecorderSpec:
         stress=out.stress,
         strain=out.strain,
         **exodus_spec(out.exodus),
+        exodus_more=tuple(exodus_spec(more) for more in out.exodus_more),
     )
 
 
@@ -75,7 +76,10 @@ def exodus_spec(exodus) -> dict:
         "exodus_file": exodus.file,
         "exodus_every": exodus.every,
         "exodus_variables": tuple(exodus.variables),
-        "exodus_sums": {k: (v.variable, v.set) for k, v in exodus.sums.items()},
+        "exodus_sums": {k: (v.variable, v.set, v.calculation) for k, v in exodus.sums.items()},
+        "exodus_order": exodus.point_order,
+        "exodus_three_d": exodus.three_d,
+        "exodus_named": True,
     }
 
 
@@ -230,14 +234,13 @@ def exodus_values(case: Case, setup: Setup, spec: RecorderSpec):
     """The recorder's ``fields``: the values of the named Exodus variables (``output.exodus``
     as a mapping) at a state, or None without them; under MPI a ``GatheredVariables``, whose
     ``collect`` every rank calls at the states recorded."""
-    if not spec.exodus_variables:
+    if not spec.exodus_named:
         return None
-    check_variables(case.name, setup.model, spec.exodus_variables)
+    variables, sums = spec.all_exodus_variables()
+    check_variables(case.name, setup.model, variables)
     if setup.domain.size > 1:  # each rank's owned values, gathered on rank 0 (``collect``)
-        return GatheredVariables(
-            setup.domain, setup.model, spec.exodus_variables, spec.exodus_sums, setup.whole_body
-        )
-    return variable_values(setup.model, spec.exodus_variables, spec.exodus_sums)
+        return GatheredVariables(setup.domain, setup.model, variables, sums, setup.whole_body, setup.loading)
+    return variable_values(setup.model, variables, sums, setup.loading)
 
 
 def step_count(case: Case, solver) -> int:
@@ -766,6 +769,8 @@ def _newmark_solver(case, setup):
         damping=s.damping,
         damage=setup.damage,
         linear_solver=s.linear_solver,
+        residual_tolerance=s.absolute_tolerance,
+        initial_acceleration=s.initial_acceleration,
     )
 
 

@@ -84,6 +84,9 @@ class BondDamage:
     protected : (n_points,) bool or None
         More points whose bonds never break (a rank's part of the ``no_damage_sets`` of the
         whole body, where its own part of a set may be empty).
+    schedule : TimeFunction or None
+        A critical stretch that changes in time (Peridigm's "Time Dependent Critical
+        Stretch"): s_c(t), given instead of ``critical_stretch``; ``update`` at time t takes it.
 
     ``critical_stretch`` (n_bonds,) and ``breakable`` (n_bonds,) bool may be edited until
     the first ``update``, which reads them into the critical lengths and makes them
@@ -103,7 +106,11 @@ class BondDamage:
         no_damage_sets=(),
         critical_bond_stress: float | None = None,
         protected: np.ndarray | None = None,
+        schedule=None,
     ):
+        self.schedule = schedule
+        if schedule is not None:
+            critical_stretch = float(schedule(0.0))
         given = [v is not None for v in (critical_stretch, fracture_energy, critical_bond_stress)]
         if sum(given) != 1:
             raise InputError(
@@ -147,11 +154,18 @@ class BondDamage:
     def __repr__(self) -> str:
         return f"BondDamage(critical_stretch={self.value:.4g})"
 
-    def update(self, u: np.ndarray) -> int:
-        """Break every over-stretched breakable bond at displacement ``u`` (n_points, 3), m.
+    def update(self, u: np.ndarray, t: float | None = None) -> int:
+        """Break every over-stretched breakable bond at displacement ``u`` (n_points, 3), m, at
+        time ``t`` (s: a ``schedule`` gives the critical stretch then).
 
         Returns the number of directed bonds broken.
         """
+        if self.schedule is not None and t is not None:
+            value = float(self.schedule(t))
+            if value != self.value:
+                self.reset()
+                self.value = value
+                self.critical_stretch[:] = value
         m = self.model
         b = m.bonds
         u = np.ascontiguousarray(u, dtype=np.float64)

@@ -8,6 +8,10 @@ Kinds of boundary condition:
   body-force density f(t) / (sum of the set's volumes);
 - ``body_force``: body-force density b[set, c] = profile * f(t) (N/m^3).
 
+A force on a component whose motion another condition prescribes is an error, unless the force
+condition says ``where_prescribed="yield"``: the prescribed motion then wins, the force still
+counting in the point's acceleration (as in Peridigm).
+
 ``profile`` is an optional spatial amplitude, (n_set,) or (n_set, n_components),
 e.g. the radial displacement field of a PZT patch. ``f`` may instead be an expression in
 x, y, z and t (``peridyn.physics.expressions.SpaceTime``), evaluated on the set's points.
@@ -57,8 +61,12 @@ class BoundaryCondition:
     components: tuple = (0, 1, 2)
     function: TimeFunction | SpaceTime = field(default_factory=lambda: Constant(0.0))
     profile: np.ndarray | None = None
+    #: a force on a component whose motion is prescribed: "error", or "yield" to the motion
+    where_prescribed: str = "error"
 
     def __post_init__(self):
+        if self.where_prescribed not in ("error", "yield"):
+            raise InputError(f"where_prescribed {self.where_prescribed!r}: use 'error' or 'yield'")
         if self.kind not in BC_KINDS:
             raise InputError(
                 f"unknown boundary condition kind {self.kind!r}"
@@ -136,7 +144,8 @@ class Loading:
                 owner[np.ix_(idx, comps)] = number
                 (self.displacement if bc.kind == "displacement" else self.velocity).append(bound)
             else:
-                forced[np.ix_(idx, comps)] = True
+                if bc.where_prescribed == "error":
+                    forced[np.ix_(idx, comps)] = True
                 if bc.kind == "force":
                     bound.amplitude = bound.amplitude / body.volumes[idx].sum()
                 self.body_force.append(bound)

@@ -154,6 +154,18 @@ class GaussianBurst(TimeFunction):
 
 
 @dataclass(frozen=True)
+class Step(TimeFunction):
+    """``before`` up to ``time`` (s) included, ``after`` later."""
+
+    time: float = 0.0
+    before: float = 0.0
+    after: float = 1.0
+
+    def __call__(self, t):
+        return np.where(np.asarray(t, dtype=float) <= self.time, self.before, self.after)
+
+
+@dataclass(frozen=True)
 class Tabulated(TimeFunction):
     """Piecewise-linear interpolation of (times, values); held constant outside the table."""
 
@@ -219,6 +231,7 @@ def _positive(name: str, value: float) -> None:
 _SIMPLE = {
     "constant": Constant,
     "ramp": Ramp,
+    "step": Step,
     "sine": Sine,
     "tone_burst": ToneBurst,
     "gaussian_burst": GaussianBurst,

@@ -182,7 +182,7 @@ class ExplicitSolver:
             broken = 0
         else:
             self.domain.exchange(state.u)
-            broken = self.damage.update(state.u) if self.damage is not None else 0
+            broken = self.damage.update(state.u, state.time) if self.damage is not None else 0
         self._acceleration(state, kick=True, overlapped=self.overlap)
         self.loading.apply_velocities(state.time, state.v)
         if differenced is not None:

@@ -8,7 +8,8 @@ damping c:
 
 solved by Newton with the consistent tangent ``K`` (``peridyn.linalg.tangent``):
 ``(K + (4 / dt^2 + 2 c / dt) M) du = R``, until the largest displacement increment
-|du| is below ``tolerance`` (m; seed 004: dt = 20 ns, 0.1 nm). Prescribed displacements
+|du| is below ``tolerance`` (m; 0.1 nm at dt = 20 ns) or, given ``residual_tolerance`` (N),
+|R| is below that. Prescribed displacements
 are imposed at t + dt, prescribed velocities integrated by the trapezoidal rule, and
 prescribed dofs get a = 0 (as in ``ExplicitSolver``). For a linear undamped system the
 scheme conserves the energy (v^T M v + u^T K u) / 2 exactly and is unconditionally stable.
@@ -47,6 +48,12 @@ class NewmarkSolver:
         Time step (any size: the scheme is unconditionally stable for linear systems).
     tolerance : float, m
         Newton stops when the largest displacement increment is below it.
+    residual_tolerance : float or None, N
+        Newton also stops when the norm of the residual force (at the free dofs) is below it
+        (Peridigm's "Absolute Tolerance").
+    initial_acceleration : {"balance", "zero"}
+        The acceleration at t = 0: from M a = V (f + b) - c M v (``balance``), or zero, as
+        Peridigm's implicit solver starts.
     max_iterations : int
         Newton iterations per step; more raises an InputError naming the step.
     damping : float, 1/s
@@ -68,6 +75,8 @@ class NewmarkSolver:
         damping: float = 0.0,
         damage: BondDamage | None = None,
         linear_solver: str = "lu",
+        residual_tolerance: float | None = None,
+        initial_acceleration: str = "balance",
     ):
         if not dt > 0:
             raise InputError(f"time step must be positive, got {dt!r}")
@@ -78,11 +87,15 @@ class NewmarkSolver:
         if damping < 0:
             raise InputError(f"damping must be non-negative, got {damping!r}")
         check_linear_solver(linear_solver)
+        if initial_acceleration not in ("balance", "zero"):
+            raise InputError(f"initial_acceleration {initial_acceleration!r}: use 'balance' or 'zero'")
+        self.initial_acceleration = initial_acceleration
         self.linear_solver = linear_solver
         self.model = model
         self.loading = loading if loading is not None else Loading(model.body)
         self.dt = float(dt)
         self.tolerance = float(tolerance)
+        self.residual_tolerance = residual_tolerance
         self.max_iterations = int(max_iterations)
         self.damping = float(damping)
         self.damage = damage
@@ -97,9 +110,12 @@ class NewmarkSolver:
         return f"NewmarkSolver(model={self.model!r}, dt={self.dt:.4g} s, tol={self.tolerance:g} m)"
 
     def initial_state(self) -> State:
-        """The state at t = 0: initial conditions applied and M a = V (f + b) - c M v solved."""
+        """The state at t = 0: initial conditions applied and M a = V (f + b) - c M v solved
+        (a = 0 with ``initial_acceleration="zero"``)."""
         state = State.zeros(self.model.body.n_points)
         self.loading.apply_start(self.dt, state.u, state.v)
+        if self.initial_acceleration == "zero":
+            return state
         state.a[:] = self._out_of_balance(state.u, state.time) / self.mass.reshape(-1, 3)
         state.a -= self.damping * state.v
         state.a[self.loading.constrained] = 0.0
@@ -131,6 +147,8 @@ class NewmarkSolver:
             a1 = 4.0 * (uf[free] - u0f[free]) / dt**2
             v1 = v0f[free] + 0.5 * dt * (a0f[free] + a1)
             r = self._out_of_balance(u, t1).reshape(-1)[free] - mass[free] * (a1 + c * v1)
+            if self.residual_tolerance is not None and np.linalg.norm(r) < self.residual_tolerance:
+                break
             k_eff = tangent_stiffness(self.model, u)[free][:, free]
             k_eff.setdiag(k_eff.diagonal() + shift)
             du = solve_held(k_eff, r, self.linear_solver)
@@ -154,7 +172,7 @@ class NewmarkSolver:
         state.step += 1
         # bonds broken here act from the next step on: the stored acceleration is the
         # converged one of this step (a lag of one step; the explicit solver breaks first)
-        broken = self.damage.update(state.u) if self.damage is not None else 0
+        broken = self.damage.update(state.u, state.time) if self.damage is not None else 0
         check_state(state)
         return broken
 

@@ -3,6 +3,7 @@ translation to peridyn cases (``peridyn.io.peridigm_case``), with the refusals t
 deck parameter. Decks from tests/data/peridigm (Peridigm's test suite)."""
 
 import copy
+import math
 import shutil
 from pathlib import Path
 
@@ -17,6 +18,7 @@ from peridyn.io.exodus import read_exodus
 from peridyn.io.peridigm_case import convert_deck, deck_case, load_deck
 from peridyn.io.peridigm_deck import is_peridigm_deck, read_deck
 from peridyn.jobs.build import build
+from peridyn.physics.timefunctions import from_spec
 
 DATA = Path(__file__).parents[2] / "data" / "peridigm"
 WAVE = DATA / "WaveInBar.xml"
@@ -259,7 +261,7 @@ def test_bad_expressions_and_compute_classes_are_refused():
     deck["Boundary Conditions"]["Prescribed Displacement Y"]["Value"] = "open('x').read()"
     _refusal(deck, "Boundary Conditions.Prescribed Displacement Y.Value")
     deck = copy.deepcopy(base)
-    deck["Compute Class Parameters"]["Top Reaction Force"]["Calculation Type"] = "Maximum"
+    deck["Compute Class Parameters"]["Top Reaction Force"]["Calculation Type"] = "Average"
     _refusal(deck, "Compute Class Parameters.Top Reaction Force.Calculation Type")
     deck = copy.deepcopy(base)
     deck["Output1"]["Output Variables"]["Dilatation"] = True
@@ -294,14 +296,26 @@ def test_translation_of_a_quasi_static_text_file_deck():
 
 
 def test_critical_stretch_damage():
-    """A block's "Critical Stretch" damage model becomes the material's critical stretch; other
-    damage models are refused naming the parameter."""
+    """A block's "Critical Stretch" damage model becomes the material's critical stretch, a
+    "Time Dependent Critical Stretch" of two values a step in time; other damage models are
+    refused naming the parameter."""
     deck = read_deck(WAVE)
     deck["Damage Models"] = {"My Damage": {"Damage Model": "Critical Stretch", "Critical Stretch": 5e-4}}
     deck["Blocks"]["My Group of Blocks"]["Damage Model"] = "My Damage"
     case = validate_case(deck_case(deck, "wave", str(WAVE), DATA))
     assert case.material.damage.critical_stretch == 5e-4
-    deck["Damage Models"]["My Damage"]["Damage Model"] = "Time Dependent Critical Stretch"
+    deck["Damage Models"]["My Damage"] = {
+        "Damage Model": "Time Dependent Critical Stretch",
+        "Time Dependent Critical Stretch": " if(t < 2.0e-5){ value = 50.0; } else{ value = 5e-4; } ",
+    }
+    stretch = validate_case(deck_case(deck, "wave", str(WAVE), DATA)).material.damage.critical_stretch
+    below = math.nextafter(2e-5, -math.inf)  # t < T: the step holds up to the float below T
+    assert stretch == {"type": "step", "time": below, "before": 50.0, "after": 5e-4}
+    schedule = from_spec(stretch)
+    assert (schedule(below), schedule(2e-5)) == (50.0, 5e-4)
+    deck["Damage Models"]["My Damage"]["Time Dependent Critical Stretch"] = "0.01*t"
+    _refusal(deck, "Damage Models.My Damage.Time Dependent Critical Stretch")
+    deck["Damage Models"]["My Damage"] = {"Damage Model": "Interface Aware", "Critical Stretch": 5e-4}
     _refusal(deck, "Damage Models.My Damage.Damage Model")
     deck["Blocks"]["My Group of Blocks"]["Damage Model"] = "Other"
     _refusal(deck, "Damage Models.Other")

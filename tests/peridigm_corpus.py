@@ -1,0 +1,144 @@
+"""Peridigm's test corpus (tests/data/peridigm_corpus: decks, meshes, exodiff ``.comp`` files and
+gold results of Peridigm's regression and verification tests) run as a user runs a deck, and the
+table of outcomes that docs/peridigm.md shows.
+
+Each deck is run with ``peridyn run DECK -o OUT``. Its outcome is one of
+
+- ``match``: every Exodus file it writes that has a gold file (``<name>_gold.e``, or
+  ``<name>_gold.h`` of a history file) equals it within the deck's ``.comp`` tolerances
+  (``<name>.comp``, or the folder's one ``.comp``), by ``exodiff_comp.compare``;
+- ``differs``: it runs, and the items over their tolerance are named (with the largest excess,
+  in units of the tolerance);
+- ``refused``: peridyn stops before running, with the one line naming what the deck asks that
+  peridyn lacks.
+
+``python tests/peridigm_corpus.py`` runs every deck and rewrites the table in docs/peridigm.md
+(between its ``corpus table`` markers); ``tests/simulation/test_peridigm_corpus.py`` checks each
+deck's row against a fresh run.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import json
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+
+from exodiff_comp import compare
+
+CORPUS = Path(__file__).parent / "data" / "peridigm_corpus"
+DOCS = Path(__file__).parents[1] / "docs" / "peridigm.md"
+BEGIN, END = "<!-- corpus table: begin -->", "<!-- corpus table: end -->"
+
+
+#: Why the decks that differ do (docs/peridigm.md, Rounding): the row adds it to the items.
+WHY = {
+    "Compression_2x1x1/Compression_2x1x1.yaml": "1e-9 N asked of 1e8 N forces: Peridigm's own rounding",
+    "NodalVariableOutput/NodalVariableOutput.xml": "1e-9 N asked of 1e8 N forces: Peridigm's own rounding",
+    "MultipleOutputFiles/MultipleOutputFiles.xml": "1e-9 N asked of 1e8 N forces, and the kinetic "
+    "energy of velocities of the same rounding",
+    "PrecrackedPlateTwoCracks/PrecrackedPlate.xml": "bonds meeting the crack tips exactly, decided by "
+    "the last bits of the points' coordinates (7 of 640 points)",
+}
+
+
+def decks() -> list[str]:
+    """Every deck of the corpus, as ``folder/deck`` relative to ``CORPUS``."""
+    found = [*CORPUS.glob("*/*.xml"), *CORPUS.glob("*/*.yaml")]
+    return sorted(p.relative_to(CORPUS).as_posix() for p in found)
+
+
+@dataclass(frozen=True)
+class Outcome:
+    """A deck's outcome: ``status`` "match", "differs" or "refused", and a one-line ``detail``."""
+
+    deck: str
+    status: str
+    detail: str
+
+    def row(self) -> str:
+        return f"| `{self.deck}` | {self.status} | {self.detail} |"
+
+
+def _gold(folder: Path, written: Path) -> tuple[Path, Path]:
+    """The gold file and the ``.comp`` file that a written Exodus file is compared with."""
+    gold = folder / f"{written.stem}_gold{written.suffix}"
+    comp = folder / f"{written.stem}.comp"
+    if not comp.is_file():
+        (comp,) = folder.glob("*.comp")
+    return gold, comp
+
+
+def run(deck: str, out: Path) -> Outcome:
+    """Run ``deck`` (``folder/deck`` under ``CORPUS``) into ``out`` with the CLI; its outcome."""
+    from peridyn.cli import main
+
+    path = CORPUS / deck
+    stdout = io.StringIO()
+    with contextlib.redirect_stdout(stdout), contextlib.redirect_stderr(io.StringIO()):
+        status = main(["run", str(path), "-o", str(out), "--no-progress", "--json"])
+    if status != 0:
+        error = json.loads(stdout.getvalue().strip().splitlines()[-1])
+        line = error["error"].replace(f"{path}: ", "")
+        return Outcome(deck, "refused", line.replace("|", "/").splitlines()[0])
+    over = {}
+    written = sorted(p for p in out.iterdir() if p.suffix in (".e", ".h"))
+    if not written:
+        return Outcome(deck, "differs", "no Exodus file written")
+    compared = [r for r in written if _gold(path.parent, r)[0].is_file()]
+    if not compared:
+        return Outcome(deck, "differs", f"no gold file of {', '.join(p.name for p in written)}")
+    for result in compared:  # a file without a gold file (a history file) is not compared
+        gold, comp = _gold(path.parent, result)
+        excess = compare(gold, result, comp)
+        over |= {f"{result.name}: {k}" if len(compared) > 1 else k: v for k, v in excess.items() if v > 0}
+    if not over:
+        return Outcome(deck, "match", "")
+    worst = sorted(over.items(), key=lambda kv: -kv[1])
+    text = ", ".join(f"{k} ({v + 1:.3g}x)" for k, v in worst[:6])
+    text += f" and {len(worst) - 6} more" if len(worst) > 6 else ""
+    return Outcome(deck, "differs", text + (f": {WHY[deck]}" if deck in WHY else ""))
+
+
+def documented() -> dict[str, str]:
+    """The rows of the table in docs/peridigm.md, by deck."""
+    text = DOCS.read_text(encoding="utf-8")
+    table = text[text.index(BEGIN) + len(BEGIN) : text.index(END)]
+    rows = {}
+    for line in table.splitlines():
+        if line.startswith("| `"):
+            rows[line.split("`")[1]] = line
+    return rows
+
+
+def write_docs(outcomes: list[Outcome]) -> None:
+    """Rewrite the table of docs/peridigm.md between its markers."""
+    text = DOCS.read_text(encoding="utf-8")
+    counts = {s: sum(o.status == s for o in outcomes) for s in ("match", "differs", "refused")}
+    lines = [
+        BEGIN,
+        f"{counts['match']} of {len(outcomes)} decks match, {counts['differs']} differ, "
+        f"{counts['refused']} are refused.",
+        "",
+        "| deck | outcome | what differs, or what is refused |",
+        "|---|---|---|",
+        *(o.row() for o in outcomes),
+        END,
+    ]
+    head, tail = text[: text.index(BEGIN)], text[text.index(END) + len(END) :]
+    DOCS.write_text(head + "\n".join(lines) + tail, encoding="utf-8")
+
+
+if __name__ == "__main__":
+    import tempfile
+
+    chosen = sys.argv[1:] or decks()
+    results = []
+    for name in chosen:
+        with tempfile.TemporaryDirectory() as tmp:
+            results.append(run(name, Path(tmp) / "out"))
+        print(results[-1].row(), flush=True)
+    if not sys.argv[1:]:
+        write_docs(results)
