@@ -8,12 +8,11 @@ space-time B-scan along the line through the PZT, and the frequency-wavenumber m
 line with the Rayleigh-Lamb curves over it.
 """
 
-from pathlib import Path
-
 from peridyn import load_case, run_case
+from peridyn.data.examples import example_path
 
 case = load_case(
-    Path("../cases/lamb_plate.yaml"),
+    example_path("cases/lamb_plate.yaml"),
     ["output.snapshot_times=[]", "analysis.kxky=null"],
 )
 summary = run_case(case, "peridyn-out/gallery/lamb_plate", overwrite=True)

@@ -7,11 +7,10 @@ the peridynamic model, a shift-invert eigensolve, six rigid modes and the first 
 classified by type (bending, torsion, ...).
 """
 
-from pathlib import Path
-
 from peridyn import load_case, run_case
+from peridyn.data.examples import example_path
 
-case = load_case(Path("../cases/pmma_plate.yaml"), ["discretization.spacing=4e-3"])
+case = load_case(example_path("cases/pmma_plate.yaml"), ["discretization.spacing=4e-3"])
 summary = run_case(case, "peridyn-out/gallery/modal", overwrite=True)
 
 # %%

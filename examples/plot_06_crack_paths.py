@@ -7,11 +7,10 @@ break above the critical bond stress and the crack runs across the plate. Shown:
 map with the crack path found from it.
 """
 
-from pathlib import Path
-
 from peridyn import load_case, run_case
+from peridyn.data.examples import example_path
 
-case = load_case(Path("../cases/plate2d_stretch.yaml"))
+case = load_case(example_path("cases/plate2d_stretch.yaml"))
 summary = run_case(case, "peridyn-out/gallery/crack_paths", overwrite=True)
 
 # %%

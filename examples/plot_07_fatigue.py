@@ -8,13 +8,12 @@ grows from the notch. Shown: crack length against cycles over the first 120 fati
 step runs to the next bond break), on a 0.5 mm grid.
 """
 
-from pathlib import Path
-
 from peridyn import load_case
+from peridyn.data.examples import example_path
 from peridyn.jobs.fatigue import run_fatigue_case
 
 case = load_case(
-    Path("../cases/sen_fatigue_2d.yaml"),
+    example_path("cases/sen_fatigue_2d.yaml"),
     ["discretization.spacing=0.5e-3", "fatigue.mapping=[{steps: 120, tau: 1.0e-6}]"],
 )
 summary = run_fatigue_case(case, "peridyn-out/gallery/fatigue", overwrite=True)

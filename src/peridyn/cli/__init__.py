@@ -27,6 +27,7 @@ COMMAND_MODULES = (
     "peridyn.cli.validate_cmd",
     "peridyn.cli.convert_cmd",
     "peridyn.cli.demo_cmd",
+    "peridyn.cli.examples_cmd",
     "peridyn.cli.bench_cmd",
     "peridyn.cli.lamb_cmd",
     "peridyn.cli.dispersion_cmd",
