@@ -28,6 +28,7 @@ COMMAND_MODULES = (
     "peridyn.cli.convert_cmd",
     "peridyn.cli.demo_cmd",
     "peridyn.cli.examples_cmd",
+    "peridyn.cli.schema_cmd",
     "peridyn.cli.bench_cmd",
     "peridyn.cli.lamb_cmd",
     "peridyn.cli.dispersion_cmd",

@@ -102,9 +102,12 @@ def _write_modal(case, body, n_bonds, table: ModeTable, out, case_path) -> tuple
         out / "results.h5", body.points[:, : body.dim], body.volumes, provenance(case_path, case=case)
     ) as h5:
         h5.set_status("running")
-        h5.write_array("modes/frequencies", result.frequencies)
-        h5.write_array("modes/shapes", result.shapes)
-        h5.write_array("modes/rigid", result.rigid)
+        h5.write_array(
+            "modes/frequencies", result.frequencies, {"units": "Hz", "long_name": "frequency"}, ["mode"]
+        )
+        about = {"units": "1", "long_name": "mode shape, mass-normalised (x^T M x = 1)"}
+        h5.write_array("modes/shapes", result.shapes, about, ["mode", "point", "component"])
+        h5.write_array("modes/rigid", result.rigid, {"units": "1", "long_name": "rigid-body mode"}, ["mode"])
     (out / "modes").mkdir(exist_ok=True)
     for i, shape in enumerate(result.shapes):
         write_vtu(
