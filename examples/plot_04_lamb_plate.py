@@ -2,7 +2,7 @@
 Lamb waves from a PZT, and their f-k map
 ========================================
 
-Seed 000's plate (300 x 200 x 2 mm, 3 layers, 125 250 points): a surface PZT driven by a
+Patra et al.'s (2018) plate (300 x 200 x 2 mm, 3 layers, 125 250 points): a surface PZT driven by a
 3.5-cycle 150 kHz tone burst launches S0 and A0. The run writes its sensor signals, a
 space-time B-scan along the line through the PZT, and the frequency-wavenumber map of that
 line with the Rayleigh-Lamb curves over it.

@@ -2,7 +2,7 @@
 Free vibration of a PMMA plate
 ==============================
 
-Seed 002's 100 x 50 x 8 mm PMMA plate, free-free, at a 4 mm spacing: the stiffness and mass of
+Freimanis's (2019) 100 x 50 x 8 mm PMMA plate, free-free, at a 4 mm spacing: the stiffness and mass of
 the peridynamic model, a shift-invert eigensolve, six rigid modes and the first elastic ones,
 classified by type (bending, torsion, ...).
 """

@@ -2,7 +2,7 @@
 A crack grows across a stretched plate
 ======================================
 
-Seed 004: a 10 x 4 mm aluminium plate with a short central crack, pulled at both ends. Bonds
+Martowicz: a 10 x 4 mm aluminium plate with a short central crack, pulled at both ends. Bonds
 break above the critical bond stress and the crack runs across the plate. Shown: the damage
 map with the crack path found from it.
 """

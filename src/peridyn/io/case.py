@@ -464,7 +464,7 @@ class InitialConditionSpec(Strict):
 
 
 class Actuator(Strict):
-    """A surface-bonded PZT patch: ``pzt_radial`` (seed 000: radial in-plane displacement, zero at
+    """A surface-bonded PZT patch: ``pzt_radial`` (Patra et al. 2018: radial in-plane displacement, zero at
     the centre, ``amplitude`` on the perimeter) or ``pin_force`` (outward line forces of
     ``line_force`` N/m along the edges); driven by the time function ``signal``."""
 
@@ -541,7 +541,7 @@ class Solver(Strict):
     ``newton_iterations`` per solve and ``breaking_rounds`` (re-equilibrations per step after
     bonds break); ``newmark``: implicit dynamics (average
     acceleration) with ``steps`` or ``time``, ``dt`` (s, required), ``displacement_tolerance``
-    (m, Newton increment; seed 004: 0.1 nm), ``newton_iterations`` and ``damping``; both take
+    (m, Newton increment; Martowicz: 0.1 nm), ``newton_iterations`` and ``damping``; both take
     ``linear_solver`` (``lu``, or ``cg`` for large 3D bodies)."""
 
     type: Literal["explicit", "static", "modal", "newton", "newmark"] = described(
@@ -1089,7 +1089,7 @@ class ParisSpecimen(Strict):
 
 
 class Fatigue(Strict):
-    """Remaining-life fatigue (thesis seed 002 ch. 7): phase I (A_I, m_I, eps_inf), phase II
+    """Remaining-life fatigue (Freimanis 2019 ch. 7): phase I (A_I, m_I, eps_inf), phase II
     (A_II, m_II; A_II given at ``A_II_horizon`` m and scaled to the case's horizon by eq. 7.15),
     phi_c, load ratio R in [-1, 1), the boundary conditions' value at ``max_load_time`` (s) as the
     maximum load, cycle ``mapping`` blocks (``adaptive``: cut a step where the next bond breaks),

@@ -76,7 +76,7 @@ class RecorderSpec:
     snapshot_every : int or None
         Steps between field snapshots (None: only at ``snapshot_steps`` and the end).
     snapshot_steps : list of int
-        Extra steps with a snapshot (e.g. the seed's 20, 40, 60 us).
+        Extra steps with a snapshot (e.g. the paper's 20, 40, 60 us).
     sensors : dict of name -> 3 floats (m)
     lines : dict of name -> LineProbe
     planes : dict of name -> (n,) point indices

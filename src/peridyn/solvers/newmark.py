@@ -8,7 +8,7 @@ damping c:
 
 solved by Newton with the consistent tangent ``K`` (``peridyn.linalg.tangent``):
 ``(K + (4 / dt^2 + 2 c / dt) M) du = R``, until the largest displacement increment
-|du| is below ``tolerance`` (m; seed 004: dt = 20 ns, 0.1 nm). Prescribed displacements
+|du| is below ``tolerance`` (m; Martowicz: dt = 20 ns, 0.1 nm). Prescribed displacements
 are imposed at t + dt, prescribed velocities integrated by the trapezoidal rule, and
 prescribed dofs get a = 0 (as in ``ExplicitSolver``). For a linear undamped system the
 scheme conserves the energy (v^T M v + u^T K u) / 2 exactly and is unconditionally stable.
