@@ -823,8 +823,8 @@ class Study:
         return rows
 
     def sweep(self, parameter: str) -> dict:
-        """Relations of one figure of the dispersion study, labelled: ``"influence"`` (base horizon and spacing),
-        ``"horizon"`` (base spacing) or ``"spacing"`` (base horizon), constant influence
+        """Relations of one figure of the dispersion study, labelled: ``"influence"`` (base
+        horizon and spacing), ``"horizon"`` (base spacing) or ``"spacing"`` (base horizon), constant influence
         function first when several are present."""
         influences = list(dict.fromkeys(key[0] for key in self.relations))
         base = influences[0]
