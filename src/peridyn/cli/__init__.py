@@ -18,7 +18,7 @@ import sys
 import time
 
 from peridyn.cli.errors import ArgumentParser, report, writing
-from peridyn.cli.logs import plain_warnings
+from peridyn.cli.logs import configure_logging, plain_warnings
 from peridyn.errors import InputError
 
 #: Subcommand modules, in the order ``peridyn --help`` lists them.
@@ -67,6 +67,7 @@ def main(argv: list[str] | None = None) -> int:
     """
     argv = sys.argv[1:] if argv is None else list(argv)
     _quiet_unless_first_rank()
+    configure_logging()
     args = None
     with plain_warnings():
         try:
