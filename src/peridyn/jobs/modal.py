@@ -142,18 +142,21 @@ def modal_table(model, n_modes: int, fixed=None, eigensolver: str = "auto"):
 
 def mode_rows(body, masses, result):
     """Types (``analysis.modes.classify_modes``) and JSON/CSV rows of the modes ``result`` of
-    ``body`` whose points weigh ``masses`` (n_points,) kg."""
+    ``body`` whose points weigh ``masses`` (n_points,) kg. A rigid mode's frequency is 0 Hz
+    (the solver's value, round-off of order 1e-3 Hz of either sign, stays in results.h5)."""
     types = classify_modes(body.points, result.shapes, masses, result.rigid)
     rows = [
         {
             "index": i,
-            "frequency_hz": float(f),
+            "frequency_hz": 0.0 if rigid else float(f),
             "type": t.type,
             "order": t.order,
             "label": str(t),
             "residual": float(r),
         }
-        for i, (f, t, r) in enumerate(zip(result.frequencies, types, result.residuals, strict=True))
+        for i, (f, t, r, rigid) in enumerate(
+            zip(result.frequencies, types, result.residuals, result.rigid, strict=True)
+        )
     ]
     return types, rows
 
