@@ -84,6 +84,14 @@ class StudyRun:
             "notes": self.notes,
         }
 
+    @classmethod
+    def from_dict(cls, row: dict) -> StudyRun:
+        """The run a ``to_dict`` row (of ``study.json``) describes."""
+        return cls(
+            row["spacing_m"], row["horizon_factor"], row["points"], row["bonds"], row["seconds"],
+            dict(row["modes"] or {}), row["skipped"], list(row["notes"]),
+        )  # fmt: skip
+
 
 def study_sweep(case_path, spacings, horizon_factors, n_modes: int | None = None, overrides=()) -> dict:
     """The sweep file (as a dict) whose runs are the study's levels.

@@ -204,7 +204,7 @@ def run_sweep(
         raise SweepInterrupted(
             interrupted, counts["completed"], len(sweep.runs), command or f"run_sweep({str(path)!r}, ...)"
         )
-    figures = _draw_figures(sweep, collector.dataset(), out)
+    figures = draw_figures(sweep, collector.dataset(), out)
     return {
         "sweep": sweep.name,
         "runs": len(sweep.runs),
@@ -461,7 +461,7 @@ def flatten_summary(summary: dict) -> dict:
     return out
 
 
-def _draw_figures(sweep: Sweep, ds, out: Path) -> list[Path]:
+def draw_figures(sweep: Sweep, ds, out: Path) -> list[Path]:
     """Each chosen scalar result against the first varied parameter (``outputs.scalars``, else
     up to :data:`MAX_FIGURES` numeric results that vary), when the sweep varies a number and
     its ``outputs.figures`` is on."""

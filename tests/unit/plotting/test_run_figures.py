@@ -68,3 +68,43 @@ def test_rigid_modes_are_reported_at_0_hz():
     assert [row["frequency_hz"] for row in rows[:6]] == [0.0] * 6
     assert [row["frequency_hz"] for row in rows[6:]] == [float(f) for f in result.frequencies[6:]]
     assert all(row["frequency_hz"] > 1e3 for row in rows[6:])
+
+
+def test_sweep_figure_axes_carry_the_units(monkeypatch, tmp_path):
+    """A sweep figure labels its axes with the dataset's units (Pa, J) and its legend the other
+    parameter's value with its unit."""
+    from matplotlib.figure import Figure
+
+    from peridyn.io.dataset import build_dataset
+    from peridyn.plotting import sweep
+
+    drawn = []
+
+    class Kept(Figure):
+        def __init__(self, *args, **kwargs):
+            super().__init__(*args, **kwargs)
+            drawn.append(self)
+
+    monkeypatch.setattr(sweep, "Figure", Kept)
+    ds = build_dataset(
+        {
+            "run_id": ["a", "b", "c", "d"],
+            "material.E": [1e9, 2e9, 1e9, 2e9],
+            "material.density": [1e3, 1e3, 2e3, 2e3],
+        },
+        {"strain_energy_j": [1.0, 2.0, 3.0, 4.0]},
+        {},
+        {},
+        about={
+            "material.E": ("Pa", "E"),
+            "material.density": ("kg/m^3", "rho"),
+            "strain_energy_j": ("J", "W"),
+        },
+    )
+    sweep.plot_against(ds, "material.E", "strain_energy_j", ["material.density"], tmp_path / "w.png")
+    (ax,) = drawn[0].axes
+    assert ax.get_xlabel() == "material.E (Pa)" and ax.get_ylabel() == "strain_energy_j (J)"
+    assert [t.get_text() for t in ax.get_legend().get_texts()] == [
+        "material.density = 1000 kg/m^3",
+        "material.density = 2000 kg/m^3",
+    ]
