@@ -33,6 +33,7 @@ extensions = [
     "sphinx.ext.mathjax",
     "sphinx_gallery.gen_gallery",
     "cli_pages",
+    "case_reference",
 ]
 
 source_suffix = {".md": "markdown", ".rst": "restructuredtext"}

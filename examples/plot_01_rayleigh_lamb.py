@@ -3,7 +3,7 @@ Rayleigh-Lamb dispersion of an aluminium plate
 ==============================================
 
 The exact phase-velocity curves of the symmetric (S) and antisymmetric (A) Lamb modes of a
-2 mm aluminium 6061-T6 plate (seed 000's plate): the reference every Lamb-wave run is checked
+2 mm aluminium 6061-T6 plate (Patra et al.'s (2018) plate): the reference every Lamb-wave run is checked
 against.
 """
 
@@ -18,6 +18,6 @@ fig, axes = plt.subplots(1, 2, figsize=(10, 4))
 plot_lamb_dispersion(curves, ax=axes)
 
 # %%
-# At the seed's 150 kHz only S0 and A0 propagate:
+# At the paper's 150 kHz only S0 and A0 propagate:
 for mode in lamb_modes(E, nu, rho, thickness, [150e3]):
     print(f"{mode.mode}: c = {mode.phase_velocity_m_s:7.1f} m/s, k = {mode.wavenumber_rad_m:6.1f} rad/m")

@@ -2,7 +2,7 @@
 Peridynamic dispersion: influence function and horizon
 ======================================================
 
-Seed 001: the longitudinal and shear dispersion of a linear PMB and LPS medium (steel) with
+The dispersion study: the longitudinal and shear dispersion of a linear PMB and LPS medium (steel) with
 the constant influence function, for two horizons. Nonlocality bends omega(k) below the
 classical line omega = c k and gives a finite group velocity at the Nyquist wavenumber.
 """

@@ -2,7 +2,7 @@
 Bloch waves of the discrete plate
 =================================
 
-The exact dispersion of the discretised seed-000 plate (3 layers through its 2 mm thickness,
+The exact dispersion of the discretised plate of Patra et al. (2018) (3 layers through its 2 mm thickness,
 1.2 mm in-plane spacing, LPS with the shear correction): the lowest symmetric, antisymmetric
 and shear-horizontal branches of the periodic point lattice, against Rayleigh-Lamb theory
 (dashed). Where they part is where the simulation cannot follow the plate.
@@ -33,6 +33,6 @@ plate = BlochLattice(
 plot_bloch(plate, out / "bloch.png", frequencies=[150e3], f_max=400e3)
 
 # %%
-# The wavenumbers of the discrete plate against theory at the seed's 150 kHz:
+# The wavenumbers of the discrete plate against theory at the paper's 150 kHz:
 for row in predict(plate, [150e3]):
     print(row)

@@ -2,18 +2,17 @@
 Lamb waves from a PZT, and their f-k map
 ========================================
 
-Seed 000's plate (300 x 200 x 2 mm, 3 layers, 125 250 points): a surface PZT driven by a
+Patra et al.'s (2018) plate (300 x 200 x 2 mm, 3 layers, 125 250 points): a surface PZT driven by a
 3.5-cycle 150 kHz tone burst launches S0 and A0. The run writes its sensor signals, a
 space-time B-scan along the line through the PZT, and the frequency-wavenumber map of that
 line with the Rayleigh-Lamb curves over it.
 """
 
-from pathlib import Path
-
 from peridyn import load_case, run_case
+from peridyn.data.examples import example_path
 
 case = load_case(
-    Path("../cases/lamb_plate.yaml"),
+    example_path("cases/lamb_plate.yaml"),
     ["output.snapshot_times=[]", "analysis.kxky=null"],
 )
 summary = run_case(case, "peridyn-out/gallery/lamb_plate", overwrite=True)

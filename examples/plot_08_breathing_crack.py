@@ -11,8 +11,9 @@ printed for each.
 
 from pathlib import Path
 
+from peridyn.data.examples import example_path
 from peridyn.jobs import breathing
 
 out = Path("peridyn-out/gallery/breathing")
 out.mkdir(parents=True, exist_ok=True)
-breathing.main(["../cases/lamb_breathing_crack.yaml", str(out / "spectra.png")])
+breathing.main([str(example_path("cases/lamb_breathing_crack.yaml")), str(out / "spectra.png")])

@@ -16,11 +16,12 @@ from pathlib import Path
 import matplotlib.pyplot as plt
 import numpy as np
 
+from peridyn.data.examples import example_path
 from peridyn.io.exodus import read_exodus
 from peridyn.io.peridigm_case import load_deck
 from peridyn.jobs.run import run_case
 
-data = Path("../tests/data/peridigm")
+data = example_path("gallery/peridigm/WaveInBar.xml").parent
 out = Path("peridyn-out/gallery/peridigm")
 case = load_deck(data / "WaveInBar.xml")
 run_case(case, out, overwrite=True)

@@ -44,7 +44,7 @@ DOC = ROOT / "docs" / "lamb.md"
 HEADING = "### Simulation against Bloch"
 MODES = ("S0", "A0")
 FREQUENCIES = (110e3, 150e3, 185e3, 225e3)
-#: The accuracy the issue asks of a discretisation, |k / k0 - 1|.
+#: The accuracy asked of a discretisation, |k / k0 - 1|.
 TARGET = 0.015
 
 

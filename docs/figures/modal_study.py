@@ -6,7 +6,7 @@
     PYTHONPATH=src python docs/figures/modal_study.py runs
     PYTHONPATH=src python docs/figures/modal_study.py lattice
 
-``run`` solves the free PMMA plate of VALIDATION.md V4 (LPS, no partial volumes) and
+``run`` solves the free PMMA plate of docs/reference-cases.md, V4 (LPS, no partial volumes) and
 appends its six elastic frequencies, by type, to docs/figures/modal_study.json; ``plot``
 draws docs/figures/modal_study_*.png from that file and ``table`` prints its Markdown table
 (frequency in Hz and its deviation from FE in %, by type; then the deviations from the
@@ -34,7 +34,7 @@ from peridyn.physics.materials import LPSModel
 N_MODES = 14
 HERE = Path(__file__).parent
 RESULTS = HERE / "modal_study.json"
-#: modes by type (VALIDATION.md V4): 1st bending, 1st torsional, 2nd torsional, 2nd bending,
+#: modes by type (docs/reference-cases.md, V4): 1st bending, 1st torsional, 2nd torsional, 2nd bending,
 #: 1st transverse bending, 1st in-plane bending
 TYPES = [
     ("bending", 1),
@@ -46,7 +46,7 @@ TYPES = [
 ]
 LABELS = ["1B", "1T", "2T", "2B", "TB", "IPB"]
 FE = [1706.1, 1982.9, 4268.0, 4542.4, 6607.0, 6868.0]
-#: the thesis's Table 5.1 (seed 002) by (points, horizon / h); it has no 135k row at 3h
+#: the thesis's Table 5.1 (Freimanis 2019) by (points, horizon / h); it has no 135k row at 3h
 THESIS = {
     (40000, 1.4143): [1656.45, 1961.24, 4213.43, 4421.60, 6463.92, 6855.45],
     (40000, 2.001): [1666.51, 1882.92, 4071.67, 4436.87, 6457.59, 6847.60],

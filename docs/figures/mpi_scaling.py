@@ -68,7 +68,7 @@ SHELL = 6
 #: whole loading's per-point flags (about 6 B)
 WHOLE_BODY_BYTES = 110.0
 #: compute coefficients of the projections, per thread, from the quiet-machine measurement of
-#: the seed Lamb case (benchmarks/HISTORY.md, "Whole explicit steps against the force kernel",
+#: the Lamb plate case (benchmarks/HISTORY.md, "Whole explicit steps against the force kernel",
 #: load 5: force 54.9 ms and rest 4.1 ms per step on 2 threads, 9 322 368 bonds, 125 250
 #: points): the runs of bench_mpi.py so far met loads of 12-25, which inflate them 2-4x
 QUIET = {"t_bond": 54.9e-3 * 2 / 9_322_368, "t_point": 4.1e-3 * 2 / 125_250}

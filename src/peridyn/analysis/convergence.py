@@ -3,7 +3,7 @@
 A quantity f(h) computed on grids of spacing h (or, in a delta-convergence study, at
 horizons delta) is modelled, in the asymptotic range, by
 
-    f(h) = f_inf + C h^p                                   (seed 002, eqs. 6.3 and 6.5)
+    f(h) = f_inf + C h^p                                   (Freimanis 2019, eqs. 6.3 and 6.5)
 
 with f_inf the value at zero spacing (the continuum value), p the observed order of
 convergence and C a constant (eq. 6.4: C = |f_inf - f(h)| / h^p).
@@ -16,7 +16,7 @@ convergence and C a constant (eq. 6.4: C = |f_inf - f(h)| / h^p).
   (Roache 1998, chapter 5; the varying-ratio form as in Celik et al. 2008).
   Then C = (f2 - f1) / (h2^p - h1^p) and f_inf = f1 - C h1^p.
 - More than three: least-squares fit of (f_inf, C, p) to all points, as the thesis
-  fitted its four meshes (seed 002, section 6.1: "minimizing the difference between the
+  fitted its four meshes (Freimanis 2019, section 6.1: "minimizing the difference between the
   left-hand side and the right-hand side in (6.3)"), started from the three finest.
 - Grid convergence index of the finest grid (Roache 1994; Roache 1998, chapter 5):
 

@@ -59,7 +59,7 @@ where two of them cross. Group velocities are analytic:
 ``d omega/dk = v^T D'(k) v / (2 rho omega)`` (Hellmann-Feynman) with ``D'`` the
 exact derivative of the sums above.
 
-:func:`study` runs seed 001's parameter study (influence functions, horizons,
+:func:`study` runs the dispersion study's parameter study (influence functions, horizons,
 grid spacings) and tabulates long-wave errors, accurate bands and the onsets of
 negative group velocity; ``docs/dispersion.md`` holds the results.
 """
@@ -185,7 +185,7 @@ class Medium:
         return float(np.sqrt(p_modulus / self.density)), float(np.sqrt(mu / self.density))
 
 
-#: Maraging steel of seed 001 (VALIDATION.md V3): K = 132.77 GPa, mu = 81.92 GPa,
+#: Maraging steel of the dispersion study (docs/reference-cases.md, V3): K = 132.77 GPa, mu = 81.92 GPa,
 #: rho = 8000 kg/m^3 (classical cL = 5500 m/s, cS = 3200 m/s).
 MARAGING_STEEL = Medium.from_moduli(132.77e9, 81.92e9, 8000.0)
 
@@ -768,11 +768,11 @@ def _wavenumbers(wavenumbers, k_max: float, points: int) -> np.ndarray:
     return k
 
 
-# -- parameter studies (seed 001, figures 4-6 and 10-12) -------------------------------------
+# -- parameter studies (the dispersion study, figures 4-6 and 10-12) -------------------------------------
 
-#: Influence functions of seed 001's study: constant, 1/|xi| and Gaussian.
+#: Influence functions of the dispersion study's study: constant, 1/|xi| and Gaussian.
 SEED_INFLUENCES = ("constant", "inverse", "gaussian")
-#: Seed 001's horizons (m) at a 1 mm grid.
+#: the dispersion study's horizons (m) at a 1 mm grid.
 SEED_HORIZONS = (2e-3, 3e-3, 5e-3, 7e-3)
 #: Grid spacings (m) of the mesh study at a 3 mm horizon (2 to 6 spacings per horizon).
 SEED_SPACINGS = (0.5e-3, 0.75e-3, 1e-3, 1.5e-3)
@@ -823,8 +823,8 @@ class Study:
         return rows
 
     def sweep(self, parameter: str) -> dict:
-        """Relations of one seed figure, labelled: ``"influence"`` (base horizon and spacing),
-        ``"horizon"`` (base spacing) or ``"spacing"`` (base horizon), constant influence
+        """Relations of one figure of the dispersion study, labelled: ``"influence"`` (base
+        horizon and spacing), ``"horizon"`` (base spacing) or ``"spacing"`` (base horizon), constant influence
         function first when several are present."""
         influences = list(dict.fromkeys(key[0] for key in self.relations))
         base = influences[0]
@@ -871,7 +871,7 @@ def study(
     direction="x",
     points: int = 400,
 ) -> Study:
-    """Dispersion relations of seed 001's parameter study (maraging steel by default).
+    """Dispersion relations of the dispersion study's parameter study (maraging steel by default).
 
     For every influence function: the horizons ``horizons`` at ``base_spacing``
     and the spacings ``spacings`` at ``base_horizon``; each relation runs to the

@@ -1,4 +1,4 @@
-"""Wave fronts of a point excitation (seed 001, section 4): speeds from axis probes.
+"""Wave fronts of a point excitation (the dispersion study, section 4): speeds from axis probes.
 
 A displacement pulse along x at the centre of a cube sends a P wave along x
 and S waves (polarised along x) along y and z. On the axes, u_x itself mixes

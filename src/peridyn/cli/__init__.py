@@ -18,7 +18,7 @@ import sys
 import time
 
 from peridyn.cli.errors import ArgumentParser, report, writing
-from peridyn.cli.logs import plain_warnings
+from peridyn.cli.logs import configure_logging, plain_warnings
 from peridyn.errors import InputError
 
 #: Subcommand modules, in the order ``peridyn --help`` lists them.
@@ -27,6 +27,8 @@ COMMAND_MODULES = (
     "peridyn.cli.validate_cmd",
     "peridyn.cli.convert_cmd",
     "peridyn.cli.demo_cmd",
+    "peridyn.cli.examples_cmd",
+    "peridyn.cli.schema_cmd",
     "peridyn.cli.bench_cmd",
     "peridyn.cli.lamb_cmd",
     "peridyn.cli.dispersion_cmd",
@@ -65,6 +67,7 @@ def main(argv: list[str] | None = None) -> int:
     """
     argv = sys.argv[1:] if argv is None else list(argv)
     _quiet_unless_first_rank()
+    configure_logging()
     args = None
     with plain_warnings():
         try:

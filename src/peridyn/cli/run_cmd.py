@@ -4,6 +4,7 @@ docs/peridigm.md)."""
 
 from __future__ import annotations
 
+import logging
 import shlex
 import sys
 from pathlib import Path
@@ -22,6 +23,8 @@ from peridyn.cli.options import (
 from peridyn.io.peridigm_case import load_case_or_deck
 from peridyn.io.provenance import provenance
 from peridyn.parallel.comm import world
+
+logger = logging.getLogger(__name__)
 
 
 def register(sub) -> None:
@@ -67,10 +70,9 @@ def run(args) -> dict:
     case = load_case_or_deck(args.case, overrides)
     check_memory(case, getattr(args, "max_memory", None), Path(args.case).parent)  # demo: no flag
     info = provenance()
-    print(
+    logger.info(
         f"peridyn {info['peridyn_version']} (commit {info['git_commit'][:12]}): case "
-        f"{case.name!r} from {args.case}",
-        file=sys.stderr,
+        f"{case.name!r} from {args.case}"
     )
     summary = run_case(
         case,

@@ -186,7 +186,7 @@ def find_bonds(
         Weigh each neighbour by the fraction of its cell inside the horizon
         sphere (computed by midpoint quadrature with ``quadrature_points`` per
         axis). On lattices with horizons of 2-3 spacings this is what makes the
-        discrete long-wave speeds match the continuum (VALIDATION.md).
+        discrete long-wave speeds match the continuum (docs/reference-cases.md).
     required : (k,) int or None
         The points that must have a neighbour (default: every point). A rank's part of a
         body (``peridyn.parallel``) requires it of its owned points only: an outer ghost may

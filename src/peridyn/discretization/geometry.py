@@ -124,7 +124,7 @@ def plate(
         ``"cell"``: layers at the centres of ``layers`` equal slabs (dz = t / layers),
         volumes add up to the plate volume. ``"surface"``: the first and last layers
         lie on the faces (dz = t / (layers - 1)) and every point has volume
-        dx dy dz, as in seed 000 (3 layers 1 mm apart in a 2 mm plate).
+        dx dy dz, as in Patra et al. 2018 (3 layers 1 mm apart in a 2 mm plate).
 
     Notes
     -----

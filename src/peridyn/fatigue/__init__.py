@@ -1,4 +1,4 @@
-"""Fatigue: Silling and Askari's remaining-life model (thesis seed 002, chapter 7).
+"""Fatigue: Silling and Askari's remaining-life model (Freimanis 2019, chapter 7).
 
 ``model`` holds the per-bond remaining life, ``mapping`` the cycles per step,
 ``tip`` the crack-tip tracking, ``run`` the fatigue loop and ``calibration``

@@ -1,4 +1,4 @@
-"""Calibration of the remaining-life parameters (thesis seed 002, eqs. 7.7-7.14).
+"""Calibration of the remaining-life parameters (Freimanis 2019, eqs. 7.7-7.14).
 
 Phase I: the strain-life data eps(N) are fitted with (eps - eps_inf) = a N^b (eq. 7.9 gives
 eps_inf: the value that makes log(eps - eps_inf) against log N straightest), then m_I = -1 / b

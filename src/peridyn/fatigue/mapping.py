@@ -1,6 +1,6 @@
 """Cycle mapping: how many load cycles each fatigue step stands for.
 
-The thesis (seed 002, section 7.1) uses a linear mapping of steps to cycles with a parameter tau:
+The thesis (Freimanis 2019, section 7.1) uses a linear mapping of steps to cycles with a parameter tau:
 each step advances N by 1 / tau cycles (tau = 1e-5 for 3 steps then 1e-4 for 57 steps gives its
 870 000 cycles). ``adaptive`` shortens a step to the cycles the next bond needs to break, so that
 no bond dies more than one step late (the per-step cap of 1 / tau still holds).

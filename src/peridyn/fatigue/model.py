@@ -1,4 +1,4 @@
-"""Remaining-life fatigue model of Silling and Askari (thesis seed 002, eqs. 7.1-7.6, 7.15).
+"""Remaining-life fatigue model of Silling and Askari (Freimanis 2019, eqs. 7.1-7.6, 7.15).
 
 Each bond carries a remaining life lambda, 1 at N = 0 (eq. 7.3). Per load cycle
 

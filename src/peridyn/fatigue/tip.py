@@ -1,4 +1,4 @@
-"""Crack-tip tracking (thesis seed 002, section 7.2).
+"""Crack-tip tracking (Freimanis 2019, section 7.2).
 
 The tip is the farthest coordinate along the growth axis, in the sense the crack grows, at which
 every point through the depth (the points of one column: same coordinates on the two other axes)

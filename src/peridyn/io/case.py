@@ -172,6 +172,13 @@ Index = Annotated[int, NotBool]
 Vector3 = Annotated[list[Finite], Field(min_length=2, max_length=3)]
 
 
+def described(default, description: str, unit: str | None = None):
+    """A case key's default (``...``: required), description and unit (SI, UDUNITS spelling; None
+    for a number without one or a word), as the case-file reference and the JSON schema show them
+    (``peridyn.io.case_schema``)."""
+    return Field(default, description=description, json_schema_extra={"unit": unit} if unit else None)
+
+
 class Strict(BaseModel):
     """Base of every section: unknown keys are errors."""
 
@@ -185,15 +192,27 @@ class Geometry(Strict):
     Exodus II mesh ``file`` (a point per element; its blocks, node sets and side sets become
     node sets, see ``peridyn.io.exodus``)."""
 
-    type: Literal["box", "plate", "rectangle", "mesh", "exodus"]
-    size: list[Positive] | None = None
-    origin: Vector3 | None = None
-    layers: Annotated[int, NotBool, Field(ge=1)] | None = None
-    layer_placement: Literal["cell", "surface"] = "cell"
-    thickness: Positive | None = None
-    plane: Literal["stress", "strain"] = "stress"
-    file: str | None = None
-    dimension: Literal[2, 3] = 3
+    type: Literal["box", "plate", "rectangle", "mesh", "exodus"] = described(
+        ..., "shape of the body: box, plate, rectangle (2D), mesh (text mesh file) or exodus (Exodus II mesh)"
+    )
+    size: list[Positive] | None = described(
+        None,
+        "lengths along x, y (and z): box [lx, ly, lz], plate [length, width, thickness], rectangle [lx, ly]",
+        "m",
+    )
+    origin: Vector3 | None = described(
+        None, "corner of the body with the smallest coordinates (default: the origin)", "m"
+    )
+    layers: Annotated[int, NotBool, Field(ge=1)] | None = described(
+        None, "plate: points through the thickness"
+    )
+    layer_placement: Literal["cell", "surface"] = described(
+        "cell", "plate: layers at cell centres (cell) or with the outer layers on the surfaces (surface)"
+    )
+    thickness: Positive | None = described(None, "rectangle or 2D mesh: out-of-plane thickness", "m")
+    plane: Literal["stress", "strain"] = described("stress", "rectangle: plane stress or plane strain")
+    file: str | None = described(None, "mesh or exodus: the mesh file, relative to the case file")
+    dimension: Literal[2, 3] = described(3, "mesh: 2 or 3 dimensions")
 
     @model_validator(mode="after")
     def _complete(self):
@@ -239,18 +258,30 @@ class Discretization(Strict):
     """Spacing (m, one value or one per axis for a box), horizon as a multiple of the spacing
     (``horizon``) or in metres (``horizon_m``), influence function and partial volumes."""
 
-    spacing: Positive | list[Positive] | None = None
-    horizon: Positive | None = None
-    horizon_m: Positive | None = None
-    influence: Literal["constant", "inverse", "gaussian", "conical"] = "constant"
-    partial_volumes: bool = True
-    #: ``sphere``: |xi| <= horizon; ``box`` (a box geometry, no partial volumes): the points
-    #: within round(horizon / spacing) cells along each axis, Peridigm's PdQuickGrid families
-    neighbourhood: Literal["sphere", "box"] = "sphere"
-    #: bonds taken out of the families (Peridigm's bond filters; a pre-crack breaks them instead)
-    bond_filters: list[BondFilter] = []
-    #: False: no bond joins two blocks (Peridigm's "Omit Bonds Between Blocks: All")
-    bonds_between_blocks: bool = True
+    spacing: Positive | list[Positive] | None = described(
+        None, "grid spacing: one value, or one per axis for a box", "m"
+    )
+    horizon: Positive | None = described(
+        None, "horizon as a multiple of the spacing (give this or horizon_m)"
+    )
+    horizon_m: Positive | None = described(None, "horizon in metres (give this or horizon)", "m")
+    influence: Literal["constant", "inverse", "gaussian", "conical"] = described(
+        "constant", "influence function of the bonds"
+    )
+    partial_volumes: bool = described(
+        True, "weigh bonds near the horizon's edge by the share of the neighbour's cell inside it"
+    )
+    neighbourhood: Literal["sphere", "box"] = described(
+        "sphere",
+        "sphere: |xi| <= horizon; box (a box geometry, no partial volumes): the points within "
+        "round(horizon / spacing) cells along each axis, Peridigm's PdQuickGrid families",
+    )
+    bond_filters: list[BondFilter] = described(
+        [], "bonds taken out of the families (Peridigm's bond filters; a pre-crack breaks them instead)"
+    )
+    bonds_between_blocks: bool = described(
+        True, "false: no bond joins two blocks (Peridigm's Omit Bonds Between Blocks: All)"
+    )
 
     def horizon_metres(self, spacing: float) -> float:
         """The horizon (m) on a grid of ``spacing`` (m): ``horizon_m``, or ``horizon`` spacings."""
@@ -306,12 +337,16 @@ class Damage(Strict):
     ``critical_bond_stress`` (Pa; bond stress E s, see ``peridyn.physics.damage``), and node sets
     where bonds never break."""
 
-    #: a number, or a time function (a mapping, ``peridyn.physics.timefunctions.from_spec``;
-    #: a body of one material): s_c(t), Peridigm's "Time Dependent Critical Stretch"
-    critical_stretch: Positive | dict | None = None
-    fracture_energy: Positive | None = None
-    critical_bond_stress: Positive | None = None
-    no_damage_sets: list[str] = []
+    critical_stretch: Positive | dict | None = described(
+        None,
+        "bonds break above this stretch (give one of the three criteria); a number, or a time function "
+        "mapping (a body of one material): s_c(t), Peridigm's Time Dependent Critical Stretch",
+    )
+    fracture_energy: Positive | None = described(
+        None, "critical energy release rate, from which the critical stretch follows", "J/m^2"
+    )
+    critical_bond_stress: Positive | None = described(None, "bonds break above this bond stress E s", "Pa")
+    no_damage_sets: list[str] = described([], "node sets whose bonds never break")
 
     @model_validator(mode="after")
     def _one(self):
@@ -324,29 +359,42 @@ class Damage(Strict):
 class Material(Strict):
     """Material model, elastic constants (Pa, kg/m^3) and optional damage."""
 
-    model: Literal["pmb", "lps", "linear_lps"]
-    E: Positive
-    nu: Annotated[float, NotBool, Field(gt=-1, lt=0.5)] | None = None
-    density: Positive
-    surface_correction: str = "none"
-    damage: Damage | None = None
+    model: Literal["pmb", "lps", "linear_lps"] = described(
+        ..., "material model: pmb (bond-based), lps (state-based) or linear_lps"
+    )
+    E: Positive = described(..., "Young's modulus", "Pa")
+    nu: Annotated[float, NotBool, Field(gt=-1, lt=0.5)] | None = described(
+        None, "Poisson's ratio (pmb: fixed by the model, 1/4 in 3D)"
+    )
+    density: Positive = described(..., "mass density", "kg/m^3")
+    surface_correction: str = described(
+        "none",
+        "surface correction of the stiffness near free surfaces (none, or a method of "
+        "peridyn.physics.surface)",
+    )
+    damage: Damage | None = described(None, "bond failure (none: bonds never break)")
 
 
 class Region(Strict):
     """A region of points: box (min, max), sphere (center, radius), cylinder (center, radius,
     axis), face (face, depth), layer (index), points (0-based ``indices``), or all."""
 
-    type: Literal["box", "sphere", "cylinder", "face", "layer", "points", "all"]
-    min: Vector3 | None = None
-    max: Vector3 | None = None
-    center: Vector3 | None = None
-    radius: Positive | None = None
-    axis: Literal["x", "y", "z"] = "z"
-    face: Literal["x-", "x+", "y-", "y+", "z-", "z+"] | None = None
-    depth: Positive | None = None
-    index: Index | None = None
-    #: ``points``: 0-based point indices
-    indices: Annotated[list[Annotated[int, NotBool, Field(ge=0)]], Field(min_length=1)] | None = None
+    type: Literal["box", "sphere", "cylinder", "face", "layer", "points", "all"] = described(
+        ..., "kind of region"
+    )
+    min: Vector3 | None = described(None, "box: lowest corner", "m")
+    max: Vector3 | None = described(None, "box: highest corner", "m")
+    center: Vector3 | None = described(None, "sphere or cylinder: centre", "m")
+    radius: Positive | None = described(None, "sphere or cylinder: radius", "m")
+    axis: Literal["x", "y", "z"] = described("z", "cylinder: axis direction")
+    face: Literal["x-", "x+", "y-", "y+", "z-", "z+"] | None = described(None, "face: which face of the body")
+    depth: Positive | None = described(None, "face: depth into the body (default: one spacing)", "m")
+    index: Index | None = described(
+        None, "layer: index of the layer through the thickness (negative from the top)"
+    )
+    indices: Annotated[list[Annotated[int, NotBool, Field(ge=0)]], Field(min_length=1)] | None = described(
+        None, "points: 0-based point indices"
+    )
 
     @model_validator(mode="after")
     def _complete(self):
@@ -370,11 +418,13 @@ class Block(Strict):
     in ``Case.materials``, with its own horizon (``horizon`` in spacings or ``horizon_m``; at most
     one; default the discretization's). Every point of the body lies in exactly one block."""
 
-    material: str
-    region: Region | None = None
-    set: str | None = None
-    horizon: Positive | None = None
-    horizon_m: Positive | None = None
+    material: str = described(..., "name of the block's material in materials")
+    region: Region | None = described(None, "the block's points (give this or set)")
+    set: str | None = described(None, "node set holding the block's points (give this or region)")
+    horizon: Positive | None = described(
+        None, "the block's horizon as a multiple of the spacing (default: the discretization's)"
+    )
+    horizon_m: Positive | None = described(None, "the block's horizon in metres", "m")
 
     def horizon_metres(self, spacing: float, default: float) -> float:
         """The block's horizon (m) on a grid of ``spacing`` (m); ``default`` (m) without one."""
@@ -397,16 +447,20 @@ class Precrack(Strict):
     2D) or a surface (``file``: an Exodus mesh of triangles, e.g. shells, relative to the case
     file; Peridigm's "Exodus Mesh" bond filter of an initial damage model) are cut."""
 
-    type: Literal["rectangle", "segment", "surface"]
-    file: str | None = None
-    #: the cut bonds still count in LPS's weighted volumes (Peridigm's initial damage breaks
-    #: them after its weighted volumes are computed); false: the family is the intact bonds
-    in_weighted_volume: bool = False
-    origin: Vector3 | None = None
-    edge_u: Vector3 | None = None
-    edge_v: Vector3 | None = None
-    start: Vector3 | None = None
-    end: Vector3 | None = None
+    type: Literal["rectangle", "segment", "surface"] = described(
+        ..., "rectangle (3D), segment (2D) or surface (the triangles of a mesh file)"
+    )
+    file: str | None = described(None, "surface: the mesh file of the crack's triangles")
+    in_weighted_volume: bool = described(
+        False,
+        "the cut bonds still count in LPS's weighted volumes (Peridigm's initial damage); false: the "
+        "family is the intact bonds",
+    )
+    origin: Vector3 | None = described(None, "rectangle: one corner", "m")
+    edge_u: Vector3 | None = described(None, "rectangle: first edge from the origin", "m")
+    edge_v: Vector3 | None = described(None, "rectangle: second edge from the origin", "m")
+    start: Vector3 | None = described(None, "segment: first end", "m")
+    end: Vector3 | None = described(None, "segment: second end", "m")
 
     @model_validator(mode="after")
     def _complete(self):
@@ -429,45 +483,71 @@ class BoundaryConditionSpec(Strict):
     another condition prescribes the motion of one of its components, or ``yield``: the prescribed
     motion wins, the force still counting in the point's acceleration (Peridigm's convention)."""
 
-    set: str
-    kind: Literal["displacement", "velocity", "force", "body_force"]
-    components: str | list[str] = "xyz"
-    value: Finite | dict = 0.0
-    where_prescribed: Literal["error", "yield"] = "error"
+    set: str = described(..., "node set the condition acts on")
+    kind: Literal["displacement", "velocity", "force", "body_force"] = described(
+        ...,
+        "prescribed displacement (m), velocity (m/s), force (N, shared by the set's points) or body force "
+        "(N/m^3)",
+    )
+    components: str | list[str] = described(
+        "xyz", "components it acts on: x, y, z or a combination such as xy"
+    )
+    value: Finite | dict = described(
+        0.0,
+        "a number, a time function mapping ({type: tone_burst, ...}) or {type: expression, text: ...} in "
+        "x, y, z and t; unit of the kind",
+    )
+    where_prescribed: Literal["error", "yield"] = described(
+        "error",
+        "a force where another condition prescribes the motion: error, or yield (the prescribed motion "
+        "wins, Peridigm's convention)",
+    )
 
 
 class InitialConditionSpec(Strict):
     """Initial displacement (m) or velocity (m/s) of node set ``set``: a number or
     ``{type: expression, text: ...}`` in x, y, z (and t = 0)."""
 
-    set: str
-    kind: Literal["displacement", "velocity"]
-    components: str | list[str] = "xyz"
-    value: Finite | dict = 0.0
+    set: str = described(..., "node set the condition acts on")
+    kind: Literal["displacement", "velocity"] = described(..., "initial displacement (m) or velocity (m/s)")
+    components: str | list[str] = described("xyz", "components it sets: x, y, z or a combination")
+    value: Finite | dict = described(
+        0.0, "a number or {type: expression, text: ...} in x, y, z (t = 0); unit of the kind"
+    )
 
 
 class Actuator(Strict):
-    """A surface-bonded PZT patch: ``pzt_radial`` (seed 000: radial in-plane displacement, zero at
+    """A surface-bonded PZT patch: ``pzt_radial`` (Patra et al. 2018: radial in-plane displacement, zero at
     the centre, ``amplitude`` on the perimeter) or ``pin_force`` (outward line forces of
     ``line_force`` N/m along the edges); driven by the time function ``signal``."""
 
-    type: Literal["pzt_radial", "pin_force"]
-    center: Annotated[list[Finite], Field(min_length=2, max_length=2)]
-    size: Positive
-    shape: Literal["square", "circular"] = "square"
-    layer: Index | None = -1
-    amplitude: Positive = 1e-6
-    line_force: Positive = 1.0
-    signal: dict
+    type: Literal["pzt_radial", "pin_force"] = described(
+        ...,
+        "pzt_radial: radial in-plane displacement, zero at the centre and amplitude on the perimeter; "
+        "pin_force: outward line forces along the edges",
+    )
+    center: Annotated[list[Finite], Field(min_length=2, max_length=2)] = described(
+        ..., "centre of the patch in the plate's plane (x, y)", "m"
+    )
+    size: Positive = described(..., "side of a square patch or diameter of a circular one", "m")
+    shape: Literal["square", "circular"] = described("square", "shape of the patch")
+    layer: Index | None = described(-1, "layer of points the patch drives (-1: the top)")
+    amplitude: Positive = described(1e-6, "pzt_radial: displacement amplitude on the perimeter", "m")
+    line_force: Positive = described(1.0, "pin_force: force per length along the edges", "N/m")
+    signal: dict = described(
+        ..., "time function of the drive, e.g. {type: tone_burst, frequency: 150e3, cycles: 3.5}"
+    )
 
 
 class PZTSensor(Strict):
     """A PZT patch used as a sensor: the mean in-plane strain (eps_xx + eps_yy) under it."""
 
-    center: Annotated[list[Finite], Field(min_length=2, max_length=2)]
-    size: Positive
-    shape: Literal["square", "circular"] = "square"
-    layer: Index = -1
+    center: Annotated[list[Finite], Field(min_length=2, max_length=2)] = described(
+        ..., "centre of the patch in the plate's plane (x, y)", "m"
+    )
+    size: Positive = described(..., "side of a square patch or diameter of a circular one", "m")
+    shape: Literal["square", "circular"] = described("square", "shape of the patch")
+    layer: Index = described(-1, "layer of points under the patch (-1: the top)")
 
 
 class FKAnalysis(Strict):
@@ -475,27 +555,33 @@ class FKAnalysis(Strict):
     ``frequency`` (default: the first actuator's centre frequency), each read from one
     displacement component."""
 
-    line: str
-    frequency: Positive | None = None
-    components: dict[str, Literal["x", "y", "z"]] = {"S0": "x", "A0": "z"}
-    window: Literal["hann", "none"] = "hann"
-    pad: Annotated[float, NotBool, Field(ge=1)] = 2.0
-    tolerance: Annotated[float, NotBool, Field(gt=0, lt=1)] = 0.2
+    line: str = described(..., "name of the line probe (output.lines) analysed")
+    frequency: Positive | None = described(
+        None, "frequency of the wavenumbers read (default: the first actuator's centre frequency)", "Hz"
+    )
+    components: dict[str, Literal["x", "y", "z"]] = described(
+        {"S0": "x", "A0": "z"}, "displacement component read for each named mode"
+    )
+    window: Literal["hann", "none"] = described("hann", "window along time and space before the transform")
+    pad: Annotated[float, NotBool, Field(ge=1)] = described(2.0, "zero padding factor of the transform")
+    tolerance: Annotated[float, NotBool, Field(gt=0, lt=1)] = described(
+        0.2, "relative wavenumber difference accepted against Rayleigh-Lamb theory"
+    )
 
 
 class KxKyAnalysis(Strict):
     """(kx, ky) maps of a plane probe at chosen frequencies, with ring radii per mode."""
 
-    plane: str
-    frequencies: list[Positive]
-    component: Literal["x", "y", "z"] = "z"
+    plane: str = described(..., "name of the plane probe (output.planes) analysed")
+    frequencies: list[Positive] = described(..., "frequencies of the maps", "Hz")
+    component: Literal["x", "y", "z"] = described("z", "displacement component mapped")
 
 
 class Analysis(Strict):
     """Post-processing run after the simulation."""
 
-    fk: FKAnalysis | None = None
-    kxky: KxKyAnalysis | None = None
+    fk: FKAnalysis | None = described(None, "frequency-wavenumber analysis of a line probe")
+    kxky: KxKyAnalysis | None = described(None, "wavenumber maps of a plane probe")
 
 
 class Solver(Strict):
@@ -508,44 +594,79 @@ class Solver(Strict):
     ``newton_iterations`` per solve and ``breaking_rounds`` (re-equilibrations per step after
     bonds break); ``newmark``: implicit dynamics (average
     acceleration) with ``steps`` or ``time``, ``dt`` (s, required), ``displacement_tolerance``
-    (m, Newton increment; seed 004: 0.1 nm), ``newton_iterations`` and ``damping``; both take
+    (m, Newton increment; Martowicz: 0.1 nm), ``newton_iterations`` and ``damping``; both take
     ``linear_solver`` (``lu``, or ``cg`` for large 3D bodies)."""
 
-    type: Literal["explicit", "static", "modal", "newton", "newmark"] = "explicit"
-    modes: Annotated[int, NotBool, Field(ge=1)] = 12
-    steps: Annotated[int, NotBool, Field(ge=1)] | None = None
-    time: Positive | None = None
-    dt: Positive | None = None
-    safety: Annotated[float, NotBool, Field(gt=0, le=1)] = 0.8
-    damping: NonNegative = 0.0
-    dtype: Literal["float64", "float32"] = "float64"
-    tolerance: Positive = 1e-6
-    max_iterations: Annotated[int, NotBool, Field(ge=1)] = 200_000
-    load_steps: Annotated[int, NotBool, Field(ge=1)] = 1
-    newton_iterations: Annotated[int, NotBool, Field(ge=1)] = 30
-    breaking_rounds: Annotated[int, NotBool, Field(ge=1)] = 100
-    displacement_tolerance: Positive = 1e-10
-    #: newton: converged when the residual force's norm (N) is below it, instead of the
-    #: relative ``tolerance``; newmark: instead of ``displacement_tolerance`` (Peridigm's
-    #: "Absolute Tolerance")
-    absolute_tolerance: Positive | None = None
-    linear_solver: Literal["lu", "cg"] = "lu"
-    #: newmark: the acceleration at t = 0, ``balance`` (of the initial forces) or ``zero``
-    #: (Peridigm's implicit solver)
-    initial_acceleration: Literal["balance", "zero"] = "balance"
-    #: explicit: the reported velocity of a DOF with a prescribed displacement, ``rate`` (its
-    #: time function's derivative) or ``difference`` (Peridigm's, see ``ExplicitSolver``)
-    prescribed_velocity: Literal["rate", "difference"] = "rate"
-    #: explicit: ``peridigm`` takes Peridigm's time step conventions: without ``dt``, ``safety``
-    #: times Peridigm's bond-based stable step (``peridyn.jobs.peridigm_step``), and ``time`` in
-    #: floor(time / dt) steps (``peridyn``: the model's stable step, ceil(time / dt) steps)
-    step_rule: Literal["peridyn", "peridigm"] = "peridyn"
-    #: modal: ``shift-invert`` (factorised), ``lobpcg`` (matrix-free) or ``auto`` (by the
-    #: estimated factor size, ``jobs.modal.choose_eigensolver``).
-    eigensolver: Literal["auto", "shift-invert", "lobpcg"] = "auto"
-    #: explicit: where the time loop runs, ``cpu`` (numba kernels) or ``gpu`` (a CUDA device
-    #: through NVIDIA Warp, ``pip install peridyn[gpu]``; docs/gpu.md)
-    backend: Literal["cpu", "gpu"] = "cpu"
+    type: Literal["explicit", "static", "modal", "newton", "newmark"] = described(
+        "explicit",
+        "explicit dynamics, static (dynamic relaxation), modal, newton (implicit statics) or newmark "
+        "(implicit dynamics)",
+    )
+    modes: Annotated[int, NotBool, Field(ge=1)] = described(12, "modal: number of lowest modes computed")
+    steps: Annotated[int, NotBool, Field(ge=1)] | None = described(
+        None, "explicit, newmark: number of time steps (give this or time)"
+    )
+    time: Positive | None = described(
+        None,
+        "explicit, newmark: simulated time (give this or steps); newton: the time at which the loads are "
+        "applied (default 1 s)",
+        "s",
+    )
+    dt: Positive | None = described(
+        None, "time step (explicit default: safety times the stable step; newmark: required)", "s"
+    )
+    safety: Annotated[float, NotBool, Field(gt=0, le=1)] = described(
+        0.8, "explicit: fraction of the stable time step used when dt is not given"
+    )
+    damping: NonNegative = described(0.0, "mass-proportional damping coefficient", "1/s")
+    dtype: Literal["float64", "float32"] = described(
+        "float64", "explicit: floating-point type of the force kernels"
+    )
+    tolerance: Positive = described(1e-6, "static, newton: relative residual at convergence")
+    max_iterations: Annotated[int, NotBool, Field(ge=1)] = described(
+        200_000, "static: most dynamic-relaxation iterations per load step"
+    )
+    load_steps: Annotated[int, NotBool, Field(ge=1)] = described(
+        1, "static, newton: steps of the linear load ramp"
+    )
+    newton_iterations: Annotated[int, NotBool, Field(ge=1)] = described(
+        30, "newton, newmark: most Newton iterations per step"
+    )
+    breaking_rounds: Annotated[int, NotBool, Field(ge=1)] = described(
+        100, "newton: most re-equilibrations per step after bonds break"
+    )
+    displacement_tolerance: Positive = described(1e-10, "newmark: Newton increment at convergence", "m")
+    absolute_tolerance: Positive | None = described(
+        None,
+        "newton: converged when the residual force's norm is below it, instead of the relative tolerance; "
+        "newmark: instead of displacement_tolerance (Peridigm's Absolute Tolerance)",
+        "N",
+    )
+    linear_solver: Literal["lu", "cg"] = described(
+        "lu", "newton, newmark: sparse LU, or conjugate gradients for large 3D bodies"
+    )
+    initial_acceleration: Literal["balance", "zero"] = described(
+        "balance", "newmark: the acceleration at t = 0, balance (of the initial forces) or zero (Peridigm's)"
+    )
+    prescribed_velocity: Literal["rate", "difference"] = described(
+        "rate",
+        "explicit: the reported velocity of a DOF with a prescribed displacement: rate (its time "
+        "function's derivative) or difference (Peridigm's)",
+    )
+    step_rule: Literal["peridyn", "peridigm"] = described(
+        "peridyn",
+        "explicit: peridyn's (the model's stable step; ceil(time / dt) steps) or Peridigm's time step "
+        "conventions (bond-based stable step; floor(time / dt) steps)",
+    )
+    eigensolver: Literal["auto", "shift-invert", "lobpcg"] = described(
+        "auto",
+        "modal: shift-invert (factorised), lobpcg (matrix-free) or auto (by the estimated factor size)",
+    )
+    backend: Literal["cpu", "gpu"] = described(
+        "cpu",
+        "explicit: where the time loop runs, cpu (numba kernels) or gpu (a CUDA device through NVIDIA Warp, "
+        "the gpu extra)",
+    )
 
     @model_validator(mode="after")
     def _backend(self):
@@ -577,9 +698,9 @@ class Solver(Strict):
 class LineSpec(Strict):
     """A line probe from ``start`` to ``end`` (m) sampled at ``points`` points."""
 
-    start: Vector3
-    end: Vector3
-    points: Annotated[int, NotBool, Field(ge=2)]
+    start: Vector3 = described(..., "first end of the line", "m")
+    end: Vector3 = described(..., "last end of the line", "m")
+    points: Annotated[int, NotBool, Field(ge=2)] = described(..., "sample points along the line")
 
 
 class SetSum(Strict):
@@ -587,9 +708,11 @@ class SetSum(Strict):
     per component) of the output variable ``variable`` (``PERIDIGM_VARIABLES``) over node set
     ``set`` (Peridigm's "Block_Data" and "Node_Set_Data" compute classes)."""
 
-    variable: str
-    set: str
-    calculation: Literal["sum", "maximum", "minimum"] = "sum"
+    variable: str = described(..., "Peridigm's name of the variable (any output variable)")
+    set: str = described(..., "node set or block it is taken over")
+    calculation: Literal["sum", "maximum", "minimum"] = described(
+        "sum", "sum, maximum or minimum over the set"
+    )
 
     @model_validator(mode="after")
     def _known(self):
@@ -608,12 +731,20 @@ class ExodusOutput(Strict):
     Peridigm numbers a PdQuickGrid); ``three_d``: a 2D body written with three coordinates and
     vector components (z = 0), as Peridigm writes it."""
 
-    file: Annotated[str, Field(pattern=r"^[^/\\]+$")] = "results.e"
-    every: Annotated[int, NotBool, Field(ge=1)] = 1
-    variables: list[str]
-    sums: dict[str, SetSum] = {}
-    point_order: Literal["peridyn", "grid"] = "peridyn"
-    three_d: bool = False
+    file: Annotated[str, Field(pattern=r"^[^/\\]+$")] = described(
+        "results.e", "Exodus file name in the output folder"
+    )
+    every: Annotated[int, NotBool, Field(ge=1)] = described(1, "write every this many steps, from step 0")
+    variables: list[str] = described(
+        ..., "Peridigm's names of the variables written (may be empty with sums)"
+    )
+    sums: dict[str, SetSum] = described(
+        {}, "global variables: name -> a sum, maximum or minimum of a variable over a node set or block"
+    )
+    point_order: Literal["peridyn", "grid"] = described(
+        "peridyn", "the body's point order, or grid (x fastest, then y, then z, as Peridigm numbers a grid)"
+    )
+    three_d: bool = described(False, "a 2D body written with three coordinates and components (z = 0)")
 
     @model_validator(mode="after")
     def _known(self):
@@ -633,26 +764,36 @@ class Output(Strict):
     write the snapshots as Exodus II, ``results.e`` (``peridyn.io.exodus_write``), or, given
     as a mapping, Peridigm's named variables (``ExodusOutput``)."""
 
-    directory: str | None = None
-    every: Annotated[int, NotBool, Field(ge=1)] = 1
-    snapshot_every: Annotated[int, NotBool, Field(ge=1)] | None = None
-    snapshot_times: list[NonNegative] = []
-    sensors: dict[str, Vector3] = {}
-    lines: dict[str, LineSpec] = {}
-    planes: dict[str, str] = {}
-    pzt_sensors: dict[str, PZTSensor] = {}
-    series_dtype: Literal["float64", "float32"] = "float64"
-    vtu: bool = True
-    #: the VTU snapshots' data arrays: "none" (the default: written 8 times as fast) or "zlib"
-    vtu_compression: Literal["none", "zlib"] = "none"
-    exodus: bool | ExodusOutput = False
-    #: more Exodus files of named variables (Peridigm's Output1, Output2, ...), each at its own
-    #: frequency; ``exodus`` must then be a mapping too
-    exodus_more: list[ExodusOutput] = []
-    plots: bool = True
-    #: per-point partial stress and Green-Lagrange strain in the final fields and VTU snapshots
-    stress: bool = False
-    strain: bool = False
+    directory: str | None = described(None, "output folder (default: peridyn-out/<case name>)")
+    every: Annotated[int, NotBool, Field(ge=1)] = described(
+        1, "record the probe series every this many steps"
+    )
+    snapshot_every: Annotated[int, NotBool, Field(ge=1)] | None = described(
+        None, "write a whole-field snapshot every this many steps"
+    )
+    snapshot_times: list[NonNegative] = described([], "times of the whole-field snapshots", "s")
+    sensors: dict[str, Vector3] = described({}, "point sensors: name -> position", "m")
+    lines: dict[str, LineSpec] = described({}, "line probes: name -> start, end and points")
+    planes: dict[str, str] = described({}, "plane probes: name -> layer (e.g. top)")
+    pzt_sensors: dict[str, PZTSensor] = described(
+        {}, "PZT sensors: name -> patch; their signal is the mean in-plane strain under the patch"
+    )
+    series_dtype: Literal["float64", "float32"] = described(
+        "float64", "floating-point type of the stored line, plane and field series"
+    )
+    vtu: bool = described(True, "write VTU snapshots for ParaView")
+    vtu_compression: Literal["none", "zlib"] = described(
+        "none", "compression of the VTU snapshots' data: none (written 8 times as fast) or zlib"
+    )
+    exodus: bool | ExodusOutput = described(
+        False, "also write the snapshots as Exodus II (results.e), or Peridigm's named variables"
+    )
+    exodus_more: list[ExodusOutput] = described(
+        [], "more Exodus files of named variables (Peridigm's Output1, Output2, ...), each at its frequency"
+    )
+    plots: bool = described(True, "draw the run's figures")
+    stress: bool = described(False, "per-point partial stress in the final fields and VTU snapshots")
+    strain: bool = described(False, "per-point Green-Lagrange strain in the final fields and VTU snapshots")
 
     @model_validator(mode="after")
     def _more_files(self):
@@ -670,9 +811,11 @@ class ContactSpec(Strict):
     short-range constant as a multiple of the PMB micromodulus (``stiffness_factor``,
     Peridigm's 15 by default)."""
 
-    radius: Positive | None = None
-    radius_m: Positive | None = None
-    stiffness_factor: Positive = 15.0
+    radius: Positive | None = described(
+        None, "contact distance as a multiple of the spacing (give this or radius_m)"
+    )
+    radius_m: Positive | None = described(None, "contact distance in metres", "m")
+    stiffness_factor: Positive = described(15.0, "short-range constant as a multiple of the PMB micromodulus")
 
     @model_validator(mode="after")
     def _one_radius(self):
@@ -684,25 +827,27 @@ class ContactSpec(Strict):
 class Case(Strict):
     """A whole simulation case."""
 
-    name: str
-    description: str = ""
-    geometry: Geometry
-    discretization: Discretization
-    material: Material | None = None
-    materials: dict[str, Material] = {}
-    blocks: dict[str, Block] = {}
-    removals: list[Region] = []
-    node_sets: dict[str, Region] = {}
-    precracks: list[Precrack] = []
-    actuators: dict[str, Actuator] = {}
-    boundary_conditions: list[BoundaryConditionSpec] = []
-    initial_conditions: list[InitialConditionSpec] = []
-    solver: Solver
-    output: Output = Output()
-    analysis: Analysis | None = None
-    contact: ContactSpec | None = None
-    fatigue: Fatigue | None = None
-    absorbing: AbsorbingSpec | None = None
+    name: str = described(..., "name of the case (the default output folder peridyn-out/<name>)")
+    description: str = described("", "one line saying what the case is")
+    geometry: Geometry = described(..., "the body's shape")
+    discretization: Discretization = described(..., "grid spacing, horizon and bond options")
+    material: Material | None = described(None, "the material of a one-material body")
+    materials: dict[str, Material] = described({}, "materials by name, for a body of several blocks")
+    blocks: dict[str, Block] = described({}, "blocks by name: their points and material")
+    removals: list[Region] = described([], "regions whose points are removed (holes, notches)")
+    node_sets: dict[str, Region] = described({}, "named sets of points, used by the conditions and outputs")
+    precracks: list[Precrack] = described([], "cuts through which no bond passes")
+    actuators: dict[str, Actuator] = described({}, "PZT actuators by name")
+    boundary_conditions: list[BoundaryConditionSpec] = described(
+        [], "prescribed displacements, velocities and forces"
+    )
+    initial_conditions: list[InitialConditionSpec] = described([], "initial displacements and velocities")
+    solver: Solver = described(..., "the solver and its settings")
+    output: Output = described(Output(), "what is written and where")
+    analysis: Analysis | None = described(None, "Lamb-wave analyses after the run")
+    contact: ContactSpec | None = described(None, "short-range contact forces")
+    fatigue: Fatigue | None = described(None, "remaining-life fatigue (peridyn fatigue)")
+    absorbing: AbsorbingSpec | None = described(None, "absorbing boundary layers")
 
     @model_validator(mode="after")
     def _box_neighbourhood(self):
@@ -991,8 +1136,8 @@ def _model_in(annotation):
 class FatigueBlock(Strict):
     """``steps`` fatigue steps of 1 / ``tau`` cycles each (the thesis's linear cycle mapping)."""
 
-    steps: Annotated[int, NotBool, Field(ge=1)]
-    tau: Positive
+    steps: Annotated[int, NotBool, Field(ge=1)] = described(..., "fatigue steps in this block")
+    tau: Positive = described(..., "fatigue step as a fraction of a cycle: each step is 1 / tau cycles")
 
 
 class FatigueTip(Strict):
@@ -1001,33 +1146,40 @@ class FatigueTip(Strict):
     crack length measured from ``start`` (m, e.g. a notch root), by default from the body's edge
     the crack grows from (``fatigue.tip.crack_tip``)."""
 
-    axis: Literal["x", "y", "z"] = "x"
-    depth_axis: Literal["x", "y", "z"] = "z"
-    damage: Annotated[float, NotBool, Field(gt=0, le=1)] = 0.385
-    start: float | None = None
-    sense: Literal["+", "-"] = "+"
+    axis: Literal["x", "y", "z"] = described("x", "axis along which the crack grows")
+    depth_axis: Literal["x", "y", "z"] = described("z", "axis through the thickness")
+    damage: Annotated[float, NotBool, Field(gt=0, le=1)] = described(
+        0.385, "damage from which a point counts as cracked"
+    )
+    start: float | None = described(
+        None, "where the crack length is measured from (default: the edge the crack grows from)", "m"
+    )
+    sense: Literal["+", "-"] = described("+", "direction in which the crack grows along axis")
 
 
 class FatigueModal(Strict):
     """Free-free modal analyses before and after the fatigue run: ``modes`` modes, rigid included."""
 
-    modes: Annotated[int, NotBool, Field(ge=7)] = 12
+    modes: Annotated[int, NotBool, Field(ge=7)] = described(12, "modes computed, rigid ones included")
 
 
 class ParisSpecimen(Strict):
     """Single-edge-notch geometry for K_I = sigma sqrt(pi a) F(a/b) (thesis eqs. 7.12-7.13):
     ``stress`` (Pa, maximum remote stress) and ``width`` b (m); see the fields for the fit."""
 
-    stress: Positive
-    width: Positive
-    #: crack lengths (m) whose growth rates enter the Paris fit: phase II only (not the growth out
-    #: of the pre-crack, not where eq. 7.12 stops holding); None: every rate
-    fit_range: tuple[Positive, Positive] | None = None
-    #: stop the run once the crack is this long (m); None: run every step
-    stop_length: Positive | None = None
-    #: dK from ``eq_7_12`` (the SEN formula, for strips loaded far from the crack) or from the
-    #: ``compliance`` of the modelled specimen (straight extensions of the first pre-crack)
-    k: Literal["eq_7_12", "compliance"] = "eq_7_12"
+    stress: Positive = described(..., "maximum remote stress", "Pa")
+    width: Positive = described(..., "specimen width b", "m")
+    fit_range: tuple[Positive, Positive] | None = described(
+        None, "crack lengths whose growth rates enter the Paris fit (default: every rate)", "m"
+    )
+    stop_length: Positive | None = described(
+        None, "stop once the crack is this long (default: run every step)", "m"
+    )
+    k: Literal["eq_7_12", "compliance"] = described(
+        "eq_7_12",
+        "stress intensity range from the single-edge-notch formula (eq_7_12) or from the compliance of "
+        "the modelled specimen",
+    )
 
     @model_validator(mode="after")
     def _range(self):
@@ -1039,28 +1191,38 @@ class ParisSpecimen(Strict):
 
 
 class Fatigue(Strict):
-    """Remaining-life fatigue (thesis seed 002 ch. 7): phase I (A_I, m_I, eps_inf), phase II
+    """Remaining-life fatigue (Freimanis 2019 ch. 7): phase I (A_I, m_I, eps_inf), phase II
     (A_II, m_II; A_II given at ``A_II_horizon`` m and scaled to the case's horizon by eq. 7.15),
     phi_c, load ratio R in [-1, 1), the boundary conditions' value at ``max_load_time`` (s) as the
     maximum load, cycle ``mapping`` blocks (``adaptive``: cut a step where the next bond breaks),
     no-damage node sets, crack ``tip``, linear ``solver`` and optional ``modal_after``."""
 
-    A_I: Positive
-    m_I: Positive
-    eps_inf: NonNegative
-    A_II: Positive
-    m_II: Positive
-    A_II_horizon: Positive | None = None
-    phi_c: Annotated[float, NotBool, Field(gt=0, le=1)] = 0.385
-    load_ratio: Annotated[float, NotBool, Field(ge=-1, lt=1)] = 0.0
-    max_load_time: NonNegative = 1.0
-    mapping: Annotated[list[FatigueBlock], Field(min_length=1)]
-    adaptive: bool = False
-    no_damage_sets: list[str] = []
-    tip: FatigueTip = FatigueTip()
-    solver: Literal["auto", "amg", "direct", "cg"] = "auto"
-    modal_after: FatigueModal | None = None
-    paris: ParisSpecimen | None = None
+    A_I: Positive = described(..., "phase I (crack nucleation) life constant")
+    m_I: Positive = described(..., "phase I exponent")
+    eps_inf: NonNegative = described(..., "phase I fatigue limit of the cyclic bond strain")
+    A_II: Positive = described(..., "phase II (crack growth) life constant")
+    m_II: Positive = described(..., "phase II exponent")
+    A_II_horizon: Positive | None = described(
+        None, "horizon at which A_II is given; it is scaled to the case's horizon", "m"
+    )
+    phi_c: Annotated[float, NotBool, Field(gt=0, le=1)] = described(
+        0.385, "damage of a point at the crack tip"
+    )
+    load_ratio: Annotated[float, NotBool, Field(ge=-1, lt=1)] = described(
+        0.0, "load ratio R of the cycles, in [-1, 1)"
+    )
+    max_load_time: NonNegative = described(
+        1.0, "time at which the boundary conditions give the maximum load", "s"
+    )
+    mapping: Annotated[list[FatigueBlock], Field(min_length=1)] = described(
+        ..., "blocks of fatigue steps and their cycle mapping"
+    )
+    adaptive: bool = described(False, "cut a step where the next bond breaks")
+    no_damage_sets: list[str] = described([], "node sets whose bonds never break")
+    tip: FatigueTip = described(FatigueTip(), "how the crack tip and length are found")
+    solver: Literal["auto", "amg", "direct", "cg"] = described("auto", "linear solver of the static steps")
+    modal_after: FatigueModal | None = described(None, "free-free modal analyses before and after the cycles")
+    paris: ParisSpecimen | None = described(None, "single-edge-notch specimen for the Paris-law fit")
 
     @model_validator(mode="after")
     def _axes(self):
@@ -1079,14 +1241,11 @@ class AbsorbingSpec(Strict):
     the cube of the depth into a layer ``width`` m wide along each of ``faces``, from 0 at its
     inner edge to ``damping`` (1/s) on the face; added to ``solver.damping``."""
 
-    width: Positive
-    damping: Positive
-    faces: Annotated[list[Literal["x-", "x+", "y-", "y+", "z-", "z+"]], Field(min_length=1)] = [
-        "x-",
-        "x+",
-        "y-",
-        "y+",
-    ]
+    width: Positive = described(..., "width of each layer", "m")
+    damping: Positive = described(..., "damping on the face", "1/s")
+    faces: Annotated[list[Literal["x-", "x+", "y-", "y+", "z-", "z+"]], Field(min_length=1)] = described(
+        ["x-", "x+", "y-", "y+"], "faces with a layer"
+    )
 
 
 Case.model_rebuild()

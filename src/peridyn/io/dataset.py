@@ -5,7 +5,9 @@ Coordinates along ``run`` are the run ids and the varied parameters; data variab
 bool when every run has one; text as strings); a collected series ``NAME`` of the results files
 is ``NAME`` (run, NAME_record, NAME_axis1, ...) padded with NaN past a run's last record, with
 its times ``NAME_time`` (run, NAME_record) in s and, when the series names its entries
-(sensors), the coordinate ``NAME_axis1``. Needs the ``sweep`` extra (xarray, h5netcdf).
+(sensors), the coordinate ``NAME_axis1``. Every variable carries ``long_name`` and, when it is
+a number, ``units`` (UDUNITS spelling, "1" for a count or a ratio). Needs the ``sweep`` extra
+(xarray, h5netcdf).
 
 The file is written to a temporary name and renamed, so a reader never sees half a file.
 """
@@ -14,7 +16,7 @@ from __future__ import annotations
 
 import json
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -37,11 +39,14 @@ class SeriesColumn:
         Each run's records (the same ``shape`` for every run).
     entry_names : list of str or None
         Names along the first axis after the record (sensor names), if any.
+    about : dict
+        ``units`` and ``long_name`` of the records (as the results file gives them).
     """
 
     times: list
     values: list
     entry_names: list | None = None
+    about: dict = field(default_factory=dict)
 
 
 def require_xarray():
@@ -62,7 +67,14 @@ def require_xarray():
     return xarray
 
 
-def build_dataset(coords: dict, table: dict, series: dict, attrs: dict, reference: dict | None = None):
+def build_dataset(
+    coords: dict,
+    table: dict,
+    series: dict,
+    attrs: dict,
+    reference: dict | None = None,
+    about: dict | None = None,
+):
     """The ``xarray.Dataset`` of a sweep.
 
     Parameters
@@ -78,6 +90,9 @@ def build_dataset(coords: dict, table: dict, series: dict, attrs: dict, referenc
         The series of the sweep's reference run (e.g. the healthy body's sensor signals): each
         becomes ``reference_<name>`` along ``reference_<name>_record`` and the series' own
         entry axes, with ``reference_<name>_time`` (s).
+    about : dict name -> (units, long_name), optional
+        What the ``coords`` and ``table`` entries are (units None for text); one not named here
+        gets its own name as long name and "1" as unit.
     """
     xr = require_xarray()
     n = len(next(iter(coords.values()))) if coords else 0
@@ -86,17 +101,37 @@ def build_dataset(coords: dict, table: dict, series: dict, attrs: dict, referenc
         coords={name: ("run", _column(values)) for name, values in coords.items()},
         attrs=attrs,
     )
+    for name in (*coords, *table):
+        units, long_name = (about or {}).get(name, ("1", name))
+        _describe(ds[name], units, long_name)
     for name, column in series.items():
         values, times, dims = _padded(name, column, n)
-        ds[name] = (dims, values)
-        ds[f"{name}_time"] = (dims[:2], times)
+        ds[name] = (dims, values, column.about)
+        ds[f"{name}_time"] = (dims[:2], times, {"units": "s", "long_name": f"time of the {name} records"})
         if column.entry_names is not None and len(dims) > 2:
-            ds.coords[dims[2]] = np.asarray(column.entry_names, dtype=str)
+            ds.coords[dims[2]] = (dims[2], np.asarray(column.entry_names, dtype=str), {"long_name": "sensor"})
     for name, (times, values) in (reference or {}).items():
         record = f"reference_{name}_record"
-        ds[f"reference_{name}"] = ((record, *_entry_dims(name, np.ndim(values) - 1)), np.asarray(values))
-        ds[f"reference_{name}_time"] = (record, np.asarray(times))
+        column = series.get(name)
+        of = column.about.get("long_name", name) if column else name
+        ds[f"reference_{name}"] = (
+            (record, *_entry_dims(name, np.ndim(values) - 1)),
+            np.asarray(values),
+            {**(column.about if column else {}), "long_name": f"{of}, reference run"},
+        )
+        ds[f"reference_{name}_time"] = (
+            record,
+            np.asarray(times),
+            {"units": "s", "long_name": f"time of the reference run's {name} records"},
+        )
     return ds
+
+
+def _describe(variable, units: str | None, long_name: str) -> None:
+    """``long_name`` and, for a number, ``units`` of a dataset variable."""
+    variable.attrs["long_name"] = long_name
+    if units is not None and variable.dtype.kind in "biuf":
+        variable.attrs["units"] = units
 
 
 def write_dataset(ds, path) -> Path:

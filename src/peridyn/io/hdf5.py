@@ -3,14 +3,19 @@
 Layout of a results file::
 
     /                       root attributes: the run's provenance and ``schema_version``
-    /geometry/points        (n_points, dim) float64, m
-    /geometry/volumes       (n_points,) float64, m^3
-    /series/<name>/data     (n_records, *shape), resizable, chunked along time
-    /series/<name>/time     (n_records,) float64, s
+    /geometry/points        (n_points, dim) float64, m; dimensions (point, coordinate)
+    /geometry/volumes       (n_points,) float64, m^3; dimension (point)
+    /series/<name>/data     (n_records, *shape), resizable, chunked along time; dimensions
+                            (time, *the record's), ``units`` and ``long_name``
+    /series/<name>/time     (n_records,) float64, s: the coordinate of the time dimension
     /series/<name>/step     (n_records,) int64, strictly increasing
     /summary/json           the job's summary, JSON text (docs/user-guide.md, "Summaries and
                             results files")
     /<any>/<name>           one-off arrays, e.g. /final/damage
+
+Since schema 3 every dataset is labelled as netCDF-4 labels it (``peridyn.io.netcdf``: HDF5
+dimension scales, coordinates, ``units`` and ``long_name``): each group opens with
+``xarray.open_dataset(path, engine="h5netcdf", group=...)`` (``Results.to_xarray``).
 
 The writer flushes after every ``flush_every`` appends, so a process that
 crashes loses at most the records appended since the last flush (with ``flush_every=None``
@@ -29,6 +34,7 @@ import h5py
 import numpy as np
 
 from peridyn.errors import InputError, did_you_mean
+from peridyn.io.netcdf import COMPONENTS, describe, label
 
 CHUNK_BYTES = 1 << 20
 """Target size of one chunk of a series' data, in bytes."""
@@ -39,11 +45,12 @@ MIN_INDEX_CHUNK = 1024
 JSON_KEYS_ATTR = "_peridyn_json_keys"
 """Root attribute listing the attributes stored as JSON text."""
 
-SCHEMA_VERSION = 2
+SCHEMA_VERSION = 3
 """Version of the results layout and of the job summaries (docs/user-guide.md, "Summaries and
 results files"). 1: files written before the version was recorded (no attribute; a fatigue
 summary counted each bond once, as ``bonds`` and ``bonds_broken``). 2: the common summary keys,
-every bond count directed."""
+every bond count directed. 3: netCDF-4 labels (dimension scales, coordinates, ``units``,
+``long_name``: ``peridyn.io.netcdf``); a file of schema 2 continued (``mode="a"``) stays 2."""
 
 SCHEMA_ATTR = "schema_version"
 """Root attribute holding :data:`SCHEMA_VERSION`."""
@@ -128,12 +135,14 @@ class HDF5Writer:
         except OSError as exc:
             raise InputError(f"cannot open results file {self.path!r} for writing: {exc}") from None
         try:
-            check_schema(self._file.attrs, self.path)
+            version = check_schema(self._file.attrs, self.path)
+            #: whether datasets get netCDF-4 labels: not in a file of an older schema continued
+            self.labelled = "geometry" not in self._file or version >= 3
             self._write_geometry(points, volumes)
             if SCHEMA_ATTR in provenance:
                 raise InputError(f"{self.path}: provenance: {SCHEMA_ATTR!r} is reserved for the writer")
             _write_attrs(self._file.attrs, provenance, f"{self.path}: provenance")
-            self._file.attrs[SCHEMA_ATTR] = SCHEMA_VERSION
+            self._file.attrs[SCHEMA_ATTR] = SCHEMA_VERSION if self.labelled else version
             self._open_existing_series()
             self._file.flush()
         except BaseException:
@@ -157,7 +166,17 @@ class HDF5Writer:
         self._file.flush()
         self._pending = 0
 
-    def create_series(self, name: str, shape, dtype="float64", attrs: dict | None = None) -> None:
+    def create_series(
+        self,
+        name: str,
+        shape,
+        dtype="float64",
+        attrs: dict | None = None,
+        dims=None,
+        coords: dict | None = None,
+        units: str = "1",
+        long_name: str | None = None,
+    ) -> None:
         """Create the time series ``/series/<name>``, with no records yet.
 
         Parameters
@@ -170,8 +189,17 @@ class HDF5Writer:
         dtype : str or numpy dtype
             Storage type; ``"float32"`` halves the size of big plane records.
         attrs : dict, optional
-            Attributes of the series group (e.g. units), encoded like
+            Attributes of the series group (e.g. sensor names), encoded like
             provenance.
+        dims : sequence of str, optional
+            Names of the record's dimensions (``peridyn.io.netcdf``), e.g.
+            ``("sensor", "component")``; "component" is labelled x, y, z. Default
+            ``axis_1, axis_2, ...``.
+        coords : dict, optional
+            Values along some of ``dims`` (e.g. ``{"sensor": names}``).
+        units, long_name : str
+            The records' unit (UDUNITS, "1" for none) and description; the long
+            name defaults to the series name.
 
         Raises
         ------
@@ -187,7 +215,10 @@ class HDF5Writer:
             self._check_existing_series(name, shape, dtype)
         else:
             group = self._file.require_group("series").create_group(name)
-            self._series[name] = _Series.create(group, shape, dtype)
+            self._series[name] = series = _Series.create(group, shape, dtype)
+            if self.labelled:
+                dims = tuple(dims) if dims is not None else tuple(f"axis_{i + 1}" for i in range(len(shape)))
+                series.label(dims, {"component": COMPONENTS, **(coords or {})}, units, long_name or name)
         if attrs:
             group = self._file["series"][name]
             _write_attrs(group.attrs, attrs, f"{self.path}: series {name!r} attrs")
@@ -260,7 +291,9 @@ class HDF5Writer:
         if self.flush_every is not None and self._pending >= self.flush_every:
             self.flush()
 
-    def write_array(self, name: str, array, attrs: dict | None = None) -> None:
+    def write_array(
+        self, name: str, array, attrs: dict | None = None, dims=None, coords: dict | None = None
+    ) -> None:
         """Write a one-off dataset, replacing any dataset of that name.
 
         Parameters
@@ -271,7 +304,14 @@ class HDF5Writer:
         array : array_like
             The data, stored with its own dtype.
         attrs : dict, optional
-            Dataset attributes, encoded like provenance.
+            Dataset attributes, encoded like provenance (``units`` and
+            ``long_name`` for netCDF readers).
+        dims : sequence of str, optional
+            Names of the array's dimensions as in :meth:`create_series`
+            ("point" and "component" name the body's points and x, y, z);
+            default ``<name>_axis_1, ...``.
+        coords : dict, optional
+            Values along some of ``dims``.
         """
         key = name.strip("/") if isinstance(name, str) else ""
         if not key or key.split("/")[0] in _RESERVED_GROUPS:
@@ -282,6 +322,10 @@ class HDF5Writer:
         if key in self._file:
             del self._file[key]
         dataset = self._file.create_dataset(key, data=np.asarray(array))
+        if self.labelled and dataset.ndim:
+            base = key.rsplit("/", 1)[-1]
+            dims = dims if dims is not None else [f"{base}_axis_{i + 1}" for i in range(dataset.ndim)]
+            label(dataset, dims, {"component": COMPONENTS, **(coords or {})})
         if attrs:
             _write_attrs(dataset.attrs, attrs, f"{self.path}: {key!r} attrs")
         self.flush()
@@ -317,8 +361,12 @@ class HDF5Writer:
     def _write_geometry(self, points: np.ndarray, volumes: np.ndarray) -> None:
         if "geometry" not in self._file:
             geometry = self._file.create_group("geometry")
-            geometry.create_dataset("points", data=points)
-            geometry.create_dataset("volumes", data=volumes)
+            x = geometry.create_dataset("points", data=points)
+            volumes = geometry.create_dataset("volumes", data=volumes)
+            label(x, ("point", "coordinate"), {"coordinate": COMPONENTS[: points.shape[1]]})
+            label(volumes, ("point",))
+            describe(x, "m", "reference position of the point")
+            describe(volumes, "m3", "volume of the point (area times thickness in 2D)")
             return
         old_points = self._file["geometry/points"][:]
         old_volumes = self._file["geometry/volumes"][:]
@@ -378,6 +426,16 @@ class _Series:
         time = group.create_dataset("time", (0,), np.float64, maxshape=(None,), chunks=index_chunk)
         step = group.create_dataset("step", (0,), np.int64, maxshape=(None,), chunks=index_chunk)
         return cls(data, time, step, None)
+
+    def label(self, dims: tuple, coords: dict, units: str, long_name: str) -> None:
+        """netCDF-4 labels: time the coordinate of the records, ``dims`` (with ``coords``)
+        their own axes, ``units`` and ``long_name`` the records'."""
+        self.time.make_scale("time")
+        describe(self.time, "s", "time")
+        label(self.data, ("time", *dims), coords)
+        label(self.step, ("time",))
+        describe(self.data, units, long_name)
+        describe(self.step, "1", "time step number")
 
     @classmethod
     def open(cls, group: h5py.Group) -> _Series:

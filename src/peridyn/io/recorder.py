@@ -39,6 +39,7 @@ from peridyn.discretization.state import ProbeState, State, check_state, runaway
 from peridyn.errors import InputError
 from peridyn.io.exodus_write import PERIDIGM_VARIABLES, ExodusWriter
 from peridyn.io.hdf5 import HDF5Writer
+from peridyn.io.netcdf import COMPONENTS
 from peridyn.io.series_buffer import SeriesBuffer
 from peridyn.io.vtk import PVDCollection, write_vtu
 
@@ -52,9 +53,16 @@ class LineProbe:
     points: int
 
 
+#: units and long names of the per-point tensor fields written in ``final/`` (``tensors``)
+FINAL_TENSORS = {
+    "stress": ("Pa", "stress (partial stress of the bonds)"),
+    "strain": ("1", "strain (least squares over the bonds)"),
+    "strain_valid": ("1", "whether the point's bonds determine its strain"),
+}
+
 #: Values per point of one snapshot in all files: field_u (3) in results.h5, points, u, v and
-#: damage in VTU (10) and u, v, volume and damage in Exodus (8), as 8-byte numbers.
-SNAPSHOT_VALUES = 21
+#: damage and volume in VTU (11) and u, v, volume and damage in Exodus (8), as 8-byte numbers.
+SNAPSHOT_VALUES = 22
 
 
 @dataclass
@@ -68,7 +76,7 @@ class RecorderSpec:
     snapshot_every : int or None
         Steps between field snapshots (None: only at ``snapshot_steps`` and the end).
     snapshot_steps : list of int
-        Extra steps with a snapshot (e.g. the seed's 20, 40, 60 us).
+        Extra steps with a snapshot (e.g. the paper's 20, 40, 60 us).
     sensors : dict of name -> 3 floats (m)
     lines : dict of name -> LineProbe
     planes : dict of name -> (n,) point indices
@@ -312,21 +320,59 @@ class Recorder:
 
     def _create_series(self) -> None:
         h5, spec = self.h5, self.spec
+        vector = ("point", "component")
         if self.sensor_names:
-            for q in ("u", "v"):
+            for q, units, what in (("u", "m", "displacement"), ("v", "m/s", "velocity")):
                 h5.create_series(
                     f"sensor_{q}",
                     (len(self.sensor_names), 3),
                     attrs={"names": self.sensor_names, "points": self.sensor_index.tolist()},
+                    dims=("sensor", "component"),
+                    coords={"sensor": self.sensor_names},
+                    units=units,
+                    long_name=f"{what} at the sensors",
                 )
         for name, idx in self.line_index.items():
-            h5.create_series(f"line_{name}", (len(idx), 3), spec.series_dtype, attrs={"points": idx.tolist()})
+            h5.create_series(
+                f"line_{name}",
+                (len(idx), 3),
+                spec.series_dtype,
+                attrs={"points": idx.tolist()},
+                dims=vector,
+                coords={"point": idx},
+                units="m",
+                long_name=f"displacement along line {name}",
+            )
         for name, idx in self.plane_index.items():
-            h5.create_series(f"plane_{name}", (len(idx), 3), spec.series_dtype)
-            h5.write_array(f"probes/plane_{name}", idx)
+            h5.create_series(
+                f"plane_{name}",
+                (len(idx), 3),
+                spec.series_dtype,
+                dims=vector,
+                coords={"point": idx},
+                units="m",
+                long_name=f"displacement on plane {name}",
+            )
+            h5.write_array(
+                f"probes/plane_{name}", idx, {"long_name": f"points of plane {name}", "units": "1"}
+            )
         if spec.pzt_sensors:
-            h5.create_series("pzt_signal", (len(spec.pzt_sensors),), attrs={"names": list(spec.pzt_sensors)})
-        h5.create_series("field_u", (self.body.n_points, 3), spec.series_dtype)
+            h5.create_series(
+                "pzt_signal",
+                (len(spec.pzt_sensors),),
+                attrs={"names": list(spec.pzt_sensors)},
+                dims=("sensor",),
+                coords={"sensor": list(spec.pzt_sensors)},
+                long_name="PZT sensor signal: weighted mean in-plane strain under the sensor",
+            )
+        h5.create_series(
+            "field_u",
+            (self.body.n_points, 3),
+            spec.series_dtype,
+            dims=vector,
+            units="m",
+            long_name="displacement",
+        )
 
     def observe(self, state: State, solver) -> None:
         """Record what is due at this step (called after every step)."""
@@ -379,10 +425,11 @@ class Recorder:
             self.pvd.add(state.time, snapshot_name(state.step, ".pvtu"))
             return
         damage = self.damage() if self.damage is not None else None
-        data = snapshot_fields(state.u, state.v, self.body.dim, damage, self._tensor_fields(state.u))
+        body = self.body
+        data = snapshot_fields(state.u, state.v, body.dim, damage, self._tensor_fields(state.u), body.volumes)
         name = snapshot_name(state.step, ".vtu")
         write_vtu(
-            self.directory / name, self.body.points[:, : self.body.dim], data, self.spec.vtu_compression
+            self.directory / name, body.points[:, : body.dim], data, self.spec.vtu_compression, state.time
         )
         self.pvd.add(state.time, name)
 
@@ -417,12 +464,18 @@ class Recorder:
     def finish(self, state: State) -> None:
         """Write the held records and the final state, then close the file."""
         self.flush()
-        self.h5.write_array("final/u", state.u)
-        self.h5.write_array("final/v", state.v)
+        vector = ("point", "component")
+        self.h5.write_array("final/u", state.u, {"units": "m", "long_name": "displacement"}, vector)
+        self.h5.write_array("final/v", state.v, {"units": "m/s", "long_name": "velocity"}, vector)
         if self.damage is not None:
-            self.h5.write_array("final/damage", self.damage())
+            about = {"units": "1", "long_name": "damage: share of the point's bonds broken"}
+            self.h5.write_array("final/damage", self.damage(), about, ("point",))
         for key, value in self._tensor_fields(state.u).items():
-            self.h5.write_array(f"final/{key}", value)
+            units, long_name = FINAL_TENSORS.get(key, ("1", key))
+            dims = ("point", "row", "column")[: np.ndim(value)]
+            labels = COMPONENTS[: np.shape(value)[-1]]
+            coords = {"row": labels, "column": labels}
+            self.h5.write_array(f"final/{key}", value, {"units": units, "long_name": long_name}, dims, coords)
         self.h5.close()
 
     def _tensor_fields(self, u: np.ndarray) -> dict:
@@ -502,11 +555,13 @@ def snapshot_name(step: int, suffix: str) -> str:
     return f"snapshots/step_{step:08d}{suffix}"
 
 
-def snapshot_fields(u: np.ndarray, v: np.ndarray, dim: int, damage, tensors: dict) -> dict:
+def snapshot_fields(
+    u: np.ndarray, v: np.ndarray, dim: int, damage, tensors: dict, volumes: np.ndarray
+) -> dict:
     """The point data of a VTU snapshot: displacement and velocity ((n, 3) m, m/s, first ``dim``
-    columns), the ``damage`` index ((n,) or None) and the ``tensors`` (``Recorder``'s
-    ``tensors``: (n, dim, dim) as 9 components, others as they are)."""
-    data = {"displacement": u[:, :dim], "velocity": v[:, :dim]}
+    columns), the points' ``volume`` ((n,) m^3), the ``damage`` index ((n,) or None) and the
+    ``tensors`` (``Recorder``'s ``tensors``: (n, dim, dim) as 9 components, others as they are)."""
+    data = {"displacement": u[:, :dim], "velocity": v[:, :dim], "volume": volumes}
     if damage is not None:
         data["damage"] = damage
     for key, value in tensors.items():

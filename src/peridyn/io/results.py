@@ -26,6 +26,7 @@ from peridyn.io.hdf5 import (
     is_integer,
     n_records,
 )
+from peridyn.io.netcdf import BARE_DIMENSION, COMPONENTS
 
 
 class Results:
@@ -78,6 +79,38 @@ class Results:
             for start in range(0, n, chunk_records):
                 stop = min(start + chunk_records, n)
                 yield times[start:stop], data[start:stop]
+
+    def to_xarray(self, name: str):
+        """A series as an ``xarray.Dataset`` (needs the ``sweep`` extra): the records as the
+        variable ``name``, dimensions ``(time, *record dims)``, coordinates ``time`` (s),
+        ``step`` and those of the record's dimensions (``component`` x, y, z; ``sensor`` names;
+        ``point`` indices of a probe), with the file's ``units`` and ``long_name``.
+
+        A file written before schema 3 has no labels: its vector axis is still ``component``,
+        its other axes ``axis_1, ...``, and there are no units.
+        """
+        try:
+            import xarray as xr
+        except ModuleNotFoundError:
+            raise InputError("Results.to_xarray needs xarray: pip install 'peridyn[sweep]'") from None
+        steps, times, data = self.series(name)
+        with self._series(name) as group:
+            dims, coords = _record_dims(group["data"])
+            attrs = {k: group["data"].attrs[k] for k in ("units", "long_name") if k in group["data"].attrs}
+            time_attrs = {
+                k: group["time"].attrs[k] for k in ("units", "long_name") if k in group["time"].attrs
+            }
+        coords = {
+            "time": ("time", times, time_attrs or {"units": "s", "long_name": "time"}),
+            "step": ("time", steps, {"long_name": "time step number"}),
+            **coords,
+        }
+        return xr.Dataset({name: (("time", *dims), data, attrs)}, coords=coords)
+
+    def series_about(self, name: str) -> dict:
+        """``units`` and ``long_name`` of a series' records (empty before schema 3)."""
+        with self._series(name) as group:
+            return _cf_attrs(group["data"])
 
     def n_records(self, name: str) -> int:
         """Number of complete records of a series."""
@@ -152,3 +185,33 @@ class Results:
                     f"{self.path}: no series {name!r}; it has {available}" + did_you_mean(name, available)
                 )
             yield f["series"][name]
+
+
+def _cf_attrs(dataset: h5py.Dataset) -> dict:
+    """The ``units`` and ``long_name`` of a dataset, those it has."""
+    return {k: _text(dataset.attrs[k]) for k in ("units", "long_name") if k in dataset.attrs}
+
+
+def _text(value) -> str:
+    return value.decode() if isinstance(value, bytes) else str(value)
+
+
+def _record_dims(data: h5py.Dataset) -> tuple[list[str], dict]:
+    """Names of a series' record axes and the coordinates along them (``{name: (name, values)}``),
+    from its dimension scales, or for an unlabelled file (schema 1 and 2) ``component`` for an
+    axis of 3 last and ``axis_i`` for the others."""
+    dims, coords = [], {}
+    for axis in range(1, data.ndim):
+        if len(data.dims[axis]):
+            scale = data.dims[axis][0]
+            name = scale.name.rsplit("/", 1)[-1]
+            if not _text(scale.attrs.get("NAME", "")).startswith(BARE_DIMENSION):
+                values = scale[()]
+                coords[name] = (name, values.astype(str) if values.dtype.kind in "OS" else values)
+        elif axis == data.ndim - 1 and data.shape[axis] == 3:
+            name = "component"
+            coords[name] = (name, list(COMPONENTS))
+        else:
+            name = f"axis_{axis}"
+        dims.append(name)
+    return dims, coords

@@ -8,7 +8,7 @@ writes them with one ``HDF5Writer.append_block`` per series, then one file flush
 block is full or when asked (``flush``).
 
 The records are cast to the series' dtype as they are held (NumPy's cast, 0.3 ms for 8 float64
-plane records of the seed Lamb case where HDF5's own conversion took 1.5 ms). It rounds as
+plane records of the Lamb plate case where HDF5's own conversion took 1.5 ms). It rounds as
 HDF5 does, with one exception at the edge of float32's range: a value less than half an ulp
 above the largest float32 becomes that float32 here and infinity in HDF5. A run's checked state
 (finite, within its runaway limit) never comes near it.
@@ -84,7 +84,7 @@ class SeriesBuffer:
 
         With ``rows`` (an integer index array or a slice), the record is ``values[rows]``; an
         index array's rows are taken straight into the buffer, with no temporary array (a plane
-        of 41 750 points of the seed Lamb case: 0.15 ms instead of 0.42 ms a record).
+        of 41 750 points of the Lamb plate case: 0.15 ms instead of 0.42 ms a record).
         """
         values = np.asarray(values)
         if isinstance(rows, slice):

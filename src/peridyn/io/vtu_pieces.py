@@ -50,14 +50,14 @@ class VtuPieces:
         n, dim = self.domain.n_owned, self.body.dim
         damage = self.damage()[:n] if self.damage is not None else None
         tensors = {k: v[:n] for k, v in self.tensors(state.u).items()} if self.tensors is not None else {}
-        data = snapshot_fields(state.u[:n], state.v[:n], dim, damage, tensors)
+        data = snapshot_fields(state.u[:n], state.v[:n], dim, damage, tensors, self.body.volumes[:n])
         name = snapshot_name(state.step, "")
         pieces = [f"{Path(name).name}/piece_{rank:04d}.vtu" for rank in range(self.domain.size)]
         folder = self.directory / name
-        self.domain.agree(self._write_piece, folder, pieces[self.domain.comm.rank], data)
+        self.domain.agree(self._write_piece, folder, pieces[self.domain.comm.rank], data, state.time)
         self.domain.on_root(write_pvtu, self.directory / f"{name}.pvtu", pieces, data)
 
-    def _write_piece(self, folder: Path, piece: str, data: dict) -> None:
+    def _write_piece(self, folder: Path, piece: str, data: dict, time: float) -> None:
         folder.mkdir(parents=True, exist_ok=True)
         n, dim = self.domain.n_owned, self.body.dim
-        write_vtu(folder.parent / piece, self.body.points[:n, :dim], data, self.compression)
+        write_vtu(folder.parent / piece, self.body.points[:n, :dim], data, self.compression, time)

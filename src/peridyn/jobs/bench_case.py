@@ -15,7 +15,7 @@ deleted afterwards) and, with damage, the crack-length observer; no checkpoints.
 
 Rates are directed bond updates per second: ``bonds`` (all directed bonds, the kernel's loop)
 per force evaluation, and ``bonds x steps / seconds`` for whole steps. ``step_share`` =
-step rate / kernel rate, the kernel's share of a step (issue 22's target on
+step rate / kernel rate, the kernel's share of a step (the target on
 ``cases/lamb_plate.yaml``: >= 0.85).
 
 The breakdown of the timed steps (``parts``, s) comes from ``time.perf_counter`` around the

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import csv
 import json
+import logging
 import time
 from contextlib import nullcontext
 from pathlib import Path
@@ -34,11 +35,14 @@ from peridyn.fatigue.specimen import compliance_energy, compliance_stress_intens
 from peridyn.fatigue.tip import AXES
 from peridyn.io.case import Case, FatigueModal
 from peridyn.io.outdir import json_job_status, prepare_output
+from peridyn.io.run_log import run_log
 from peridyn.io.vtk import write_vtu
 from peridyn.jobs.build import build
 from peridyn.jobs.modal import case_modes, match_modes
 from peridyn.jobs.run import output_directory
 from peridyn.jobs.summary import finish_summary
+
+logger = logging.getLogger(__name__)
 
 
 def check_fatigue_case(case: Case) -> None:
@@ -167,8 +171,11 @@ def run_fatigue_case(
     setup = build(case, base_dir, comm)
     d = setup.domain
     out = d.on_root(prepare_output, output_directory(case, output_dir), "fatigue.json", overwrite)
-    with json_job_status(out) if d.is_root else nullcontext():
-        return d.comm.bcast(_run_fatigue(case, setup, out, modal, progress, start))
+    with json_job_status(out) if d.is_root else nullcontext(), run_log(out, d.is_root):
+        logger.info(f"fatigue case {case.name!r} ({setup.whole_body.n_points} points) into {out}")
+        summary = d.comm.bcast(_run_fatigue(case, setup, out, modal, progress, start))
+        logger.info(f"fatigue case {case.name!r} complete in {time.perf_counter() - start:.1f} s")
+        return summary
 
 
 def _run_fatigue(case, setup, out, modal, progress, start) -> dict:

@@ -2,7 +2,7 @@
 
 After the time loop a run's own work is single-threaded: the f-k and kx-ky analyses and their
 maps in one half, the sensor, B-scan, field and wavefield figures in the other (2-3 s each for
-the seed Lamb plate). A worker started before the build, when the run may use a second core,
+the Lamb plate case). A worker started before the build, when the run may use a second core,
 imports matplotlib and peridyn's plotting while the run builds its model (mostly one core's
 work), waits through the time loop, then draws the run figures while the run analyses. The
 figures are the same files; only the wall time changes.

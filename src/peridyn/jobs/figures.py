@@ -70,7 +70,7 @@ def final_crack_paths(case: Case, body: Body, phi: np.ndarray):
 
 
 def draw_crack_figures(body: Body, out: Path, paths, summary: dict) -> list[Path]:
-    """Damage map on the deformed configuration (x50, as seed 004, or less) with the crack
+    """Damage map on the deformed configuration (x50, as Martowicz, or less) with the crack
     ``paths``, and the crack length against time when it was sampled; displacements and
     damage are the final ones of ``out``/results.h5."""
     from peridyn.plotting.crack import plot_crack_length, plot_damage_map

@@ -102,9 +102,12 @@ def _write_modal(case, body, n_bonds, table: ModeTable, out, case_path) -> tuple
         out / "results.h5", body.points[:, : body.dim], body.volumes, provenance(case_path, case=case)
     ) as h5:
         h5.set_status("running")
-        h5.write_array("modes/frequencies", result.frequencies)
-        h5.write_array("modes/shapes", result.shapes)
-        h5.write_array("modes/rigid", result.rigid)
+        h5.write_array(
+            "modes/frequencies", result.frequencies, {"units": "Hz", "long_name": "frequency"}, ["mode"]
+        )
+        about = {"units": "1", "long_name": "mode shape, mass-normalised (x^T M x = 1)"}
+        h5.write_array("modes/shapes", result.shapes, about, ["mode", "point", "component"])
+        h5.write_array("modes/rigid", result.rigid, {"units": "1", "long_name": "rigid-body mode"}, ["mode"])
     (out / "modes").mkdir(exist_ok=True)
     for i, shape in enumerate(result.shapes):
         write_vtu(
@@ -139,18 +142,21 @@ def modal_table(model, n_modes: int, fixed=None, eigensolver: str = "auto"):
 
 def mode_rows(body, masses, result):
     """Types (``analysis.modes.classify_modes``) and JSON/CSV rows of the modes ``result`` of
-    ``body`` whose points weigh ``masses`` (n_points,) kg."""
+    ``body`` whose points weigh ``masses`` (n_points,) kg. A rigid mode's frequency is 0 Hz
+    (the solver's value, round-off of order 1e-3 Hz of either sign, stays in results.h5)."""
     types = classify_modes(body.points, result.shapes, masses, result.rigid)
     rows = [
         {
             "index": i,
-            "frequency_hz": float(f),
+            "frequency_hz": 0.0 if rigid else float(f),
             "type": t.type,
             "order": t.order,
             "label": str(t),
             "residual": float(r),
         }
-        for i, (f, t, r) in enumerate(zip(result.frequencies, types, result.residuals, strict=True))
+        for i, (f, t, r, rigid) in enumerate(
+            zip(result.frequencies, types, result.residuals, result.rigid, strict=True)
+        )
     ]
     return types, rows
 

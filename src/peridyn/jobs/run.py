@@ -7,9 +7,10 @@ from __future__ import annotations
 import functools
 import hashlib
 import json
+import logging
 import shutil
-import sys
 import time
+from contextlib import ExitStack
 from pathlib import Path
 
 import numpy as np
@@ -25,6 +26,7 @@ from peridyn.io.hdf5 import HDF5Writer
 from peridyn.io.outdir import end_status, prepare_output
 from peridyn.io.provenance import package_version, provenance
 from peridyn.io.recorder import LineProbe, Probes, Recorder, RecorderSpec
+from peridyn.io.run_log import run_log
 from peridyn.io.vtu_pieces import VtuPieces
 from peridyn.jobs.build import Setup, build, pad3
 from peridyn.jobs.exodus_variables import GatheredVariables, check_variables, variable_values
@@ -40,6 +42,8 @@ from peridyn.physics.deformation import strain_field
 from peridyn.physics.transducers import pzt_sensor_weights
 from peridyn.solvers import ExplicitSolver, relax
 from peridyn.solvers.explicit_gpu import GPUExplicitSolver
+
+logger = logging.getLogger(__name__)
 
 #: The results file in a run's output folder.
 RESULTS = "results.h5"
@@ -169,7 +173,7 @@ def run_case(
     if parallel:
         _check_parallel(case)
     wanted = figure_worker and _draws_run_figures(case) and not parallel
-    with figure_worker_for(case, base_dir, wanted) as worker:
+    with figure_worker_for(case, base_dir, wanted) as worker, ExitStack() as log:
         setup = build(case, base_dir, comm)
         domain = setup.domain
         solver = time_stepper(case, setup) if stepping else None
@@ -179,6 +183,8 @@ def run_case(
             n_steps = step_count(case, solver)
             domain.on_root(check_output_fits, spec, setup.whole_body, n_steps, solver.dt, out)
         domain.on_root(prepare_output, out, RESULTS, overwrite, restart)
+        log.enter_context(run_log(out, domain.is_root))
+        logger.info(f"case {case.name!r} ({case.solver.type}, {setup.whole_body.n_points} points) into {out}")
         written = not restart  # a restart writes once its checkpoint is accepted (the recorder's part)
         try:
             summary, plots = _solve(
@@ -186,7 +192,9 @@ def run_case(
             )
             written = True
             _finish(case, setup, out, summary, plots, start, worker)
+            logger.info(f"case {case.name!r} complete in {time.perf_counter() - start:.1f} s")
         except Exception as exc:
+            logger.warning(f"case {case.name!r}: {end_status(exc)}")
             if written and domain.is_root:
                 try:
                     _set_status(out / RESULTS, setup.whole_body, end_status(exc))
@@ -442,9 +450,7 @@ def _run_explicit(
     if restart:
         state = _restart(ckpt_path, setup, meta, parts, whole_bonds, n_steps)
         resume = (state.step, state.time)
-        print(
-            f"restarting from the checkpoint at step {state.step} (t = {state.time:.6g} s)", file=sys.stderr
-        )
+        logger.info(f"restarting from the checkpoint at step {state.step} (t = {state.time:.6g} s)")
     else:
         state, resume = solver.initial_state(), None
     info = provenance(case_path, case=case)

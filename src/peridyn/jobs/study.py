@@ -7,7 +7,7 @@ each in its own folder, and a second study into the same folder skips the levels
 complete); the analysis reads the sweep's dataset (:func:`runs_from_dataset`).
 Modes are matched across runs by type and order ("1st bending", ...; rigid and
 unclassified modes are left out) and each series of runs is extrapolated with
-:func:`peridyn.analysis.convergence.richardson`. The series (seed 002, section 6.1,
+:func:`peridyn.analysis.convergence.richardson`. The series (Freimanis 2019, section 6.1,
 after Bobaru et al. 2009):
 
 - ``delta-m``: horizon factor m = delta/h fixed, spacing h -> 0 (so delta -> 0 too); the
@@ -84,6 +84,14 @@ class StudyRun:
             "skipped": self.skipped,
             "notes": self.notes,
         }
+
+    @classmethod
+    def from_dict(cls, row: dict) -> StudyRun:
+        """The run a ``to_dict`` row (of ``study.json``) describes."""
+        return cls(
+            row["spacing_m"], row["horizon_factor"], row["points"], row["bonds"], row["seconds"],
+            dict(row["modes"] or {}), row["skipped"], list(row["notes"]),
+        )  # fmt: skip
 
 
 def study_sweep(case_path, spacings, horizon_factors, n_modes: int | None = None, overrides=()) -> dict:
@@ -292,7 +300,7 @@ def fit_series(
     stagnating or diverging sequence, with its numbers).
     With ``references`` (label -> Hz), ``reference_hz`` and the relative errors of the
     extrapolated and of the finest value are added. With ``finest``, only that many of the
-    finest runs of each series enter the fit (the asymptotic range, seed 002 section 6.1);
+    finest runs of each series enter the fit (the asymptotic range, Freimanis 2019 section 6.1);
     ``fitted_runs`` says how many did.
     """
     if finest is not None and finest < 3:

@@ -25,6 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from peridyn.errors import InputError, Interrupted
+from peridyn.io.case_schema import case_unit
 from peridyn.io.dataset import SeriesColumn, build_dataset, require_xarray, write_dataset
 from peridyn.io.results import Results
 from peridyn.jobs.sweep_run import (
@@ -203,7 +204,7 @@ def run_sweep(
         raise SweepInterrupted(
             interrupted, counts["completed"], len(sweep.runs), command or f"run_sweep({str(path)!r}, ...)"
         )
-    figures = _draw_figures(sweep, collector.dataset(), out)
+    figures = draw_figures(sweep, collector.dataset(), out)
     return {
         "sweep": sweep.name,
         "runs": len(sweep.runs),
@@ -338,7 +339,7 @@ class Collector:
     def add_reference(self, folder: Path) -> None:
         """Take the series of the sweep's (complete) reference run in ``folder``."""
         self.reference_series = {
-            name: (times, values) for name, (times, values, _) in self._read_series(folder).items()
+            name: (times, values) for name, (times, values, _, _) in self._read_series(folder).items()
         }
 
     def _read_series(self, folder: Path) -> dict:
@@ -350,7 +351,7 @@ class Collector:
         out = {}
         for name in self.sweep.spec.outputs.series:
             _, times, values = results.series(name)
-            out[name] = (times, values, results.series_attrs(name).get("names"))
+            out[name] = (times, values, results.series_attrs(name).get("names"), results.series_about(name))
         return out
 
     def counts(self) -> dict:
@@ -391,11 +392,12 @@ class Collector:
         series = {}
         for name in self.sweep.spec.outputs.series:
             got = [self.series.get(r.run_id, {}).get(name) for r in runs]
-            entry_names = next((g[2] for g in got if g is not None), None)
+            first = next((g for g in got if g is not None), None)
             series[name] = SeriesColumn(
                 times=[None if g is None else g[0] for g in got],
                 values=[None if g is None else g[1] for g in got],
-                entry_names=entry_names,
+                entry_names=first[2] if first else None,
+                about=first[3] if first else {},
             )
         attrs = {
             "sweep": self.sweep.name,
@@ -404,7 +406,31 @@ class Collector:
             "command": self.sweep.spec.command,
             "parameters": json.dumps(self.sweep.spec.parameter_names()),
         }
-        return build_dataset(coords, table, series, attrs, self.reference_series)
+        about = {name: (case_unit(name), f"parameter {name}") for name in self.sweep.spec.parameter_names()}
+        about.update({name: (summary_unit(name), name.replace("_", " ")) for name in names})
+        about.update(SWEEP_COLUMNS)
+        return build_dataset(coords, table, series, attrs, self.reference_series, about)
+
+
+#: Units and long names of the columns every sweep dataset has (text: no unit).
+SWEEP_COLUMNS = {
+    "run_id": (None, "run: the first hex digits of the SHA-256 of its case"),
+    "status": (None, "status of the run"),
+    "error": (None, "error of a failed run"),
+    "seconds": ("s", "wall-clock time of the run"),
+    "finished": ("s", "when the run ended, Unix time"),
+}
+
+#: A summary key's unit by its last word (docs/user-guide.md, "Summaries and results files").
+SUMMARY_UNIT_SUFFIXES = {"_s": "s", "_j": "J", "_hz": "Hz", "_m": "m", "_rad_m": "rad/m", "_bytes": "byte"}
+
+
+def summary_unit(name: str) -> str:
+    """The unit of a flattened summary key (``flatten_summary``): by its suffix (``time_s``: s,
+    ``strain_energy_j``: J, ``frequency_hz.bending.1``: Hz, ...), else "1" (counts, ratios)."""
+    head = name.split(".", 1)[0]
+    suffix = max((s for s in SUMMARY_UNIT_SUFFIXES if head.endswith(s)), key=len, default=None)
+    return SUMMARY_UNIT_SUFFIXES[suffix] if suffix else "1"
 
 
 def flatten_summary(summary: dict) -> dict:
@@ -435,7 +461,7 @@ def flatten_summary(summary: dict) -> dict:
     return out
 
 
-def _draw_figures(sweep: Sweep, ds, out: Path) -> list[Path]:
+def draw_figures(sweep: Sweep, ds, out: Path) -> list[Path]:
     """Each chosen scalar result against the first varied parameter (``outputs.scalars``, else
     up to :data:`MAX_FIGURES` numeric results that vary), when the sweep varies a number and
     its ``outputs.figures`` is on."""

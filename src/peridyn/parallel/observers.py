@@ -3,7 +3,7 @@
 ``RootObservers`` is the one observer every rank attaches. At a step where one of its observers
 is due, the ranks gather the state (and the damage index) in global point order on rank 0,
 which calls the observers with it; their errors reach every rank (``Domain.on_root``). At a step
-where only a recorder's series are due (``attach``'s ``series``; the seed Lamb case records them at
+where only a recorder's series are due (``attach``'s ``series``; the Lamb plate case records them at
 every step) the ranks check the state together (``Domain.check_state``) and gather only the
 values at the probe points (``peridyn.parallel.points.PointGather``). Per-point
 tensors (``output.stress``, ``output.strain``) are computed by each rank on its owned points

@@ -14,7 +14,7 @@ material,
 which is the classical stress when the body is in uniaxial stress along the
 bond (then every bond along the load carries stretch s = eps and sigma = E eps).
 The criterion sigma_b > sigma_u is therefore the critical stretch
-s_c = sigma_u / E (seed 004: sigma_u = 40 MPa, E = 70 GPa -> s_c = 5.71e-4), the same
+s_c = sigma_u / E (Martowicz: sigma_u = 40 MPa, E = 70 GPa -> s_c = 5.71e-4), the same
 for PMB and LPS, 2D and 3D. See docs/theory.md, "Critical bond stress".
 
 The stretch-test skin. A bond (i, j) breaks when its deformed length ``|Y|`` passes its

@@ -87,7 +87,7 @@ class ToneBurst(TimeFunction):
 
     Examples
     --------
-    Seed 000's 3.5-cycle burst at 150 kHz lasts 23.3 us; the window peaks mid-burst.
+    Patra et al.'s (2018) 3.5-cycle burst at 150 kHz lasts 23.3 us; the window peaks mid-burst.
 
     >>> burst = ToneBurst(150e3, cycles=3.5)
     >>> round(burst.duration * 1e6, 2)
@@ -121,10 +121,10 @@ class ToneBurst(TimeFunction):
 
 @dataclass(frozen=True)
 class GaussianBurst(TimeFunction):
-    """Gaussian-windowed burst of seed 000, eqs. 8-9.
+    """Gaussian-windowed burst of Patra et al. 2018, eqs. 8-9.
 
     f(t) = amplitude exp(-p tau^2 / 2) sin(omega tau), tau = t - delay,
-    p = (2 shape omega / N)^2, omega = 2 pi frequency. The seed writes the shape
+    p = (2 shape omega / N)^2, omega = 2 pi frequency. The paper writes the shape
     product as k h; the default 3 / (2 pi) makes the +-3 sigma envelope span the
     N cycles. The default delay is 4 sigma so that the signal starts at rest
     (envelope below 3.4e-4 at t = 0).

@@ -10,7 +10,7 @@ offset of a point from the patch centre, the *patch radius* of a point is
 Actuators (each returns the body with a new node set and the boundary
 conditions to pass to :class:`~peridyn.physics.loads.Loading`):
 
-- :func:`pzt_radial_actuator`, seed 000 (sec. 2.2, after its ref. 37): an
+- :func:`pzt_radial_actuator`, Patra et al. 2018 (sec. 2.2, after its ref. 37): an
   in-plane *radial* displacement prescribed on the patch's points, zero at the
   centre and growing linearly along every ray to ``amplitude`` on the
   perimeter::
@@ -79,7 +79,7 @@ def pzt_radial_actuator(
     amplitude: float = 1e-6,
     name: str = "pzt",
 ) -> tuple[Body, list[BoundaryCondition]]:
-    """Radial in-plane displacement of a PZT patch (seed 000), see the module docstring.
+    """Radial in-plane displacement of a PZT patch (Patra et al. 2018), see the module docstring.
 
     Parameters
     ----------

@@ -34,7 +34,7 @@ def plot_damage_map(
     phi : (n,) float64
     paths : crack paths of ``peridyn.analysis.crack.crack_paths``
     scale : float or None
-        Displacement magnification; None: 50 (as seed 004 draws) or less, so that the largest
+        Displacement magnification; None: 50 (as Martowicz draws) or less, so that the largest
         drawn displacement is at most a tenth of the body's size.
     """
     xy0, uv = points[:, :2], u[:, :2]

@@ -63,7 +63,7 @@ def plot_dispersion(relations, path=None, title: str | None = None) -> Figure:
 
 def plot_study(study: Study, directory, prefix: str = "dispersion") -> list[Path]:
     """Write one figure per sweep of a study (``<prefix>_influence.png``, ``_horizon``,
-    ``_spacing``: seed 001 figures 4-6 and 10-12); returns the paths written."""
+    ``_spacing``: the dispersion study figures 4-6 and 10-12); returns the paths written."""
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
     written = []

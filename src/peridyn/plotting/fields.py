@@ -53,15 +53,19 @@ def plot_run(directory, body: Body) -> list[Path]:
 
 
 def plot_sensors(results: Results, path: Path) -> Path:
-    """Displacement components against time at each sensor (series ``sensor_u``)."""
-    names = [str(n) for n in results.series_attrs("sensor_u")["names"]]
+    """Displacement components against time at each sensor (series ``sensor_u``), each labelled
+    with its name and position (the grid point it reads, mm)."""
+    attrs = results.series_attrs("sensor_u")
+    names = [str(n) for n in attrs["names"]]
+    where = results.array("geometry/points")[attrs["points"]] * 1e3
     _, t, data = results.series("sensor_u")
     t = t * 1e6
     fig, axes = plt.subplots(len(names), 1, figsize=(7, 1.8 + 1.6 * len(names)), squeeze=False, sharex=True)
     for k, (ax, name) in enumerate(zip(axes[:, 0], names, strict=True)):
         for c in range(3):
             ax.plot(t, data[:, k, c], label=f"u{COMPONENT_NAMES[c]}")
-        ax.set_ylabel(f"{name}\nu (m)")
+        position = ", ".join(f"{v:.4g}" for v in where[k])
+        ax.set_ylabel(f"{name}\n({position}) mm\nu (m)", fontsize=8)
         ax.grid(alpha=0.3)
     axes[0, 0].legend(loc="upper right", ncol=3, fontsize=8)
     axes[-1, 0].set_xlabel("time (us)")
@@ -86,11 +90,11 @@ def plot_bscan(results: Results, name: str, path: Path) -> Path:
         ax.legend()
         ax.grid(alpha=0.3)
         return _save(fig, path)
-    fig, axes = plt.subplots(1, 3, figsize=(12, 4), sharey=True)
+    fig, axes = plt.subplots(1, 3, figsize=(13, 4), sharey=True, layout="constrained")
+    lim = float(np.max(np.abs(data))) or 1.0  # one scale: the components compare at a glance
     for c, ax in enumerate(axes):
         field = data[:, :, c]
-        lim = np.max(np.abs(field)) or 1.0
-        ax.imshow(
+        image = ax.imshow(
             field,
             aspect="auto",
             origin="lower",
@@ -102,6 +106,7 @@ def plot_bscan(results: Results, name: str, path: Path) -> Path:
         ax.set_title(f"u{COMPONENT_NAMES[c]} along line '{name}'")
         ax.set_xlabel("distance along the line (mm)")
     axes[0].set_ylabel("time (us)")
+    fig.colorbar(image, ax=axes, label="displacement (m)", shrink=0.9)
     return _save(fig, path)
 
 
@@ -170,7 +175,8 @@ def _triangulation(points: np.ndarray, xs: np.ndarray, ys: np.ndarray, longest: 
 
 
 def _save(fig, path: Path) -> Path:
-    fig.tight_layout()
+    if fig.get_layout_engine() is None:
+        fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
     return path

@@ -39,14 +39,26 @@ def plot_against(ds, x: str, y: str, others, path) -> Path:
             continue
         order = idx[np.argsort(xs[idx], kind="stable")]
         label = ", ".join(
-            f"{o} = {v:.4g}" if isinstance(v, float) else f"{o} = {v}"
+            f"{o} = {v:.4g}{_unit(ds, o, ' ')}" if isinstance(v, float) else f"{o} = {v}{_unit(ds, o, ' ')}"
             for o, v in zip(others, group, strict=True)
         )
         ax.plot(xs[order], ys[order], "o-", label=label or None)
-    ax.set_xlabel(x)
-    ax.set_ylabel(y)
+    ax.set_xlabel(_label(ds, x))
+    ax.set_ylabel(_label(ds, y))
     ax.grid(True, alpha=0.3)
     if others and len(groups) <= MAX_LEGEND:
         ax.legend(fontsize="small")
     fig.savefig(path, dpi=120)
     return Path(path)
+
+
+def _unit(ds, name: str, before: str) -> str:
+    """The variable's ``units`` after ``before``; nothing for a ratio or count ("1") or none."""
+    units = ds[name].attrs.get("units")
+    return f"{before}{units}" if units and units != "1" else ""
+
+
+def _label(ds, name: str) -> str:
+    """An axis label: the name and its unit in brackets (``material.E (Pa)``)."""
+    units = ds[name].attrs.get("units")
+    return f"{name} ({units})" if units else name

@@ -8,8 +8,8 @@ damping c:
 
 solved by Newton with the consistent tangent ``K`` (``peridyn.linalg.tangent``):
 ``(K + (4 / dt^2 + 2 c / dt) M) du = R``, until the largest displacement increment
-|du| is below ``tolerance`` (m; 0.1 nm at dt = 20 ns) or, given ``residual_tolerance`` (N),
-|R| is below that. Prescribed displacements
+|du| is below ``tolerance`` (m; Martowicz: dt = 20 ns, 0.1 nm) or, given ``residual_tolerance``
+(N), |R| is below that. Prescribed displacements
 are imposed at t + dt, prescribed velocities integrated by the trapezoidal rule, and
 prescribed dofs get a = 0 (as in ``ExplicitSolver``). For a linear undamped system the
 scheme conserves the energy (v^T M v + u^T K u) / 2 exactly and is unconditionally stable.

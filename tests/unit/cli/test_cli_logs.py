@@ -42,10 +42,18 @@ def test_warnings_are_one_line_without_source_paths(capsys):
 
 
 def test_progress_bar_factory_follows_the_flags_and_the_terminal(monkeypatch):
+    """A tqdm bar where someone watches (a terminal, or --progress); else a heartbeat log line
+    (peridyn.cli.logs.Heartbeat)."""
+
+    def kind(choice):
+        bar = progress_bar(choice, "x")(10)
+        bar.close()
+        return type(bar).__name__
+
     monkeypatch.setattr(sys.stderr, "isatty", lambda: True)
-    assert progress_bar(None, "x") is not None and progress_bar(False, "x") is None
+    assert kind(None) == "tqdm" and kind(False) == "Heartbeat"
     monkeypatch.setattr(sys.stderr, "isatty", lambda: False)
-    assert progress_bar(None, "x") is None and progress_bar(True, "x") is not None
+    assert kind(None) == "Heartbeat" and kind(True) == "tqdm"
 
 
 @pytest.mark.parametrize("command", ["run", "demo", "fatigue"])

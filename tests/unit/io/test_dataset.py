@@ -11,7 +11,7 @@ import pytest
 
 from peridyn.errors import InputError
 from peridyn.io.dataset import SeriesColumn, build_dataset, load_sweep, write_dataset
-from peridyn.jobs.sweep import flatten_summary
+from peridyn.jobs.sweep import flatten_summary, summary_unit
 
 #: The dataset tests need the sweep extra (pip install 'peridyn[sweep]').
 needs_sweep_extra = pytest.mark.skipif(
@@ -98,3 +98,43 @@ def test_modal_summary_flattens_to_frequencies_by_type_and_order():
         "kxky.110000.A0": 777.0,
         "kxky.110000.S0": None,
     }
+
+
+@needs_sweep_extra
+def test_every_variable_has_a_long_name_and_every_number_a_unit(tmp_path):
+    """The dataset says what each variable is: ``about`` for the columns, the results file's
+    units for a series, seconds for the times (written and read back)."""
+    column = SeriesColumn(
+        times=[np.arange(2) * 1e-7], values=[np.zeros((2, 1, 3))], entry_names=["s1"],
+        about={"units": "m", "long_name": "displacement at the sensors"},
+    )  # fmt: skip
+    ds = build_dataset(
+        {"run_id": ["a"], "material.E": [2e11]},
+        {"status": ["complete"], "strain_energy_j": [1.5], "steps": [10]},
+        {"sensor_u": column},
+        {},
+        reference={"sensor_u": (np.arange(2) * 1e-7, np.zeros((2, 1, 3)))},
+        about={
+            "run_id": (None, "run"),
+            "material.E": ("Pa", "parameter material.E"),
+            "status": (None, "status"),
+        },
+    )
+    back = load_sweep(write_dataset(ds, tmp_path / "dataset.nc"))
+    for name, variable in back.variables.items():
+        assert "long_name" in variable.attrs, name
+        if variable.dtype.kind in "biuf":
+            assert "units" in variable.attrs, name
+    assert back["material.E"].attrs["units"] == "Pa" and back["sensor_u"].attrs["units"] == "m"
+    assert back["sensor_u_time"].attrs["units"] == "s" and back["reference_sensor_u"].attrs["units"] == "m"
+    assert back["steps"].attrs == {"units": "1", "long_name": "steps"}
+    assert "units" not in back["status"].attrs
+
+
+@pytest.mark.parametrize(
+    ("key", "unit"),
+    [("strain_energy_j", "J"), ("time_s", "s"), ("frequency_hz.bending.1", "Hz"), ("crack_length_m", "m"),
+     ("fk_peaks_rad_m.S0", "rad/m"), ("max_damage", "1"), ("mac.1st_bending", "1")],
+)  # fmt: skip
+def test_summary_units_follow_the_key_suffixes(key, unit):
+    assert summary_unit(key) == unit

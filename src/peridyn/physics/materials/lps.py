@@ -60,12 +60,12 @@ from peridyn.physics.materials.registry import register_material
 SURFACE_CORRECTIONS = ("none", "shear-factor", "energy")
 
 #: Rows a block of the fused float64 force (``kernels.lps.lps_force_fused``; 256 measured as
-#: fast as 1024 and faster than 64 or 2048 on the seed Lamb plate, benchmarks/HISTORY.md, "Stored
+#: fast as 1024 and faster than 64 or 2048 on the Lamb plate case, benchmarks/HISTORY.md, "Stored
 #: bond vectors, the fused LPS force, ...").
 FUSED_BLOCK_ROWS = 256
 #: The fused force is used when each thread's ring holds at most this many bonds (32 B each:
 #: 8 MiB), i.e. when the point order's index bandwidth keeps a block's bonds in the cache
-#: between its dilatation and its force (the seed Lamb plate: 131 k; the 49^3 bench cube,
+#: between its dilatation and its force (the Lamb plate case: 131 k; the 49^3 bench cube,
 #: bandwidth 7203 rows: 850 k, where the two passes are used).
 FUSED_RING_BONDS = 2**18
 
@@ -189,7 +189,7 @@ class LPSModel(Model):
         S_bulk = 4 gamma^2 m / 15 (3D; 4 gamma^2 m / 8 in 2D), and alpha is
         multiplied by S_bulk / max(S): the point's stiffest pure-shear response is
         brought to the bulk value. This reproduces the independent assembly of
-        VALIDATION.md V4 to all printed digits (40 000 points, 1.4143 h).
+        docs/reference-cases.md, V4 to all printed digits (40 000 points, 1.4143 h).
         """
         body, b = self.body, self.bonds
         x, xi = body.points, self.bond_vectors_once()
