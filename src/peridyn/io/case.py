@@ -246,12 +246,12 @@ class BondFilter(Strict):
     the plane through ``corner`` (m) of ``normal``, ``bottom_length`` (m) along ``bottom`` and
     ``side_length`` (m) along bottom x normal; a bond touching it at an end counts."""
 
-    type: Literal["finite_plane"] = "finite_plane"
-    corner: Vector3
-    normal: Vector3
-    bottom: Vector3
-    bottom_length: Positive
-    side_length: Positive
+    type: Literal["finite_plane"] = described("finite_plane", "the filter's shape: a finite plane")
+    corner: Vector3 = described(..., "a corner of the plane", "m")
+    normal: Vector3 = described(..., "the plane's normal")
+    bottom: Vector3 = described(..., "direction of the plane's bottom edge from the corner")
+    bottom_length: Positive = described(..., "length of the bottom edge", "m")
+    side_length: Positive = described(..., "length of the side edge, along bottom x normal", "m")
 
 
 class Discretization(Strict):
