@@ -14,6 +14,7 @@ JSON, keeps it in ``status.json`` (``{"status": ...}``), written and read here.
 from __future__ import annotations
 
 import json
+import shutil
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -24,8 +25,12 @@ from peridyn.errors import InputError, InstabilityError, Interrupted, PeridynErr
 STATUS_FILE = "status.json"
 
 
-def prepare_output(out, marker: str, overwrite: bool = False, restart: bool = False) -> Path:
-    """Check the output folder ``out`` and create it; returns it as a Path.
+def prepare_output(
+    out, marker: str, overwrite: bool = False, restart: bool = False, earlier: tuple = ()
+) -> Path:
+    """Check the output folder ``out`` and create it; returns it as a Path. With ``overwrite``,
+    the earlier job's files (``earlier``: names and glob patterns of what such a job writes,
+    e.g. ``RUN_OUTPUTS``) are removed first, so that none is left beside the new job's.
 
     Parameters
     ----------
@@ -52,7 +57,41 @@ def prepare_output(out, marker: str, overwrite: bool = False, restart: bool = Fa
             "it, --restart to continue it, or choose another --output"
         )
     out.mkdir(parents=True, exist_ok=True)  # an OSError names the path and the reason (the CLI prints it)
+    if overwrite:
+        remove_outputs(out, earlier)
     return out
+
+
+#: What a run, static or modal job writes in its output folder (names and glob patterns):
+#: removed by ``--overwrite`` before the new job writes.
+RUN_OUTPUTS = (
+    "results.h5",
+    "checkpoint.h5",
+    "checkpoint.h5.tmp",
+    "snapshots.pvd",
+    "snapshots",
+    "modes",
+    "figures",
+    "*.png",
+    "*.e",
+    "*.exo",
+    "crack_length.csv",
+    "modes.csv",
+    "modes.json",
+    "modal.json",
+    "damage.vtu",
+    "mode_*.vtu",
+)
+
+
+def remove_outputs(out: Path, patterns) -> None:
+    """Remove the files and folders of ``out`` that match ``patterns`` (top level only)."""
+    for pattern in patterns:
+        for path in sorted(out.glob(pattern)):
+            if path.is_dir() and not path.is_symlink():
+                shutil.rmtree(path)
+            else:
+                path.unlink(missing_ok=True)
 
 
 def write_status(out, status: str) -> None:

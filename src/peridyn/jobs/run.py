@@ -4,6 +4,7 @@ runs are ``jobs.modal``), recording, checkpoints, crack history and the stored s
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import hashlib
 import json
@@ -22,7 +23,8 @@ from peridyn.errors import CaseFileError, InputError, Interrupted
 from peridyn.io.case import Case
 from peridyn.io.checkpoint import Checkpointer, load_checkpoint
 from peridyn.io.hdf5 import HDF5Writer
-from peridyn.io.outdir import end_status, prepare_output
+from peridyn.io.lock import OutputLock
+from peridyn.io.outdir import RUN_OUTPUTS, end_status, prepare_output
 from peridyn.io.provenance import package_version, provenance
 from peridyn.io.recorder import LineProbe, Probes, Recorder, RecorderSpec
 from peridyn.io.vtu_pieces import VtuPieces
@@ -164,7 +166,7 @@ def run_case(
     if parallel:
         _check_parallel(case)
     wanted = figure_worker and _draws_run_figures(case) and not parallel
-    with figure_worker_for(case, base_dir, wanted) as worker:
+    with figure_worker_for(case, base_dir, wanted) as worker, contextlib.ExitStack() as held:
         setup = build(case, base_dir, comm)
         domain = setup.domain
         solver = time_stepper(case, setup) if stepping else None
@@ -173,7 +175,10 @@ def run_case(
         if stepping:
             n_steps = step_count(case, solver)
             domain.on_root(check_output_fits, spec, setup.whole_body, n_steps, solver.dt, out)
-        domain.on_root(prepare_output, out, RESULTS, overwrite, restart)
+        lock = domain.on_root(OutputLock, out)  # one run writes a folder at a time
+        if lock is not None:
+            held.callback(lock.release)
+        domain.on_root(prepare_output, out, RESULTS, overwrite, restart, RUN_OUTPUTS)
         written = not restart  # a restart writes once its checkpoint is accepted (the recorder's part)
         try:
             summary, plots = _solve(
@@ -435,7 +440,7 @@ def _run_explicit(
     }
     whole_bonds = d.bond_offsets(setup.bonds.offsets)
     if restart:
-        state = _restart(ckpt_path, setup, meta, parts, whole_bonds, n_steps)
+        state = _restart(ckpt_path, setup, meta, parts, whole_bonds, n_steps, out / RESULTS)
         resume = (state.step, state.time)
         print(
             f"restarting from the checkpoint at step {state.step} (t = {state.time:.6g} s)", file=sys.stderr
@@ -475,6 +480,7 @@ def _run_explicit(
         parts,
         whole_bonds,
         [recorder.flush] if recorder is not None else [],
+        recorder.h5.identity if recorder is not None else None,
     )
     watched = [recorder, *([cracks] if cracks is not None else [])]
     due = [spec.whole_due, *([cracks.due] if cracks is not None else [])]  # the series: ``series``
@@ -562,16 +568,19 @@ def _run_explicit(
     return summary
 
 
-def _restart(path, setup: Setup, meta: dict, parts: dict, whole_bonds: np.ndarray, n_steps: int) -> State:
+def _restart(
+    path, setup: Setup, meta: dict, parts: dict, whole_bonds: np.ndarray, n_steps: int, results
+) -> State:
     """The state of the checkpoint at ``path`` (this rank's points), with the bonds' intact mask
     and the parts' states restored; a checkpoint at or past the run's last step ``n_steps`` is
     refused (before the recorder reopens, and would rewrite, results.h5). Checkpoints hold the
     whole body in serial numbering, so a run may restart on another number of ranks. A rank's
     damage skin covers its part only and is not saved under MPI: it starts again with a full
-    stretch test (the same bonds break, see ``peridyn.physics.damage``)."""
+    stretch test (the same bonds break, see ``peridyn.physics.damage``). The results file
+    ``results`` must be the one the checkpoint was saved with (``check_results``)."""
     d = setup.domain
     state, intact, saved = d.agree(
-        load_checkpoint, path, setup.whole_body.n_points, int(whole_bonds[-1]), meta
+        load_checkpoint, path, setup.whole_body.n_points, int(whole_bonds[-1]), meta, results
     )
     if state.step >= n_steps:
         raise InputError(
@@ -588,19 +597,33 @@ def _restart(path, setup: Setup, meta: dict, parts: dict, whole_bonds: np.ndarra
 
 
 def _checkpointer(
-    path, every: int, setup: Setup, meta: dict, parts: dict, whole_bonds: np.ndarray, before_save=()
+    path,
+    every: int,
+    setup: Setup,
+    meta: dict,
+    parts: dict,
+    whole_bonds: np.ndarray,
+    before_save=(),
+    results=None,
 ):
     """The run's ``Checkpointer`` and what must be gathered before it saves (``RootObservers``):
     under MPI it writes, on rank 0, the whole body's state and intact mask in serial numbering
     and the parts that hold whole-body state (the contact list's build displacement, gathered;
     not a rank's damage skin). ``before_save``: the calls made before every save (the
-    recorder's ``flush``, on rank 0)."""
+    recorder's ``flush``, on rank 0); ``results``: the identity of the results file
+    (``HDF5Writer.identity``, on rank 0)."""
     d = setup.domain
     if d.size == 1:
-        return Checkpointer(path, every, setup.bonds.intact, meta, parts, before_save), []
+        return Checkpointer(path, every, setup.bonds.intact, meta, parts, before_save, results), []
     whole_intact = np.ones(int(whole_bonds[-1]), dtype=bool) if d.is_root else None
     checkpointer = Checkpointer(
-        path, every, whole_intact, meta, {k: v for k, v in parts.items() if k != "damage"}, before_save
+        path,
+        every,
+        whole_intact,
+        meta,
+        {k: v for k, v in parts.items() if k != "damage"},
+        before_save,
+        results,
     )
 
     def gather_whole(state):  # the state itself is gathered by RootObservers.call
