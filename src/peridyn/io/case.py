@@ -18,6 +18,7 @@ from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, ValidationEr
 
 from peridyn.errors import CaseFileError, InputError, did_you_mean
 from peridyn.io.exodus_write import PERIDIGM_VARIABLES
+from peridyn.io.text_file import read_input_text
 from peridyn.physics.loads import parse_components
 
 #: Deepest nesting of collections a YAML text may have (a case nests 5 levels; PyYAML composes
@@ -761,14 +762,9 @@ def load_case(path, overrides=()) -> Case:
         Applied before validation; values are parsed as YAML (``1e-3``, ``true``, ``[1, 2]``).
     """
     path = Path(path)
-    if not path.is_file():
-        raise CaseFileError(str(path), "<file>", None, "an existing YAML case file")
+    text = read_input_text(path, "YAML case file")
     try:
-        raw = parse_yaml(path.read_text(encoding="utf-8"))
-    except UnicodeDecodeError as exc:
-        raise CaseFileError(
-            str(path), "<file>", None, f"UTF-8 text (byte {exc.start} is {exc.object[exc.start]:#04x})"
-        ) from None
+        raw = parse_yaml(text)
     except yaml.YAMLError as exc:
         raise CaseFileError(str(path), "<file>", None, f"valid YAML ({yaml_problem(exc)})") from None
     if not isinstance(raw, dict):

@@ -26,7 +26,7 @@ STATUS_FILE = "status.json"
 
 
 def prepare_output(
-    out, marker: str, overwrite: bool = False, restart: bool = False, earlier: tuple = ()
+    out, marker: str, overwrite: bool = False, restart: bool = False, earlier: tuple = (), restartable=True
 ) -> Path:
     """Check the output folder ``out`` and create it; returns it as a Path. With ``overwrite``,
     the earlier job's files (``earlier``: names and glob patterns of what such a job writes,
@@ -39,6 +39,10 @@ def prepare_output(
         The file whose presence means an earlier job's results (e.g. ``"results.h5"``).
     overwrite, restart : bool
         Replace the earlier results, or continue them (mutually exclusive).
+    earlier : tuple of str
+        What ``overwrite`` removes.
+    restartable : bool
+        Whether the command can continue earlier results (the refusal suggests ``--restart``).
 
     Raises
     ------
@@ -52,9 +56,10 @@ def prepare_output(
     if out.exists() and not out.is_dir():
         raise InputError(f"output folder {str(out)!r} is a file, not a folder: choose another --output")
     if (out / marker).exists() and not (overwrite or restart):
+        restart_hint = ", --restart to continue it" if restartable else ""
         raise InputError(
             f"output folder {str(out)!r} holds an earlier run's {marker}: pass --overwrite to replace "
-            "it, --restart to continue it, or choose another --output"
+            f"it{restart_hint}, or choose another --output"
         )
     out.mkdir(parents=True, exist_ok=True)  # an OSError names the path and the reason (the CLI prints it)
     if overwrite:

@@ -127,7 +127,8 @@ def run_case(
     overwrite : bool
         Replace an earlier run's results in the output folder.
     command : str or None
-        The command line that started the run, for the resume hint of ``Interrupted``.
+        The command line that started the run, for the resume hint of ``Interrupted``; ""
+        for a command that cannot be restarted (``peridyn demo``): no hint of ``--restart``.
     comm : communicator or None
         ``peridyn.parallel.comm.world()`` under ``mpiexec -n N`` (N > 1): each rank runs its
         part of the body (``peridyn.parallel``), rank 0 writes the one results.h5 with every
@@ -178,7 +179,7 @@ def run_case(
         lock = domain.on_root(OutputLock, out)  # one run writes a folder at a time
         if lock is not None:
             held.callback(lock.release)
-        domain.on_root(prepare_output, out, RESULTS, overwrite, restart, RUN_OUTPUTS)
+        domain.on_root(prepare_output, out, RESULTS, overwrite, restart, RUN_OUTPUTS, command != "")
         written = not restart  # a restart writes once its checkpoint is accepted (the recorder's part)
         try:
             summary, plots = _solve(
@@ -291,6 +292,8 @@ def _resume_hint(command: str | None) -> str:
     """How to continue an interrupted run."""
     if command is None:
         return "run_case(..., restart=True) with the same case and output folder"
+    if not command:
+        return ""
     return command if "--restart" in command.split() else f"{command} --restart"
 
 

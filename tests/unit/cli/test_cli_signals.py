@@ -117,3 +117,37 @@ def test_a_full_disk_during_a_run_names_the_file(tiny_disk, capsys, monkeypatch)
     status, line = _run_on(tiny_disk, capsys)
     assert status == 1
     assert line.startswith(f"peridyn run: error: {tiny_disk / 'out' / 'results.h5'}: {os.strerror(28)} (")
+
+
+def test_a_closed_stdout_or_stderr_runs_the_command(tmp_path):
+    """``>&-`` gave an internal error and two tracebacks; ``2>&-`` must not stop a command either."""
+    import json
+    import shlex
+
+    base = f"{shlex.quote(sys.executable)} -m peridyn"
+    env = {**os.environ, "PYTHONPATH": str(ROOT / "src")}
+    for redirect in (">&-", "2>&-", ">&- 2>&-"):
+        done = subprocess.run(
+            f"{base} {' '.join(LAMB)} --json {redirect}", shell=True, cwd=ROOT, env=env, capture_output=True
+        )
+        assert done.returncode == 0, (redirect, done.stderr)
+        _no_traceback(done.stderr.decode())
+        if redirect == "2>&-":
+            assert [m["mode"] for m in json.loads(done.stdout)["modes"]][:2] == ["S0", "A0"]
+    failed = subprocess.run(
+        f"{base} validate missing.yaml >&-", shell=True, cwd=ROOT, env=env, capture_output=True
+    )
+    assert failed.returncode == 1
+    lines = failed.stderr.decode().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("peridyn validate: error: missing.yaml: ")
+
+
+def test_a_broken_stderr_keeps_the_json_error_on_stdout():
+    """The reader of stderr went away (EPIPE): the error is still one JSON object on stdout."""
+    import json
+
+    proc = _peridyn(["validate", "missing.yaml", "--json"], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    proc.stderr.close()
+    out, _ = proc.communicate(timeout=120)
+    assert proc.returncode == 1
+    assert "missing.yaml" in json.loads(out)["error"]
