@@ -114,6 +114,22 @@ def test_a_failing_run_is_recorded_and_the_sweep_goes_on(tmp_path):
     assert "InputError" in ds["error"].values[1] and np.isnan(ds["dt_s"].values[1])
 
 
+def test_a_sweep_with_failed_runs_exits_non_zero_listing_each(tmp_path, capsys):
+    """A sweep with a failed run exited 0: now 1, one line naming the failed run and why, and
+    with --json the sweep's summary (its failed runs listed) is still the JSON on stdout."""
+    from peridyn.cli import main
+
+    path = tiny_sweep(tmp_path, {"product": {"solver.dt": [1e-7, 1e-5]}})  # 1e-5 s: above the stable step
+    assert main(["sweep", str(path), "-o", str(tmp_path / "out"), "--json", "--no-progress"]) == 1
+    captured = capsys.readouterr()
+    summary = json.loads(captured.out)
+    (failed,) = summary["failed_runs"]
+    assert failed["status"].startswith("failed: time step 1e-05 s exceeds the stable step")
+    line = captured.err.strip().splitlines()[-1]
+    assert line.startswith(f"peridyn sweep: error: 1 of 2 runs failed ({failed['run_id']}: failed: time step")
+    assert summary["error"] == line.split("error: ", 1)[1] and summary["completed"] == 1
+
+
 def test_a_killed_worker_is_replaced_and_its_run_done(tmp_path, monkeypatch):
     marker = tmp_path / "crashed"
     monkeypatch.setenv(CRASH_ONCE_ENV, str(marker))  # the first run to start kills its worker

@@ -107,7 +107,7 @@ def report(exc: BaseException, prog: str, as_json: bool, debug: bool) -> int:
     label = "" if status in INTERRUPTED_STATUSES else "error: "
     print(f"{prog}: {label}{line}", file=sys.stderr)
     if as_json:
-        fields = {"error": line}
+        fields = {**getattr(exc, "summary", {}), "error": line}  # a job's summary, when it has one
         fields.update(
             {k: _jsonable(getattr(exc, k)) for k in JSON_FIELDS if getattr(exc, k, None) is not None}
         )

@@ -14,7 +14,15 @@ from typing import Annotated, Literal
 
 import numpy as np
 import yaml
-from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, ValidationError, model_validator
+from pydantic import (
+    AfterValidator,
+    BaseModel,
+    BeforeValidator,
+    ConfigDict,
+    Field,
+    ValidationError,
+    model_validator,
+)
 
 from peridyn.errors import CaseFileError, InputError, did_you_mean
 from peridyn.io.exodus_write import PERIDIGM_VARIABLES
@@ -165,6 +173,18 @@ def _not_a_bool(value):
 
 
 NotBool = BeforeValidator(_not_a_bool)
+
+
+def _folder_name(name: str) -> str:
+    """Refuse a case name that is not one folder name (it names the run's output folder)."""
+    if not name.strip() or name in (".", "..") or any(c in name for c in "/\\\0"):
+        raise ValueError(
+            f"a folder name (the output folder is peridyn-out/<name>): not empty, '.' or '..', "
+            f"without '/', '\\' or NUL, got {name!r}"
+        )
+    return name
+
+
 Positive = Annotated[float, NotBool, Field(gt=0, allow_inf_nan=False)]
 NonNegative = Annotated[float, NotBool, Field(ge=0, allow_inf_nan=False)]
 Finite = Annotated[float, NotBool, Field(allow_inf_nan=False)]
@@ -526,6 +546,12 @@ class LineSpec(Strict):
     end: Vector3
     points: Annotated[int, NotBool, Field(ge=2)]
 
+    @model_validator(mode="after")
+    def _length(self):
+        if len(self.start) == len(self.end) and self.start == self.end:
+            raise ValueError(f"start and end are the same point {self.start}: a line probe needs a length")
+        return self
+
 
 class SetSum(Strict):
     """A global output variable: the sum of the nodal vector ``variable`` over node set ``set``
@@ -598,9 +624,10 @@ class ContactSpec(Strict):
 
 
 class Case(Strict):
-    """A whole simulation case."""
+    """A whole simulation case. ``name`` is a folder name (the default output folder is
+    ``peridyn-out/<name>``): not empty, not ``.`` or ``..``, without a path separator or NUL."""
 
-    name: str
+    name: Annotated[str, AfterValidator(_folder_name)]
     description: str = ""
     geometry: Geometry
     discretization: Discretization

@@ -34,6 +34,7 @@ from peridyn.jobs.figure_worker import figure_worker_for, figures_of, submit
 from peridyn.jobs.figures import draw_crack_figures, draw_run_figures, final_crack_paths
 from peridyn.jobs.lamb_analysis import analyse
 from peridyn.jobs.peridigm_step import peridigm_stable_step
+from peridyn.jobs.run_checks import check_run_plan
 from peridyn.jobs.summary import finish_summary, peak_memory_bytes
 from peridyn.parallel.observers import RootObservers
 from peridyn.physics.absorbing import layer_damping
@@ -175,6 +176,7 @@ def run_case(
         spec = recorder_spec(case, setup.whole_body, solver.dt) if stepping else None
         if stepping:
             n_steps = step_count(case, solver)
+            check_run_plan(case, solver.dt, n_steps)
             domain.on_root(check_output_fits, spec, setup.whole_body, n_steps, solver.dt, out)
         lock = domain.on_root(OutputLock, out)  # one run writes a folder at a time
         if lock is not None:
