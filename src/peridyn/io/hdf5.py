@@ -34,6 +34,7 @@ import numpy as np
 
 from peridyn.errors import InputError, did_you_mean
 from peridyn.io import integrity
+from peridyn.io.reserve import as_disk_error, ensure_room
 
 CHUNK_BYTES = 1 << 20
 """Target size of one chunk of a series' data, in bytes."""
@@ -161,14 +162,26 @@ class HDF5Writer:
         self.close()
 
     def close(self) -> None:
-        """Flush and close the file; calling it again does nothing."""
+        """Flush and close the file; calling it again does nothing. The file is closed even
+        when the flush fails (whose error is raised)."""
         if self._file.id.valid:
-            self._file.flush()
-            self._file.close()
+            try:
+                self.flush()
+            finally:
+                self._file.close()
 
     def flush(self) -> None:
-        """Flush everything written so far to the operating system."""
-        self._file.flush()
+        """Flush everything written so far to the operating system.
+
+        Raises
+        ------
+        OSError
+            The disk failed the write (full, or an I/O error), naming the file.
+        """
+        try:
+            self._file.flush()
+        except (OSError, RuntimeError) as exc:
+            raise as_disk_error(exc, self.path) from exc
         self._pending = 0
 
     def create_series(self, name: str, shape, dtype="float64", attrs: dict | None = None) -> None:
@@ -267,9 +280,13 @@ class HDF5Writer:
             last = step
         if not checked:
             return
-        series.append(
-            np.array([s for s, _ in checked], dtype=np.int64), np.array([t for _, t in checked]), values
-        )
+        ensure_room(self.path, values.nbytes + 16 * len(checked))
+        try:
+            series.append(
+                np.array([s for s, _ in checked], dtype=np.int64), np.array([t for _, t in checked]), values
+            )
+        except (OSError, RuntimeError) as exc:
+            raise as_disk_error(exc, self.path) from exc
         self._pending += 1
         if self.flush_every is not None and self._pending >= self.flush_every:
             self.flush()
@@ -296,6 +313,7 @@ class HDF5Writer:
         if key in self._file:
             del self._file[key]
         values = np.asarray(array)
+        ensure_room(self.path, values.nbytes)
         dataset = self._file.create_dataset(key, data=values)
         integrity.stamp_whole(dataset, values)
         if attrs:

@@ -14,12 +14,14 @@ JSON, keeps it in ``status.json`` (``{"status": ...}``), written and read here.
 from __future__ import annotations
 
 import json
+import os
 import shutil
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
 from peridyn.errors import InputError, InstabilityError, Interrupted, PeridynError
+from peridyn.io.reserve import disk_errno
 
 #: Name of the status file of the jobs that write JSON rather than results.h5.
 STATUS_FILE = "status.json"
@@ -86,6 +88,7 @@ RUN_OUTPUTS = (
     "modal.json",
     "damage.vtu",
     "mode_*.vtu",
+    ".peridyn.reserve",
 )
 
 
@@ -131,6 +134,10 @@ def end_status(exc: BaseException) -> str:
         return f"interrupted {exc.progress}".rstrip()
     if isinstance(exc, InstabilityError):
         return f"failed: unstable at step {exc.step} (t = {exc.time:.6g} s, point {exc.point}): {exc}"
+    number = disk_errno(exc)
+    if number is not None:  # a full or failing disk: what and where, not the HDF5 report
+        where = getattr(exc, "filename", None)
+        return f"failed: {os.strerror(number)}" + (f" ({where})" if where else "")
     reason = str(exc) if isinstance(exc, PeridynError) else f"{type(exc).__name__}: {exc}"
     return f"failed: {reason}"
 

@@ -39,6 +39,8 @@ from peridyn.discretization.state import ProbeState, State, check_state, runaway
 from peridyn.errors import InputError
 from peridyn.io.exodus_write import PERIDIGM_VARIABLES, ExodusWriter
 from peridyn.io.hdf5 import HDF5Writer
+from peridyn.io.outdir import end_status
+from peridyn.io.reserve import Reserve, as_disk_error, ensure_room
 from peridyn.io.series_buffer import SeriesBuffer
 from peridyn.io.vtk import PVDCollection, write_vtu
 
@@ -222,6 +224,7 @@ class Recorder:
             key: rows_of(idx) if key.startswith("plane_") else idx for key, idx in index.items()
         }
         mode = "a" if resume is not None else "w"
+        self.reserve = Reserve(self.directory)  # room to close the files on a full disk
         self.h5 = HDF5Writer(
             self.directory / "results.h5",
             body.points[:, : body.dim],
@@ -327,9 +330,14 @@ class Recorder:
         damage = self.damage() if self.damage is not None else None
         data = snapshot_fields(state.u, state.v, self.body.dim, damage, self._tensor_fields(state.u))
         name = snapshot_name(state.step, ".vtu")
-        write_vtu(
-            self.directory / name, self.body.points[:, : self.body.dim], data, self.spec.vtu_compression
-        )
+        ensure_room(self.directory / name, 8.0 * SNAPSHOT_VALUES * self.body.n_points)
+        try:
+            write_vtu(
+                self.directory / name, self.body.points[:, : self.body.dim], data, self.spec.vtu_compression
+            )
+        except OSError as exc:  # a part-written snapshot is no snapshot (and frees its room)
+            (self.directory / name).unlink(missing_ok=True)
+            raise as_disk_error(exc, self.directory / name) from exc
         self.pvd.add(state.time, name)
 
     def write_exodus(self, state: State) -> None:
@@ -348,14 +356,20 @@ class Recorder:
         self.series.flush()
 
     def finish(self, state: State) -> None:
-        """Write the held records and the final state, then close the file."""
-        self.flush()
-        self.h5.write_array("final/u", state.u)
-        self.h5.write_array("final/v", state.v)
-        if self.damage is not None:
-            self.h5.write_array("final/damage", self.damage())
-        for key, value in self._tensor_fields(state.u).items():
-            self.h5.write_array(f"final/{key}", value)
+        """Write the held records and the final state, then close the file (on a failure,
+        closed as by :meth:`close` with the failure's status). The reserve stays until the
+        run's owner deletes it (the summary is written after)."""
+        try:
+            self.flush()
+            self.h5.write_array("final/u", state.u)
+            self.h5.write_array("final/v", state.v)
+            if self.damage is not None:
+                self.h5.write_array("final/damage", self.damage())
+            for key, value in self._tensor_fields(state.u).items():
+                self.h5.write_array(f"final/{key}", value)
+        except Exception as exc:
+            self.close(end_status(exc))
+            raise
         self.h5.close()
 
     def _tensor_fields(self, u: np.ndarray) -> dict:
@@ -364,8 +378,10 @@ class Recorder:
 
     def close(self, status: str | None = None) -> None:
         """Close the file early (failure, interruption), setting its ``status`` when given,
-        after writing the records held (a failing write, e.g. a full disk, does not keep the
-        status from being set)."""
+        after writing the records held. The room of the run's ``Reserve`` is given back first,
+        so that on a full disk the records held, the status and the file's closing are written
+        all the same."""
+        self.reserve.release()
         try:
             self.flush()
         finally:

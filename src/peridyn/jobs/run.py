@@ -27,6 +27,7 @@ from peridyn.io.lock import OutputLock
 from peridyn.io.outdir import RUN_OUTPUTS, end_status, prepare_output
 from peridyn.io.provenance import package_version, provenance
 from peridyn.io.recorder import LineProbe, Probes, Recorder, RecorderSpec
+from peridyn.io.reserve import RESERVE_BYTES, RESERVE_FILE
 from peridyn.io.vtu_pieces import VtuPieces
 from peridyn.jobs.build import Setup, build, pad3
 from peridyn.jobs.exodus_variables import GatheredVariables, check_variables, variable_values
@@ -181,6 +182,7 @@ def run_case(
         lock = domain.on_root(OutputLock, out)  # one run writes a folder at a time
         if lock is not None:
             held.callback(lock.release)
+            held.callback((out / RESERVE_FILE).unlink, missing_ok=True)  # a recorder's ``Reserve``
         domain.on_root(prepare_output, out, RESULTS, overwrite, restart, RUN_OUTPUTS, command != "")
         written = not restart  # a restart writes once its checkpoint is accepted (the recorder's part)
         try:
@@ -191,6 +193,7 @@ def run_case(
             _finish(case, setup, out, summary, plots, start, worker)
         except Exception as exc:
             if written and domain.is_root:
+                (out / RESERVE_FILE).unlink(missing_ok=True)  # room for the status on a full disk
                 try:
                     _set_status(out / RESULTS, setup.whole_body, end_status(exc))
                 except Exception:  # noqa: BLE001 - e.g. the full disk that failed the run: its error is the one to report
@@ -272,7 +275,7 @@ def check_output_fits(spec: RecorderSpec, body: Body, n_steps: int, dt: float, o
     InputError
         Naming the steps, the bytes and the free space.
     """
-    need = spec.output_bytes(body.n_points, n_steps)
+    need = spec.output_bytes(body.n_points, n_steps) + RESERVE_BYTES
     folder = out.resolve()
     while not folder.exists():
         folder = folder.parent
@@ -539,11 +542,16 @@ def _run_explicit(
         if recorder is not None:
             recorder.close(end_status(exc))
         raise
-    collect(state)  # the end-of-run snapshot's Exodus record
-    if not spec.snapshot_due(state.step):
-        if pieces is not None:
-            pieces.write(state)
-        gathered.call(state, lambda whole: recorder.snapshot(whole))
+    try:
+        collect(state)  # the end-of-run snapshot's Exodus record
+        if not spec.snapshot_due(state.step):
+            if pieces is not None:
+                pieces.write(state)
+            gathered.call(state, lambda whole: recorder.snapshot(whole))
+    except BaseException as exc:  # e.g. a full disk: the records held are written, the file closed
+        if recorder is not None:
+            recorder.close(end_status(exc))
+        raise
     n = d.n_owned
     summary = _base_summary(setup)
     summary.update(
