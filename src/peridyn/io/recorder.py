@@ -38,7 +38,7 @@ from peridyn.discretization.body import Body
 from peridyn.discretization.state import ProbeState, State, check_state, runaway_limit
 from peridyn.errors import InputError
 from peridyn.io.exodus_write import PERIDIGM_VARIABLES, ExodusWriter
-from peridyn.io.hdf5 import HDF5Writer
+from peridyn.io.hdf5 import CHUNK_BYTES, MIN_INDEX_CHUNK, HDF5Writer
 from peridyn.io.outdir import end_status
 from peridyn.io.reserve import Reserve, as_disk_error, ensure_room
 from peridyn.io.series_buffer import SeriesBuffer
@@ -140,19 +140,50 @@ class RecorderSpec:
         """True when anything is recorded at ``step``."""
         return self.series_due(step) or self.whole_due(step)
 
-    def output_bytes(self, n_points: int, n_steps: int) -> float:
-        """Bytes a run of ``n_steps`` steps on ``n_points`` points writes, about: the probe
-        series at every ``every``-th step (step and time, sensors' u and v, PZT signals in
-        float64; lines and planes in ``series_dtype``) and the snapshots (``field_u`` and about
-        as much again in VTU and Exodus files: ``SNAPSHOT_VALUES`` values of 8 bytes a point)."""
+    def output_bytes(self, n_points: int, n_steps: int, dim: int = 3, damage: bool = False) -> float:
+        """Bytes a run of ``n_steps`` steps on ``n_points`` points of dimension ``dim`` (with a
+        ``damage`` field or not) writes, about: results.h5 (the geometry, every series in whole
+        chunks as ``peridyn.io.hdf5`` allocates them, the final u and v), the VTU snapshots
+        (uncompressed: base64 of the points, u, v, damage, stress/strain and the vertex cells,
+        ``VTU_CELL_BYTES`` a point; u and v padded to 3 components, the damage index always) and
+        the Exodus snapshots (tests/simulation/test_run_safety.py compares it with what runs
+        wrote)."""
         item = np.dtype(self.series_dtype).itemsize
-        probe_points = sum(line.points for line in self.lines.values()) + sum(map(len, self.planes.values()))
-        per_record = 8 * (2 + 6 * len(self.sensors) + len(self.pzt_sensors)) + 3 * item * probe_points
-        snapshots = len(self.snapshot_steps) + (n_steps // self.snapshot_every if self.snapshot_every else 0)
-        return (
-            float(n_steps // self.every + 1) * per_record
-            + float(snapshots + 1) * n_points * 8 * SNAPSHOT_VALUES
+        records = float(n_steps // self.every + 1)
+        every = self.snapshot_every
+        extra = {s for s in self.snapshot_steps if 0 < s <= n_steps} | ({n_steps} if n_steps > 0 else set())
+        # step 0, the multiples of snapshot_every, the snapshot steps and the end, each once
+        snapshots = (
+            1.0
+            + float(n_steps // every if every else 0)
+            + sum(1 for s in extra if not (every and s % every == 0))
         )
+        series = [(records, 6 * 8 * len(self.sensors))] * (2 if self.sensors else 0)
+        series += [(records, 3 * item * line.points) for line in self.lines.values()]
+        series += [(records, 3 * item * len(idx)) for idx in self.planes.values()]
+        series += [(records, 8 * len(self.pzt_sensors))] if self.pzt_sensors else []
+        series += [(snapshots, 3 * item * n_points)]
+        h5 = sum(_chunked_bytes(k, b) for k, b in series if b) + n_points * 8.0 * (dim + 1 + 6 + damage)
+        tensors = 72 * (self.stress + self.strain)
+        vtu = snapshots * n_points * (4 / 3) * (3 * 3 * 8 + 8 + tensors + VTU_CELL_BYTES) if self.vtu else 0
+        exodus = snapshots * n_points * 8.0 * (2 * dim + 1 + damage) if self.exodus else 0
+        return float(h5 + vtu + exodus)
+
+
+#: Bytes a point of a VTU snapshot holds besides its fields (before base64): its vertex cell's
+#: connectivity and offset (8 bytes each), type (1 byte) and the arrays' headers: 24 fits the
+#: 138.7 bytes a point measured in the snapshots of the 3D bar and of the 2D plate alike.
+VTU_CELL_BYTES = 24
+
+
+def _chunked_bytes(records: float, record_bytes: int) -> float:
+    """Bytes of a series of ``records`` records of ``record_bytes`` in whole chunks, with its
+    time and step datasets (``peridyn.io.hdf5``'s chunk sizes)."""
+    per_chunk = max(1, CHUNK_BYTES // record_bytes)
+    index = max(per_chunk, MIN_INDEX_CHUNK)
+    return float(
+        np.ceil(records / per_chunk) * per_chunk * record_bytes + 16.0 * np.ceil(records / index) * index
+    )
 
 
 class Recorder:

@@ -178,7 +178,8 @@ def run_case(
         if stepping:
             n_steps = step_count(case, solver)
             check_run_plan(case, solver.dt, n_steps)
-            domain.on_root(check_output_fits, spec, setup.whole_body, n_steps, solver.dt, out)
+            damage = setup.damage is not None
+            domain.on_root(check_output_fits, spec, setup.whole_body, n_steps, solver.dt, out, damage)
         lock = domain.on_root(OutputLock, out)  # one run writes a folder at a time
         if lock is not None:
             held.callback(lock.release)
@@ -266,7 +267,9 @@ def step_count(case: Case, solver) -> int:
     return int(np.ceil(s.time / solver.dt - 1e-9))
 
 
-def check_output_fits(spec: RecorderSpec, body: Body, n_steps: int, dt: float, out: Path) -> None:
+def check_output_fits(
+    spec: RecorderSpec, body: Body, n_steps: int, dt: float, out: Path, damage: bool = False
+) -> None:
     """Refuse a run whose records (``spec.output_bytes``, ``spec`` from ``recorder_spec``) would
     not fit in the free space of the disk of its output folder, before anything is written.
 
@@ -275,7 +278,7 @@ def check_output_fits(spec: RecorderSpec, body: Body, n_steps: int, dt: float, o
     InputError
         Naming the steps, the bytes and the free space.
     """
-    need = spec.output_bytes(body.n_points, n_steps) + RESERVE_BYTES
+    need = spec.output_bytes(body.n_points, n_steps, body.dim, damage) + RESERVE_BYTES
     folder = out.resolve()
     while not folder.exists():
         folder = folder.parent
