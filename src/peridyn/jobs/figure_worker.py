@@ -11,19 +11,13 @@ The worker is started by ``spawn``, which imports the main module of a script an
 that asks ``run_case`` for it must guard its run with ``if __name__ == "__main__":``.
 
 The worker ends with the run, whatever ended the run (a SIGKILL or an out-of-memory kill too,
-which leave the run no chance to shut it down): on Linux the kernel sends it SIGKILL when its
-parent dies (``prctl(PR_SET_PDEATHSIG)``), elsewhere a thread of the worker watches its parent
-and ends it."""
+which leave the run no chance to shut it down; ``peridyn.jobs.children``)."""
 
 from __future__ import annotations
 
-import ctypes
 import multiprocessing
 import os
 import signal
-import sys
-import threading
-import time
 from collections.abc import Iterator
 from concurrent.futures import Future, ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
@@ -34,6 +28,7 @@ import numpy as np
 
 from peridyn.errors import InputError
 from peridyn.io.case import Case
+from peridyn.jobs.children import end_with_parent
 from peridyn.jobs.estimate import grid_shape
 
 #: Grids with fewer points draw their figures in the run's own process: the worker's start (about
@@ -99,39 +94,15 @@ def figures_of(pending: Future | None, draw, *args) -> list:
     return draw(*args)
 
 
-#: Seconds between two looks at the parent by the watching thread (where prctl is missing).
-WATCH_S = 0.5
-
-#: Linux's ``PR_SET_PDEATHSIG`` (``<sys/prctl.h>``).
-PR_SET_PDEATHSIG = 1
-
-
 def _initialise(parent: int) -> None:
     """The worker's start: it ends when its ``parent`` (the run's process id) does; Ctrl-C,
     SIGTERM and SIGHUP are the run's to handle (it stops at a safe point, closes its files and
     shuts the worker down); a lower priority, and the plotting imports done now rather than at
     the first figure."""
-    _end_with(parent)
+    end_with_parent(parent)
     for sig in (signal.SIGINT, signal.SIGHUP):
         signal.signal(sig, signal.SIG_IGN)
     os.nice(NICENESS)
     import peridyn.jobs.figures  # noqa: F401
     import peridyn.plotting.fields  # noqa: F401
     import peridyn.plotting.lamb_wavefield  # noqa: F401
-
-
-def _end_with(parent: int) -> None:
-    """End this process when the process ``parent`` ends."""
-    if sys.platform.startswith("linux"):
-        libc = ctypes.CDLL(None, use_errno=True)
-        if libc.prctl(PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0) == 0:
-            if os.getppid() != parent:  # the parent died before the prctl
-                os._exit(1)
-            return
-
-    def watch():
-        while os.getppid() == parent:
-            time.sleep(WATCH_S)
-        os._exit(1)
-
-    threading.Thread(target=watch, daemon=True, name="parent-watch").start()
