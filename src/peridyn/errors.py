@@ -62,12 +62,12 @@ class InstabilityError(PeridynError, RuntimeError):
 
 
 class Interrupted(PeridynError):
-    """A job stopped by a signal (SIGINT, SIGTERM) at a safe point, its files closed.
+    """A job stopped by a signal (SIGINT, SIGTERM, SIGHUP) at a safe point, its files closed.
 
     Parameters
     ----------
     signal_name : str
-        "SIGINT" or "SIGTERM".
+        "SIGINT", "SIGTERM" or "SIGHUP".
     step : int or None
         The last completed time step of a time-stepping job, else None.
     resume : str
@@ -77,7 +77,7 @@ class Interrupted(PeridynError):
     """
 
     #: exit status of the command line: 128 + the signal number
-    EXIT_CODES = {"SIGINT": 130, "SIGTERM": 143}
+    EXIT_CODES = {"SIGHUP": 129, "SIGINT": 130, "SIGTERM": 143}
 
     def __init__(self, signal_name: str, step: int | None = None, resume: str = "", where: str = ""):
         self.signal_name, self.step, self.resume, self.where = signal_name, step, resume, where

@@ -1,11 +1,14 @@
-"""SIGINT (Ctrl-C) and SIGTERM, acted on at safe points.
+"""SIGINT (Ctrl-C), SIGTERM and SIGHUP (the terminal closed), acted on at safe points.
 
 Python's own SIGINT handler raises ``KeyboardInterrupt`` wherever the interpreter happens to
 be; when that is the launch of a parallel numba kernel the process can die of SIGSEGV
 (measured: tests/unit/cli/test_cli_signals.py). Within :func:`deferred` the two signals are
 only noted, and the code acts on them where stopping is safe by calling :func:`check` (after
 a time step, between the phases of a build, in the iterations of the static, modal and
-fatigue solvers), which raises :class:`peridyn.errors.Interrupted`. A second signal while the
+fatigue solvers), which raises :class:`peridyn.errors.Interrupted`. SIGHUP, sent when the
+terminal or the ssh session of a run goes away, ends it as SIGTERM does: its checkpoint and
+status are written (its messages to the lost terminal are dropped, ``peridyn.cli.streams``).
+A second signal while the
 first is still pending raises ``KeyboardInterrupt`` at once: the user insists.
 
 Outside :func:`deferred`, and outside the main thread (where handlers cannot be set), the
@@ -22,7 +25,7 @@ from contextlib import contextmanager
 from peridyn.errors import Interrupted
 
 #: The signals that end a job at its next safe point.
-STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
+STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
 
 #: Signals noted and not yet acted on (at most one: a second one raises KeyboardInterrupt).
 _pending: list[int] = []
@@ -32,7 +35,7 @@ _depth = 0
 
 @contextmanager
 def deferred() -> Iterator[None]:
-    """Within the block, SIGINT and SIGTERM are noted for :func:`check` instead of acting.
+    """Within the block, the ``STOP_SIGNALS`` are noted for :func:`check` instead of acting.
 
     Re-entrant: the handlers are set by the outermost block and the previous ones come back
     when it ends, with any signal still pending dropped.

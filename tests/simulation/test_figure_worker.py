@@ -83,3 +83,56 @@ def test_no_worker_where_it_cannot_pay(why, monkeypatch):
         monkeypatch.setattr(fw, "MIN_POINTS", 0)
     with fw.figure_worker_for(_case(), ROOT / "cases", wanted=why != "not wanted") as pool:
         assert pool is None
+
+
+#: A run's process that starts its figure worker, prints the worker's pid and is then killed
+#: outright (SIGKILL: no shutdown of the pool runs).
+KILLED_PARENT = """
+import os, signal, sys
+import peridyn.jobs.figure_worker as fw
+from peridyn.io.case import load_case
+
+fw.MIN_POINTS = 0
+fw._threads = lambda: 2
+if __name__ == "__main__":
+    with fw.figure_worker_for(load_case(sys.argv[1], sys.argv[2:])) as pool:
+        print(pool.submit(os.getpid).result(timeout=120), flush=True)
+        os.kill(os.getpid(), signal.SIGKILL)
+"""
+
+
+def _gone(pid: int) -> bool:
+    """True when ``pid`` no longer runs (no such process, or a zombie nobody reaped yet)."""
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except FileNotFoundError:
+        return True
+    return state in ("Z", "X")
+
+
+@pytest.mark.skipif(not Path("/proc").is_dir(), reason="reads process states from /proc")
+def test_the_worker_ends_with_a_killed_run(tmp_path):
+    """A run killed outright left its figure worker (240 MB) alive: it now ends within a second."""
+    import subprocess
+    import sys
+    import time
+
+    script = tmp_path / "killed.py"
+    script.write_text(KILLED_PARENT)
+    env = {**os.environ, "PYTHONPATH": str(ROOT / "src")}
+    proc = subprocess.run(
+        [sys.executable, str(script), str(ROOT / "cases" / "lamb_plate.yaml"), *SMALL_LAMB],
+        capture_output=True,
+        text=True,
+        timeout=180,
+        env=env,
+    )
+    assert proc.returncode == -9, proc.stderr
+    worker = int(proc.stdout.split()[0])
+    deadline = time.monotonic() + 5.0  # PR_SET_PDEATHSIG acts at once; the watching thread in 0.5 s
+    while not _gone(worker) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    gone = _gone(worker)
+    if not gone:
+        os.kill(worker, 9)
+    assert gone

@@ -181,9 +181,10 @@ def test_twenty_random_sigkills_restart_bit_for_bit(references, tmp_path):
         )
 
 
-@pytest.mark.parametrize("signal_name, code", [("SIGINT", 130), ("SIGTERM", 143)])
+@pytest.mark.parametrize("signal_name, code", [("SIGINT", 130), ("SIGTERM", 143), ("SIGHUP", 129)])
 def test_a_signal_ends_the_step_and_the_run_resumes(signal_name, code, references, tmp_path):
-    """SIGINT/SIGTERM: exit 130/143 with one line naming the step and the resume command,
+    """SIGINT/SIGTERM/SIGHUP (SIGHUP killed the run silently, its status left ``running``): exit
+    130/143/129 with one line naming the step and the resume command,
     status ``interrupted at step N``, a checkpoint at that step (even with a checkpoint
     interval longer than the run); the resume command completes the run bit for bit."""
     case, at = "plate2d_precrack_pull", 77

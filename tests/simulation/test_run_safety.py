@@ -5,6 +5,7 @@ another run, every job records its status, and an unstable run stops before writ
 import hashlib
 import re
 import signal
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -13,13 +14,15 @@ import yaml
 from peridyn.cli import main
 from peridyn.discretization.state import State, check_state
 from peridyn.errors import InputError, InstabilityError, Interrupted
-from peridyn.io.case import validate_case
+from peridyn.io.case import load_case, validate_case
 from peridyn.io.outdir import json_job_status, read_status
 from peridyn.io.results import Results
 from peridyn.jobs.build import build
 from peridyn.jobs.run import run_case
 from peridyn.solvers import ExplicitSolver
 from peridyn.solvers.stepping import advance
+
+ROOT = Path(__file__).resolve().parents[2]
 
 BAR = {
     "name": "bar",
@@ -210,13 +213,98 @@ def test_a_run_whose_results_cannot_fit_on_the_disk_is_refused_before_writing(tm
     assert not out.exists()
 
 
-def test_the_output_estimate_counts_every_record():
-    """``RecorderSpec.output_bytes``: 40 steps recorded every 2 (21 records of step, time and the
-    sensor's u and v: 8 x (2 + 6) bytes) and 4 + 1 snapshots of 21 values of 8 bytes a point."""
-    from peridyn.jobs.run import recorder_spec
+@pytest.mark.parametrize(
+    "case_of",
+    [
+        lambda: _case(),
+        lambda: _case(output={"every": 1, "snapshot_every": 5, "snapshot_times": [3.3e-6, 1.0]}),
+        lambda: load_case(
+            ROOT / "cases" / "plate2d_precrack_pull.yaml",
+            ["discretization.spacing=1e-3", "solver.time=null", "solver.steps=60", "output.plots=false"],
+        ),
+    ],
+    ids=["bar", "bar every step", "plate2d"],
+)
+def test_the_output_estimate_is_within_30_percent_of_what_a_run_writes(case_of, tmp_path):
+    """The disk guard estimated 2.0 MB for a run that wrote 6.9 MB: ``RecorderSpec.output_bytes``
+    now counts every series in whole chunks, the geometry and final fields, the VTU snapshots
+    as written (base64, 3 components) and snapshot times after the end as none. Measured
+    0.77-0.93 of the bytes written for the bar and the 2D plate at two spacings each."""
+    from peridyn.jobs.run import recorder_spec, step_count, time_stepper
 
-    case = _case()
-    setup = build(case)
-    spec = recorder_spec(case, setup.body, 1e-7)
-    n = setup.body.n_points
-    assert spec.output_bytes(n, 40) == 21 * 8 * 8 + 5 * n * 8 * 21
+    case = case_of()
+    setup = build(case, ROOT / "cases")
+    solver = time_stepper(case, setup)
+    n_steps = step_count(case, solver)
+    body = setup.whole_body
+    estimate = recorder_spec(case, body, solver.dt).output_bytes(
+        body.n_points, n_steps, body.dim, setup.damage is not None
+    )
+    run_case(case, tmp_path, base_dir=ROOT / "cases")
+    written = sum(p.stat().st_size for p in tmp_path.rglob("*") if p.is_file())
+    assert 0.7 * written <= estimate <= 1.3 * written, (estimate, written)
+
+
+def _flip(path, dataset: str, index: int) -> None:
+    """Invert one stored byte of ``dataset`` (a contiguous dataset of a checkpoint)."""
+    import h5py
+
+    with h5py.File(path, "r") as f:
+        offset = f[dataset].id.get_offset()
+    with open(path, "r+b") as f:
+        f.seek(offset + index)
+        byte = f.read(1)[0]
+        f.seek(offset + index)
+        f.write(bytes([byte ^ 0xFF]))
+
+
+@pytest.fixture
+def interrupted(tmp_path):
+    """A finished 20-step run with its checkpoint at step 20, which a 60-step run continues."""
+    run_case(_case(solver={"steps": 20}), tmp_path, checkpoint_every=20)
+    return tmp_path
+
+
+def test_a_restart_from_a_corrupted_checkpoint_is_refused(interrupted):
+    """A checkpoint with flipped bytes was restarted from (exit 0, displacements 47x the true
+    ones): now refused, naming the dataset, and nothing of the earlier run changes."""
+    _flip(interrupted / "checkpoint.h5", "u", 11)
+    before = _digests(interrupted)
+    with pytest.raises(InputError, match="dataset /u does not match its checksum"):
+        run_case(_case(solver={"steps": 60}), interrupted, restart=True)
+    assert _digests(interrupted) == before
+
+
+def test_a_restart_without_its_results_file_is_refused(interrupted):
+    """--restart after results.h5 was deleted gave status complete with 3 of 154 sensor records."""
+    (interrupted / "results.h5").unlink()
+    with pytest.raises(
+        InputError, match="results.h5' is missing: the records before the checkpoint's step 20"
+    ):
+        run_case(_case(solver={"steps": 60}), interrupted, restart=True)
+    assert not (interrupted / "results.h5").exists()
+
+
+def test_a_restart_with_another_runs_results_is_refused(interrupted, tmp_path_factory):
+    other = tmp_path_factory.mktemp("other")
+    run_case(_case(solver={"steps": 20}), other)
+    (other / "results.h5").replace(interrupted / "results.h5")
+    with pytest.raises(InputError, match="written by another run than the checkpoint"):
+        run_case(_case(solver={"steps": 60}), interrupted, restart=True)
+
+
+def test_a_folder_in_use_is_refused_and_overwrite_removes_the_earlier_files(tmp_path):
+    """Two runs into one folder mixed their snapshots and lost the first's results; --overwrite
+    left the earlier run's snapshots beside the new ones."""
+    from peridyn.io.lock import LOCK_FILE, OutputLock
+
+    run_case(_case(), tmp_path)  # snapshots at steps 0, 10, 20, 30, 40
+    before = _digests(tmp_path)
+    with OutputLock(tmp_path):  # another run writing the folder
+        with pytest.raises(InputError, match=r"in use by another run \(process \d+ on "):
+            run_case(_case(output={"snapshot_every": 20}), tmp_path, overwrite=True)
+        assert {p: d for p, d in _digests(tmp_path).items() if p.name != LOCK_FILE} == before
+    run_case(_case(output={"snapshot_every": 20}), tmp_path, overwrite=True)
+    names = sorted(p.name for p in (tmp_path / "snapshots").iterdir())
+    assert names == ["step_00000000.vtu", "step_00000020.vtu", "step_00000040.vtu"]
+    assert not (tmp_path / LOCK_FILE).exists()

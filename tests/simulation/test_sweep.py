@@ -114,6 +114,61 @@ def test_a_failing_run_is_recorded_and_the_sweep_goes_on(tmp_path):
     assert "InputError" in ds["error"].values[1] and np.isnan(ds["dt_s"].values[1])
 
 
+def test_a_sweep_with_failed_runs_exits_non_zero_listing_each(tmp_path, capsys):
+    """A sweep with a failed run exited 0: now 1, one line naming the failed run and why, and
+    with --json the sweep's summary (its failed runs listed) is still the JSON on stdout."""
+    from peridyn.cli import main
+
+    path = tiny_sweep(tmp_path, {"product": {"solver.dt": [1e-7, 1e-5]}})  # 1e-5 s: above the stable step
+    assert main(["sweep", str(path), "-o", str(tmp_path / "out"), "--json", "--no-progress"]) == 1
+    captured = capsys.readouterr()
+    summary = json.loads(captured.out)
+    (failed,) = summary["failed_runs"]
+    assert failed["status"].startswith("failed: time step 1e-05 s exceeds the stable step")
+    line = captured.err.strip().splitlines()[-1]
+    assert line.startswith(f"peridyn sweep: error: 1 of 2 runs failed ({failed['run_id']}: failed: time step")
+    assert summary["error"] == line.split("error: ", 1)[1] and summary["completed"] == 1
+
+
+#: A sweep's process that starts its pool as ``_run_processes`` does, prints a worker's pid
+#: and is then killed outright (SIGKILL: no shutdown of the pool runs).
+KILLED_SWEEP = """
+import multiprocessing, os, signal
+from concurrent.futures import ProcessPoolExecutor
+from peridyn.jobs.sweep_run import _quiet_worker
+
+if __name__ == "__main__":
+    pool = ProcessPoolExecutor(
+        1, mp_context=multiprocessing.get_context("spawn"), initializer=_quiet_worker, initargs=(os.getpid(),)
+    )
+    print(pool.submit(os.getpid).result(timeout=120), flush=True)
+    os.kill(os.getpid(), signal.SIGKILL)
+"""
+
+
+@pytest.mark.skipif(not Path("/proc").is_dir(), reason="reads process states from /proc")
+def test_sweep_workers_end_with_a_killed_sweep(tmp_path):
+    """A killed sweep left its pool workers running: they now end with it."""
+    script = tmp_path / "killed.py"
+    script.write_text(KILLED_SWEEP)
+    env = {**os.environ, "PYTHONPATH": str(ROOT / "src")}
+    proc = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=180, env=env)
+    assert proc.returncode == -9, proc.stderr
+    worker = int(proc.stdout.split()[0])
+    deadline = time.monotonic() + 5.0  # PR_SET_PDEATHSIG acts at once; the watching thread in 0.5 s
+    while not _gone(worker) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert _gone(worker)
+
+
+def _gone(pid: int) -> bool:
+    """True when ``pid`` no longer runs (no such process, or a zombie nobody reaped yet)."""
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] in ("Z", "X")
+    except FileNotFoundError:
+        return True
+
+
 def test_a_killed_worker_is_replaced_and_its_run_done(tmp_path, monkeypatch):
     marker = tmp_path / "crashed"
     monkeypatch.setenv(CRASH_ONCE_ENV, str(marker))  # the first run to start kills its worker

@@ -171,3 +171,133 @@ def test_stable_step_estimate_against_the_model(changes):
         assert est == pytest.approx(real, rel=1e-9)
     else:
         assert 0.85 * real <= est <= (1 + STEP_MARGIN) * real
+
+
+# --- what a run accepted without a word: each now a warning or an error (docs/user-guide.md,
+# "Warnings and errors before a run") ---------------------------------------------------------
+
+
+def _plan(**changes):
+    from peridyn.jobs.run_checks import check_run_plan
+
+    case = validate_case(_raw(**changes))
+    return lambda dt, steps: check_run_plan(case, dt, steps)
+
+
+def test_an_excitation_above_the_steps_nyquist_frequency_is_refused():
+    """A 10 MHz sine sampled every 0.1 us (Nyquist 5 MHz) is aliased to another frequency."""
+    plan = _plan(**{"boundary_conditions.0.value": "{type: sine, frequency: 1.0e7, amplitude: 1.0}"})
+    with pytest.raises(
+        CaseFileError, match=r"boundary_conditions\[0\].value.frequency = 10000000.0: .* 5e\+06 Hz"
+    ):
+        plan(1e-7, 100)
+    plan(1e-8, 100)  # Nyquist 50 MHz: accepted
+
+
+@pytest.mark.parametrize(
+    "changes, dt, steps, message",
+    [
+        (
+            {"solver.steps": "null", "solver.time": "1e-9"},
+            1e-7,
+            1,
+            r"solver.time = 1e-09 s is shorter than one",
+        ),
+        ({"output.snapshot_times": "[1.0e-6, 5.0e-5]"}, 1e-7, 100, r"snapshot_times \[5e-05\] come after"),
+        ({"output.every": "500"}, 1e-7, 100, r"output.every = 500 steps is longer than the run's 100"),
+    ],
+)
+def test_what_a_run_would_lose_is_warned_of(changes, dt, steps, message):
+    with pytest.warns(UserWarning, match=message):
+        _plan(**changes)(dt, steps)
+
+
+def test_a_plain_run_plan_gives_no_warning(recwarn):
+    _plan(**{"output.snapshot_times": "[1.0e-6]", "output.every": "10"})(1e-7, 100)
+    assert not recwarn.list
+
+
+def test_a_zero_length_line_probe_is_refused():
+    line = "{axis: {start: [0.01, 0.003, 0.003], end: [0.01, 0.003, 0.003], points: 5}}"
+    with pytest.raises(CaseFileError, match=r"output.lines.axis.*same point .* a line probe needs a length"):
+        validate_case(_raw(**{"output.lines": line}))
+
+
+def test_a_precrack_outside_the_body_is_refused():
+    crack = (
+        "[{type: rectangle, origin: [0.5, 0.0, 0.0], edge_u: [0.0, 0.006, 0.0], edge_v: [0.0, 0.0, 0.006]}]"
+    )
+    case = validate_case(_raw(precracks=crack))
+    with pytest.raises(
+        CaseFileError, match=r"precracks\[0\] = .*it lies 0.44\d* m outside and would cut no bond"
+    ):
+        check_placements(case, build_body(case))
+    inside = (
+        "[{type: rectangle, origin: [0.03, 0.0, 0.0], edge_u: [0.0, 0.006, 0.0], edge_v: [0.0, 0.0, 0.006]}]"
+    )
+    case = validate_case(_raw(precracks=inside))
+    check_placements(case, build_body(case))  # a crack through the bar: accepted
+
+
+def test_duplicate_mesh_points_are_refused():
+    import numpy as np
+
+    from peridyn.errors import InputError
+    from peridyn.jobs.build import check_distinct_points
+
+    points = np.array([[0.0, 0, 0], [1e-3, 0, 0], [2e-3, 0, 0], [1e-3, 0, 0]])
+    with pytest.raises(InputError, match=r"mesh.txt: points 1 and 3 are at the same place"):
+        check_distinct_points(points, "mesh.txt")
+    check_distinct_points(points[:3], "mesh.txt")
+
+
+@pytest.mark.parametrize("modes", [3, 6])
+def test_modes_not_above_the_rigid_modes_are_refused(tmp_path, capsys, modes):
+    """A free 3D bar has 6 rigid-body modes: --modes 6 finds no vibration mode."""
+    free = _file(tmp_path, **{"solver": "{type: modal, modes: 20}", "boundary_conditions": "[]"})
+    assert main(["validate", free, "--set", f"solver.modes={modes}"]) == 1
+    assert "solver.modes = " + str(modes) + ": more than the 6 rigid-body modes of a free 3D body" in (
+        capsys.readouterr().err
+    )
+    assert main(["validate", free, "--set", "solver.modes=7"]) == 0
+
+
+def test_a_paris_fit_of_identical_points_is_refused():
+    from peridyn.errors import InputError
+    from peridyn.fatigue.calibration import paris_fit
+
+    with pytest.raises(InputError, match=r"two or more different dK: all 3 are at dK = 2e\+06"):
+        paris_fit([2e6, 2e6, 2e6], [1e-8, 2e-8, 3e-8])
+    with pytest.raises(InputError, match=r"point 1 has dK = -1"):
+        paris_fit([2e6, -1.0], [1e-8, 2e-8])
+    m, c = paris_fit([1e6, 2e6, 4e6], [1e-9, 8e-9, 64e-9])  # da/dN = c dK^3
+    assert m == pytest.approx(3.0, rel=1e-12) and c == pytest.approx(1e-27, rel=1e-9)
+
+
+@pytest.mark.parametrize("name", ["..", ".", "../escape", "a/b", "a\\b", ""])
+def test_a_case_name_must_be_a_folder_name(name):
+    """A case named ``..`` wrote its results outside peridyn-out."""
+    raw = _raw()
+    raw["name"] = name
+    with pytest.raises(CaseFileError, match=r"name = .*a folder name"):
+        validate_case(raw)
+
+
+def test_validate_refuses_what_run_refuses(tmp_path, capsys):
+    """A PMB material with the case's nu = 0.3 was valid for validate and refused by run."""
+    path = _file(tmp_path, **{"material.model": "pmb"})
+    assert main(["validate", path]) == 1
+    assert "material.nu = 0.3: a bond-based PMB material has Poisson ratio 0.25" in capsys.readouterr().err
+
+
+def test_convert_does_not_overwrite_a_file(tmp_path, capsys):
+    from pathlib import Path
+
+    deck = Path(__file__).resolve().parents[1] / "data" / "decks" / "bimaterial_bar.xml"
+    target = tmp_path / "case.yaml"
+    target.write_text("mine\n")
+    assert main(["convert", str(deck), "-o", str(target)]) == 1
+    assert "exists: pass --overwrite to replace it" in capsys.readouterr().err
+    assert target.read_text() == "mine\n"
+    assert main(["convert", str(deck), "-o", str(target), "--overwrite"]) == 0
+    assert target.read_text() != "mine\n"

@@ -6,7 +6,8 @@ function ``func(args) -> dict``. The returned dict is the machine-readable
 summary: printed as one JSON object on stdout with ``--json``; otherwise the
 command prints its own human-readable report (to stdout) and logs go to stderr.
 A failure is one line on stderr (and one JSON object on stdout with ``--json``):
-see :mod:`peridyn.cli.errors`.
+see :mod:`peridyn.cli.errors`. A closed or broken stdout or stderr never ends a command in a
+traceback (:mod:`peridyn.cli.streams`).
 """
 
 from __future__ import annotations
@@ -19,6 +20,7 @@ import time
 
 from peridyn.cli.errors import ArgumentParser, report, writing
 from peridyn.cli.logs import configure_logging, plain_warnings
+from peridyn.cli.streams import usable_streams
 from peridyn.errors import InputError
 
 #: Subcommand modules, in the order ``peridyn --help`` lists them.
@@ -69,7 +71,7 @@ def main(argv: list[str] | None = None) -> int:
     _quiet_unless_first_rank()
     configure_logging()
     args = None
-    with plain_warnings():
+    with plain_warnings(), usable_streams():
         try:
             parser = build_parser()
             args = _parse(parser, argv)

@@ -35,5 +35,6 @@ def run(args) -> dict:
             progress=args.progress,
             overwrite=args.overwrite,
             json=args.json,
+            command_line="",  # the demo cannot be restarted: no --restart hint
         )
         return run_cmd.run(ns)

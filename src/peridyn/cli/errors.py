@@ -3,7 +3,7 @@ on stdout, and an exit status; the traceback only with ``--debug``.
 
 Exit statuses: 1 for an error in the input or the run (a ``PeridynError``, an I/O failure, no
 memory left), 2 for a command line that argparse refuses and for an internal error (a bug),
-130 (SIGINT) or 143 (SIGTERM) for an interrupted run.
+129 (SIGHUP), 130 (SIGINT) or 143 (SIGTERM) for an interrupted run.
 """
 
 from __future__ import annotations
@@ -102,12 +102,12 @@ def report(exc: BaseException, prog: str, as_json: bool, debug: bool) -> int:
     JSON object on stdout, with ``debug`` after its traceback; returns the exit status."""
     if debug:
         traceback.print_exception(exc, file=sys.stderr)
-    message, status = describe(exc)
+    message, status = describe(exc, prog)
     line = one_line(message)
     label = "" if status in INTERRUPTED_STATUSES else "error: "
     print(f"{prog}: {label}{line}", file=sys.stderr)
     if as_json:
-        fields = {"error": line}
+        fields = {**getattr(exc, "summary", {}), "error": line}  # a job's summary, when it has one
         fields.update(
             {k: _jsonable(getattr(exc, k)) for k in JSON_FIELDS if getattr(exc, k, None) is not None}
         )
@@ -131,8 +131,13 @@ def _jsonable(value):
     return value
 
 
-def describe(exc: BaseException) -> tuple[str, int]:
-    """The message of ``exc`` for the user and the exit status."""
+#: The commands that discretize a body: an out-of-memory error there suggests a coarser spacing.
+SPACING_COMMANDS = ("run", "demo", "modal", "fatigue", "study", "sweep", "validate", "bench")
+
+
+def describe(exc: BaseException, prog: str = "") -> tuple[str, int]:
+    """The message of ``exc`` for the user and the exit status (``prog``: the command, e.g.
+    ``"peridyn lamb"``, whose advice an out-of-memory error gives)."""
     if isinstance(exc, PeridynError):
         return str(exc), getattr(exc, "exit_code", 1)
     cause = _underlying(exc)
@@ -140,7 +145,13 @@ def describe(exc: BaseException) -> tuple[str, int]:
         return "interrupted", KEYBOARD_INTERRUPT_STATUS
     if isinstance(cause, MemoryError):
         detail = f" ({cause})" if str(cause) else ""
-        return f"out of memory{detail}: try a coarser discretization.spacing or a smaller body", 1
+        command = prog.split()[1] if len(prog.split()) > 1 else ""
+        advice = (
+            "try a coarser discretization.spacing or a smaller body"
+            if command in SPACING_COMMANDS
+            else "ask for less (fewer or lower frequencies, fewer points)"
+        )
+        return f"out of memory{detail}: {advice}", 1
     if isinstance(exc, OSError):
         return os_error_message(exc), 1
     return (

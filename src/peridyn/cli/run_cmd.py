@@ -54,9 +54,13 @@ def register(sub) -> None:
     p.set_defaults(func=run)
 
 
-def command_line() -> str:
-    """This process's ``peridyn ...`` command line (without --overwrite), for resume hints."""
-    return shlex.join(["peridyn", *(a for a in sys.argv[1:] if a != "--overwrite")])
+def command_line(argv=None) -> str:
+    """This process's ``peridyn ...`` command line (without --overwrite), for resume hints;
+    under ``mpiexec -n N`` (N > 1) with its launcher, ``mpiexec -n N peridyn ...``, so that the
+    hint resumes on as many ranks."""
+    args = sys.argv[1:] if argv is None else argv
+    launcher = ["mpiexec", "-n", str(world().size)] if world().size > 1 else []
+    return shlex.join([*launcher, "peridyn", *(a for a in args if a != "--overwrite")])
 
 
 def run(args) -> dict:
@@ -83,7 +87,7 @@ def run(args) -> dict:
         progress=progress_bar(args.progress, case.name),
         base_dir=Path(args.case).parent,
         overwrite=args.overwrite,
-        command=command_line(),
+        command=args.command_line if hasattr(args, "command_line") else command_line(),  # demo: ""
         comm=world(),
         figure_worker=True,
     )

@@ -13,6 +13,7 @@ from peridyn.cli.options import (
     positive_int,
 )
 from peridyn.cli.run_cmd import command_line
+from peridyn.errors import PeridynError
 
 
 def register(sub) -> None:
@@ -56,7 +57,21 @@ def run(args) -> dict:
         print(f"dataset: {summary['dataset']}")
         for path in summary["figures"]:
             print(f"  plot: {path}")
+    if summary["failed_runs"]:
+        raise RunsFailed(summary)
     return summary
+
+
+class RunsFailed(PeridynError):
+    """A sweep that finished with failed runs: exit status 1, one line listing each failed run
+    and why; with ``--json`` the sweep's summary is still the JSON object on stdout (``summary``,
+    with the ``error``)."""
+
+    def __init__(self, summary: dict):
+        self.summary = summary
+        runs = summary["failed_runs"]
+        listed = "; ".join(f"{r['run_id']}: {r['status']}" for r in runs)
+        super().__init__(f"{len(runs)} of {summary['runs']} runs failed ({listed})")
 
 
 def _runs(factory):

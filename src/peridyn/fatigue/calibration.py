@@ -93,11 +93,32 @@ def growth_rates(cycles, crack_length) -> tuple[np.ndarray, np.ndarray]:
 
 
 def paris_fit(delta_k, rate) -> tuple[float, float]:
-    """Paris law da/dN = c dK^M fitted in log-log; returns (M, c)."""
+    """Paris law da/dN = c dK^M fitted in log-log; returns (M, c).
+
+    Raises
+    ------
+    InputError
+        Fewer than two rates, a dK or rate not positive and finite, or every dK the same (a
+        line through points at one abscissa has no slope: a fit gave an exponent of -0.571).
+    """
     dk = np.asarray(delta_k, dtype=float)
     r = np.asarray(rate, dtype=float)
     if dk.size < 2:
         raise InputError("a Paris fit needs at least two crack growth rates")
+    if dk.shape != r.shape:
+        raise InputError(f"a Paris fit needs one rate per dK, got {dk.size} dK and {r.size} rates")
+    bad = ~(np.isfinite(dk) & np.isfinite(r) & (dk > 0) & (r > 0))
+    if bad.any():
+        i = int(np.flatnonzero(bad)[0])
+        raise InputError(
+            f"a Paris fit needs positive, finite dK and rates: point {i} has dK = {dk[i]:.4g}, "
+            f"rate {r[i]:.4g}"
+        )
+    if np.ptp(np.log(dk)) <= 1e-12 * max(1.0, float(np.abs(np.log(dk)).max())):
+        raise InputError(
+            f"a Paris fit needs crack growth rates at two or more different dK: all {dk.size} are "
+            f"at dK = {dk[0]:.6g} Pa m^0.5"
+        )
     slope, intercept, _ = _line_fit(np.log(dk), np.log(r))
     return slope, float(np.exp(intercept))
 

@@ -14,11 +14,20 @@ from typing import Annotated, Literal
 
 import numpy as np
 import yaml
-from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, ValidationError, model_validator
+from pydantic import (
+    AfterValidator,
+    BaseModel,
+    BeforeValidator,
+    ConfigDict,
+    Field,
+    ValidationError,
+    model_validator,
+)
 
 from peridyn.discretization.bonds import horizon_metres
 from peridyn.errors import CaseFileError, InputError, did_you_mean
 from peridyn.io.exodus_write import PERIDIGM_VARIABLES
+from peridyn.io.text_file import read_input_text
 from peridyn.physics.loads import parse_components
 
 #: Deepest nesting of collections a YAML text may have (a case nests 5 levels; PyYAML composes
@@ -165,6 +174,18 @@ def _not_a_bool(value):
 
 
 NotBool = BeforeValidator(_not_a_bool)
+
+
+def _folder_name(name: str) -> str:
+    """Refuse a case name that is not one folder name (it names the run's output folder)."""
+    if not name.strip() or name in (".", "..") or any(c in name for c in "/\\\0"):
+        raise ValueError(
+            f"a folder name (the output folder is peridyn-out/<name>): not empty, '.' or '..', "
+            f"without '/', '\\' or NUL, got {name!r}"
+        )
+    return name
+
+
 Positive = Annotated[float, NotBool, Field(gt=0, allow_inf_nan=False)]
 NonNegative = Annotated[float, NotBool, Field(ge=0, allow_inf_nan=False)]
 Finite = Annotated[float, NotBool, Field(allow_inf_nan=False)]
@@ -702,6 +723,12 @@ class LineSpec(Strict):
     end: Vector3 = described(..., "last end of the line", "m")
     points: Annotated[int, NotBool, Field(ge=2)] = described(..., "sample points along the line")
 
+    @model_validator(mode="after")
+    def _length(self):
+        if len(self.start) == len(self.end) and self.start == self.end:
+            raise ValueError(f"start and end are the same point {self.start}: a line probe needs a length")
+        return self
+
 
 class SetSum(Strict):
     """A global output variable: the sum (``calculation``: or the largest or smallest value,
@@ -825,9 +852,12 @@ class ContactSpec(Strict):
 
 
 class Case(Strict):
-    """A whole simulation case."""
+    """A whole simulation case. ``name`` is a folder name (the default output folder is
+    ``peridyn-out/<name>``): not empty, not ``.`` or ``..``, without a path separator or NUL."""
 
-    name: str = described(..., "name of the case (the default output folder peridyn-out/<name>)")
+    name: Annotated[str, AfterValidator(_folder_name)] = described(
+        ..., "name of the case (the default output folder peridyn-out/<name>)"
+    )
     description: str = described("", "one line saying what the case is")
     geometry: Geometry = described(..., "the body's shape")
     discretization: Discretization = described(..., "grid spacing, horizon and bond options")
@@ -993,14 +1023,9 @@ def load_case(path, overrides=()) -> Case:
         Applied before validation; values are parsed as YAML (``1e-3``, ``true``, ``[1, 2]``).
     """
     path = Path(path)
-    if not path.is_file():
-        raise CaseFileError(str(path), "<file>", None, "an existing YAML case file")
+    text = read_input_text(path, "YAML case file")
     try:
-        raw = parse_yaml(path.read_text(encoding="utf-8"))
-    except UnicodeDecodeError as exc:
-        raise CaseFileError(
-            str(path), "<file>", None, f"UTF-8 text (byte {exc.start} is {exc.object[exc.start]:#04x})"
-        ) from None
+        raw = parse_yaml(text)
     except yaml.YAMLError as exc:
         raise CaseFileError(str(path), "<file>", None, f"valid YAML ({yaml_problem(exc)})") from None
     if not isinstance(raw, dict):

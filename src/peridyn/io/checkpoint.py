@@ -7,6 +7,13 @@ damage model's stretch-test skin, the contact neighbour list, the crack-length s
 each a dict of arrays and numbers given by the part's ``checkpoint_state()`` and given back
 to its ``restore_state(saved)``. It is written to a temporary file and renamed, so a run
 killed while writing leaves the previous checkpoint intact.
+
+Every dataset carries its CRC-32 and the attributes their own (``peridyn.io.integrity``); a
+checkpoint that does not match them is refused, naming what differs. A checkpoint also names
+the results file it belongs to (``results``: the run id of ``results.h5`` and how many records
+each series held when it was saved), and a restart whose ``results.h5`` is missing, another
+run's, or short of those records is refused: continuing it would leave a results file with
+records missing.
 """
 
 from __future__ import annotations
@@ -20,47 +27,74 @@ import numpy as np
 
 from peridyn.discretization.state import State
 from peridyn.errors import InputError
+from peridyn.io import integrity
+from peridyn.io.results import Results
 
 #: What ``meta`` holds, with its name in the refusal message (``case``, the case as JSON
 #: text, names the case entries that differ when ``case_hash`` does).
 META_KEYS = {"case_hash": "case", "dt": "time step (s)", "version": "peridyn version"}
 
+#: The root attributes of a checkpoint, guarded by the checksum in ``ATTRS_CRC``.
+SAVED_ATTRS = ("time", "step", *META_KEYS, "case", "results")
+#: Root attribute: CRC-32 of ``SAVED_ATTRS``.
+ATTRS_CRC = "attrs_crc32"
 
-def save_checkpoint(path, state: State, intact: np.ndarray, meta: dict, parts: dict | None = None) -> None:
-    """Write ``state``, the bonds' ``intact`` mask, ``meta`` (``META_KEYS`` and ``case``) and the ``parts``
-    (name -> object with ``checkpoint_state()``) to ``path`` atomically."""
+
+def save_checkpoint(
+    path, state: State, intact: np.ndarray, meta: dict, parts: dict | None = None, results: dict | None = None
+) -> None:
+    """Write ``state``, the bonds' ``intact`` mask, ``meta`` (``META_KEYS`` and ``case``), the ``parts``
+    (name -> object with ``checkpoint_state()``) and ``results`` (``{"run_id": ..., "records":
+    {series: count}}`` of the run's results file, ``HDF5Writer.identity``; None: a run without
+    one) to ``path`` atomically, every dataset with its checksum."""
     path = Path(path)
     tmp = path.with_suffix(path.suffix + ".tmp")
     with h5py.File(tmp, "w") as f:
         for name in ("u", "v", "a"):
-            f.create_dataset(name, data=getattr(state, name))
-        f.create_dataset("intact", data=intact)
+            _write(f, name, getattr(state, name))
+        _write(f, "intact", intact)
         f.attrs["time"] = state.time
         f.attrs["step"] = state.step
         for key in (*META_KEYS, "case"):
             f.attrs[key] = meta[key]
+        f.attrs["results"] = json.dumps(results)
         for name, part in (parts or {}).items():
             group = f.create_group(f"parts/{name}")
             for key, value in part.checkpoint_state().items():
-                group.create_dataset(key, data=value)
+                _write(group, key, value)
+        f.attrs[ATTRS_CRC] = np.uint32(integrity.attrs_crc(f.attrs, SAVED_ATTRS))
+        integrity.mark_file(f)
     os.replace(tmp, path)
 
 
-def load_checkpoint(path, n_points: int, n_bonds: int, meta: dict) -> tuple[State, np.ndarray, dict]:
+def _write(group: h5py.Group, name: str, value) -> None:
+    """A dataset with its checksum."""
+    value = np.asarray(value)
+    integrity.stamp_whole(group.create_dataset(name, data=value), value)
+
+
+def load_checkpoint(
+    path, n_points: int, n_bonds: int, meta: dict, results_path=None
+) -> tuple[State, np.ndarray, dict]:
     """Read a checkpoint made for this run: returns the state, the intact mask and the saved
-    parts (name -> dict for ``restore_state``).
+    parts (name -> dict for ``restore_state``). With ``results_path``, the run's results file
+    must be the one the checkpoint was saved with (``check_results``).
 
     Raises
     ------
     InputError
-        No checkpoint, or one made for another body, case, time step or peridyn version
-        (the message names what differs).
+        No checkpoint, a corrupted one (naming the dataset or the attributes that do not match
+        their checksum), one made for another body, case, time step or peridyn version (the
+        message names what differs), or a results file that does not belong to it.
     """
     path = Path(path)
     if not path.is_file():
         raise InputError(f"checkpoint file {str(path)!r} does not exist: nothing to restart from")
     try:
         with h5py.File(path, "r") as f:
+            _verify(f, str(path))
+            saved_results = f.attrs.get("results")
+            results = json.loads(_text(saved_results)) if saved_results is not None else None
             state = State(f["u"][...], f["v"][...], f["a"][...], float(f.attrs["time"]), int(f.attrs["step"]))
             intact = f["intact"][...]
             saved = {key: f.attrs.get(key) for key in (*META_KEYS, "case")}
@@ -88,7 +122,55 @@ def load_checkpoint(path, n_points: int, n_bonds: int, meta: dict) -> tuple[Stat
             f"checkpoint {str(path)!r} was made for another run ({'; '.join(differ)}): restart only "
             "with the case and settings that made it, or start again with --overwrite"
         )
+    if results_path is not None:
+        check_results(results_path, state.step, results)
     return state, intact, parts
+
+
+def _verify(f: h5py.File, path: str) -> None:
+    """Check a checkpoint's datasets and attributes against their checksums."""
+    if not integrity.is_marked(f):
+        raise InputError(
+            f"checkpoint {path!r} has no checksums (made by an older peridyn, or damaged): "
+            "start again with --overwrite"
+        )
+    if int(f.attrs.get(ATTRS_CRC, -1)) != integrity.attrs_crc(f.attrs, SAVED_ATTRS):
+        raise InputError(
+            f"{path}: the checkpoint's attributes (time, step, case) do not match their checksum: "
+            "the file is corrupted; it is not used (start again with --overwrite)"
+        )
+    try:
+        integrity.verify_file(f, path)
+    except InputError as exc:
+        raise InputError(f"{exc} (start again with --overwrite)") from None
+
+
+def check_results(results_path, step: int, saved: dict | None) -> None:
+    """Refuse to continue a checkpoint at ``step`` whose results file (``saved``: its run id and
+    record counts when the checkpoint was saved) is missing, another run's, corrupted, or holds
+    another number of records up to ``step``."""
+    if saved is None:
+        return
+    path = Path(results_path)
+    again = "start again with --overwrite"
+    if not path.is_file():
+        raise InputError(
+            f"--restart: {str(path)!r} is missing: the records before the checkpoint's step {step} "
+            f"would be lost; {again}"
+        )
+    results = Results(path)
+    if results.run_id() != saved["run_id"]:
+        raise InputError(
+            f"--restart: {str(path)!r} was written by another run than the checkpoint (run id "
+            f"{results.run_id()} there, {saved['run_id']} in the checkpoint); {again}"
+        )
+    for name, count in saved["records"].items():
+        held = int(np.count_nonzero(results.steps(name) <= step)) if name in results.series_names() else 0
+        if held != count:
+            raise InputError(
+                f"--restart: {str(path)!r} holds {held} records of series {name!r} up to step {step}, "
+                f"the checkpoint was saved with {count}; {again}"
+            )
 
 
 def _case_differences(saved, current: str) -> str:
@@ -142,10 +224,20 @@ class Checkpointer:
     before_save : sequence of callables () -> None
         Called before every save, e.g. ``Recorder.flush``: the records held in memory up to the
         checkpoint's step are on disk before the checkpoint is.
+    results : callable () -> dict, or None
+        The identity of the run's results file after ``before_save`` (``HDF5Writer.identity``),
+        saved with the checkpoint and checked on restart.
     """
 
     def __init__(
-        self, path, every: int, intact: np.ndarray, meta: dict, parts: dict | None = None, before_save=()
+        self,
+        path,
+        every: int,
+        intact: np.ndarray,
+        meta: dict,
+        parts: dict | None = None,
+        before_save=(),
+        results=None,
     ):
         if every < 1:
             raise InputError(f"checkpoint interval must be at least 1 step, got {every}")
@@ -155,6 +247,7 @@ class Checkpointer:
         self.meta = meta
         self.parts = parts or {}
         self.before_save = list(before_save)
+        self.results = results
 
     def due(self, step: int) -> bool:
         """True when a checkpoint is saved at ``step``."""
@@ -169,4 +262,5 @@ class Checkpointer:
         """Save a checkpoint of ``state`` now (after the ``before_save`` calls)."""
         for call in self.before_save:
             call()
-        save_checkpoint(self.path, state, self.intact, self.meta, self.parts)
+        results = self.results() if self.results is not None else None
+        save_checkpoint(self.path, state, self.intact, self.meta, self.parts, results)

@@ -17,6 +17,9 @@ Since schema 3 every dataset is labelled as netCDF-4 labels it (``peridyn.io.net
 dimension scales, coordinates, ``units`` and ``long_name``): each group opens with
 ``xarray.open_dataset(path, engine="h5netcdf", group=...)`` (``Results.to_xarray``).
 
+Every dataset carries the CRC-32 of its bytes (``peridyn.io.integrity``), kept up to date as
+records are appended and checked when a file is read or continued.
+
 The writer flushes after every ``flush_every`` appends, so a process that
 crashes loses at most the records appended since the last flush (with ``flush_every=None``
 the caller flushes, e.g. ``peridyn.io.series_buffer.SeriesBuffer`` after each block).
@@ -28,13 +31,16 @@ import json
 import math
 import operator
 import os
-from dataclasses import dataclass
+import uuid
+from dataclasses import dataclass, field
 
 import h5py
 import numpy as np
 
 from peridyn.errors import InputError, did_you_mean
+from peridyn.io import integrity
 from peridyn.io.netcdf import COMPONENTS, describe, label
+from peridyn.io.reserve import as_disk_error, ensure_room
 
 CHUNK_BYTES = 1 << 20
 """Target size of one chunk of a series' data, in bytes."""
@@ -57,6 +63,9 @@ SCHEMA_ATTR = "schema_version"
 
 #: Root attribute holding the job's status (``HDF5Writer.set_status``).
 STATUS_ATTR = "status"
+#: Root attribute holding the run id: a random hex string given when the file is created, that
+#: a checkpoint records to find its own results file on restart (``peridyn.io.checkpoint``).
+RUN_ID_ATTR = "run_id"
 SUMMARY = "summary/json"
 """Dataset holding the job's summary as JSON text."""
 
@@ -138,9 +147,15 @@ class HDF5Writer:
             version = check_schema(self._file.attrs, self.path)
             #: whether datasets get netCDF-4 labels: not in a file of an older schema continued
             self.labelled = "geometry" not in self._file or version >= 3
+            if mode == "a" and not integrity.is_marked(self._file):
+                self._stamp_unchecked()
+            integrity.mark_file(self._file)
+            if RUN_ID_ATTR not in self._file.attrs:
+                self._file.attrs[RUN_ID_ATTR] = uuid.uuid4().hex
             self._write_geometry(points, volumes)
-            if SCHEMA_ATTR in provenance:
-                raise InputError(f"{self.path}: provenance: {SCHEMA_ATTR!r} is reserved for the writer")
+            for reserved in (SCHEMA_ATTR, RUN_ID_ATTR, integrity.FILE_ATTR):
+                if reserved in provenance:
+                    raise InputError(f"{self.path}: provenance: {reserved!r} is reserved for the writer")
             _write_attrs(self._file.attrs, provenance, f"{self.path}: provenance")
             self._file.attrs[SCHEMA_ATTR] = SCHEMA_VERSION if self.labelled else version
             self._open_existing_series()
@@ -156,14 +171,26 @@ class HDF5Writer:
         self.close()
 
     def close(self) -> None:
-        """Flush and close the file; calling it again does nothing."""
+        """Flush and close the file; calling it again does nothing. The file is closed even
+        when the flush fails (whose error is raised)."""
         if self._file.id.valid:
-            self._file.flush()
-            self._file.close()
+            try:
+                self.flush()
+            finally:
+                self._file.close()
 
     def flush(self) -> None:
-        """Flush everything written so far to the operating system."""
-        self._file.flush()
+        """Flush everything written so far to the operating system.
+
+        Raises
+        ------
+        OSError
+            The disk failed the write (full, or an I/O error), naming the file.
+        """
+        try:
+            self._file.flush()
+        except (OSError, RuntimeError) as exc:
+            raise as_disk_error(exc, self.path) from exc
         self._pending = 0
 
     def create_series(
@@ -284,9 +311,13 @@ class HDF5Writer:
             last = step
         if not checked:
             return
-        series.append(
-            np.array([s for s, _ in checked], dtype=np.int64), np.array([t for _, t in checked]), values
-        )
+        ensure_room(self.path, values.nbytes + 16 * len(checked))
+        try:
+            series.append(
+                np.array([s for s, _ in checked], dtype=np.int64), np.array([t for _, t in checked]), values
+            )
+        except (OSError, RuntimeError) as exc:
+            raise as_disk_error(exc, self.path) from exc
         self._pending += 1
         if self.flush_every is not None and self._pending >= self.flush_every:
             self.flush()
@@ -321,7 +352,10 @@ class HDF5Writer:
             )
         if key in self._file:
             del self._file[key]
-        dataset = self._file.create_dataset(key, data=np.asarray(array))
+        values = np.asarray(array)
+        ensure_room(self.path, values.nbytes)
+        dataset = self._file.create_dataset(key, data=values)
+        integrity.stamp_whole(dataset, values)
         if self.labelled and dataset.ndim:
             base = key.rsplit("/", 1)[-1]
             dims = dims if dims is not None else [f"{base}_axis_{i + 1}" for i in range(dataset.ndim)]
@@ -340,6 +374,15 @@ class HDF5Writer:
         """
         self.write_array(SUMMARY, np.bytes_(_to_json(summary, f"{self.path}: summary")))
 
+    def identity(self) -> dict:
+        """The file's run id and the records written to each series: what a checkpoint saved now
+        expects of the file on restart (``peridyn.io.checkpoint.check_results``)."""
+        run_id = self._file.attrs[RUN_ID_ATTR]
+        return {
+            "run_id": run_id.decode() if isinstance(run_id, bytes) else str(run_id),
+            "records": {name: int(series.data.shape[0]) for name, series in self._series.items()},
+        }
+
     def set_status(self, status: str) -> None:
         """Set the job's status (root attribute ``status``: ``running``, ``complete``,
         ``failed: <reason>`` or ``interrupted at step N``) and flush it to disk."""
@@ -355,19 +398,32 @@ class HDF5Writer:
         if not is_integer(step):
             raise InputError(f"truncate: step must be an integer, got {step!r}")
         for series in self._series.values():
-            series.resize(int(np.searchsorted(series.step[:], step, side="right")))
+            integrity.verify(series.step, self.path)
+            series.resize(int(np.searchsorted(series.step[:], step, side="right")), self.path)
         self.flush()
+
+    def _stamp_unchecked(self) -> None:
+        """Checksum the datasets of a file written before checksums were recorded, so that it
+        can be continued (``mode="a"``) as a checksummed file."""
+        datasets = []
+        self._file.visititems(lambda _, obj: datasets.append(obj) if isinstance(obj, h5py.Dataset) else None)
+        for dataset in datasets:
+            integrity.stamp_whole(dataset)
 
     def _write_geometry(self, points: np.ndarray, volumes: np.ndarray) -> None:
         if "geometry" not in self._file:
             geometry = self._file.create_group("geometry")
             x = geometry.create_dataset("points", data=points)
-            volumes = geometry.create_dataset("volumes", data=volumes)
+            volumes_set = geometry.create_dataset("volumes", data=volumes)
+            integrity.stamp_whole(x, points)
+            integrity.stamp_whole(volumes_set, volumes)
             label(x, ("point", "coordinate"), {"coordinate": COMPONENTS[: points.shape[1]]})
-            label(volumes, ("point",))
+            label(volumes_set, ("point",))
             describe(x, "m", "reference position of the point")
-            describe(volumes, "m3", "volume of the point (area times thickness in 2D)")
+            describe(volumes_set, "m3", "volume of the point (area times thickness in 2D)")
             return
+        for name in ("points", "volumes"):
+            integrity.verify(self._file["geometry"][name], self.path)
         old_points = self._file["geometry/points"][:]
         old_volumes = self._file["geometry/volumes"][:]
         if not (np.array_equal(old_points, points) and np.array_equal(old_volumes, volumes)):
@@ -379,7 +435,7 @@ class HDF5Writer:
 
     def _open_existing_series(self) -> None:
         for name, group in self._file.get("series", {}).items():
-            self._series[name] = _Series.open(group)
+            self._series[name] = _Series.open(group, self.path)
 
     def series_dtype(self, name: str) -> np.dtype:
         """The dtype in which series ``name`` (made by :meth:`create_series`) stores its records."""
@@ -408,12 +464,14 @@ class HDF5Writer:
 
 @dataclass
 class _Series:
-    """Open handles of one series' datasets, kept for fast appends."""
+    """Open handles of one series' datasets, kept for fast appends, and the CRC-32 of each
+    dataset's records so far (``peridyn.io.integrity``), carried along as records are appended."""
 
     data: h5py.Dataset
     time: h5py.Dataset
     step: h5py.Dataset
     last_step: int | None
+    crcs: dict = field(default_factory=dict)
 
     @classmethod
     def create(cls, group: h5py.Group, shape: tuple, dtype: np.dtype) -> _Series:
@@ -425,7 +483,15 @@ class _Series:
         )
         time = group.create_dataset("time", (0,), np.float64, maxshape=(None,), chunks=index_chunk)
         step = group.create_dataset("step", (0,), np.int64, maxshape=(None,), chunks=index_chunk)
-        return cls(data, time, step, None)
+        series = cls(data, time, step, None)
+        for dataset in series.datasets:
+            integrity.stamp(dataset, 0, 0)
+            series.crcs[dataset.name] = 0
+        return series
+
+    @property
+    def datasets(self) -> tuple[h5py.Dataset, h5py.Dataset, h5py.Dataset]:
+        return self.data, self.time, self.step
 
     def label(self, dims: tuple, coords: dict, units: str, long_name: str) -> None:
         """netCDF-4 labels: time the coordinate of the records, ``dims`` (with ``coords``)
@@ -438,25 +504,37 @@ class _Series:
         describe(self.step, "1", "time step number")
 
     @classmethod
-    def open(cls, group: h5py.Group) -> _Series:
-        """Open an existing series, dropping a record half-written by a crash."""
+    def open(cls, group: h5py.Group, path: str) -> _Series:
+        """Open an existing series, dropping a record half-written by a crash (and records
+        that their checksums do not cover yet)."""
         series = cls(group["data"], group["time"], group["step"], None)
-        series.resize(n_records(group))
+        n = n_records(group)
+        if all(integrity.covered_rows(d) == n == d.shape[0] for d in series.datasets):
+            series.crcs = {d.name: int(d.attrs[integrity.CRC_ATTR]) for d in series.datasets}
+            series.last_step = int(series.step[n - 1]) if n else None
+        else:
+            series.resize(n, path)
         return series
 
     def append(self, steps: np.ndarray, times: np.ndarray, values: np.ndarray) -> None:
         """Write ``k`` records ((k,) steps and times, (k, *shape) values): data, then time,
         then step (the step marks them complete)."""
         n, k = self.data.shape[0], len(steps)
-        for dataset, value in ((self.data, values), (self.time, times), (self.step, steps)):
+        for dataset, value in zip(self.datasets, (values, times, steps), strict=True):
+            value = np.asarray(value, dtype=dataset.dtype)
             dataset.resize(n + k, axis=0)
             dataset[n : n + k] = value
+            self.crcs[dataset.name] = integrity.crc_of(value, self.crcs[dataset.name])
+            integrity.stamp(dataset, self.crcs[dataset.name], n + k)
         self.last_step = int(steps[-1])
 
-    def resize(self, n: int) -> None:
-        """Keep the first ``n`` records."""
-        for dataset in (self.data, self.time, self.step):
+    def resize(self, n: int, path: str) -> None:
+        """Keep the first ``n`` records, after checking the datasets against their checksums
+        (``path``: the file, for the message)."""
+        for dataset in self.datasets:
+            self.crcs[dataset.name] = integrity.verify(dataset, path, keep=n)
             dataset.resize(n, axis=0)
+            integrity.stamp(dataset, self.crcs[dataset.name], n)
         self.last_step = int(self.step[n - 1]) if n else None
 
 
@@ -537,8 +615,13 @@ def _check_dtype(name: str, dtype) -> np.dtype:
 
 
 def n_records(group: h5py.Group) -> int:
-    """Number of complete records (a crash may leave data or time one longer)."""
-    return min(group[key].shape[0] for key in ("data", "time", "step"))
+    """Number of complete records (a crash may leave data or time one longer, or records that
+    their checksums do not cover yet)."""
+    datasets = [group[key] for key in ("data", "time", "step")]
+    covered = [integrity.covered_rows(d) for d in datasets]
+    return min(
+        d.shape[0] if c is None else min(c, d.shape[0]) for d, c in zip(datasets, covered, strict=True)
+    )
 
 
 def _write_attrs(attrs: h5py.AttributeManager, values: dict, where: str) -> None:

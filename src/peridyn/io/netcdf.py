@@ -18,6 +18,7 @@ import h5py
 import numpy as np
 
 from peridyn.errors import InputError
+from peridyn.io import integrity
 
 #: Labels of the x, y, z component axis of vectors.
 COMPONENTS = ("x", "y", "z")
@@ -65,6 +66,7 @@ def _scale(group: h5py.Group, name: str, length: int, values, user: str) -> h5py
         return scale
     if values is None:
         scale = group.create_dataset(name, (length,), np.float32)
+        integrity.stamp_whole(scale, np.zeros(length, np.float32))
         scale.make_scale(name)
         scale.attrs["NAME"] = np.bytes_(f"{BARE_DIMENSION}{length:10d}")
         return scale
@@ -74,5 +76,6 @@ def _scale(group: h5py.Group, name: str, length: int, values, user: str) -> h5py
     if values.dtype.kind in "US":
         values = np.array([str(v) for v in values], dtype=h5py.string_dtype())
     scale = group.create_dataset(name, data=values)
+    integrity.stamp_whole(scale, values)
     scale.make_scale(name)
     return scale

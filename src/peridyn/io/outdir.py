@@ -14,18 +14,25 @@ JSON, keeps it in ``status.json`` (``{"status": ...}``), written and read here.
 from __future__ import annotations
 
 import json
+import os
+import shutil
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
 from peridyn.errors import InputError, InstabilityError, Interrupted, PeridynError
+from peridyn.io.reserve import disk_errno
 
 #: Name of the status file of the jobs that write JSON rather than results.h5.
 STATUS_FILE = "status.json"
 
 
-def prepare_output(out, marker: str, overwrite: bool = False, restart: bool = False) -> Path:
-    """Check the output folder ``out`` and create it; returns it as a Path.
+def prepare_output(
+    out, marker: str, overwrite: bool = False, restart: bool = False, earlier: tuple = (), restartable=True
+) -> Path:
+    """Check the output folder ``out`` and create it; returns it as a Path. With ``overwrite``,
+    the earlier job's files (``earlier``: names and glob patterns of what such a job writes,
+    e.g. ``RUN_OUTPUTS``) are removed first, so that none is left beside the new job's.
 
     Parameters
     ----------
@@ -34,6 +41,10 @@ def prepare_output(out, marker: str, overwrite: bool = False, restart: bool = Fa
         The file whose presence means an earlier job's results (e.g. ``"results.h5"``).
     overwrite, restart : bool
         Replace the earlier results, or continue them (mutually exclusive).
+    earlier : tuple of str
+        What ``overwrite`` removes.
+    restartable : bool
+        Whether the command can continue earlier results (the refusal suggests ``--restart``).
 
     Raises
     ------
@@ -47,12 +58,48 @@ def prepare_output(out, marker: str, overwrite: bool = False, restart: bool = Fa
     if out.exists() and not out.is_dir():
         raise InputError(f"output folder {str(out)!r} is a file, not a folder: choose another --output")
     if (out / marker).exists() and not (overwrite or restart):
+        restart_hint = ", --restart to continue it" if restartable else ""
         raise InputError(
             f"output folder {str(out)!r} holds an earlier run's {marker}: pass --overwrite to replace "
-            "it, --restart to continue it, or choose another --output"
+            f"it{restart_hint}, or choose another --output"
         )
     out.mkdir(parents=True, exist_ok=True)  # an OSError names the path and the reason (the CLI prints it)
+    if overwrite:
+        remove_outputs(out, earlier)
     return out
+
+
+#: What a run, static or modal job writes in its output folder (names and glob patterns):
+#: removed by ``--overwrite`` before the new job writes (not ``run.log``: each job appends to it).
+RUN_OUTPUTS = (
+    "results.h5",
+    "checkpoint.h5",
+    "checkpoint.h5.tmp",
+    "snapshots.pvd",
+    "snapshots",
+    "modes",
+    "figures",
+    "*.png",
+    "*.e",
+    "*.exo",
+    "crack_length.csv",
+    "modes.csv",
+    "modes.json",
+    "modal.json",
+    "damage.vtu",
+    "mode_*.vtu",
+    ".peridyn.reserve",
+)
+
+
+def remove_outputs(out: Path, patterns) -> None:
+    """Remove the files and folders of ``out`` that match ``patterns`` (top level only)."""
+    for pattern in patterns:
+        for path in sorted(out.glob(pattern)):
+            if path.is_dir() and not path.is_symlink():
+                shutil.rmtree(path)
+            else:
+                path.unlink(missing_ok=True)
 
 
 def write_status(out, status: str) -> None:
@@ -87,6 +134,10 @@ def end_status(exc: BaseException) -> str:
         return f"interrupted {exc.progress}".rstrip()
     if isinstance(exc, InstabilityError):
         return f"failed: unstable at step {exc.step} (t = {exc.time:.6g} s, point {exc.point}): {exc}"
+    number = disk_errno(exc)
+    if number is not None:  # a full or failing disk: what and where, not the HDF5 report
+        where = getattr(exc, "filename", None)
+        return f"failed: {os.strerror(number)}" + (f" ({where})" if where else "")
     reason = str(exc) if isinstance(exc, PeridynError) else f"{type(exc).__name__}: {exc}"
     return f"failed: {reason}"
 

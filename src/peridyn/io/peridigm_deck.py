@@ -17,6 +17,7 @@ import yaml
 
 from peridyn.errors import CaseFileError
 from peridyn.io.case import parse_yaml, yaml_problem
+from peridyn.io.text_file import read_input_text
 
 #: Suffixes of the two deck forms.
 XML_SUFFIXES = (".xml",)
@@ -38,8 +39,8 @@ def is_peridigm_deck(path) -> bool:
     """True for a file whose root is a ``<ParameterList>`` (XML) or a ``Peridigm:`` mapping (YAML)."""
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError):
+        text = read_input_text(path, "Peridigm deck")
+    except CaseFileError:  # not a readable text file: load_case says why
         return False
     if path.suffix.lower() in XML_SUFFIXES:
         return "<ParameterList" in text
@@ -56,12 +57,7 @@ def read_deck(path) -> dict:
         An unreadable file, malformed XML or YAML, or a parameter that does not read as its type.
     """
     path = Path(path)
-    if not path.is_file():
-        raise CaseFileError(str(path), "<file>", None, "an existing Peridigm deck (.xml or .yaml)")
-    try:
-        text = path.read_text(encoding="utf-8")
-    except UnicodeDecodeError as exc:
-        raise CaseFileError(str(path), "<file>", None, f"UTF-8 text (byte {exc.start})") from None
+    text = read_input_text(path, "Peridigm deck (.xml or .yaml)")
     if path.suffix.lower() in XML_SUFFIXES:
         return _read_xml(text, str(path))
     try:

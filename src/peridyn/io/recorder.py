@@ -38,8 +38,10 @@ from peridyn.discretization.body import Body
 from peridyn.discretization.state import ProbeState, State, check_state, runaway_limit
 from peridyn.errors import InputError
 from peridyn.io.exodus_write import PERIDIGM_VARIABLES, ExodusWriter
-from peridyn.io.hdf5 import HDF5Writer
+from peridyn.io.hdf5 import CHUNK_BYTES, MIN_INDEX_CHUNK, HDF5Writer
 from peridyn.io.netcdf import COMPONENTS
+from peridyn.io.outdir import end_status
+from peridyn.io.reserve import Reserve, as_disk_error, ensure_room
 from peridyn.io.series_buffer import SeriesBuffer
 from peridyn.io.vtk import PVDCollection, write_vtu
 
@@ -177,19 +179,50 @@ class RecorderSpec:
         """True when anything is recorded at ``step``."""
         return self.series_due(step) or self.whole_due(step)
 
-    def output_bytes(self, n_points: int, n_steps: int) -> float:
-        """Bytes a run of ``n_steps`` steps on ``n_points`` points writes, about: the probe
-        series at every ``every``-th step (step and time, sensors' u and v, PZT signals in
-        float64; lines and planes in ``series_dtype``) and the snapshots (``field_u`` and about
-        as much again in VTU and Exodus files: ``SNAPSHOT_VALUES`` values of 8 bytes a point)."""
+    def output_bytes(self, n_points: int, n_steps: int, dim: int = 3, damage: bool = False) -> float:
+        """Bytes a run of ``n_steps`` steps on ``n_points`` points of dimension ``dim`` (with a
+        ``damage`` field or not) writes, about: results.h5 (the geometry, every series in whole
+        chunks as ``peridyn.io.hdf5`` allocates them, the final u and v), the VTU snapshots
+        (uncompressed: base64 of the points, u, v, damage, stress/strain and the vertex cells,
+        ``VTU_CELL_BYTES`` a point; u and v padded to 3 components, the damage index always) and
+        the Exodus snapshots (tests/simulation/test_run_safety.py compares it with what runs
+        wrote)."""
         item = np.dtype(self.series_dtype).itemsize
-        probe_points = sum(line.points for line in self.lines.values()) + sum(map(len, self.planes.values()))
-        per_record = 8 * (2 + 6 * len(self.sensors) + len(self.pzt_sensors)) + 3 * item * probe_points
-        snapshots = len(self.snapshot_steps) + (n_steps // self.snapshot_every if self.snapshot_every else 0)
-        return (
-            float(n_steps // self.every + 1) * per_record
-            + float(snapshots + 1) * n_points * 8 * SNAPSHOT_VALUES
+        records = float(n_steps // self.every + 1)
+        every = self.snapshot_every
+        extra = {s for s in self.snapshot_steps if 0 < s <= n_steps} | ({n_steps} if n_steps > 0 else set())
+        # step 0, the multiples of snapshot_every, the snapshot steps and the end, each once
+        snapshots = (
+            1.0
+            + float(n_steps // every if every else 0)
+            + sum(1 for s in extra if not (every and s % every == 0))
         )
+        series = [(records, 6 * 8 * len(self.sensors))] * (2 if self.sensors else 0)
+        series += [(records, 3 * item * line.points) for line in self.lines.values()]
+        series += [(records, 3 * item * len(idx)) for idx in self.planes.values()]
+        series += [(records, 8 * len(self.pzt_sensors))] if self.pzt_sensors else []
+        series += [(snapshots, 3 * item * n_points)]
+        h5 = sum(_chunked_bytes(k, b) for k, b in series if b) + n_points * 8.0 * (dim + 1 + 6 + damage)
+        tensors = 72 * (self.stress + self.strain)
+        vtu = snapshots * n_points * (4 / 3) * (3 * 3 * 8 + 8 + tensors + VTU_CELL_BYTES) if self.vtu else 0
+        exodus = snapshots * n_points * 8.0 * (2 * dim + 1 + damage) if self.exodus else 0
+        return float(h5 + vtu + exodus)
+
+
+#: Bytes a point of a VTU snapshot holds besides its fields (before base64): its vertex cell's
+#: connectivity and offset (8 bytes each), type (1 byte) and the arrays' headers: 24 fits the
+#: 138.7 bytes a point measured in the snapshots of the 3D bar and of the 2D plate alike.
+VTU_CELL_BYTES = 24
+
+
+def _chunked_bytes(records: float, record_bytes: int) -> float:
+    """Bytes of a series of ``records`` records of ``record_bytes`` in whole chunks, with its
+    time and step datasets (``peridyn.io.hdf5``'s chunk sizes)."""
+    per_chunk = max(1, CHUNK_BYTES // record_bytes)
+    index = max(per_chunk, MIN_INDEX_CHUNK)
+    return float(
+        np.ceil(records / per_chunk) * per_chunk * record_bytes + 16.0 * np.ceil(records / index) * index
+    )
 
 
 class Recorder:
@@ -261,6 +294,7 @@ class Recorder:
             key: rows_of(idx) if key.startswith("plane_") else idx for key, idx in index.items()
         }
         mode = "a" if resume is not None else "w"
+        self.reserve = Reserve(self.directory)  # room to close the files on a full disk
         self.h5 = HDF5Writer(
             self.directory / "results.h5",
             body.points[:, : body.dim],
@@ -428,9 +462,18 @@ class Recorder:
         body = self.body
         data = snapshot_fields(state.u, state.v, body.dim, damage, self._tensor_fields(state.u), body.volumes)
         name = snapshot_name(state.step, ".vtu")
-        write_vtu(
-            self.directory / name, body.points[:, : body.dim], data, self.spec.vtu_compression, state.time
-        )
+        ensure_room(self.directory / name, 8.0 * SNAPSHOT_VALUES * self.body.n_points)
+        try:
+            write_vtu(
+                self.directory / name,
+                self.body.points[:, : self.body.dim],
+                data,
+                self.spec.vtu_compression,
+                state.time,
+            )
+        except OSError as exc:  # a part-written snapshot is no snapshot (and frees its room)
+            (self.directory / name).unlink(missing_ok=True)
+            raise as_disk_error(exc, self.directory / name) from exc
         self.pvd.add(state.time, name)
 
     def write_exodus(self, state: State, at_snapshot: bool = False) -> None:
@@ -462,20 +505,28 @@ class Recorder:
         self.series.flush()
 
     def finish(self, state: State) -> None:
-        """Write the held records and the final state, then close the file."""
-        self.flush()
-        vector = ("point", "component")
-        self.h5.write_array("final/u", state.u, {"units": "m", "long_name": "displacement"}, vector)
-        self.h5.write_array("final/v", state.v, {"units": "m/s", "long_name": "velocity"}, vector)
-        if self.damage is not None:
-            about = {"units": "1", "long_name": "damage: share of the point's bonds broken"}
-            self.h5.write_array("final/damage", self.damage(), about, ("point",))
-        for key, value in self._tensor_fields(state.u).items():
-            units, long_name = FINAL_TENSORS.get(key, ("1", key))
-            dims = ("point", "row", "column")[: np.ndim(value)]
-            labels = COMPONENTS[: np.shape(value)[-1]]
-            coords = {"row": labels, "column": labels}
-            self.h5.write_array(f"final/{key}", value, {"units": units, "long_name": long_name}, dims, coords)
+        """Write the held records and the final state, then close the file (on a failure,
+        closed as by :meth:`close` with the failure's status). The reserve stays until the
+        run's owner deletes it (the summary is written after)."""
+        try:
+            self.flush()
+            vector = ("point", "component")
+            self.h5.write_array("final/u", state.u, {"units": "m", "long_name": "displacement"}, vector)
+            self.h5.write_array("final/v", state.v, {"units": "m/s", "long_name": "velocity"}, vector)
+            if self.damage is not None:
+                about = {"units": "1", "long_name": "damage: share of the point's bonds broken"}
+                self.h5.write_array("final/damage", self.damage(), about, ("point",))
+            for key, value in self._tensor_fields(state.u).items():
+                units, long_name = FINAL_TENSORS.get(key, ("1", key))
+                dims = ("point", "row", "column")[: np.ndim(value)]
+                labels = COMPONENTS[: np.shape(value)[-1]]
+                coords = {"row": labels, "column": labels}
+                self.h5.write_array(
+                    f"final/{key}", value, {"units": units, "long_name": long_name}, dims, coords
+                )
+        except Exception as exc:
+            self.close(end_status(exc))
+            raise
         self.h5.close()
 
     def _tensor_fields(self, u: np.ndarray) -> dict:
@@ -484,8 +535,10 @@ class Recorder:
 
     def close(self, status: str | None = None) -> None:
         """Close the file early (failure, interruption), setting its ``status`` when given,
-        after writing the records held (a failing write, e.g. a full disk, does not keep the
-        status from being set)."""
+        after writing the records held. The room of the run's ``Reserve`` is given back first,
+        so that on a full disk the records held, the status and the file's closing are written
+        all the same."""
+        self.reserve.release()
         try:
             self.flush()
         finally:

@@ -2,8 +2,11 @@
 
 Every reader of a ``results.h5`` (figures, the command line, the jobs, the analyses) goes
 through :class:`Results`, so that each read checks the same things: the file exists and is
-HDF5, its schema is one this peridyn knows, and a series is read up to its last complete
-record (a crash may leave ``data`` or ``time`` one record longer than ``step``).
+HDF5, its schema is one this peridyn knows, every dataset matches its checksum
+(``peridyn.io.integrity``: a corrupted file is refused, naming the dataset), and a series is
+read up to its last complete record (a crash may leave ``data`` or ``time`` one record longer
+than ``step``). The checksums are checked when a file is opened, once per process for each
+version of the file (its size and modification time).
 """
 
 from __future__ import annotations
@@ -17,7 +20,9 @@ import h5py
 import numpy as np
 
 from peridyn.errors import InputError, did_you_mean
+from peridyn.io import integrity
 from peridyn.io.hdf5 import (
+    RUN_ID_ATTR,
     SCHEMA_ATTR,
     STATUS_ATTR,
     SUMMARY,
@@ -47,7 +52,8 @@ class Results:
     Raises
     ------
     InputError
-        The file is missing, not HDF5, or written with a newer schema than this peridyn reads.
+        The file is missing, not HDF5, written with a newer schema than this peridyn reads, or
+        one of its datasets does not match its checksum.
 
     Examples
     --------
@@ -60,6 +66,7 @@ class Results:
         self.path = os.fspath(path)
         with self._open() as f:
             self.schema_version = check_schema(f.attrs, self.path)
+            _verify_once(f, self.path)
 
     def series(self, name: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """A whole series: steps (n_records,) int64, times (n_records,) float64 in s, and the
@@ -143,13 +150,25 @@ class Results:
             return bool(key) and isinstance(f.get(key), h5py.Dataset)
 
     def provenance(self) -> dict:
-        """The root attributes as given to the writer (without ``schema_version`` and
-        ``status``), JSON entries decoded; numbers come back as Python scalars, tuples as lists."""
+        """The root attributes as given to the writer (without ``schema_version``, ``status``,
+        ``run_id`` and ``checksums``), JSON entries decoded; numbers come back as Python
+        scalars, tuples as lists."""
         with self._open() as f:
             attrs = decode_attrs(f.attrs)
-        attrs.pop(SCHEMA_ATTR, None)
-        attrs.pop(STATUS_ATTR, None)
+        for key in (SCHEMA_ATTR, STATUS_ATTR, RUN_ID_ATTR, integrity.FILE_ATTR):
+            attrs.pop(key, None)
         return attrs
+
+    def run_id(self) -> str | None:
+        """The run id given when the file was created (None for files written before it was)."""
+        with self._open() as f:
+            value = f.attrs.get(RUN_ID_ATTR)
+        return value.decode() if isinstance(value, bytes) else None if value is None else str(value)
+
+    def steps(self, name: str) -> np.ndarray:
+        """The steps (n_records,) int64 of a series' complete records."""
+        with self._series(name) as group:
+            return group["step"][: n_records(group)]
 
     def status(self) -> str:
         """The job's status: ``running``, ``complete``, ``failed: <reason>``, ``interrupted at
@@ -215,3 +234,17 @@ def _record_dims(data: h5py.Dataset) -> tuple[list[str], dict]:
             name = f"axis_{axis}"
         dims.append(name)
     return dims, coords
+
+
+#: The files whose checksums this process has checked: (real path, inode, size, mtime in ns).
+_verified: set = set()
+
+
+def _verify_once(f: h5py.File, path: str) -> None:
+    """``integrity.verify_file`` unless this version of the file was checked already."""
+    st = os.stat(path)
+    key = (os.path.realpath(path), st.st_ino, st.st_size, st.st_mtime_ns)
+    if key in _verified:
+        return
+    integrity.verify_file(f, path)
+    _verified.add(key)

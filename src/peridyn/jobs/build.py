@@ -134,10 +134,30 @@ def build_points(case: Case, base_dir=".", removals: bool = True) -> Body:
 
 
 def mesh_body(g: Geometry, base_dir=".") -> Body:
-    """The body of a text-mesh or Exodus geometry, its file relative to ``base_dir``."""
+    """The body of a text-mesh or Exodus geometry, its file relative to ``base_dir``; a mesh
+    with two points at one place (their bond would have zero length) is refused."""
     mesh = Path(g.file) if Path(g.file).is_absolute() else Path(base_dir) / g.file
     read = exodus.body_from_exodus if g.type == "exodus" else mesh_text.from_text_mesh
-    return read(mesh, dim=g.dimension, thickness=g.thickness, plane=g.plane if g.dimension == 2 else None)
+    body = read(mesh, dim=g.dimension, thickness=g.thickness, plane=g.plane if g.dimension == 2 else None)
+    check_distinct_points(body.points, str(mesh))
+    return body
+
+
+def check_distinct_points(points: np.ndarray, source: str) -> None:
+    """Refuse ``points`` (n, 3), m, of which two are equal, naming the first such pair (0-based).
+
+    Raises
+    ------
+    InputError
+    """
+    order = np.lexsort(points.T[::-1])
+    same = np.flatnonzero(np.all(points[order[1:]] == points[order[:-1]], axis=1))
+    if same.size:
+        i, j = sorted((int(order[same[0]]), int(order[same[0] + 1])))
+        raise InputError(
+            f"{source}: points {i} and {j} are at the same place {points[i].tolist()} m "
+            f"({same.size} duplicate point{'s' if same.size > 1 else ''}): a mesh needs distinct points"
+        )
 
 
 def region_mask(body: Body, region: Region, where: str) -> np.ndarray:
@@ -331,7 +351,8 @@ def value_function(spec, where: str):
 
 
 def check_placements(case: Case, body: Body) -> None:
-    """Refuse sensors, line-probe ends, PZT sensors and actuators outside the body.
+    """Refuse sensors, line-probe ends, PZT sensors and actuators outside the body, and
+    pre-cracks that do not meet it (``check_precracks``).
 
     A position is outside when it lies more than half a spacing outside the cell of every
     point near it (an in-plane ``center`` is compared with the x-y cells only).
@@ -347,6 +368,7 @@ def check_placements(case: Case, body: Body) -> None:
         spots += [(f"output.lines.{k}.start", line.start), (f"output.lines.{k}.end", line.end)]
     spots += [(f"output.pzt_sensors.{k}.center", v.center) for k, v in out.pzt_sensors.items()]
     spots += [(f"actuators.{k}.center", v.center) for k, v in case.actuators.items()]
+    check_precracks(case, body)
     if not spots:
         return
     in_plane = [len(v) == 2 and body.dim == 3 for _, v in spots]
@@ -364,6 +386,48 @@ def check_placements(case: Case, body: Body) -> None:
                         f"(spacing {body.spacing:g} m; the body spans "
                         f"{body.points.min(axis=0).tolist()} to {body.points.max(axis=0).tolist()} m)",
                     )
+
+
+#: Most sample points along a pre-crack's edge (``check_precracks``).
+MAX_CRACK_SAMPLES = 200
+
+
+def check_precracks(case: Case, body: Body) -> None:
+    """Refuse a pre-crack that lies wholly outside the body (it would cut no bond): none of its
+    sample points (every half spacing along it, at most ``MAX_CRACK_SAMPLES`` an edge) within
+    half a spacing of a point's cell.
+
+    Raises
+    ------
+    CaseFileError
+        Naming ``precracks[i]`` and how far outside it lies (m).
+    """
+    axes = 3 if body.dim == 3 else 2
+    for i, crack in enumerate(case.precracks):
+        if crack.type == "rectangle":
+            o, u, v = (np.asarray(pad3(p)) for p in (crack.origin, crack.edge_u, crack.edge_v))
+            a, b = _samples(u, body.spacing), _samples(v, body.spacing)
+            samples = o + a[:, None, None] * u + b[None, :, None] * v
+        else:
+            start, end = np.asarray(pad3(crack.start)), np.asarray(pad3(crack.end))
+            samples = start + _samples(end - start, body.spacing)[:, None] * (end - start)
+        samples = samples.reshape(-1, 3)[:, :axes]
+        gap = float(distance_outside(body, samples, axes).min())
+        low, high = body.points.min(axis=0).tolist(), body.points.max(axis=0).tolist()
+        if gap > 0.5 * body.spacing:
+            raise CaseFileError(
+                case.name,
+                f"precracks[{i}]",
+                crack.model_dump(exclude_none=True),
+                f"a pre-crack that meets the body: it lies {gap:.3g} m outside and would cut no bond "
+                f"(the body spans {low} to {high} m)",
+            )
+
+
+def _samples(edge: np.ndarray, spacing: float) -> np.ndarray:
+    """Fractions 0..1 along ``edge`` (m) every half ``spacing``, at most ``MAX_CRACK_SAMPLES``."""
+    n = int(min(MAX_CRACK_SAMPLES, np.ceil(2.0 * np.linalg.norm(edge) / spacing) + 1))
+    return np.linspace(0.0, 1.0, max(n, 2))
 
 
 #: Nearest points searched for the cell that a position is closest to.

@@ -8,7 +8,10 @@ work), waits through the time loop, then draws the run figures while the run ana
 figures are the same files; only the wall time changes.
 
 The worker is started by ``spawn``, which imports the main module of a script anew: a script
-that asks ``run_case`` for it must guard its run with ``if __name__ == "__main__":``."""
+that asks ``run_case`` for it must guard its run with ``if __name__ == "__main__":``.
+
+The worker ends with the run, whatever ended the run (a SIGKILL or an out-of-memory kill too,
+which leave the run no chance to shut it down; ``peridyn.jobs.children``)."""
 
 from __future__ import annotations
 
@@ -25,6 +28,7 @@ import numpy as np
 
 from peridyn.errors import InputError
 from peridyn.io.case import Case
+from peridyn.jobs.children import end_with_parent
 from peridyn.jobs.estimate import grid_shape
 
 #: Grids with fewer points draw their figures in the run's own process: the worker's start (about
@@ -52,7 +56,9 @@ def figure_worker_for(case: Case, base_dir=".", wanted: bool = True) -> Iterator
     if points < MIN_POINTS:
         yield None
         return
-    pool = ProcessPoolExecutor(1, mp_context=multiprocessing.get_context("spawn"), initializer=_initialise)
+    pool = ProcessPoolExecutor(
+        1, mp_context=multiprocessing.get_context("spawn"), initializer=_initialise, initargs=(os.getpid(),)
+    )
     pool.submit(int)  # the pool starts its process at the first task
     try:
         yield pool
@@ -88,11 +94,14 @@ def figures_of(pending: Future | None, draw, *args) -> list:
     return draw(*args)
 
 
-def _initialise() -> None:
-    """The worker's start: Ctrl-C is the run's to handle (it stops at a safe point and closes
-    its files), a lower priority, and the plotting imports done now rather than at the first
-    figure."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
+def _initialise(parent: int) -> None:
+    """The worker's start: it ends when its ``parent`` (the run's process id) does; Ctrl-C,
+    SIGTERM and SIGHUP are the run's to handle (it stops at a safe point, closes its files and
+    shuts the worker down); a lower priority, and the plotting imports done now rather than at
+    the first figure."""
+    end_with_parent(parent)
+    for sig in (signal.SIGINT, signal.SIGHUP):
+        signal.signal(sig, signal.SIG_IGN)
     os.nice(NICENESS)
     import peridyn.jobs.figures  # noqa: F401
     import peridyn.plotting.fields  # noqa: F401

@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from peridyn.analysis.modes import classify_modes, mac_matrix
-from peridyn.errors import InputError
+from peridyn.errors import CaseFileError, InputError
 from peridyn.io.hdf5 import HDF5Writer
 from peridyn.io.provenance import provenance
 from peridyn.io.vtk import write_vtu
@@ -86,11 +86,36 @@ def run_modal(case, setup, out: Path, case_path=None) -> tuple[dict, list[Path]]
     (collective)."""
     fixed = setup.loading.constrained if setup.loading.has_loads else None
     d = setup.domain
+    held = fixed is not None and d.max(int(np.any(fixed[: d.n_owned]))) > 0  # on any rank
+    check_mode_count(case, setup.whole_body.dim, held)
     table = case_modes(setup, case.solver.modes, fixed, case.solver.eigensolver)
     n_bonds = d.count(setup.bonds.offsets[d.n_owned])  # the owned points' families come first
     written = d.on_root(_write_modal, case, setup.whole_body, n_bonds, table, out, case_path)
     summary, plots = written if d.is_root else (None, [])
     return d.comm.bcast({**summary, **table.stats} if d.is_root else None), plots
+
+
+#: Rigid-body modes of a free body by its dimension: translations and rotations.
+RIGID_MODES = {2: 3, 3: 6}
+
+
+def check_mode_count(case, dim: int, held: bool) -> None:
+    """Refuse a modal run of a free body (not ``held`` by a boundary condition) that asks for
+    no more modes than its rigid-body modes: it would find no vibration mode.
+
+    Raises
+    ------
+    CaseFileError
+        Naming ``solver.modes`` and the rigid modes.
+    """
+    rigid = RIGID_MODES[dim]
+    if not held and case.solver.modes <= rigid:
+        raise CaseFileError(
+            case.name,
+            "solver.modes",
+            case.solver.modes,
+            f"more than the {rigid} rigid-body modes of a free {dim}D body (--modes), e.g. {rigid + 10}",
+        )
 
 
 def _write_modal(case, body, n_bonds, table: ModeTable, out, case_path) -> tuple[dict, list[Path]]:

@@ -4,13 +4,13 @@ runs are ``jobs.modal``), recording, checkpoints, crack history and the stored s
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import hashlib
 import json
 import logging
 import shutil
 import time
-from contextlib import ExitStack
 from pathlib import Path
 
 import numpy as np
@@ -23,9 +23,11 @@ from peridyn.errors import CaseFileError, InputError, Interrupted
 from peridyn.io.case import Case
 from peridyn.io.checkpoint import Checkpointer, load_checkpoint
 from peridyn.io.hdf5 import HDF5Writer
-from peridyn.io.outdir import end_status, prepare_output
+from peridyn.io.lock import OutputLock
+from peridyn.io.outdir import RUN_OUTPUTS, end_status, prepare_output
 from peridyn.io.provenance import package_version, provenance
 from peridyn.io.recorder import LineProbe, Probes, Recorder, RecorderSpec
+from peridyn.io.reserve import RESERVE_BYTES, RESERVE_FILE
 from peridyn.io.run_log import run_log
 from peridyn.io.vtu_pieces import VtuPieces
 from peridyn.jobs.build import Setup, build, pad3
@@ -34,6 +36,7 @@ from peridyn.jobs.figure_worker import figure_worker_for, figures_of, submit
 from peridyn.jobs.figures import draw_crack_figures, draw_run_figures, final_crack_paths
 from peridyn.jobs.lamb_analysis import analyse
 from peridyn.jobs.peridigm_step import peridigm_stable_step
+from peridyn.jobs.run_checks import check_run_plan
 from peridyn.jobs.summary import finish_summary, peak_memory_bytes
 from peridyn.parallel.observers import RootObservers
 from peridyn.physics.absorbing import layer_damping
@@ -134,7 +137,8 @@ def run_case(
     overwrite : bool
         Replace an earlier run's results in the output folder.
     command : str or None
-        The command line that started the run, for the resume hint of ``Interrupted``.
+        The command line that started the run, for the resume hint of ``Interrupted``; ""
+        for a command that cannot be restarted (``peridyn demo``): no hint of ``--restart``.
     comm : communicator or None
         ``peridyn.parallel.comm.world()`` under ``mpiexec -n N`` (N > 1): each rank runs its
         part of the body (``peridyn.parallel``), rank 0 writes the one results.h5 with every
@@ -173,7 +177,7 @@ def run_case(
     if parallel:
         _check_parallel(case)
     wanted = figure_worker and _draws_run_figures(case) and not parallel
-    with figure_worker_for(case, base_dir, wanted) as worker, ExitStack() as log:
+    with figure_worker_for(case, base_dir, wanted) as worker, contextlib.ExitStack() as held:
         setup = build(case, base_dir, comm)
         domain = setup.domain
         solver = time_stepper(case, setup) if stepping else None
@@ -181,9 +185,15 @@ def run_case(
         spec = recorder_spec(case, setup.whole_body, solver.dt) if stepping else None
         if stepping:
             n_steps = step_count(case, solver)
-            domain.on_root(check_output_fits, spec, setup.whole_body, n_steps, solver.dt, out)
-        domain.on_root(prepare_output, out, RESULTS, overwrite, restart)
-        log.enter_context(run_log(out, domain.is_root))
+            check_run_plan(case, solver.dt, n_steps)
+            damage = setup.damage is not None
+            domain.on_root(check_output_fits, spec, setup.whole_body, n_steps, solver.dt, out, damage)
+        lock = domain.on_root(OutputLock, out)  # one run writes a folder at a time
+        if lock is not None:
+            held.callback(lock.release)
+            held.callback((out / RESERVE_FILE).unlink, missing_ok=True)  # a recorder's ``Reserve``
+        domain.on_root(prepare_output, out, RESULTS, overwrite, restart, RUN_OUTPUTS, command != "")
+        held.enter_context(run_log(out, domain.is_root))
         logger.info(f"case {case.name!r} ({case.solver.type}, {setup.whole_body.n_points} points) into {out}")
         written = not restart  # a restart writes once its checkpoint is accepted (the recorder's part)
         try:
@@ -196,6 +206,7 @@ def run_case(
         except Exception as exc:
             logger.warning(f"case {case.name!r}: {end_status(exc)}")
             if written and domain.is_root:
+                (out / RESERVE_FILE).unlink(missing_ok=True)  # room for the status on a full disk
                 try:
                     _set_status(out / RESULTS, setup.whole_body, end_status(exc))
                 except Exception:  # noqa: BLE001 - e.g. the full disk that failed the run: its error is the one to report
@@ -267,7 +278,9 @@ def step_count(case: Case, solver) -> int:
     return int(np.ceil(s.time / solver.dt - 1e-9))
 
 
-def check_output_fits(spec: RecorderSpec, body: Body, n_steps: int, dt: float, out: Path) -> None:
+def check_output_fits(
+    spec: RecorderSpec, body: Body, n_steps: int, dt: float, out: Path, damage: bool = False
+) -> None:
     """Refuse a run whose records (``spec.output_bytes``, ``spec`` from ``recorder_spec``) would
     not fit in the free space of the disk of its output folder, before anything is written.
 
@@ -276,7 +289,7 @@ def check_output_fits(spec: RecorderSpec, body: Body, n_steps: int, dt: float, o
     InputError
         Naming the steps, the bytes and the free space.
     """
-    need = spec.output_bytes(body.n_points, n_steps)
+    need = spec.output_bytes(body.n_points, n_steps, body.dim, damage) + RESERVE_BYTES
     folder = out.resolve()
     while not folder.exists():
         folder = folder.parent
@@ -298,6 +311,8 @@ def _resume_hint(command: str | None) -> str:
     """How to continue an interrupted run."""
     if command is None:
         return "run_case(..., restart=True) with the same case and output folder"
+    if not command:
+        return ""
     return command if "--restart" in command.split() else f"{command} --restart"
 
 
@@ -448,7 +463,7 @@ def _run_explicit(
     }
     whole_bonds = d.bond_offsets(setup.bonds.offsets)
     if restart:
-        state = _restart(ckpt_path, setup, meta, parts, whole_bonds, n_steps)
+        state = _restart(ckpt_path, setup, meta, parts, whole_bonds, n_steps, out / RESULTS)
         resume = (state.step, state.time)
         logger.info(f"restarting from the checkpoint at step {state.step} (t = {state.time:.6g} s)")
     else:
@@ -486,6 +501,7 @@ def _run_explicit(
         parts,
         whole_bonds,
         [recorder.flush] if recorder is not None else [],
+        recorder.h5.identity if recorder is not None else None,
     )
     watched = [recorder, *([cracks] if cracks is not None else [])]
     due = [spec.whole_due, *([cracks.due] if cracks is not None else [])]  # the series: ``series``
@@ -540,11 +556,16 @@ def _run_explicit(
         if recorder is not None:
             recorder.close(end_status(exc))
         raise
-    collect(state)  # the end-of-run snapshot's Exodus record
-    if not spec.snapshot_due(state.step):
-        if pieces is not None:
-            pieces.write(state)
-        gathered.call(state, lambda whole: recorder.snapshot(whole))
+    try:
+        collect(state)  # the end-of-run snapshot's Exodus record
+        if not spec.snapshot_due(state.step):
+            if pieces is not None:
+                pieces.write(state)
+            gathered.call(state, lambda whole: recorder.snapshot(whole))
+    except BaseException as exc:  # e.g. a full disk: the records held are written, the file closed
+        if recorder is not None:
+            recorder.close(end_status(exc))
+        raise
     n = d.n_owned
     summary = _base_summary(setup)
     summary.update(
@@ -574,16 +595,19 @@ def _run_explicit(
     return summary
 
 
-def _restart(path, setup: Setup, meta: dict, parts: dict, whole_bonds: np.ndarray, n_steps: int) -> State:
+def _restart(
+    path, setup: Setup, meta: dict, parts: dict, whole_bonds: np.ndarray, n_steps: int, results
+) -> State:
     """The state of the checkpoint at ``path`` (this rank's points), with the bonds' intact mask
     and the parts' states restored; a checkpoint at or past the run's last step ``n_steps`` is
     refused (before the recorder reopens, and would rewrite, results.h5). Checkpoints hold the
     whole body in serial numbering, so a run may restart on another number of ranks. A rank's
     damage skin covers its part only and is not saved under MPI: it starts again with a full
-    stretch test (the same bonds break, see ``peridyn.physics.damage``)."""
+    stretch test (the same bonds break, see ``peridyn.physics.damage``). The results file
+    ``results`` must be the one the checkpoint was saved with (``check_results``)."""
     d = setup.domain
     state, intact, saved = d.agree(
-        load_checkpoint, path, setup.whole_body.n_points, int(whole_bonds[-1]), meta
+        load_checkpoint, path, setup.whole_body.n_points, int(whole_bonds[-1]), meta, results
     )
     if state.step >= n_steps:
         raise InputError(
@@ -600,19 +624,33 @@ def _restart(path, setup: Setup, meta: dict, parts: dict, whole_bonds: np.ndarra
 
 
 def _checkpointer(
-    path, every: int, setup: Setup, meta: dict, parts: dict, whole_bonds: np.ndarray, before_save=()
+    path,
+    every: int,
+    setup: Setup,
+    meta: dict,
+    parts: dict,
+    whole_bonds: np.ndarray,
+    before_save=(),
+    results=None,
 ):
     """The run's ``Checkpointer`` and what must be gathered before it saves (``RootObservers``):
     under MPI it writes, on rank 0, the whole body's state and intact mask in serial numbering
     and the parts that hold whole-body state (the contact list's build displacement, gathered;
     not a rank's damage skin). ``before_save``: the calls made before every save (the
-    recorder's ``flush``, on rank 0)."""
+    recorder's ``flush``, on rank 0); ``results``: the identity of the results file
+    (``HDF5Writer.identity``, on rank 0)."""
     d = setup.domain
     if d.size == 1:
-        return Checkpointer(path, every, setup.bonds.intact, meta, parts, before_save), []
+        return Checkpointer(path, every, setup.bonds.intact, meta, parts, before_save, results), []
     whole_intact = np.ones(int(whole_bonds[-1]), dtype=bool) if d.is_root else None
     checkpointer = Checkpointer(
-        path, every, whole_intact, meta, {k: v for k, v in parts.items() if k != "damage"}, before_save
+        path,
+        every,
+        whole_intact,
+        meta,
+        {k: v for k, v in parts.items() if k != "damage"},
+        before_save,
+        results,
     )
 
     def gather_whole(state):  # the state itself is gathered by RootObservers.call

@@ -360,6 +360,11 @@ class Collector:
         return {
             "completed": sum(s == "complete" for s in statuses),
             "failed": sum(s.startswith("failed") for s in statuses),
+            "failed_runs": [
+                {"run_id": r["run_id"], "status": r["status"]}
+                for r in self.records.values()
+                if r["status"].startswith("failed")
+            ],
         }
 
     def write(self, final: bool) -> None:

@@ -254,7 +254,10 @@ def _run_processes(tasks, on_done, workers: int) -> None:
     with worker_environment(tasks[0].threads):
         while todo:
             pool = ProcessPoolExecutor(
-                workers, mp_context=multiprocessing.get_context("spawn"), initializer=_quiet_worker
+                workers,
+                mp_context=multiprocessing.get_context("spawn"),
+                initializer=_quiet_worker,
+                initargs=(os.getpid(),),
             )
             pending, broken = {}, []
             try:
@@ -284,11 +287,15 @@ def _run_processes(tasks, on_done, workers: int) -> None:
                     return
 
 
-def _quiet_worker() -> None:
-    """A pool worker ignores Ctrl-C (the sweep's process stops the sweep), except within a run's
-    time stepping, whose own handlers end the run at the end of a step."""
+def _quiet_worker(parent: int) -> None:
+    """A pool worker ends with the sweep's process ``parent`` (``peridyn.jobs.children``) and
+    ignores Ctrl-C (the sweep's process stops the sweep), except within a run's time stepping,
+    whose own handlers end the run at the end of a step."""
     import signal
 
+    from peridyn.jobs.children import end_with_parent
+
+    end_with_parent(parent)
     signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 

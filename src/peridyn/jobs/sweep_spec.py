@@ -35,6 +35,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_valida
 
 from peridyn.errors import CaseFileError, InputError
 from peridyn.io.case import Case, apply_override, load_case, parse_yaml, validate_case, yaml_problem
+from peridyn.io.text_file import read_input_text
 from peridyn.jobs.run import case_identity
 from peridyn.physics.expressions import evaluate
 
@@ -273,10 +274,9 @@ def read_spec(path) -> SweepSpec:
         Missing or unreadable file, bad YAML, or an entry that is wrong (named with its path).
     """
     path = Path(path)
-    if not path.is_file():
-        raise CaseFileError(str(path), "<file>", None, "an existing YAML sweep file")
+    text = read_input_text(path, "YAML sweep file")
     try:
-        raw = parse_yaml(path.read_text(encoding="utf-8"))
+        raw = parse_yaml(text)
     except yaml.YAMLError as exc:
         raise CaseFileError(str(path), "<file>", None, f"valid YAML ({yaml_problem(exc)})") from None
     if not isinstance(raw, dict):
@@ -347,7 +347,7 @@ class _BaseCase:
     def __init__(self, path: Path):
         load_case(path)  # a missing, unreadable or invalid base case is reported as for any case
         self.path = path
-        self.raw = parse_yaml(path.read_text(encoding="utf-8"))
+        self.raw = parse_yaml(read_input_text(path, "YAML case file"))
 
     def case(self, overrides: list) -> Case:
         raw = copy.deepcopy(self.raw)

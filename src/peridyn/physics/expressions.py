@@ -11,6 +11,11 @@ for ``precracks.0.end.1``): ``lookup(path)`` gives its value (a varied parameter
 entry). Nothing else is accepted: the text is parsed with :mod:`ast` and only these nodes are
 evaluated, so no Python code ever runs.
 
+An expression is bounded, so that no text can take the machine's memory or time: at most
+``MAX_LENGTH`` characters and ``MAX_NODES`` syntax nodes, whole-number powers whose result
+stays within ``MAX_INT_BITS`` bits (``9**9**9`` is refused at once; a float power overflows
+to an error), and at most ``TIME_LIMIT_S`` seconds of evaluation.
+
 >>> evaluate("3 * discretization.spacing + 1", {"discretization.spacing": 0.5}.__getitem__)
 2.5
 >>> evaluate("max(size[1], 2) ** 2", {"size": [1.0, 3.0]}.__getitem__)
@@ -22,18 +27,46 @@ from __future__ import annotations
 import ast
 import math
 import operator
+import time
 from dataclasses import dataclass
 
 import numpy as np
 
 from peridyn.errors import InputError
 
+#: The longest expression text, in characters.
+MAX_LENGTH = 2000
+#: The most syntax nodes of an expression.
+MAX_NODES = 500
+#: The largest whole number a power may give, in bits (a float's range is 2**1024).
+MAX_INT_BITS = 1024
+#: The longest evaluation of an expression, in seconds.
+TIME_LIMIT_S = 10.0
+
+
+def _power(base, exponent):
+    """``base ** exponent``, refusing a whole-number power beyond ``MAX_INT_BITS`` bits
+    (Python would compute it exactly, for hours, in unbounded memory)."""
+    if (
+        isinstance(base, int)
+        and isinstance(exponent, int)
+        and abs(base) > 1
+        and exponent > 0
+        and exponent * math.log2(abs(base)) > MAX_INT_BITS
+    ):
+        raise OverflowError(
+            f"a whole-number power of about {exponent * math.log2(abs(base)):.3g} bits, more than "
+            f"{MAX_INT_BITS}"
+        )
+    return operator.pow(base, exponent)
+
+
 _BINARY = {
     ast.Add: operator.add,
     ast.Sub: operator.sub,
     ast.Mult: operator.mul,
     ast.Div: operator.truediv,
-    ast.Pow: operator.pow,
+    ast.Pow: _power,
 }
 
 
@@ -79,17 +112,28 @@ def evaluate(text: str, lookup):
     Raises
     ------
     InputError
-        A syntax error, a construct outside the language, an unknown name or an arithmetic
-        error (division by zero...), naming the expression.
+        A syntax error, a construct outside the language, an unknown name, an arithmetic
+        error (division by zero, a power too large...) or an expression over the bounds
+        (``MAX_LENGTH``, ``MAX_NODES``, ``TIME_LIMIT_S``), naming the expression.
     """
+    text = str(text)
+    shown = text if len(text) <= 80 else text[:77] + "..."
+    if len(text) > MAX_LENGTH:
+        raise InputError(f"expression {shown!r}: {len(text)} characters, more than {MAX_LENGTH}")
     try:
-        tree = ast.parse(str(text), mode="eval")
+        tree = ast.parse(text, mode="eval")
     except SyntaxError as exc:
-        raise InputError(f"expression {text!r}: not valid ({exc.msg})") from None
+        raise InputError(f"expression {shown!r}: not valid ({exc.msg})") from None
+    except (RecursionError, MemoryError):
+        raise InputError(f"expression {shown!r}: nested too deeply") from None
+    nodes = sum(1 for _ in ast.walk(tree))
+    if nodes > MAX_NODES:
+        raise InputError(f"expression {shown!r}: {nodes} terms, more than {MAX_NODES}")
+    deadline = time.monotonic() + TIME_LIMIT_S
     try:
-        return _eval(tree.body, lookup, text)
+        return _eval(tree.body, lookup, text, deadline)
     except (ArithmeticError, TypeError, ValueError, IndexError) as exc:
-        raise InputError(f"expression {text!r}: {type(exc).__name__}: {exc}") from None
+        raise InputError(f"expression {shown!r}: {type(exc).__name__}: {exc}") from None
 
 
 def _path(node) -> str | None:
@@ -110,7 +154,9 @@ def _path(node) -> str | None:
     return None
 
 
-def _eval(node, lookup, text):
+def _eval(node, lookup, text, deadline):
+    if time.monotonic() > deadline:
+        raise InputError(f"expression {text!r}: not evaluated within {TIME_LIMIT_S:g} s")
     if (
         isinstance(node, ast.Constant)
         and isinstance(node.value, int | float)
@@ -127,22 +173,24 @@ def _eval(node, lookup, text):
                     f"expression {text!r}: unknown name {path!r} (a varied parameter or a case entry)"
                 ) from None
     if isinstance(node, ast.BinOp) and type(node.op) in _BINARY:
-        return _BINARY[type(node.op)](_eval(node.left, lookup, text), _eval(node.right, lookup, text))
+        return _BINARY[type(node.op)](
+            _eval(node.left, lookup, text, deadline), _eval(node.right, lookup, text, deadline)
+        )
     if isinstance(node, ast.UnaryOp) and isinstance(node.op, ast.USub | ast.UAdd):
-        value = _eval(node.operand, lookup, text)
+        value = _eval(node.operand, lookup, text, deadline)
         return -value if isinstance(node.op, ast.USub) else +value
     if isinstance(node, ast.Subscript):
-        index = _eval(node.slice, lookup, text)
+        index = _eval(node.slice, lookup, text, deadline)
         if not isinstance(index, int):
             raise InputError(f"expression {text!r}: a list index must be a whole number, got {index!r}")
-        return _eval(node.value, lookup, text)[index]
+        return _eval(node.value, lookup, text, deadline)[index]
     if (
         isinstance(node, ast.Call)
         and isinstance(node.func, ast.Name)
         and node.func.id in _FUNCTIONS
         and not node.keywords
     ):
-        return _FUNCTIONS[node.func.id](*(_eval(a, lookup, text) for a in node.args))
+        return _FUNCTIONS[node.func.id](*(_eval(a, lookup, text, deadline) for a in node.args))
     raise InputError(
         f"expression {text!r}: {ast.unparse(node)!r} is not allowed (numbers, names, + - * / **, "
         f"[index] and {', '.join(_FUNCTIONS)} only)"

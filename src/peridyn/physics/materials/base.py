@@ -115,6 +115,24 @@ class Model:
         it takes the ``nu`` given (the default)."""
         return None
 
+    @classmethod
+    def check_nu(cls, nu, dim: int, plane: str | None = None) -> None:
+        """Refuse a Poisson ratio ``nu`` (a number, per-point values or None) that the material
+        cannot have on a body of dimension ``dim`` (``implied_poisson_ratio``): what the model's
+        construction refuses, asked before anything is built (``peridyn validate``).
+
+        Raises
+        ------
+        InputError
+            Naming ``nu`` and the ratio the material has.
+        """
+        implied = cls.implied_poisson_ratio(dim, plane)
+        if implied is not None and nu is not None and np.any(np.abs(np.asarray(nu) - implied) > 1e-3):
+            raise InputError(
+                f"nu = {nu}: a bond-based {cls.name.upper()} material has Poisson ratio {implied:.4g} here "
+                "(1/4 in 3D and plane strain, 1/3 in plane stress): omit nu or use lps"
+            )
+
     def __repr__(self) -> str:
         return f"{type(self).__name__}(n_points={self.body.n_points}, dtype={self.dtype.name})"
 

@@ -110,11 +110,7 @@ class PMBModel(Model):
     ):
         implied = self.implied_poisson_ratio(body.dim, body.plane)
         check_elastic(E, implied if nu is None else nu, density)
-        if nu is not None and np.any(np.abs(np.asarray(nu) - implied) > 1e-3):
-            raise InputError(
-                f"nu = {nu}: a bond-based PMB material has Poisson ratio {implied:.4g} here "
-                "(1/4 in 3D and plane strain, 1/3 in plane stress): omit nu or use lps"
-            )
+        self.check_nu(nu, body.dim, body.plane)
         if surface_correction not in SURFACE_CORRECTIONS:
             raise InputError(
                 f"PMB surface_correction must be one of {SURFACE_CORRECTIONS}, got {surface_correction!r}"
