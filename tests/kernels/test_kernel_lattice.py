@@ -131,17 +131,21 @@ def test_lattice_sums_and_energy_match_reference(rng):
 
 
 def test_lattice_stretch_test_and_scatter_match_reference(rng):
-    """Bonds past |xi| (1 + s_c) break from both ends; unbreakable points keep theirs."""
+    """Bonds past |xi| (1 + s_c) break from both ends; unbreakable points keep theirs; the room
+    left per row is the smallest over the bonds left intact."""
     shape, s, vol, broken, u = _grid(rng, np.float64)
     n = vol.size
     limit = s.length * (1 + 1e-3)
     breakable = rng.random(n) > 0.1
-    expected, count = ref.lattice_stretch_test(u, vol, broken, shape, s.offsets, s.xi, limit, breakable)
+    expected, count, room = ref.lattice_stretch_test(u, vol, broken, shape, s.offsets, s.xi, limit, breakable)
     got = broken.copy()
-    rows = np.empty(int(shape[1] * shape[2]), dtype=np.int64)
-    assert kern.lattice_stretch_test(u, vol, got, shape, s.offsets, s.xi, limit, breakable, rows) == count
+    rows = int(shape[1] * shape[2])
+    got_room = np.empty(rows)
+    args = (limit, breakable, np.empty(rows, dtype=np.int64), got_room)
+    assert kern.lattice_stretch_test(u, vol, got, shape, s.offsets, s.xi, *args) == count
     assert count > 0
     np.testing.assert_array_equal(got, expected)
+    np.testing.assert_array_equal(got_room, room)  # the same subtractions of the same |Y|
     index = rng.permutation(n)[: n // 2]
     up = rng.normal(size=(len(index), 3))
     ug = kern.lattice_scatter(up, index, np.zeros((3, n)))
@@ -259,3 +263,18 @@ def test_lattice_damage_breaks_the_bonds_bond_lists_break(rng):
     assert all(near), f"bonds broken by one storage only, not at their threshold: {sorted(differ)}"
     assert got > 0 and abs(got - expected) == len(differ)
     np.testing.assert_allclose(latticed.damage_index(), bonded.damage_index(), rtol=0, atol=1e-14)
+
+
+def test_lattice_damage_skips_only_tests_that_break_nothing(rng):
+    """Over a loading history, the damage that skips tests while no point has moved half the
+    room breaks the same bits at the same calls as one that tests every bond at every call."""
+    body, _, latticed, _ = _both(_box_with_hole_and_crack, "pmb", False)
+    _, _, other, _ = _both(_box_with_hole_and_crack, "pmb", False)
+    skin, every = LatticeDamage(latticed, critical_stretch=2e-3), LatticeDamage(other, critical_stretch=2e-3)
+    noise = rng.normal(size=(body.n_points, 3)) * 1e-4 * H
+    for t in np.linspace(0.0, 1.0, 40):
+        u = t * (np.array([3e-3, 0.0, 0.0]) * body.points + noise)
+        every.reset()
+        assert skin.update(u) == every.update(u)
+    np.testing.assert_array_equal(latticed.lattice.broken, other.lattice.broken)
+    assert latticed.lattice.n_broken() > 0 and skin.full_tests < every.full_tests

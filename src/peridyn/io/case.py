@@ -222,7 +222,8 @@ class Geometry(Strict):
 
 class Discretization(Strict):
     """Spacing (m, one value or one per axis for a box), horizon as a multiple of the spacing
-    (``horizon``) or in metres (``horizon_m``), influence function and partial volumes."""
+    (``horizon``) or in metres (``horizon_m``), influence function, partial volumes and the
+    storage of the bonds."""
 
     spacing: Positive | list[Positive] | None = None
     horizon: Positive | None = None
@@ -232,6 +233,10 @@ class Discretization(Strict):
     #: ``sphere``: |xi| <= horizon; ``box`` (a box geometry, no partial volumes): the points
     #: within round(horizon / spacing) cells along each axis, Peridigm's PdQuickGrid families
     neighbourhood: Literal["sphere", "box"] = "sphere"
+    #: how the bonds are stored: ``bonds`` (CSR bond lists, every case), ``lattice`` (one
+    #: stencil and a broken bit per bond: grid bodies of explicit runs, docs/user-guide.md), or
+    #: ``auto`` (lattice where the case allows it, else bond lists)
+    storage: Literal["bonds", "lattice", "auto"] = "bonds"
 
     @model_validator(mode="after")
     def _one_horizon(self):

@@ -234,17 +234,19 @@ def lattice_energy_sum(u, vol, broken, shape, offs, xi, length, coef, theta, dim
 
 
 @numba.njit(parallel=True, cache=True)
-def lattice_stretch_test(u, vol, broken, shape, offs, xi, limit, breakable, count):
+def lattice_stretch_test(u, vol, broken, shape, offs, xi, limit, breakable, count, room):
     """Break every intact bond between points with material whose deformed length |Y| exceeds
     ``limit`` (m, per offset: |xi| (1 + s_c)) and whose two ends are ``breakable`` ((n_grid,)
-    bool): sets its bit
-    in ``broken`` (IN/OUT). Both ends of a bond see the same |Y| (exactly opposite vectors),
-    so each point sets its own bits only and a bond breaks from both ends in the same call.
-    ``count`` (OUT, (n_rows,) int64): bits set per row; returns their sum."""
+    bool): sets its bit in ``broken`` (IN/OUT). Both ends of a bond see the same |Y| (exactly
+    opposite vectors), so each point sets its own bits only and a bond breaks from both ends in
+    the same call. ``count`` (OUT, (n_rows,) int64): bits set per row; ``room`` (OUT, (n_rows,)
+    float64, m): per row, the smallest ``limit - |Y|`` of the breakable bonds left intact (inf
+    without one). Returns the number of bits set."""
     nx, ny, nz = shape[0], shape[1], shape[2]
     for r in numba.prange(ny * nz):
         base = r * nx
         count[r] = 0
+        least = np.inf
         for k in range(offs.shape[0]):
             lo, hi, shift = _neighbour_row(r, ny, nz, nx, offs[k, 0], offs[k, 1], offs[k, 2])
             word = k >> 6
@@ -260,16 +262,20 @@ def lattice_stretch_test(u, vol, broken, shape, offs, xi, limit, breakable, coun
                 y0 = deformed_component(x0, u[0, q], u[0, p])
                 y1 = deformed_component(x1, u[1, q], u[1, p])
                 y2 = deformed_component(x2, u[2, q], u[2, p])
-                if np.sqrt(y0 * y0 + y1 * y1 + y2 * y2) > limit[k]:
+                rest = limit[k] - np.sqrt(y0 * y0 + y1 * y1 + y2 * y2)
+                if rest < 0.0:
                     broken[word, p] |= bit
                     count[r] += 1
+                else:
+                    least = min(least, rest)
+        room[r] = least
     return count.sum()
 
 
-@numba.njit(parallel=True, cache=True)
+@numba.njit(cache=True)
 def lattice_scatter(u, grid_index, ug):
     """``ug[:, grid_index[i]]`` (OUT, (3, n_grid)) = ``u[i]`` ((n_points, 3)) for every body point."""
-    for i in numba.prange(grid_index.shape[0]):
+    for i in range(grid_index.shape[0]):
         g = grid_index[i]
         ug[0, g] = u[i, 0]
         ug[1, g] = u[i, 1]
@@ -277,10 +283,10 @@ def lattice_scatter(u, grid_index, ug):
     return ug
 
 
-@numba.njit(parallel=True, cache=True)
+@numba.njit(cache=True)
 def lattice_gather(fg, grid_index, f):
     """``f[i]`` (OUT, (n_points, 3)) = ``fg[:, grid_index[i]]`` ((3, n_grid)) for every body point."""
-    for i in numba.prange(grid_index.shape[0]):
+    for i in range(grid_index.shape[0]):
         g = grid_index[i]
         f[i, 0] = fg[0, g]
         f[i, 1] = fg[1, g]

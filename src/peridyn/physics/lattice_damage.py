@@ -2,8 +2,13 @@
 
 The criterion of ``peridyn.physics.damage``: a bond breaks when its deformed length passes
 ``|xi| (1 + s_c)``, never where an end point lies in a ``no_damage`` set; breaking is
-irreversible. Each :meth:`LatticeDamage.update` tests every bond (one pass over the stencil,
-about the cost of a force); the broken bits live in the lattice.
+irreversible. The broken bits live in the lattice.
+
+A test of every bond costs about a force. As ``BondDamage`` does with its skin (there per
+point), :meth:`LatticeDamage.update` keeps the smallest room ``L_c - |Y|`` left to any
+breakable intact bond at the displacement of its last test, and skips the test while no
+point has moved half of it since (|Y| changes by at most |du_i| + |du_j|): the bonds broken
+are those a test at every call breaks.
 """
 
 from __future__ import annotations
@@ -13,6 +18,9 @@ import numpy as np
 from peridyn.errors import InputError
 from peridyn.kernels.lattice import lattice_scatter, lattice_stretch_test
 from peridyn.physics.damage import protected_points, stretch_from_bond_stress
+
+#: Relative slack on the room (of the largest critical length) for the roundings of |Y|.
+ROUNDING_SLACK = 1e-9
 
 
 class LatticeDamage:
@@ -52,7 +60,13 @@ class LatticeDamage:
         self.breakable = np.ones(lattice.n_grid, dtype=bool)
         self.breakable[lattice.grid_index[protected_points(model.body, no_damage_sets)]] = False
         self._ug = np.zeros((3, lattice.n_grid))
-        self._count = np.zeros(int(lattice.shape[1] * lattice.shape[2]), dtype=np.int64)
+        rows = int(lattice.shape[1] * lattice.shape[2])
+        self._count = np.zeros(rows, dtype=np.int64)
+        self._room = np.zeros(rows)
+        self._u_ref: np.ndarray | None = None  # (n_points, 3) m, the displacement of the last test
+        self._least = 0.0  # m, the smallest room at u_ref
+        self._slack = ROUNDING_SLACK * float(self.limit.max())  # m, the roundings of |Y|
+        self.full_tests = 0  # calls of ``update`` that tested every bond
 
     def __repr__(self) -> str:
         return f"LatticeDamage(critical_stretch={self.value:.4g})"
@@ -60,18 +74,30 @@ class LatticeDamage:
     def update(self, u: np.ndarray) -> int:
         """Break every over-stretched breakable bond at displacement ``u`` (n_points, 3), m;
         returns the number of directed bonds broken."""
+        u = np.ascontiguousarray(u, dtype=np.float64)
+        if self._u_ref is not None:
+            moved = u - self._u_ref
+            if 2.0 * np.sqrt(np.max(np.einsum("ij,ij->i", moved, moved))) < self._least - self._slack:
+                return 0
         lat = self.model.lattice
-        ug = lattice_scatter(np.ascontiguousarray(u, dtype=np.float64), lat.grid_index, self._ug)
+        ug = lattice_scatter(u, lat.grid_index, self._ug)
         s = lat.stencil
-        args = (lat.volume, lat.broken, lat.shape, s.offsets, s.xi, self.limit, self.breakable, self._count)
-        return int(lattice_stretch_test(ug, *args))
+        args = (lat.volume, lat.broken, lat.shape, s.offsets, s.xi, self.limit, self.breakable)
+        broken = int(lattice_stretch_test(ug, *args, self._count, self._room))
+        self._u_ref = u.copy()
+        self._least = float(self._room.min(initial=np.inf))
+        self.full_tests += 1
+        return broken
 
     def reset(self) -> None:
-        """Nothing to forget: every update tests every bond."""
+        """Forget the room (after editing ``limit`` or ``breakable``, or mending bonds): the next
+        ``update`` tests every bond."""
+        self._u_ref = None
 
     def checkpoint_state(self) -> dict:
-        """Nothing beyond the broken bits (saved with the state)."""
+        """Nothing beyond the broken bits (saved with the state): a restart tests every bond."""
         return {}
 
     def restore_state(self, saved: dict) -> None:
-        """Nothing beyond the broken bits (restored with the state)."""
+        """Start again with a test of every bond (the broken bits are restored with the state)."""
+        self.reset()

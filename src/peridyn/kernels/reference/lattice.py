@@ -106,15 +106,20 @@ def lattice_energy_sum(u, vol, broken, shape, offs, xi, length, coef, theta, dim
 
 
 def lattice_stretch_test(u, vol, broken, shape, offs, xi, limit, breakable):
-    """(broken bits after the test, count): every intact breakable bond between points with
-    material with |Y| > limit_k broken."""
+    """(broken bits after the test, count, room (n_rows,)): every intact breakable bond between
+    points with material with |Y| > limit_k broken; room: the smallest limit_k - |Y| of the
+    bonds left so per row of the grid (inf without one)."""
     p, q, k, ok = lattice_bonds(vol, broken, shape, offs)
     _, r = _deformed(u, xi, p, q, k)
-    fail = ok & (np.asarray(vol)[p] > 0) & breakable[p] & breakable[q] & (r > np.asarray(limit)[k])
+    tested = ok & (np.asarray(vol)[p] > 0) & breakable[p] & breakable[q]
+    fail = tested & (r > np.asarray(limit)[k])
+    rows = int(shape[1] * shape[2])
+    room = np.full(rows, np.inf)
+    np.minimum.at(room, p[tested & ~fail] // int(shape[0]), (np.asarray(limit)[k] - r)[tested & ~fail])
     out = np.array(broken, copy=True)
     for pp, kk in zip(p[fail], k[fail], strict=True):
         out[kk // 64, pp] |= np.uint64(1) << np.uint64(kk % 64)
-    return out, int(fail.sum())
+    return out, int(fail.sum()), room
 
 
 def lattice_scatter(u, grid_index, n_grid):
