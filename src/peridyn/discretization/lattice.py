@@ -193,10 +193,12 @@ def make_stencil(
     influence: str = "constant",
     partial_volumes: bool = True,
     quadrature_points: int = 8,
+    shape=None,
 ) -> Stencil:
     """The offsets of a grid of ``spacing`` (3,) m within the ``horizon`` (m), as ``find_bonds``
     keeps bonds: every neighbour whose cell reaches into the horizon sphere with partial volumes
-    (its factor by the same quadrature), else those with ``|xi| <= horizon (1 + 1e-12)``."""
+    (its factor by the same quadrature), else those with ``|xi| <= horizon (1 + 1e-12)``;
+    with the grid's ``shape`` (3,), only offsets that fit in it (``|o_a| < n_a``)."""
     omega = influence_function(influence)
     cell = spacing.copy()
     if dim == 2:
@@ -207,6 +209,8 @@ def make_stencil(
     bound = np.floor(reach / spacing).astype(np.int64)
     if dim == 2:
         bound[2] = 0
+    if shape is not None:
+        bound = np.minimum(bound, np.asarray(shape, dtype=np.int64) - 1)
     axes = [np.arange(-b, b + 1) for b in bound]
     offsets = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
     offsets = offsets[np.any(offsets != 0, axis=1)]
@@ -244,7 +248,7 @@ def build_lattice(
         raise InputError(
             f"horizon {horizon:g} m is smaller than half the spacing: points would have no neighbours"
         )
-    stencil = make_stencil(spacing, horizon, body.dim, influence, partial_volumes, quadrature_points)
+    stencil = make_stencil(spacing, horizon, body.dim, influence, partial_volumes, quadrature_points, shape)
     volume = np.zeros(int(np.prod(shape)))
     volume[grid_index] = body.volumes
     n_words = -(-stencil.size // WORD_BITS)
