@@ -8,8 +8,9 @@ force scatters ``u`` (n_points, 3) to the grid, runs the lattice kernels
 solvers, loads and recorders see the body as with bond lists. It has no bond linearisation
 (static, Newton, Newmark, modal runs and the stress output keep bond lists).
 
-What lattice storage takes: one material, the surface correction ``none``, float64 and
-float32; :func:`lattice_support` says why a case needs bond lists.
+What lattice storage takes: one material, the surface corrections of
+``LATTICE_SURFACE_CORRECTIONS`` (PMB none; LPS none and shear-factor), float64 and float32;
+:func:`lattice_support` says why a case needs bond lists.
 """
 
 from __future__ import annotations
@@ -30,11 +31,11 @@ from peridyn.kernels.lattice import (
 )
 from peridyn.physics.materials.base import Model
 from peridyn.physics.materials.elastic import bulk_modulus, check_elastic, plane_bulk_modulus, shear_modulus
-from peridyn.physics.materials.lps import LPSModel
+from peridyn.physics.materials.lps import LPSModel, shear_correction_factor
 from peridyn.physics.materials.pmb import PMBModel, check_pmb_parameters, pmb_micromodulus
 
-#: Surface corrections lattice storage computes (the others keep bond lists).
-LATTICE_SURFACE_CORRECTIONS = ("none",)
+#: Surface corrections lattice storage computes, per material (the others keep bond lists).
+LATTICE_SURFACE_CORRECTIONS = {"pmb": ("none",), "lps": ("none", "shear-factor")}
 
 
 class LatticeModel(Model):
@@ -114,7 +115,7 @@ class LatticePMB(LatticeModel):
 
     def __init__(self, body, lattice, E, density, nu=None, surface_correction="none", dtype=np.float64):
         check_pmb_parameters(body, E, nu, density, surface_correction)
-        check_lattice_correction(surface_correction)
+        check_lattice_correction("pmb", surface_correction)
         super().__init__(body, lattice, E, density, dtype)
         s = lattice.stencil
         self.c0 = pmb_micromodulus(
@@ -166,7 +167,7 @@ class LatticeLPS(LatticeModel):
         if nu is None:
             raise InputError("an LPS material needs Poisson's ratio nu")
         check_elastic(E, nu, density)
-        check_lattice_correction(surface_correction)
+        check_lattice_correction("lps", surface_correction)
         super().__init__(body, lattice, E, density, dtype)
         dim = body.dim
         s = lattice.stencil
@@ -183,6 +184,10 @@ class LatticeLPS(LatticeModel):
         self.weighted_volume = np.where(occupied, m, 0.0)
         self.alpha = np.where(occupied, (15.0 if dim == 3 else 8.0) * self.shear / safe, 0.0)
         self.theta_coef = np.where(occupied, dim / safe, 0.0)
+        self.shear_factor = np.ones(body.n_points)
+        if surface_correction == "shear-factor":
+            self.shear_factor = self._shear_correction_factor()
+            self.alpha[lattice.grid_index] *= self.shear_factor
         self.p_coef = np.where(occupied, dim * self.bulk / safe - self.alpha / dim, 0.0)
         self._weight = self._offset_table(self._weight64)
         self._alpha = self.alpha.astype(self.dtype)
@@ -190,6 +195,29 @@ class LatticeLPS(LatticeModel):
         self._p_coef = self.p_coef.astype(self.dtype)
         self._theta = np.zeros(lattice.n_grid, dtype=self.dtype)
         self._p = np.zeros(lattice.n_grid, dtype=self.dtype)
+
+    def _shear_correction_factor(self) -> np.ndarray:
+        """``materials.lps.shear_correction_factor`` over the lattice's bonds (float64)."""
+        lat, s = self.lattice, self.lattice.stencil
+        table = (lat.volume, lat.broken, lat.shape, s.offsets, s.xi, s.length)
+
+        def dilatation(u):
+            theta = lattice_lps_dilatation(
+                self._grid64(u), *table, self._weight64, False, self.theta_coef, np.empty(lat.n_grid)
+            )
+            return self._at_points(theta)
+
+        def deviatoric_norm(u, theta):
+            grid_theta = np.zeros(lat.n_grid)
+            grid_theta[lat.grid_index] = theta
+            coef = self._weight64 * s.length
+            norm = lattice_energy_sum(
+                self._grid64(u), *table, coef, grid_theta, float(self.dim), np.empty(lat.n_grid)
+            )
+            return self._at_points(norm)
+
+        m = self._at_points(self.weighted_volume)
+        return shear_correction_factor(self.body.points, self.dim, m, dilatation, deviatoric_norm)
 
     def _grid_dilatation(self, ug, vol, theta_coef, out):
         lat, s = self.lattice, self.lattice.stencil
@@ -252,12 +280,12 @@ class LatticeLPS(LatticeModel):
 LATTICE_MODELS = {"pmb": LatticePMB, "lps": LatticeLPS}
 
 
-def check_lattice_correction(surface_correction: str) -> None:
-    """Refuse a surface correction that lattice storage does not compute."""
-    if surface_correction not in LATTICE_SURFACE_CORRECTIONS:
+def check_lattice_correction(name: str, surface_correction: str) -> None:
+    """Refuse a surface correction of material ``name`` that lattice storage does not compute."""
+    if surface_correction not in LATTICE_SURFACE_CORRECTIONS[name]:
         raise InputError(
             f"surface_correction {surface_correction!r} needs bond lists: lattice storage computes "
-            f"{list(LATTICE_SURFACE_CORRECTIONS)}; use discretization.storage: bonds"
+            f"{list(LATTICE_SURFACE_CORRECTIONS[name])} for {name}; use discretization.storage: bonds"
         )
 
 
@@ -265,8 +293,8 @@ def lattice_support(name: str, surface_correction: str = "none") -> str | None:
     """Why material ``name`` with ``surface_correction`` cannot run on lattice storage, or None."""
     if name not in LATTICE_MODELS:
         return f"material {name!r} has no lattice form (lattice storage runs {sorted(LATTICE_MODELS)})"
-    if surface_correction not in LATTICE_SURFACE_CORRECTIONS:
-        return f"surface_correction {surface_correction!r} needs bond lists"
+    if surface_correction not in LATTICE_SURFACE_CORRECTIONS[name]:
+        return f"surface_correction {surface_correction!r} of {name} needs bond lists"
     return None
 
 
