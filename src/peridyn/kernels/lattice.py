@@ -87,7 +87,7 @@ def lattice_pmb_force(u, vol, broken, shape, offs, xi, length, inv_len, coef, cf
                     t = _extension(cf, u, p, q, x0, x1, x2, L, y0, y1, y2, rr) * il / rr
                 else:
                     t = il - one / rr
-                ok = (broken[word, p] & bit) == 0 and vol[q] > zero
+                ok = ((broken[word, p] & bit) == 0) & (vol[q] > zero)
                 s = c * vol[q] * t if ok else zero
                 f[0, p] += s * y0
                 f[1, p] += s * y1
@@ -118,7 +118,7 @@ def lattice_lps_dilatation(u, vol, broken, shape, offs, xi, length, weight, cf, 
                 y2 = deformed_component(x2, u[2, q], u[2, p])
                 rr = np.sqrt(y0 * y0 + y1 * y1 + y2 * y2)
                 e = _extension(cf, u, p, q, x0, x1, x2, L, y0, y1, y2, rr)
-                ok = (broken[word, p] & bit) == 0 and vol[q] > zero
+                ok = ((broken[word, p] & bit) == 0) & (vol[q] > zero)
                 theta[p] += (wk * vol[q]) * L * e if ok else zero
         for ix in range(nx):
             theta[base + ix] *= theta_coef[base + ix]
@@ -152,7 +152,7 @@ def lattice_lps_force(u, vol, broken, shape, offs, xi, length, weight, cf, alpha
                 e = _extension(cf, u, i, j, x0, x1, x2, L, y0, y1, y2, rr)
                 w = wk * vol[j]
                 t = (w * L * (p[i] + p[j]) + w * (alpha[i] + alpha[j]) * e) / rr
-                ok = (broken[word, i] & bit) == 0 and vol[j] > zero
+                ok = ((broken[word, i] & bit) == 0) & (vol[j] > zero)
                 s = t if ok else zero
                 f[0, i] += s * y0
                 f[1, i] += s * y1
