@@ -159,22 +159,22 @@ def test_lattice_stretch_test_and_scatter_match_reference(rng):
 
 
 def _box_with_hole_and_crack():
-    """A 12 x 10 x 8 box at 1 mm with a spherical hole and a rectangular pre-crack."""
-    body = geometry.box((0.012, 0.010, 0.008), H)
-    body = body.remove(lambda x: np.sum((x - [0.006, 0.005, 0.004]) ** 2, axis=1) < 0.0015**2)
+    """A 10 x 9 x 7 box at 1 mm with a spherical hole and a rectangular pre-crack."""
+    body = geometry.box((0.010, 0.009, 0.007), H)
+    body = body.remove(lambda x: np.sum((x - [0.0055, 0.0045, 0.0035]) ** 2, axis=1) < 0.0013**2)
     return body, lambda a, b: crossing_rectangle(a, b, (0.0025, -1, -1), (0, 3, 0), (0, 0, 3))
 
 
 def _surface_plate():
     """The seed plate's layout: 3 surface layers 1 mm apart, 0.8 mm in plane, a crack segment."""
-    body = geometry.plate(0.012, 0.008, 0.002, spacing=0.8e-3, layers=3, layer_placement="surface")
-    return body, lambda a, b: crossing_rectangle(a, b, (0.006, 0.0, -1), (0, 0.004, 0), (0, 0, 3))
+    body = geometry.plate(0.0096, 0.0064, 0.002, spacing=0.8e-3, layers=3, layer_placement="surface")
+    return body, lambda a, b: crossing_rectangle(a, b, (0.0048, 0.0, -1), (0, 0.0032, 0), (0, 0, 3))
 
 
 def _rectangle_2d():
     """A plane-stress rectangle with a centre slit."""
-    body = geometry.rectangle(0.02, 0.012, H, 0.001)
-    return body, lambda a, b: crossing_segment(a, b, (0.01, 0.003), (0.01, 0.009))
+    body = geometry.rectangle(0.014, 0.010, H, 0.001)
+    return body, lambda a, b: crossing_segment(a, b, (0.007, 0.003), (0.007, 0.007))
 
 
 BODIES = {
