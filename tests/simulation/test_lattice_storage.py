@@ -9,6 +9,7 @@ series' largest value (the acceptance of lattice storage).
 """
 
 import json
+from dataclasses import replace
 from pathlib import Path
 
 import h5py
@@ -19,7 +20,7 @@ from conftest import results_datasets
 from peridyn.cli import main
 from peridyn.errors import CaseFileError
 from peridyn.io.case import load_case
-from peridyn.jobs.build import build
+from peridyn.jobs.build import build, build_points
 from peridyn.jobs.storage import choose_storage
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -97,3 +98,17 @@ def test_explicit_lattice_refuses_what_needs_bond_lists(case, edit, named, tmp_p
         build(load_case(path, ["discretization.storage=lattice", *edit[1::2]]), path.parent)
     auto = load_case(path, ["discretization.storage=auto", *edit[1::2]])
     assert choose_storage(auto, None) == "bonds"
+
+
+def test_auto_takes_the_lattice_where_nothing_needs_bond_lists():
+    """``storage: auto`` on a grid case that lattice storage runs (an LPS plate with the shear
+    factor, PZT actuator and sensors) chooses the lattice; on a body that is not a grid (cells
+    of several sizes) bond lists."""
+    path = ROOT / "cases" / "lamb_plate.yaml"
+    case = load_case(path, ["discretization.storage=auto"])
+    body = build_points(case, path.parent)
+    assert choose_storage(case, body) == "lattice"
+    uneven = replace(body, cells=np.where(np.arange(body.n_points)[:, None] == 0, 2.0, 1.0) * body.cells)
+    assert choose_storage(case, uneven) == "bonds"
+    with pytest.raises(CaseFileError, match="not a grid"):
+        choose_storage(load_case(path, ["discretization.storage=lattice"]), uneven)
