@@ -28,22 +28,10 @@ per-offset ``length`` (``cf`` False), float32 the cancellation-free
 import numba
 import numpy as np
 
-from peridyn.kernels import FASTMATH, deformed_component
+from peridyn.kernels import CHUNK, FASTMATH, deformed_component, stack_array
 
 
 @numba.njit(fastmath=FASTMATH, cache=True, inline="always")
-def _extension(cf, u, p, q, x0, x1, x2, length, y0, y1, y2, r):
-    """e = |Y| - |xi| (``cf`` False) or its cancellation-free form (``cf`` True), with
-    ``du = u_q - u_p`` taken from ``u`` itself (Y - xi would keep only the rounding of Y)."""
-    if cf:
-        d0 = u[0, q] - u[0, p]
-        d1 = u[1, q] - u[1, p]
-        d2 = u[2, q] - u[2, p]
-        return (d0 * (y0 + x0) + d1 * (y1 + x1) + d2 * (y2 + x2)) / (r + length)
-    return r - length
-
-
-@numba.njit(cache=True, inline="always")
 def _neighbour_row(r, ny, nz, nx, ox, oy, oz):
     """(first column, end column, flat offset of the neighbour) of row ``r`` along (ox, oy, oz);
     an empty range when the neighbour row lies outside the grid."""
@@ -58,40 +46,88 @@ def _neighbour_row(r, ny, nz, nx, ox, oy, oz):
     return lo, hi, (jz * ny + jy) * nx + ox - r * nx
 
 
+@numba.njit(fastmath=FASTMATH, cache=True, inline="always")
+def _bond_terms(cf, u, p0, q0, m, x0, x1, x2, L, bits, bit, vq, buf):
+    """The first loop of a chunk (``peridyn.kernels``): for the ``m`` bonds of the points
+    ``p0 .. p0 + m - 1`` along one offset (neighbours ``q0 ..``), Y into ``buf[CHUNK + q]``,
+    ``buf[2 CHUNK + q]``, ``buf[3 CHUNK + q]``, |Y| into ``buf[4 CHUNK + q]``, the extension e
+    into ``buf[5 CHUNK + q]`` and whether the bond counts (intact, to material) as 1 or 0 into
+    ``buf[q]``. No sum: it vectorises. ``bits``: the chunk's broken words of the offset, ``vq``
+    the neighbours' volumes."""
+    zero = buf.dtype.type(0.0)
+    one = buf.dtype.type(1.0)
+    a0 = u[0, p0 : p0 + m]
+    a1 = u[1, p0 : p0 + m]
+    a2 = u[2, p0 : p0 + m]
+    b0 = u[0, q0 : q0 + m]
+    b1 = u[1, q0 : q0 + m]
+    b2 = u[2, q0 : q0 + m]
+    for q in range(m):
+        y0 = deformed_component(x0, b0[q], a0[q])
+        y1 = deformed_component(x1, b1[q], a1[q])
+        y2 = deformed_component(x2, b2[q], a2[q])
+        r = np.sqrt(y0 * y0 + y1 * y1 + y2 * y2)
+        if cf:  # du . (Y + xi) / (|Y| + |xi|), du from u itself (Y - xi keeps only Y's rounding)
+            d0 = b0[q] - a0[q]
+            d1 = b1[q] - a1[q]
+            d2 = b2[q] - a2[q]
+            e = (d0 * (y0 + x0) + d1 * (y1 + x1) + d2 * (y2 + x2)) / (r + L)
+        else:
+            e = r - L
+        ok = ((bits[q] & bit) == 0) & (vq[q] > zero)
+        buf[q] = one if ok else zero
+        buf[CHUNK + q] = y0
+        buf[2 * CHUNK + q] = y1
+        buf[3 * CHUNK + q] = y2
+        buf[4 * CHUNK + q] = r
+        buf[5 * CHUNK + q] = e
+
+
+#: Values per bond of a chunk in the lattice kernels' stack buffer (see ``_bond_terms``).
+LATTICE_BUFFER = 6 * CHUNK
+
+
 @numba.njit(parallel=True, fastmath=FASTMATH, cache=True)
 def lattice_pmb_force(u, vol, broken, shape, offs, xi, length, inv_len, coef, cf, f):
     """PMB force density ``f`` (OUT, (3, n_grid), N/m^3) on every grid point:
     f_i = sum_k coef_k V_j (1/|xi| - 1/|Y|) Y over the counted bonds (``coef`` = c0 omega beta,
-    N/m^6; ``cf``: cancellation-free form, ``(e / (|xi| |Y|))`` instead). Hole rows get 0."""
+    N/m^6; ``cf``: the cancellation-free form ``e / (|xi| |Y|)`` instead). Each row's offsets in
+    chunks of ``CHUNK`` columns, two loops a chunk (``peridyn.kernels``)."""
     nx, ny, nz = shape[0], shape[1], shape[2]
     zero = f.dtype.type(0.0)
     one = f.dtype.type(1.0)
     for r in numba.prange(ny * nz):
         base = r * nx
-        for a in range(3):
-            for ix in range(nx):
-                f[a, base + ix] = zero
+        buf = stack_array(LATTICE_BUFFER, f.dtype)
+        f0 = f[0, base : base + nx]
+        f1 = f[1, base : base + nx]
+        f2 = f[2, base : base + nx]
+        for ix in range(nx):
+            f0[ix] = zero
+            f1[ix] = zero
+            f2[ix] = zero
         for k in range(offs.shape[0]):
             lo, hi, shift = _neighbour_row(r, ny, nz, nx, offs[k, 0], offs[k, 1], offs[k, 2])
-            word = k >> 6
             bit = np.uint64(1) << np.uint64(k & 63)
+            bits = broken[k >> 6]
             x0, x1, x2, L, il, c = xi[k, 0], xi[k, 1], xi[k, 2], length[k], inv_len[k], coef[k]
-            for ix in range(lo, hi):
-                p = base + ix
-                q = p + shift
-                y0 = deformed_component(x0, u[0, q], u[0, p])
-                y1 = deformed_component(x1, u[1, q], u[1, p])
-                y2 = deformed_component(x2, u[2, q], u[2, p])
-                rr = np.sqrt(y0 * y0 + y1 * y1 + y2 * y2)
-                if cf:
-                    t = _extension(cf, u, p, q, x0, x1, x2, L, y0, y1, y2, rr) * il / rr
-                else:
-                    t = il - one / rr
-                ok = ((broken[word, p] & bit) == 0) & (vol[q] > zero)
-                s = c * vol[q] * t if ok else zero
-                f[0, p] += s * y0
-                f[1, p] += s * y1
-                f[2, p] += s * y2
+            for c0 in range(lo, hi, CHUNK):
+                m = min(CHUNK, hi - c0)
+                p0 = base + c0
+                vq = vol[p0 + shift : p0 + shift + m]
+                _bond_terms(cf, u, p0, p0 + shift, m, x0, x1, x2, L, bits[p0 : p0 + m], bit, vq, buf)
+                for q in range(m):
+                    rr = buf[4 * CHUNK + q]
+                    t = buf[5 * CHUNK + q] * il / rr if cf else il - one / rr
+                    buf[q] = c * vq[q] * t if buf[q] > zero else zero
+                g0 = f0[c0 : c0 + m]
+                g1 = f1[c0 : c0 + m]
+                g2 = f2[c0 : c0 + m]
+                for q in range(m):
+                    s = buf[q]
+                    g0[q] += s * buf[CHUNK + q]
+                    g1[q] += s * buf[2 * CHUNK + q]
+                    g2[q] += s * buf[3 * CHUNK + q]
     return f
 
 
@@ -103,25 +139,26 @@ def lattice_lps_dilatation(u, vol, broken, shape, offs, xi, length, weight, cf, 
     zero = theta.dtype.type(0.0)
     for r in numba.prange(ny * nz):
         base = r * nx
+        buf = stack_array(LATTICE_BUFFER, theta.dtype)
+        th = theta[base : base + nx]
         for ix in range(nx):
-            theta[base + ix] = zero
+            th[ix] = zero
         for k in range(offs.shape[0]):
             lo, hi, shift = _neighbour_row(r, ny, nz, nx, offs[k, 0], offs[k, 1], offs[k, 2])
-            word = k >> 6
             bit = np.uint64(1) << np.uint64(k & 63)
+            bits = broken[k >> 6]
             x0, x1, x2, L, wk = xi[k, 0], xi[k, 1], xi[k, 2], length[k], weight[k]
-            for ix in range(lo, hi):
-                p = base + ix
-                q = p + shift
-                y0 = deformed_component(x0, u[0, q], u[0, p])
-                y1 = deformed_component(x1, u[1, q], u[1, p])
-                y2 = deformed_component(x2, u[2, q], u[2, p])
-                rr = np.sqrt(y0 * y0 + y1 * y1 + y2 * y2)
-                e = _extension(cf, u, p, q, x0, x1, x2, L, y0, y1, y2, rr)
-                ok = ((broken[word, p] & bit) == 0) & (vol[q] > zero)
-                theta[p] += (wk * vol[q]) * L * e if ok else zero
+            for c0 in range(lo, hi, CHUNK):
+                m = min(CHUNK, hi - c0)
+                p0 = base + c0
+                vq = vol[p0 + shift : p0 + shift + m]
+                _bond_terms(cf, u, p0, p0 + shift, m, x0, x1, x2, L, bits[p0 : p0 + m], bit, vq, buf)
+                g = th[c0 : c0 + m]
+                for q in range(m):
+                    g[q] += (wk * vq[q]) * L * buf[5 * CHUNK + q] if buf[q] > zero else zero
+        tc = theta_coef[base : base + nx]
         for ix in range(nx):
-            theta[base + ix] *= theta_coef[base + ix]
+            th[ix] *= tc[ix]
     return theta
 
 
@@ -134,29 +171,42 @@ def lattice_lps_force(u, vol, broken, shape, offs, xi, length, weight, cf, alpha
     zero = f.dtype.type(0.0)
     for r in numba.prange(ny * nz):
         base = r * nx
-        for a in range(3):
-            for ix in range(nx):
-                f[a, base + ix] = zero
+        buf = stack_array(LATTICE_BUFFER, f.dtype)
+        f0 = f[0, base : base + nx]
+        f1 = f[1, base : base + nx]
+        f2 = f[2, base : base + nx]
+        for ix in range(nx):
+            f0[ix] = zero
+            f1[ix] = zero
+            f2[ix] = zero
         for k in range(offs.shape[0]):
             lo, hi, shift = _neighbour_row(r, ny, nz, nx, offs[k, 0], offs[k, 1], offs[k, 2])
-            word = k >> 6
             bit = np.uint64(1) << np.uint64(k & 63)
+            bits = broken[k >> 6]
             x0, x1, x2, L, wk = xi[k, 0], xi[k, 1], xi[k, 2], length[k], weight[k]
-            for ix in range(lo, hi):
-                i = base + ix
-                j = i + shift
-                y0 = deformed_component(x0, u[0, j], u[0, i])
-                y1 = deformed_component(x1, u[1, j], u[1, i])
-                y2 = deformed_component(x2, u[2, j], u[2, i])
-                rr = np.sqrt(y0 * y0 + y1 * y1 + y2 * y2)
-                e = _extension(cf, u, i, j, x0, x1, x2, L, y0, y1, y2, rr)
-                w = wk * vol[j]
-                t = (w * L * (p[i] + p[j]) + w * (alpha[i] + alpha[j]) * e) / rr
-                ok = ((broken[word, i] & bit) == 0) & (vol[j] > zero)
-                s = t if ok else zero
-                f[0, i] += s * y0
-                f[1, i] += s * y1
-                f[2, i] += s * y2
+            for c0 in range(lo, hi, CHUNK):
+                m = min(CHUNK, hi - c0)
+                i0 = base + c0
+                j0 = i0 + shift
+                vq = vol[j0 : j0 + m]
+                _bond_terms(cf, u, i0, j0, m, x0, x1, x2, L, bits[i0 : i0 + m], bit, vq, buf)
+                pi = p[i0 : i0 + m]
+                pj = p[j0 : j0 + m]
+                ai = alpha[i0 : i0 + m]
+                aj = alpha[j0 : j0 + m]
+                for q in range(m):
+                    w = wk * vq[q]
+                    e = buf[5 * CHUNK + q]
+                    t = (w * L * (pi[q] + pj[q]) + w * (ai[q] + aj[q]) * e) / buf[4 * CHUNK + q]
+                    buf[q] = t if buf[q] > zero else zero
+                g0 = f0[c0 : c0 + m]
+                g1 = f1[c0 : c0 + m]
+                g2 = f2[c0 : c0 + m]
+                for q in range(m):
+                    s = buf[q]
+                    g0[q] += s * buf[CHUNK + q]
+                    g1[q] += s * buf[2 * CHUNK + q]
+                    g2[q] += s * buf[3 * CHUNK + q]
     return f
 
 
