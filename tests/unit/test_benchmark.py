@@ -142,3 +142,19 @@ def test_bad_arguments():
         benchmark.run_benchmark(points=4)
     with pytest.raises(InputError):
         benchmark.run_benchmark(points=512, repeat=0)
+
+
+def test_bench_storage_lattice_adds_the_lattice_rows(monkeypatch, capsys):
+    """``peridyn bench --storage lattice`` times the lattice rows in the same rounds, on the
+    same bonds (a lattice bond count equal to the bond list's), each streaming one broken bit
+    per bond and pass."""
+    monkeypatch.setattr(
+        bench_cmd, "run_benchmark", functools.partial(benchmark.run_benchmark, triad_elements=TINY_TRIAD)
+    )
+    assert main(["bench", "--points", "512", "--repeat", "1", "--storage", "lattice", "--json"]) == 0
+    rows = json.loads(capsys.readouterr().out)["results"]
+    assert [(r["model"], r["dtype"]) for r in rows] == list(benchmark.ROWS + benchmark.LATTICE_ROWS)
+    lattice = [r for r in rows if r["model"].endswith("-lattice")]
+    assert {r["bonds"] for r in rows} == {rows[0]["bonds"]}
+    assert [r["bytes_per_bond"] for r in lattice] == [1 / 8, 1 / 8, 2 / 8, 2 / 8]
+    assert min(r["bond_updates_per_s"] for r in lattice) > 0

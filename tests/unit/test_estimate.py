@@ -8,6 +8,7 @@ import pytest
 
 from peridyn.discretization import geometry
 from peridyn.discretization.bonds import find_bonds
+from peridyn.discretization.lattice import build_lattice
 from peridyn.errors import InputError
 from peridyn.io.case import apply_override, validate_case
 from peridyn.jobs import estimate
@@ -144,3 +145,22 @@ def test_wide_horizons_fall_back_to_the_ball_volume(monkeypatch):
     exact = estimate.estimate_case(_case(**plate)).bonds
     monkeypatch.setattr(estimate, "MAX_OFFSETS", 10)
     assert 0.7 * exact <= estimate.estimate_case(_case(**plate)).bonds <= 1.4 * exact
+
+
+@pytest.mark.parametrize("changes", GEOMETRIES[:6])
+def test_lattice_storage_estimate_counts_its_broken_words(changes):
+    """On lattice storage an explicit job holds one broken bit per grid point and stencil offset
+    (64-bit words: ``discretization.lattice``) and no per-bond array; ``auto`` picks it for
+    these grids and keeps bond lists for a static job."""
+    case = _case(**changes, **{"discretization.storage": "auto"})
+    est = estimate.estimate_case(case)
+    body = build_points(case)
+    lattice = build_lattice(
+        body, case.discretization.horizon * body.spacing, "constant", case.discretization.partial_volumes
+    )
+    assert est.storage == "lattice" and est.bonds == lattice.n_bonds
+    assert est.parts["bonds"] == lattice.broken.nbytes
+    assert est.parts["points"] == estimate.LATTICE_PER_POINT * body.n_points
+    bonded = estimate.estimate_case(_case(**changes))
+    assert bonded.storage == "bonds" and bonded.peak_bytes > est.peak_bytes
+    assert estimate.estimate_case(case, job="static").storage == "bonds"

@@ -56,6 +56,12 @@ def register(sub) -> None:
         help="build the bonds with partial volumes (default: full-volume bonds)",
     )
     p.add_argument(
+        "--storage",
+        choices=("bonds", "lattice"),
+        default="bonds",
+        help="lattice: also time the models on lattice storage, in the same rounds (default: bonds)",
+    )
+    p.add_argument(
         "--case",
         metavar="CASE.yaml",
         help="time an explicit case's whole steps against its force kernel instead of the grid",
@@ -101,6 +107,7 @@ def run(args) -> dict:
         repeat=args.repeat,
         partial_volumes=args.partial_volumes,
         log=log,
+        lattice=args.storage == "lattice",
     )
     if not args.json:
         print(format_table(result))
@@ -114,6 +121,10 @@ def _run_case(args, log) -> dict:
 
     if args.points is not None or args.partial_volumes:
         raise InputError("--points and --partial-volumes set the benchmark grid, not a --case run")
+    if args.storage != "bonds":
+        raise InputError(
+            "--storage sets the benchmark grid's rows; a case takes --set discretization.storage=lattice"
+        )
     backend = [f"solver.backend={args.backend}"] if args.backend == "gpu" else []
     case = load_case(args.case, [*args.overrides, *backend])
     result = run_case_benchmark(

@@ -90,6 +90,7 @@ def check_without_bonds(case, base_dir) -> dict:
 
         check_mode_count(case, body.dim, bool(loading.constrained.any()))
     found = {"points": est.points, "estimated_bonds": est.bonds, "estimated_peak_bytes": est.peak_bytes}
+    found["storage"] = est.storage
     if case.solver.type == "explicit":
         damping = float(np.max(explicit_damping(case, body)))
         stable = damped_stable_step(estimated_stable_step(case, base_dir), damping)

@@ -277,7 +277,8 @@ class BondFilter(Strict):
 
 class Discretization(Strict):
     """Spacing (m, one value or one per axis for a box), horizon as a multiple of the spacing
-    (``horizon``) or in metres (``horizon_m``), influence function and partial volumes."""
+    (``horizon``) or in metres (``horizon_m``), influence function, partial volumes and the
+    storage of the bonds."""
 
     spacing: Positive | list[Positive] | None = described(
         None, "grid spacing: one value, or one per axis for a box", "m"
@@ -296,6 +297,11 @@ class Discretization(Strict):
         "sphere",
         "sphere: |xi| <= horizon; box (a box geometry, no partial volumes): the points within "
         "round(horizon / spacing) cells along each axis, Peridigm's PdQuickGrid families",
+    )
+    storage: Literal["bonds", "lattice", "auto"] = described(
+        "bonds",
+        "how the bonds are stored: bonds (bond lists, every case), lattice (one stencil and a broken bit "
+        "per bond: grid bodies of explicit runs) or auto (lattice where the case allows it)",
     )
     bond_filters: list[BondFilter] = described(
         [], "bonds taken out of the families (Peridigm's bond filters; a pre-crack breaks them instead)"

@@ -13,7 +13,10 @@ passes count as one update of each bond):
 - ``pmb-baseline`` float64: ``kernels.pmb.pmb_force_baseline``, the straightforward
   loop (reference row, ``speedup_vs_baseline`` = 1);
 - ``pmb`` and ``lps`` in float64 and float32, through ``model.force(u, out)``, i.e. what
-  the solvers run.
+  the solvers run;
+- with ``--storage lattice``, ``pmb-lattice`` and ``lps-lattice``: the same models on lattice
+  storage (``discretization.lattice``; their ``force`` includes scattering u to the grid and
+  gathering f back), which stream one broken bit per bond and pass (1/8 B).
 
 Timing: every row is called once first (JIT compilation or cache load, excluded); then
 ``repeat`` rounds each call every row once, in turn, and a row's time is its best
@@ -72,11 +75,13 @@ import numpy as np
 
 from peridyn.discretization import geometry
 from peridyn.discretization.bonds import find_bonds
+from peridyn.discretization.lattice import build_lattice
 from peridyn.errors import InputError
 from peridyn.kernels.pmb import pmb_force_baseline
 from peridyn.kernels.roof import div_probe, sqrt_probe
 from peridyn.kernels.triad import triad
 from peridyn.physics.materials import make_model
+from peridyn.physics.materials.lattice import make_lattice_model
 
 #: Default grid: 46^3 = 97,336 points.
 DEFAULT_POINTS_PER_SIDE = 46
@@ -93,6 +98,14 @@ ROWS = (
     ("lps", "float64"),
     ("lps", "float32"),
 )
+#: Rows of lattice storage (``peridyn bench --storage lattice``, ``discretization.lattice``):
+#: the same models and dtypes on a stencil and broken bits, timed with the rows above.
+LATTICE_ROWS = (
+    ("pmb-lattice", "float64"),
+    ("pmb-lattice", "float32"),
+    ("lps-lattice", "float64"),
+    ("lps-lattice", "float32"),
+)
 #: Square roots and divisions per bond update of each row (both passes for LPS).
 OPS_PER_BOND = {
     ("pmb-baseline", "float64"): (1, 2),  # |Y|; (r - L) / L and c s / r
@@ -100,6 +113,10 @@ OPS_PER_BOND = {
     ("pmb", "float32"): (2, 1),  # |Y|, |xi|; one division
     ("lps", "float64"): (2, 1),  # |Y| in each pass; one division in the force pass
     ("lps", "float32"): (4, 2),  # |Y|, |xi| and one division in each pass
+    ("pmb-lattice", "float64"): (1, 1),  # 1 / |Y|
+    ("pmb-lattice", "float32"): (1, 2),  # |Y|; e / (|Y| + |xi|) and 1 / |Y| (|xi| per offset)
+    ("lps-lattice", "float64"): (2, 1),  # |Y| in each pass; one division in the force pass
+    ("lps-lattice", "float32"): (2, 3),  # |Y| in each pass; e / (|Y| + |xi|) in each, / |Y| in the force
 }
 #: Compute probes: elements per row (in L1) and in-place iterations per call.
 PROBE_ELEMENTS = 1024
@@ -176,6 +193,8 @@ def bytes_per_bond(model: str, dtype: str, half_list: bool = False) -> float:
         inverse_length = real if dtype == "float64" else 0  # float32 recomputes |xi| from the points
         full = index + vector + inverse_length + real + flag  # + stiffness
         return (full + real) / 2 if half_list else full  # + the reverse stiffness, per two updates
+    if model.endswith("-lattice"):
+        return (2 if model == "lps-lattice" else 1) / 8  # the broken bit, per pass
     if model == "lps":
         length = real if dtype == "float64" else 0  # float32 recomputes |xi| from the points
         dilatation = index + vector + length + real + flag  # + weight
@@ -184,10 +203,10 @@ def bytes_per_bond(model: str, dtype: str, half_list: bool = False) -> float:
 
 
 def _row_callables(
-    body, bonds, u64: np.ndarray
+    body, bonds, u64: np.ndarray, lattice=None
 ) -> tuple[dict[tuple[str, str], Callable[[], np.ndarray]], set]:
     """One zero-argument callable per row, each computing a full force evaluation, and the
-    rows that run the PMB half list."""
+    rows that run the PMB half list; with a ``lattice`` of the body, its rows too."""
     calls = {}
     models = {}
     for name, dtype in ROWS:
@@ -195,6 +214,11 @@ def _row_callables(
             continue
         models[name, dtype] = make_model(
             name, body, bonds, E=E, nu=NU, density=DENSITY, dtype=np.dtype(dtype)
+        )
+    for name, dtype in LATTICE_ROWS if lattice is not None else ():
+        material = name.removesuffix("-lattice")
+        models[name, dtype] = make_lattice_model(
+            material, body, lattice, E=E, nu=NU, density=DENSITY, dtype=np.dtype(dtype)
         )
     # the baseline computes the PMB force with c = the PMB bond stiffness (k (1/|xi| - 1/|Y|) Y)
     c = models["pmb", "float64"].bond_stiffness.astype(np.float64)
@@ -221,6 +245,7 @@ def run_benchmark(
     triad_elements: int = DEFAULT_TRIAD_ELEMENTS,
     seed: int = 0,
     log: Callable[[str], None] | None = None,
+    lattice: bool = False,
 ) -> dict:
     """Measure every row and the triad bandwidth; returns the ``peridyn bench --json`` dict.
 
@@ -238,6 +263,8 @@ def run_benchmark(
         Seed of the random displacement field (amplitude 1e-4 spacing).
     log : callable or None
         Receives progress messages (the CLI sends them to stderr).
+    lattice : bool
+        Also time the models on lattice storage (``LATTICE_ROWS``), interleaved with the others.
     """
     if repeat < 1:
         raise InputError(f"repeat must be at least 1, got {repeat}")
@@ -247,7 +274,9 @@ def run_benchmark(
     body, bonds = benchmark_grid(side, partial_volumes)
     rng = np.random.default_rng(seed)
     u64 = 1e-4 * SPACING * rng.standard_normal(body.points.shape)
-    calls, half = _row_callables(body, bonds, u64)
+    grid = build_lattice(body, HORIZON_FACTOR * SPACING, partial_volumes=partial_volumes) if lattice else None
+    calls, half = _row_callables(body, bonds, u64, grid)
+    rows = ROWS + (LATTICE_ROWS if lattice else ())
     say(f"{body.n_points} points, {bonds.n_bonds} directed bonds; warming up (JIT)")
     for call in calls.values():
         call()
@@ -264,7 +293,7 @@ def run_benchmark(
     rates = {dtype: op_rates(dtype, max(repeat, 5)) for dtype in ("float64", "float32")}
     base_rate = bonds.n_bonds / best["pmb-baseline", "float64"]
     results = []
-    for name, dtype in ROWS:
+    for name, dtype in rows:
         rate = bonds.n_bonds / best[name, dtype]
         nbytes = bytes_per_bond(name, dtype, (name, dtype) in half)
         n_sqrt, n_div = ops_per_bond(name, dtype, (name, dtype) in half)

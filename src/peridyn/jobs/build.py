@@ -27,10 +27,12 @@ from peridyn.discretization.bonds import (
     search_reach,
     without_bonds,
 )
+from peridyn.discretization.lattice import build_lattice, cut_lattice
 from peridyn.discretization.pairs import index_bandwidth, row_blocks
 from peridyn.errors import CaseFileError, InputError
 from peridyn.io import exodus, mesh_text
 from peridyn.io.case import Case, Geometry, Region, box_cells
+from peridyn.jobs.storage import choose_storage
 from peridyn.parallel.contact import RankContact
 from peridyn.parallel.domain import Domain, agree
 from peridyn.parallel.halo import Halo, clearance, ghost_layers, plan_halo
@@ -38,9 +40,11 @@ from peridyn.parallel.partition import rcb
 from peridyn.physics.contact import Contact
 from peridyn.physics.damage import BondDamage, protected_points
 from peridyn.physics.expressions import SpaceTime
+from peridyn.physics.lattice_damage import LatticeDamage
 from peridyn.physics.loads import BoundaryCondition, InitialCondition, Loading
 from peridyn.physics.materials import Model, make_model
 from peridyn.physics.materials.blocks import BlockMaterial, assign_blocks, make_block_model
+from peridyn.physics.materials.lattice import make_lattice_model
 from peridyn.physics.timefunctions import from_spec
 from peridyn.physics.transducers import pin_force_actuator, pzt_radial_actuator
 
@@ -66,6 +70,8 @@ class Setup:
     contact: Contact | None = None
     domain: Domain | None = None
     whole_body: Body | None = None
+    #: ``bonds`` (``bonds`` a ``Bonds``) or ``lattice`` (``bonds`` a ``discretization.lattice.Lattice``)
+    storage: str = "bonds"
 
     def __post_init__(self):
         if self.domain is None:
@@ -237,21 +243,7 @@ def cut_precracks(case: Case, body: Body, bonds: Bonds, in_weighted_volume: bool
     for crack in case.precracks:
         if crack.in_weighted_volume != in_weighted_volume:
             continue
-        if crack.type == "rectangle":
-
-            def crossing(a, b, c=crack):
-                return crossing_rectangle(a, b, c.origin, c.edge_u, c.edge_v)
-        elif crack.type == "surface":
-            triangles = surface_triangles(crack.file)
-
-            def crossing(a, b, tris=triangles):
-                return crossing_triangles(a, b, tris)
-        else:
-
-            def crossing(a, b, c=crack):
-                return crossing_segment(a, b, c.start, c.end)
-
-        cut_bonds(body, bonds, crossing)
+        cut_bonds(body, bonds, precrack_crossing(crack))
 
 
 def surface_triangles(path) -> np.ndarray:
@@ -457,11 +449,14 @@ def build(case: Case, base_dir=".", comm=None) -> Setup:
     Within ``peridyn.interrupts.deferred``, a SIGINT or SIGTERM stops a serial build after the
     phase under way (points, bonds, model) with ``Interrupted``."""
     if comm is not None and comm.size > 1:
+        choose_storage(case, None, comm)  # refuses an explicit lattice: MPI runs on bond lists
         return build_part(case, comm, base_dir)
     body = build_body(case, base_dir)
     interrupts.check(where=BUILDING)
     check_placements(case, body)
     body, actuation = add_actuators(case, body)
+    if choose_storage(case, body, comm) == "lattice":
+        return build_on_lattice(case, body, actuation)
     bonds = build_bonds(case, body)
     interrupts.check(where=BUILDING)
     model = build_model(case, body, bonds)
@@ -471,6 +466,48 @@ def build(case: Case, base_dir=".", comm=None) -> Setup:
     loading = build_loading(case, body, actuation)
     check_loading(case, loading)
     return Setup(body, bonds, model, loading, damage, build_contact(case, model))
+
+
+def build_on_lattice(case: Case, body: Body, actuation=()) -> Setup:
+    """The Setup of a case on lattice storage (``jobs.storage``): the body's lattice with the
+    pre-cracks cut, the material and damage on it (``setup.bonds`` is the lattice)."""
+    lattice = build_lattice(
+        body, case_horizon(case, body), case.discretization.influence, case.discretization.partial_volumes
+    )
+    for crack in case.precracks:
+        cut_lattice(body, lattice, precrack_crossing(crack))
+    interrupts.check(where=BUILDING)
+    mat = case.material
+    model = make_lattice_model(
+        mat.model,
+        body,
+        lattice,
+        E=mat.E,
+        density=mat.density,
+        nu=mat.nu,
+        surface_correction=mat.surface_correction,
+        dtype=case.solver.dtype,
+    )
+    d = mat.damage
+    damage = None
+    if d is not None:
+        damage = LatticeDamage(
+            model, d.critical_stretch, d.fracture_energy, d.no_damage_sets, d.critical_bond_stress
+        )
+    interrupts.check(where=BUILDING)
+    loading = build_loading(case, body, actuation)
+    check_loading(case, loading)
+    return Setup(body, lattice, model, loading, damage, storage="lattice")
+
+
+def precrack_crossing(crack):
+    """``crossing(x_from, x_to)`` (bool mask of the segments that cross) of a case's pre-crack."""
+    if crack.type == "rectangle":
+        return lambda a, b: crossing_rectangle(a, b, crack.origin, crack.edge_u, crack.edge_v)
+    if crack.type == "surface":
+        triangles = surface_triangles(crack.file)
+        return lambda a, b: crossing_triangles(a, b, triangles)
+    return lambda a, b: crossing_segment(a, b, crack.start, crack.end)
 
 
 #: Ghost layers of a rank's part (``peridyn.parallel.halo``): two, so that every per-point

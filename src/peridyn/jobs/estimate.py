@@ -27,6 +27,7 @@ import numpy as np
 from peridyn.discretization import geometry
 from peridyn.errors import CaseFileError, InputError
 from peridyn.io.case import Case
+from peridyn.jobs.storage import lattice_refusals
 
 #: Resident bytes of the interpreter with numpy, scipy, numba (and its loaded kernels), h5py
 #: and peridyn imported, before the first array: measured with ``/usr/bin/time -v`` on a
@@ -69,6 +70,14 @@ COSTS = {
     "modal": Costs(per_point=600.0, per_bond=500.0),
 }
 
+#: An explicit run on lattice storage (``discretization.storage``, docs/user-guide.md) holds no
+#: per-bond array: per point the body and state as bond lists (350 B), the grid index, the grid's
+#: volume, displacement and force (float64: 56 B), the per-point LPS coefficients, dilatation
+#: and set-up sums (about 100 B) and the damage's grid displacement and reference (48 B); per
+#: point and offset of the stencil one broken bit (``LATTICE_BIT_BYTES``).
+LATTICE_PER_POINT = 560.0
+LATTICE_BIT_BYTES = 1.0 / 8.0
+
 #: Bytes per directed bond an explicit run saves with float32 kernels: half of the model's 32 B,
 #: and the 24 B of bond vectors that only the float64 kernels read.
 FLOAT32_SAVING = 40.0
@@ -86,13 +95,15 @@ MAX_OFFSETS = 2_000_000
 
 @dataclass(frozen=True)
 class Estimate:
-    """What a job would hold: ``points``, directed ``bonds`` and ``peak_bytes`` (by ``parts``)."""
+    """What a job would hold: ``points``, directed ``bonds`` and ``peak_bytes`` (by ``parts``),
+    on the ``storage`` of its bonds (``bonds`` or ``lattice``)."""
 
     job: str
     points: int
     bonds: int
     peak_bytes: float
     parts: dict = field(default_factory=dict)
+    storage: str = "bonds"
 
 
 def parse_bytes(text) -> int:
@@ -223,9 +234,21 @@ def estimate_case(case: Case, base_dir=".", job: str | None = None) -> Estimate:
         FLOAT32_SAVING if job == "explicit" and case.solver.dtype == "float32" else 0
     )
     parts = {"base": BASE_BYTES, "points": points * costs.per_point, "bonds": bonds * per_bond}
+    storage = "lattice" if job == "explicit" and runs_on_lattice(case) else "bonds"
+    if storage == "lattice":
+        offsets = len(neighbour_offsets(counts, cell, horizon, d.partial_volumes, dim)[0])
+        words = 8.0 * math.ceil(offsets / 64)  # the broken bits, in 64-bit words per grid point
+        grid = float(np.prod(counts.astype(float)))  # removed points keep their grid place
+        parts.update(points=points * LATTICE_PER_POINT, bonds=grid * max(words, offsets * LATTICE_BIT_BYTES))
     if job == "modal":
         parts["factor"] = modal_factor_bytes(case, base_dir, points, horizon)
-    return Estimate(job, int(round(points)), int(round(bonds)), float(sum(parts.values())), parts)
+    return Estimate(job, int(round(points)), int(round(bonds)), float(sum(parts.values())), parts, storage)
+
+
+def runs_on_lattice(case: Case) -> bool:
+    """Whether ``discretization.storage`` puts the case on lattice storage (``jobs.storage``):
+    ``lattice``, or ``auto`` where nothing needs bond lists (a box, plate or rectangle is a grid)."""
+    return case.discretization.storage != "bonds" and not lattice_refusals(case)
 
 
 def modal_factor_bytes(case: Case, base_dir, points: float, horizon: float) -> float:

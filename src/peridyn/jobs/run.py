@@ -396,14 +396,29 @@ def _base_summary(setup: Setup) -> dict:
     """Points, directed bonds, broken bonds and largest damage of the whole body (collective)."""
     d = setup.domain
     n = d.n_owned
-    owned_bonds = int(setup.bonds.offsets[n])  # the owned points' families come first
     phi = damage_field(setup.model)
+    if setup.storage == "lattice":  # one process
+        bonds, broken = setup.bonds.n_bonds, setup.bonds.n_broken()
+    else:
+        owned_bonds = int(setup.bonds.offsets[n])  # the owned points' families come first
+        bonds, broken = d.count(owned_bonds), d.count((~setup.bonds.intact[:owned_bonds]).sum())
     return {
         "points": setup.whole_body.n_points,
-        "bonds": d.count(owned_bonds),
-        "broken_bonds": d.count((~setup.bonds.intact[:owned_bonds]).sum()),
+        "bonds": bonds,
+        "broken_bonds": broken,
         "max_damage": float(d.max(phi[:n].max())),
+        "storage": setup.storage,
     }
+
+
+def bond_state(setup: Setup) -> tuple[np.ndarray, np.ndarray]:
+    """(array, offsets): the bonds' state that a checkpoint saves and a restart writes back in
+    place, with its CSR family ``offsets``: the intact mask of bond lists, or the broken words
+    of a lattice (flat, ``offsets`` [0, their number]: one process)."""
+    if setup.storage == "lattice":
+        words = setup.bonds.broken.reshape(-1)
+        return words, np.array([0, len(words)])
+    return setup.bonds.intact, setup.bonds.offsets
 
 
 def time_stepper(case, setup):
@@ -461,7 +476,7 @@ def _run_explicit(
         for name, part in (("damage", setup.damage), ("contact", setup.contact), ("cracks", cracks))
         if part is not None
     }
-    whole_bonds = d.bond_offsets(setup.bonds.offsets)
+    whole_bonds = d.bond_offsets(bond_state(setup)[1])
     if restart:
         state = _restart(ckpt_path, setup, meta, parts, whole_bonds, n_steps, out / RESULTS)
         resume = (state.step, state.time)
@@ -617,7 +632,7 @@ def _restart(
     if d.size > 1:
         ids = d.global_ids
         state = State(state.u[ids], state.v[ids], state.a[ids], state.time, state.step)
-    setup.bonds.intact[:] = d.scatter_bonds(intact, setup.bonds, whole_bonds)
+    bond_state(setup)[0][:] = d.scatter_bonds(intact, setup.bonds, whole_bonds)
     for name, part in parts.items():
         part.restore_state(saved.get(name, {}) if d.size == 1 or name != "damage" else {})
     return state
@@ -641,7 +656,7 @@ def _checkpointer(
     (``HDF5Writer.identity``, on rank 0)."""
     d = setup.domain
     if d.size == 1:
-        return Checkpointer(path, every, setup.bonds.intact, meta, parts, before_save, results), []
+        return Checkpointer(path, every, bond_state(setup)[0], meta, parts, before_save, results), []
     whole_intact = np.ones(int(whole_bonds[-1]), dtype=bool) if d.is_root else None
     checkpointer = Checkpointer(
         path,

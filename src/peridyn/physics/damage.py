@@ -37,7 +37,7 @@ from __future__ import annotations
 import numpy as np
 
 from peridyn.errors import InputError
-from peridyn.kernels.damage import MAX_QUANTA, damage_index, flag_moved_points, stretch_test_families
+from peridyn.kernels.damage import MAX_QUANTA, flag_moved_points, stretch_test_families
 from peridyn.physics.materials.base import Model
 
 
@@ -265,6 +265,6 @@ class BondDamage:
 
 
 def damage_field(model: Model) -> np.ndarray:
-    """Damage index phi (n_points,): the broken share of each family's bond volume."""
-    b = model.bonds
-    return damage_index(b.offsets, model.bond_volume, b.intact, np.empty(model.body.n_points))
+    """Damage index phi (n_points,): the broken share of each family's bond volume
+    (``Model.damage_index``)."""
+    return model.damage_index()

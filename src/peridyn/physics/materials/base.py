@@ -29,6 +29,7 @@ from peridyn.discretization.body import Body
 from peridyn.discretization.bonds import Bonds
 from peridyn.errors import InputError
 from peridyn.kernels.bond_search import initial_bond_vectors
+from peridyn.kernels.damage import damage_index
 from peridyn.kernels.lps import lps_dilatation
 from peridyn.kernels.stress import partial_stress
 from peridyn.physics.materials.linearisation import BondLinearisation
@@ -261,6 +262,12 @@ class Model:
         return partial_stress(
             x, u, b.offsets, b.neighbours, b.length, axial, 0.5 * lin.pair, b.intact, p, np.empty((n, 3, 3))
         )
+
+    def damage_index(self) -> np.ndarray:
+        """Damage index phi (n_points,): 1 - the intact share of each family's bond volume
+        (neighbour volume times partial-volume factor); 0 for a point without bonds."""
+        b = self.bonds
+        return damage_index(b.offsets, self.bond_volume, b.intact, np.empty(self.body.n_points))
 
     @property
     def has_dilatation(self) -> bool:

@@ -181,51 +181,19 @@ class LPSModel(Model):
         self._fused_cache: dict = {}
 
     def _shear_correction_factor(self, w: np.ndarray) -> np.ndarray:
-        """Shear correction factor (Peridigm's former "Apply Shear Correction Factor").
-
-        For the pure shears of amplitude gamma in the planes xy, xz, yz (xy only in
-        2D), u_a = gamma x_b, u_b = gamma x_a, each point's deviatoric norm
-        S = sum_j w (e - theta |xi| / d)^2 is compared with its bulk value
-        S_bulk = 4 gamma^2 m / 15 (3D; 4 gamma^2 m / 8 in 2D), and alpha is
-        multiplied by S_bulk / max(S): the point's stiffest pure-shear response is
-        brought to the bulk value. This reproduces the independent assembly of
-        docs/reference-cases.md, V4 to all printed digits (40 000 points, 1.4143 h).
-        """
+        """Peridigm's shear correction factor (``shear_correction_factor``) over the bonds."""
         body, b = self.body, self.bonds
         x, xi = body.points, self.bond_vectors_once()
-        gamma = 1e-6
-        planes = [(0, 1), (0, 2), (1, 2)] if self.dim == 3 else [(0, 1)]
-        largest = np.zeros(body.n_points)
-        for a, c in planes:
-            u = np.zeros_like(x)
-            u[:, a] = gamma * x[:, c]
-            u[:, c] = gamma * x[:, a]
-            theta = lps_dilatation(
-                xi,
-                u,
-                b.offsets,
-                b.neighbours,
-                b.length,
-                w,
-                b.intact,
-                self.theta_coef,
-                np.empty(body.n_points),
-            )
-            norm = lps_deviatoric_energy(
-                x,
-                u,
-                b.offsets,
-                b.neighbours,
-                b.length,
-                w,
-                b.intact,
-                theta,
-                float(self.dim),
-                np.empty(body.n_points),
-            )
-            largest = np.maximum(largest, norm)
-        bulk = 4.0 * gamma**2 * self.weighted_volume / (15.0 if self.dim == 3 else 8.0)
-        return bulk / largest
+        n = body.n_points
+        family = (b.offsets, b.neighbours, b.length, w, b.intact)
+
+        def dilatation(u):
+            return lps_dilatation(xi, u, *family, self.theta_coef, np.empty(n))
+
+        def deviatoric_norm(u, theta):
+            return lps_deviatoric_energy(x, u, *family, theta, float(self.dim), np.empty(n))
+
+        return shear_correction_factor(x, self.dim, self.weighted_volume, dilatation, deviatoric_norm)
 
     def _dilatation(self, u: np.ndarray, first: int = 0, stop: int = -1) -> np.ndarray:
         """theta into the rows ``first .. stop - 1`` (``stop`` < 0: to the last row) of
@@ -417,3 +385,30 @@ class LPSModel(Model):
             denom = (6.0 * mu / np.pi + 16.0 / (9.0 * np.pi**2) * (k - 2.0 * mu)) * delta
         s_c = np.sqrt(fracture_energy / denom)
         return float(s_c) if np.ndim(s_c) == 0 else s_c
+
+
+def shear_correction_factor(points, dim: int, weighted_volume, dilatation, deviatoric_norm) -> np.ndarray:
+    """Shear correction factor (Peridigm's former "Apply Shear Correction Factor"), (n_points,).
+
+    For the pure shears of amplitude gamma in the planes xy, xz, yz (xy only in 2D),
+    u_a = gamma x_b, u_b = gamma x_a, each point's deviatoric norm
+    S = sum_j w (e - theta |xi| / d)^2 is compared with its bulk value
+    S_bulk = 4 gamma^2 m / 15 (3D; 4 gamma^2 m / 8 in 2D), and alpha is
+    multiplied by S_bulk / max(S): the point's stiffest pure-shear response is
+    brought to the bulk value. This reproduces the independent assembly of
+    VALIDATION.md V4 to all printed digits (40 000 points, 1.4143 h).
+
+    ``points`` (n_points, 3) m; ``weighted_volume`` m (n_points,) m^5; ``dilatation(u)`` the
+    points' theta at u (n_points, 3) m and ``deviatoric_norm(u, theta)`` their S, m^5, over
+    the storage of the bonds (bond lists or a lattice).
+    """
+    gamma = 1e-6
+    planes = [(0, 1), (0, 2), (1, 2)] if dim == 3 else [(0, 1)]
+    largest = np.zeros(len(points))
+    for a, c in planes:
+        u = np.zeros_like(points)
+        u[:, a] = gamma * points[:, c]
+        u[:, c] = gamma * points[:, a]
+        largest = np.maximum(largest, deviatoric_norm(u, dilatation(u)))
+    bulk = 4.0 * gamma**2 * weighted_volume / (15.0 if dim == 3 else 8.0)
+    return bulk / largest

@@ -65,6 +65,18 @@ def pmb_micromodulus(
     return 8.0 * kappa / (thickness * 2.0 * np.pi * radial_moments(influence, horizon, 2))
 
 
+def check_pmb_parameters(body: Body, E, nu, density, surface_correction: str) -> None:
+    """Refuse PMB constants a body cannot take: E and density as ``check_elastic``, a ``nu``
+    other than the implied Poisson ratio (``pmb_poisson_ratio``), an unknown surface correction."""
+    implied = pmb_poisson_ratio(body.dim, body.plane)
+    check_elastic(E, implied if nu is None else nu, density)
+    PMBModel.check_nu(nu, body.dim, body.plane)
+    if surface_correction not in SURFACE_CORRECTIONS:
+        raise InputError(
+            f"PMB surface_correction must be one of {SURFACE_CORRECTIONS}, got {surface_correction!r}"
+        )
+
+
 def bond_micromodulus(c0, bonds: Bonds):
     """c0 of each bond, N/m^6 (3D): ``c0`` itself if one number, else the mean of its two end
     points' c0 (``c0`` (n_points,), a body of several blocks), an (n_bonds,) array.
@@ -108,13 +120,7 @@ class PMBModel(Model):
         surface_correction: str = "none",
         dtype=np.float64,
     ):
-        implied = self.implied_poisson_ratio(body.dim, body.plane)
-        check_elastic(E, implied if nu is None else nu, density)
-        self.check_nu(nu, body.dim, body.plane)
-        if surface_correction not in SURFACE_CORRECTIONS:
-            raise InputError(
-                f"PMB surface_correction must be one of {SURFACE_CORRECTIONS}, got {surface_correction!r}"
-            )
+        check_pmb_parameters(body, E, nu, density, surface_correction)
         super().__init__(body, bonds, E=E, density=density, dtype=dtype)
         self.c0 = pmb_micromodulus(
             E, body.dim, bonds.horizons(), bonds.influence_name, body.plane, body.thickness

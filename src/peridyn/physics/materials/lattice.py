@@ -1,0 +1,317 @@
+"""PMB and LPS on lattice storage (``peridyn.discretization.lattice``): the same laws as
+``materials.pmb`` and ``materials.lps``, their coefficients per stencil offset and per grid
+point instead of per bond.
+
+A lattice model keeps the displacement and force of the grid as (3, n_grid) arrays: each
+force scatters ``u`` (n_points, 3) to the grid, runs the lattice kernels
+(``peridyn.kernels.lattice``) and gathers the force back to the body's points, so that
+solvers, loads and recorders see the body as with bond lists. It has no bond linearisation
+(static, Newton, Newmark, modal runs and the stress output keep bond lists).
+
+What lattice storage takes: one material, the surface corrections of
+``LATTICE_SURFACE_CORRECTIONS`` (PMB none; LPS none and shear-factor), float64 and float32;
+:func:`lattice_support` says why a case needs bond lists.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from peridyn.discretization.body import Body
+from peridyn.discretization.lattice import Lattice
+from peridyn.errors import InputError
+from peridyn.kernels.lattice import (
+    lattice_energy_sum,
+    lattice_gather,
+    lattice_lps_dilatation,
+    lattice_lps_force,
+    lattice_pair_sum,
+    lattice_pmb_force,
+    lattice_scatter,
+)
+from peridyn.physics.materials.base import Model
+from peridyn.physics.materials.elastic import bulk_modulus, check_elastic, plane_bulk_modulus, shear_modulus
+from peridyn.physics.materials.lps import LPSModel, shear_correction_factor
+from peridyn.physics.materials.pmb import PMBModel, check_pmb_parameters, pmb_micromodulus
+
+#: Surface corrections lattice storage computes, per material (the others keep bond lists).
+LATTICE_SURFACE_CORRECTIONS = {"pmb": ("none",), "lps": ("none", "shear-factor")}
+
+
+class LatticeModel(Model):
+    """A material law over a :class:`Lattice` (abstract; see the module docstring).
+
+    Attributes beyond ``Model``'s: ``lattice`` (also ``bonds``: what damage, summaries and
+    checkpoints read), ``storage`` = "lattice".
+    """
+
+    storage = "lattice"
+
+    def __init__(self, body: Body, lattice: Lattice, E, density, dtype=np.float64):
+        if np.ndim(E) or np.ndim(density):
+            raise InputError("lattice storage takes one material: E and density must be numbers")
+        self.body = body
+        self.lattice = self.bonds = lattice
+        self.E = float(E)
+        self.dtype = np.dtype(dtype)
+        self.x = np.ascontiguousarray(body.points, dtype=self.dtype)
+        self.density = np.full(body.n_points, float(density))
+        s = lattice.stencil
+        self._cf = self.dtype == np.float32  # the cancellation-free extension in float32
+        self._vol = lattice.volume.astype(self.dtype)
+        self._xi = s.xi.astype(self.dtype)
+        self._length = s.length.astype(self.dtype)
+        self._ug = np.zeros((3, lattice.n_grid), dtype=self.dtype)  # holes stay 0
+        self._fg = np.empty((3, lattice.n_grid), dtype=self.dtype)
+        self._linearisation = None
+        self._bond_vectors = None
+
+    def _scatter(self, u: np.ndarray) -> np.ndarray:
+        """``u`` (n_points, 3) into the grid's (3, n_grid) displacement (kernel dtype)."""
+        return lattice_scatter(np.ascontiguousarray(u), self.lattice.grid_index, self._ug)
+
+    def _gather(self, out: np.ndarray | None) -> np.ndarray:
+        out = np.empty_like(self.x) if out is None else out
+        return lattice_gather(self._fg, self.lattice.grid_index, out)
+
+    def _grid64(self, u: np.ndarray) -> np.ndarray:
+        """(3, n_grid) float64 displacement of the grid (energies and set-up sums)."""
+        return lattice_scatter(
+            np.ascontiguousarray(u, dtype=np.float64),
+            self.lattice.grid_index,
+            np.zeros((3, self.lattice.n_grid)),
+        )
+
+    def _at_points(self, grid_values: np.ndarray) -> np.ndarray:
+        return grid_values[self.lattice.grid_index]
+
+    def bond_vectors_once(self):
+        raise InputError("lattice storage keeps no bond list: use discretization.storage: bonds")
+
+    def linearisation(self):
+        raise InputError(
+            "lattice storage has no bond linearisation (static, Newton, Newmark and modal runs, "
+            "the stress and strain outputs): use discretization.storage: bonds"
+        )
+
+    def damage_index(self) -> np.ndarray:
+        """(n_points,) 1 - intact / total partial-volume-weighted neighbour volume of each family."""
+        lat = self.lattice
+        factor = lat.stencil.volume_factor
+        total = self._at_points(lat.bond_sum(factor, every=True))
+        alive = self._at_points(lat.bond_sum(factor))
+        return np.where(total > 0, 1.0 - alive / np.where(total > 0, total, 1.0), 0.0)
+
+    def _offset_table(self, values) -> np.ndarray:
+        return np.ascontiguousarray(values, dtype=self.dtype)
+
+
+class LatticePMB(LatticeModel):
+    """PMB (``materials.pmb``) on a lattice: bond stiffness c0 omega beta V_j per offset."""
+
+    name = "pmb"
+    implied_poisson_ratio = PMBModel.implied_poisson_ratio
+    critical_stretch = PMBModel.critical_stretch
+
+    def __init__(self, body, lattice, E, density, nu=None, surface_correction="none", dtype=np.float64):
+        check_pmb_parameters(body, E, nu, density, surface_correction)
+        check_lattice_correction("pmb", surface_correction)
+        super().__init__(body, lattice, E, density, dtype)
+        s = lattice.stencil
+        self.c0 = pmb_micromodulus(
+            E, body.dim, lattice.horizon, lattice.influence_name, body.plane, body.thickness
+        )
+        self._coef64 = self.c0 * s.influence * s.volume_factor
+        self._coef = self._offset_table(self._coef64)
+        self._inv_len = self._offset_table(1.0 / s.length)
+
+    def force(self, u, out=None):
+        lat = self.lattice
+        ug = self._scatter(self._as_state(u))
+        s = lat.stencil
+        lattice_pmb_force(
+            ug,
+            self._vol,
+            lat.broken,
+            lat.shape,
+            s.offsets,
+            self._xi,
+            self._length,
+            self._inv_len,
+            self._coef,
+            self._cf,
+            self._fg,
+        )
+        return self._gather(out)
+
+    def energy_density(self, u):
+        lat, s = self.lattice, self.lattice.stencil
+        w = lattice_energy_sum(
+            self._grid64(u), lat.volume, lat.broken, lat.shape, s.offsets, s.xi, s.length,
+            0.25 * self._coef64, np.zeros(lat.n_grid), 1.0, np.empty(lat.n_grid),
+        )  # fmt: skip
+        return self._at_points(w)
+
+    def stiffness_bound(self):
+        return self._at_points(2.0 * self.lattice.bond_sum(self._coef64 / self.lattice.stencil.length))
+
+
+class LatticeLPS(LatticeModel):
+    """LPS (``materials.lps``, no surface correction) on a lattice: w = omega beta V_j per
+    offset, m, alpha, theta and P per grid point."""
+
+    name = "lps"
+    critical_stretch = LPSModel.critical_stretch
+
+    def __init__(self, body, lattice, E, density, nu=None, surface_correction="none", dtype=np.float64):
+        if nu is None:
+            raise InputError("an LPS material needs Poisson's ratio nu")
+        check_elastic(E, nu, density)
+        check_lattice_correction("lps", surface_correction)
+        super().__init__(body, lattice, E, density, dtype)
+        dim = body.dim
+        s = lattice.stencil
+        self.dim, self.nu = dim, float(nu)
+        self.shear = shear_modulus(E, nu)
+        self.bulk = bulk_modulus(E, nu) if dim == 3 else plane_bulk_modulus(E, nu, body.plane)
+        self._weight64 = s.influence * s.volume_factor
+        m = lattice.bond_sum(self._weight64 * s.length**2)
+        occupied = lattice.volume > 0
+        if np.any(m[lattice.grid_index] <= 0):
+            lonely = int(np.flatnonzero(m[lattice.grid_index] <= 0)[0])
+            raise InputError(f"point {lonely} has no intact bond: its weighted volume is zero")
+        safe = np.where(occupied, m, 1.0)
+        self.weighted_volume = np.where(occupied, m, 0.0)
+        self.alpha = np.where(occupied, (15.0 if dim == 3 else 8.0) * self.shear / safe, 0.0)
+        self.theta_coef = np.where(occupied, dim / safe, 0.0)
+        self.shear_factor = np.ones(body.n_points)
+        if surface_correction == "shear-factor":
+            self.shear_factor = self._shear_correction_factor()
+            self.alpha[lattice.grid_index] *= self.shear_factor
+        self.p_coef = np.where(occupied, dim * self.bulk / safe - self.alpha / dim, 0.0)
+        self._weight = self._offset_table(self._weight64)
+        self._alpha = self.alpha.astype(self.dtype)
+        self._theta_coef = self.theta_coef.astype(self.dtype)
+        self._p_coef = self.p_coef.astype(self.dtype)
+        self._theta = np.zeros(lattice.n_grid, dtype=self.dtype)
+        self._p = np.zeros(lattice.n_grid, dtype=self.dtype)
+
+    def _shear_correction_factor(self) -> np.ndarray:
+        """``materials.lps.shear_correction_factor`` over the lattice's bonds (float64)."""
+        lat, s = self.lattice, self.lattice.stencil
+        table = (lat.volume, lat.broken, lat.shape, s.offsets, s.xi, s.length)
+
+        def dilatation(u):
+            theta = lattice_lps_dilatation(
+                self._grid64(u), *table, self._weight64, False, self.theta_coef, np.empty(lat.n_grid)
+            )
+            return self._at_points(theta)
+
+        def deviatoric_norm(u, theta):
+            grid_theta = np.zeros(lat.n_grid)
+            grid_theta[lat.grid_index] = theta
+            coef = self._weight64 * s.length
+            norm = lattice_energy_sum(
+                self._grid64(u), *table, coef, grid_theta, float(self.dim), np.empty(lat.n_grid)
+            )
+            return self._at_points(norm)
+
+        m = self._at_points(self.weighted_volume)
+        return shear_correction_factor(self.body.points, self.dim, m, dilatation, deviatoric_norm)
+
+    def _grid_dilatation(self, ug, vol, theta_coef, out):
+        lat, s = self.lattice, self.lattice.stencil
+        args = (s.offsets, self._xi, self._length, self._weight, self._cf)
+        if ug.dtype == np.float64 and self.dtype != np.float64:
+            args = (s.offsets, s.xi, s.length, self._weight64, False)
+        return lattice_lps_dilatation(ug, vol, lat.broken, lat.shape, *args, theta_coef, out)
+
+    def dilatation(self, u) -> np.ndarray:
+        """Dilatation theta (n_points,), dimensionless."""
+        ug = self._scatter(self._as_state(u))
+        return self._at_points(self._grid_dilatation(ug, self._vol, self._theta_coef, self._theta)).copy()
+
+    def force(self, u, out=None):
+        lat, s = self.lattice, self.lattice.stencil
+        ug = self._scatter(self._as_state(u))
+        self._grid_dilatation(ug, self._vol, self._theta_coef, self._theta)
+        np.multiply(self._theta, self._p_coef, out=self._p)
+        args = (s.offsets, self._xi, self._length, self._weight, self._cf, self._alpha, self._p)
+        lattice_lps_force(ug, self._vol, lat.broken, lat.shape, *args, self._fg)
+        return self._gather(out)
+
+    def energy_density(self, u):
+        lat, s = self.lattice, self.lattice.stencil
+        ug = self._grid64(u)
+        theta = lattice_lps_dilatation(
+            ug, lat.volume, lat.broken, lat.shape, s.offsets, s.xi, s.length, self._weight64, False,
+            self.theta_coef, np.empty(lat.n_grid),
+        )  # fmt: skip
+        squares = lattice_energy_sum(
+            ug, lat.volume, lat.broken, lat.shape, s.offsets, s.xi, s.length, self._weight64 * s.length,
+            theta, float(self.dim), np.empty(lat.n_grid),
+        )  # fmt: skip
+        return self._at_points(0.5 * self.bulk * theta**2 + 0.5 * self.alpha * squares)
+
+    def stiffness_bound(self):
+        """The block-Gershgorin bound of ``LPSModel.stiffness_bound`` over the lattice's bonds."""
+        lat, s = self.lattice, self.lattice.stencil
+        w = self._weight64
+        spread = self.theta_coef * lat.bond_sum(w * s.length)
+        zero = np.zeros(lat.n_grid)
+        pairs = lattice_pair_sum(
+            lat.volume,
+            lat.broken,
+            lat.shape,
+            s.offsets,
+            2.0 * w,
+            self.alpha,
+            self.alpha,
+            np.empty(lat.n_grid),
+        )
+        dilatation = lattice_pair_sum(
+            lat.volume, lat.broken, lat.shape, s.offsets, 2.0 * w * s.length, zero,
+            self.bulk * self.theta_coef * spread, np.empty(lat.n_grid),
+        )  # fmt: skip
+        return self._at_points(pairs + dilatation + 2.0 * self.bulk * spread * spread)
+
+
+#: Material name -> its lattice class.
+LATTICE_MODELS = {"pmb": LatticePMB, "lps": LatticeLPS}
+
+
+def check_lattice_correction(name: str, surface_correction: str) -> None:
+    """Refuse a surface correction of material ``name`` that lattice storage does not compute."""
+    if surface_correction not in LATTICE_SURFACE_CORRECTIONS[name]:
+        raise InputError(
+            f"surface_correction {surface_correction!r} needs bond lists: lattice storage computes "
+            f"{list(LATTICE_SURFACE_CORRECTIONS[name])} for {name}; use discretization.storage: bonds"
+        )
+
+
+def lattice_support(name: str, surface_correction: str = "none") -> str | None:
+    """Why material ``name`` with ``surface_correction`` cannot run on lattice storage, or None."""
+    if name not in LATTICE_MODELS:
+        return f"material {name!r} has no lattice form (lattice storage runs {sorted(LATTICE_MODELS)})"
+    if surface_correction not in LATTICE_SURFACE_CORRECTIONS[name]:
+        return f"surface_correction {surface_correction!r} of {name} needs bond lists"
+    return None
+
+
+def make_lattice_model(
+    name: str,
+    body: Body,
+    lattice: Lattice,
+    *,
+    E,
+    density,
+    nu=None,
+    surface_correction="none",
+    dtype=np.float64,
+) -> LatticeModel:
+    """Bind material ``name`` ("pmb" or "lps") to a body and its lattice (see ``make_model``)."""
+    why = lattice_support(name, surface_correction)
+    if why is not None:
+        raise InputError(f"lattice storage: {why}; use discretization.storage: bonds")
+    cls = LATTICE_MODELS[name]
+    return cls(body, lattice, E=E, density=density, nu=nu, surface_correction=surface_correction, dtype=dtype)

@@ -1,0 +1,289 @@
+"""Lattice kernels (``peridyn.kernels.lattice``) against their NumPy references, and lattice
+storage against bond lists on the same bodies (grids with holes and pre-cracks).
+
+Tolerances: kernels vs references as ``kernel_inputs`` (1e-12 float64, 1e-5 float32, of the
+sum of the terms' magnitudes). Lattice vs bond lists: the two store the reference bond
+differently (per offset ``o h``, per bond ``x_j - x_i`` of rounded coordinates, differing by
+~1e-16 of the coordinates), so forces agree to round-off, not bit for bit: 1e-12 of the largest
+force at bond strains ~1e-3 (the acceptance of lattice storage).
+"""
+
+import numpy as np
+import pytest
+from kernel_inputs import TOL, assert_close
+
+from peridyn.discretization import geometry
+from peridyn.discretization.bonds import crossing_rectangle, crossing_segment, cut_bonds, find_bonds
+from peridyn.discretization.lattice import build_lattice, cut_lattice, make_stencil
+from peridyn.kernels import lattice as kern
+from peridyn.kernels.reference import lattice as ref
+from peridyn.physics.damage import BondDamage
+from peridyn.physics.lattice_damage import LatticeDamage
+from peridyn.physics.materials import make_model
+from peridyn.physics.materials.lattice import make_lattice_model
+
+pytestmark = pytest.mark.kernels
+
+DTYPES = [np.float64, np.float32]
+H = 1e-3
+#: Lattice against bond lists: relative to the largest force (module docstring).
+STORAGE_RTOL = 1e-12
+
+
+def _grid(rng, dtype, shape=(6, 5, 4), horizon=2.015):
+    """A small lattice: random holes, random broken bits, displacement of strain ~1e-3."""
+    spacing = np.array([H, 1.1 * H, 0.9 * H])
+    stencil = make_stencil(spacing, horizon * H, 3)
+    n = int(np.prod(shape))
+    vol = np.where(rng.random(n) < 0.15, 0.0, spacing.prod()).astype(dtype)
+    broken = np.zeros((-(-stencil.size // 64), n), dtype=np.uint64)
+    for k in range(stencil.size):
+        cut = np.flatnonzero(rng.random(n) < 0.1)
+        broken[k // 64, cut] |= np.uint64(1) << np.uint64(k % 64)
+    u = (rng.normal(size=(3, n)) * 1e-3 * H).astype(dtype)
+    return np.array(shape, dtype=np.int64), stencil, vol, broken, u
+
+
+def _tables(stencil, dtype):
+    return stencil.xi.astype(dtype), stencil.length.astype(dtype)
+
+
+def _magnitude(vol, broken, shape, offs, per_bond):
+    """(n_grid,) sum over each point's counted bonds of |term| (the scale of a comparison)."""
+    p, _, _, ok = ref.lattice_bonds(vol, broken, shape, offs)
+    return np.bincount(p, np.where(ok, np.abs(per_bond), 0.0), minlength=np.asarray(vol).size)
+
+
+@pytest.mark.parametrize("dtype", DTYPES)
+def test_lattice_pmb_force_matches_reference(rng, dtype):
+    """c V_j (1/|xi| - 1/|Y|) Y summed over counted bonds; both forms round relative to k |Y| / |xi|."""
+    shape, s, vol, broken, u = _grid(rng, dtype)
+    xi, length = _tables(s, dtype)
+    coef = (1e20 * s.influence * s.volume_factor).astype(dtype)
+    f = np.full((3, vol.size), np.nan, dtype=dtype)
+    cf = dtype == np.float32
+    kern.lattice_pmb_force(
+        u, vol, broken, shape, s.offsets, xi, length, (1 / length).astype(dtype), coef, cf, f
+    )
+    expected = ref.lattice_pmb_force(u, vol, broken, shape, s.offsets, xi, length, coef, cf)
+    p, q, k, _ = ref.lattice_bonds(vol, broken, shape, s.offsets)
+    scale = _magnitude(
+        vol, broken, shape, s.offsets, coef[k] * vol[q] * np.linalg.norm(xi[k], axis=1) / length[k]
+    )
+    assert f.dtype == dtype
+    assert_close(f.T, expected.T, TOL[dtype], scale)
+
+
+@pytest.mark.parametrize("dtype", DTYPES)
+def test_lattice_lps_dilatation_and_force_match_reference(rng, dtype):
+    """theta and the pair force sum w |xi| (P_i + P_j) + w (alpha_i + alpha_j) e over counted bonds."""
+    shape, s, vol, broken, u = _grid(rng, dtype)
+    xi, length = _tables(s, dtype)
+    weight = (s.influence * s.volume_factor).astype(dtype)
+    n = vol.size
+    cf = dtype == np.float32
+    theta_coef = (rng.random(n) * 3e14).astype(dtype)
+    theta = kern.lattice_lps_dilatation(
+        u, vol, broken, shape, s.offsets, xi, length, weight, cf, theta_coef, np.empty(n, dtype)
+    )
+    expected = ref.lattice_lps_dilatation(
+        u, vol, broken, shape, s.offsets, xi, length, weight, theta_coef, cf
+    )
+    p, q, k, _ = ref.lattice_bonds(vol, broken, shape, s.offsets)
+    w = weight[k].astype(np.float64) * vol[q]
+    y = xi[k].astype(np.float64) + (u[:, q] - u[:, p]).T.astype(np.float64)
+    extension = np.linalg.norm(y, axis=1) - length[k]
+    scale = theta_coef * _magnitude(vol, broken, shape, s.offsets, w * length[k] * extension)
+    assert_close(theta, expected, TOL[dtype], scale)
+    alpha = (rng.random(n) * 1e25).astype(dtype)
+    pressure = (rng.normal(size=n) * 1e22).astype(dtype)
+    f = np.full((3, n), np.nan, dtype=dtype)
+    kern.lattice_lps_force(u, vol, broken, shape, s.offsets, xi, length, weight, cf, alpha, pressure, f)
+    expected = ref.lattice_lps_force(
+        u, vol, broken, shape, s.offsets, xi, length, weight, alpha, pressure, cf
+    )
+    size = w * (
+        length[k] * (np.abs(pressure[p]) + np.abs(pressure[q])) + (alpha[p] + alpha[q]) * np.abs(extension)
+    )
+    assert_close(f.T, expected.T, TOL[dtype], _magnitude(vol, broken, shape, s.offsets, size))
+
+
+def test_lattice_sums_and_energy_match_reference(rng):
+    """The set-up sums (intact or every bond, pair sums) and the energy sums, float64."""
+    shape, s, vol, broken, u = _grid(rng, np.float64)
+    n = vol.size
+    coef = s.influence * s.length**2
+    for every in (False, True):
+        got = kern.lattice_bond_sum(vol, broken, shape, s.offsets, coef, every, np.empty(n))
+        expected = ref.lattice_bond_sum(vol, broken, shape, s.offsets, coef, every)
+        assert_close(got, expected, TOL[np.float64], np.abs(expected))
+    a, b = rng.random(n), rng.random(n)
+    got = kern.lattice_pair_sum(vol, broken, shape, s.offsets, coef, a, b, np.empty(n))
+    expected = ref.lattice_pair_sum(vol, broken, shape, s.offsets, coef, a, b)
+    assert_close(got, expected, TOL[np.float64], np.abs(expected))
+    theta = rng.normal(size=n) * 1e-3
+    got = kern.lattice_energy_sum(
+        u, vol, broken, shape, s.offsets, s.xi, s.length, coef, theta, 3.0, np.empty(n)
+    )
+    expected = ref.lattice_energy_sum(u, vol, broken, shape, s.offsets, s.xi, s.length, coef, theta, 3.0)
+    # each square's extension |Y| - |xi| ~ 1e-3 |xi| keeps ~1e-13 of its value: TOL64 of the sum
+    assert_close(got, expected, TOL[np.float64], np.abs(expected))
+
+
+def test_lattice_stretch_test_and_scatter_match_reference(rng):
+    """Bonds past |xi| (1 + s_c) break from both ends; unbreakable points keep theirs; the room
+    left per row is the smallest over the bonds left intact."""
+    shape, s, vol, broken, u = _grid(rng, np.float64)
+    n = vol.size
+    limit = s.length * (1 + 1e-3)
+    breakable = rng.random(n) > 0.1
+    expected, count, room = ref.lattice_stretch_test(u, vol, broken, shape, s.offsets, s.xi, limit, breakable)
+    got = broken.copy()
+    rows = int(shape[1] * shape[2])
+    got_room = np.empty(rows)
+    args = (limit, breakable, np.empty(rows, dtype=np.int64), got_room)
+    assert kern.lattice_stretch_test(u, vol, got, shape, s.offsets, s.xi, *args) == count
+    assert count > 0
+    np.testing.assert_array_equal(got, expected)
+    np.testing.assert_array_equal(got_room, room)  # the same subtractions of the same |Y|
+    index = rng.permutation(n)[: n // 2]
+    up = rng.normal(size=(len(index), 3))
+    ug = kern.lattice_scatter(up, index, np.zeros((3, n)))
+    np.testing.assert_array_equal(ug, ref.lattice_scatter(up, index, n))
+    np.testing.assert_array_equal(
+        kern.lattice_gather(ug, index, np.empty_like(up)), ref.lattice_gather(ug, index)
+    )
+
+
+# -- lattice storage against bond lists on the same body ------------------------------------
+
+
+def _box_with_hole_and_crack():
+    """A 10 x 9 x 7 box at 1 mm with a spherical hole and a rectangular pre-crack."""
+    body = geometry.box((0.010, 0.009, 0.007), H)
+    body = body.remove(lambda x: np.sum((x - [0.0055, 0.0045, 0.0035]) ** 2, axis=1) < 0.0013**2)
+    return body, lambda a, b: crossing_rectangle(a, b, (0.0025, -1, -1), (0, 3, 0), (0, 0, 3))
+
+
+def _surface_plate():
+    """The seed plate's layout: 3 surface layers 1 mm apart, 0.8 mm in plane, a crack segment."""
+    body = geometry.plate(0.0096, 0.0064, 0.002, spacing=0.8e-3, layers=3, layer_placement="surface")
+    return body, lambda a, b: crossing_rectangle(a, b, (0.0048, 0.0, -1), (0, 0.0032, 0), (0, 0, 3))
+
+
+def _rectangle_2d():
+    """A plane-stress rectangle with a centre slit."""
+    body = geometry.rectangle(0.014, 0.010, H, 0.001)
+    return body, lambda a, b: crossing_segment(a, b, (0.007, 0.003), (0.007, 0.007))
+
+
+BODIES = {
+    "box_hole_crack": _box_with_hole_and_crack,
+    "surface_plate": _surface_plate,
+    "rectangle": _rectangle_2d,
+}
+
+
+def _both(make, name, partial_volumes, dtype=np.float64):
+    """(body, bond-list model, lattice model, (bonds cut, lattice bonds cut)); ``name`` a
+    material, or ``material/surface correction``."""
+    name, _, correction = name.partition("/")
+    body, crossing = make()
+    horizon = 3.015 * body.spacing
+    bonds = find_bonds(body, horizon, partial_volumes=partial_volumes)
+    lattice = build_lattice(body, horizon, partial_volumes=partial_volumes)
+    cut = (cut_bonds(body, bonds, crossing), cut_lattice(body, lattice, crossing))
+    kw = {"E": 70e9, "density": 2700.0, "nu": None if name == "pmb" else 0.3, "dtype": dtype}
+    kw["surface_correction"] = correction or "none"
+    return body, make_model(name, body, bonds, **kw), make_lattice_model(name, body, lattice, **kw), cut
+
+
+@pytest.mark.parametrize("partial_volumes", [False, True])
+@pytest.mark.parametrize("material", ["pmb", "lps", "lps/shear-factor"])
+@pytest.mark.parametrize("which", sorted(BODIES))
+def test_lattice_storage_matches_bond_lists(rng, which, material, partial_volumes):
+    """Same bonds, same cut bonds; force, energy density and stiffness bound within round-off."""
+    body, bonded, latticed, (cut_b, cut_l) = _both(BODIES[which], material, partial_volumes)
+    assert latticed.lattice.n_bonds == bonded.bonds.n_bonds
+    np.testing.assert_array_equal(latticed.lattice.family_sizes(), np.diff(bonded.bonds.offsets))
+    assert cut_l == cut_b > 0
+    u = rng.normal(size=(body.n_points, 3)) * 1e-3 * body.spacing
+    if body.dim == 2:
+        u[:, 2] = 0.0
+    # the shear-factor tests shear by 1e-6, where |Y| - |xi| keeps ~1e-16 / 1e-6 of itself: each
+    # storage's factors carry ~1e-10 of rounding, which scales the deviatoric forces
+    factor = np.abs(latticed.shear_factor / bonded.shear_factor - 1).max() if "shear" in material else 0.0
+    assert factor <= 1e-9
+    rtol = STORAGE_RTOL + factor
+    f = bonded.force(u)
+    assert np.abs(latticed.force(u) - f).max() <= rtol * np.abs(f).max()
+    w = bonded.energy_density(u)
+    assert np.abs(latticed.energy_density(u) - w).max() <= rtol * np.abs(w).max()
+    bound = bonded.stiffness_bound()
+    assert np.abs(latticed.stiffness_bound() - bound).max() <= rtol * bound.max()
+    np.testing.assert_allclose(latticed.damage_index(), bonded.damage_index(), rtol=0, atol=1e-14)
+    assert latticed.critical_stretch(100.0) == bonded.critical_stretch(100.0)
+
+
+def test_lattice_float32_force_is_the_float64_force_in_float32(rng):
+    """float32 (cancellation-free) against float64 lattice forces: float32 rounding of the
+    terms (TOL32 of the largest force) at strain 1e-3."""
+    body, crossing = _box_with_hole_and_crack()
+    lattice = build_lattice(body, 3.015 * H)
+    kw = {"E": 70e9, "density": 2700.0, "nu": 0.3}
+    u = rng.normal(size=(body.n_points, 3)) * 1e-3 * H
+    f64 = make_lattice_model("lps", body, lattice, **kw).force(u)
+    f32 = make_lattice_model("lps", body, lattice, dtype=np.float32, **kw).force(u)
+    assert f32.dtype == np.float32
+    assert np.abs(f32 - f64).max() <= TOL[np.float32] * np.abs(f64).max()
+
+
+def _broken_pairs_bonds(model):
+    b = model.bonds
+    owners = b.owners()
+    return {(int(i), int(j)) for i, j in zip(owners[~b.intact], b.neighbours[~b.intact], strict=True)}
+
+
+def _broken_pairs_lattice(model):
+    lat = model.lattice
+    p, q, _, ok = ref.lattice_bonds(lat.volume, lat.broken, lat.shape, lat.stencil.offsets)
+    point_of = np.full(lat.n_grid, -1)
+    point_of[lat.grid_index] = np.arange(lat.n_points)
+    return {(int(i), int(j)) for i, j in zip(point_of[p[~ok]], point_of[q[~ok]], strict=True)}
+
+
+def test_lattice_damage_breaks_the_bonds_bond_lists_break(rng):
+    """A stretched box with a hole: the same directed bonds break at critical stretch 2e-3 (a
+    bond whose stretch lies within 1e-12 of it may differ by round-off: it is named)."""
+    body, bonded, latticed, _ = _both(_box_with_hole_and_crack, "pmb", True)
+    u = np.zeros((body.n_points, 3))
+    u[:, 0] = 3e-3 * body.points[:, 0] + rng.normal(size=body.n_points) * 1e-3 * H
+    got = LatticeDamage(latticed, critical_stretch=2e-3).update(u)
+    expected = BondDamage(bonded, critical_stretch=2e-3).update(u)
+    differ = _broken_pairs_bonds(bonded) ^ _broken_pairs_lattice(latticed)
+    near = []
+    for i, j in differ:
+        stretch = (
+            np.linalg.norm(body.points[j] + u[j] - body.points[i] - u[i])
+            / np.linalg.norm(body.points[j] - body.points[i])
+            - 1
+        )
+        near.append(abs(stretch - 2e-3) <= 1e-12)
+    assert all(near), f"bonds broken by one storage only, not at their threshold: {sorted(differ)}"
+    assert got > 0 and abs(got - expected) == len(differ)
+    np.testing.assert_allclose(latticed.damage_index(), bonded.damage_index(), rtol=0, atol=1e-14)
+
+
+def test_lattice_damage_skips_only_tests_that_break_nothing(rng):
+    """Over a loading history, the damage that skips tests while no point has moved half the
+    room breaks the same bits at the same calls as one that tests every bond at every call."""
+    body, _, latticed, _ = _both(_box_with_hole_and_crack, "pmb", False)
+    _, _, other, _ = _both(_box_with_hole_and_crack, "pmb", False)
+    skin, every = LatticeDamage(latticed, critical_stretch=2e-3), LatticeDamage(other, critical_stretch=2e-3)
+    noise = rng.normal(size=(body.n_points, 3)) * 1e-4 * H
+    for t in np.linspace(0.0, 1.0, 40):
+        u = t * (np.array([3e-3, 0.0, 0.0]) * body.points + noise)
+        every.reset()
+        assert skin.update(u) == every.update(u)
+    np.testing.assert_array_equal(latticed.lattice.broken, other.lattice.broken)
+    assert latticed.lattice.n_broken() > 0 and skin.full_tests < every.full_tests
