@@ -147,8 +147,8 @@ def _verify(f: h5py.File, path: str) -> None:
 
 def check_results(results_path, step: int, saved: dict | None) -> None:
     """Refuse to continue a checkpoint at ``step`` whose results file (``saved``: its run id and
-    record counts when the checkpoint was saved) is missing, another run's, corrupted, or holds
-    another number of records up to ``step``."""
+    record counts before ``step`` when the checkpoint was saved) is missing, another run's,
+    corrupted, or holds another number of records before ``step``."""
     if saved is None:
         return
     path = Path(results_path)
@@ -165,10 +165,10 @@ def check_results(results_path, step: int, saved: dict | None) -> None:
             f"{results.run_id()} there, {saved['run_id']} in the checkpoint); {again}"
         )
     for name, count in saved["records"].items():
-        held = int(np.count_nonzero(results.steps(name) <= step)) if name in results.series_names() else 0
+        held = int(np.count_nonzero(results.steps(name) < step)) if name in results.series_names() else 0
         if held != count:
             raise InputError(
-                f"--restart: {str(path)!r} holds {held} records of series {name!r} up to step {step}, "
+                f"--restart: {str(path)!r} holds {held} records of series {name!r} before step {step}, "
                 f"the checkpoint was saved with {count}; {again}"
             )
 
@@ -224,8 +224,9 @@ class Checkpointer:
     before_save : sequence of callables () -> None
         Called before every save, e.g. ``Recorder.flush``: the records held in memory up to the
         checkpoint's step are on disk before the checkpoint is.
-    results : callable () -> dict, or None
-        The identity of the run's results file after ``before_save`` (``HDF5Writer.identity``),
+    results : callable (step) -> dict, or None
+        The identity of the run's results file at the checkpoint's step, after ``before_save``
+        (``HDF5Writer.identity``),
         saved with the checkpoint and checked on restart.
     """
 
@@ -262,5 +263,5 @@ class Checkpointer:
         """Save a checkpoint of ``state`` now (after the ``before_save`` calls)."""
         for call in self.before_save:
             call()
-        results = self.results() if self.results is not None else None
+        results = self.results(state.step) if self.results is not None else None
         save_checkpoint(self.path, state, self.intact, self.meta, self.parts, results)

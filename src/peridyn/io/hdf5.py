@@ -374,13 +374,18 @@ class HDF5Writer:
         """
         self.write_array(SUMMARY, np.bytes_(_to_json(summary, f"{self.path}: summary")))
 
-    def identity(self) -> dict:
-        """The file's run id and the records written to each series: what a checkpoint saved now
-        expects of the file on restart (``peridyn.io.checkpoint.check_results``)."""
+    def identity(self, step: int) -> dict:
+        """The file's run id and each series' records before ``step``: what a checkpoint saved at
+        ``step`` expects of the file on restart (``peridyn.io.checkpoint.check_results``). A
+        record at ``step`` itself may be written before the checkpoint or after it (the final
+        state's), so it is not counted."""
         run_id = self._file.attrs[RUN_ID_ATTR]
         return {
             "run_id": run_id.decode() if isinstance(run_id, bytes) else str(run_id),
-            "records": {name: int(series.data.shape[0]) for name, series in self._series.items()},
+            "records": {
+                name: int(np.searchsorted(series.step[:], step, side="left"))
+                for name, series in self._series.items()
+            },
         }
 
     def set_status(self, status: str) -> None:

@@ -125,17 +125,19 @@ def test_a_checkpoint_with_an_altered_step_is_refused(tmp_path):
 
 def test_a_restart_checks_the_results_file_belongs_to_the_checkpoint(tmp_path):
     results = tmp_path / "results.h5"
-    write_run(results, range(0, 60, 10))  # steps 0..50: 4 records up to the checkpoint's step 30
+    # steps 0..50: 3 records before the checkpoint's step 30 (one at step 30 itself may be written
+    # before the checkpoint or after it, as the final state's record is: not counted)
+    write_run(results, range(0, 60, 10))
     ckpt = tmp_path / "checkpoint.h5"
     run_id = Results(results).run_id()
-    _checkpoint(ckpt, {"run_id": run_id, "records": {"u": 4}})
+    _checkpoint(ckpt, {"run_id": run_id, "records": {"u": 3}})
     load_checkpoint(ckpt, N, 40, META, results)  # the right file: accepted
     _checkpoint(ckpt, {"run_id": run_id, "records": {"u": 5}})
     with pytest.raises(
-        InputError, match="holds 4 records of series 'u' up to step 30, the checkpoint was saved with 5"
+        InputError, match="holds 3 records of series 'u' before step 30, the checkpoint was saved with 5"
     ):
         load_checkpoint(ckpt, N, 40, META, results)
-    _checkpoint(ckpt, {"run_id": "0" * 32, "records": {"u": 4}})
+    _checkpoint(ckpt, {"run_id": "0" * 32, "records": {"u": 3}})
     with pytest.raises(InputError, match="written by another run than the checkpoint"):
         load_checkpoint(ckpt, N, 40, META, results)
     results.unlink()
