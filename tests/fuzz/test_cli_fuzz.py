@@ -80,8 +80,14 @@ def _call(argv: list[str]) -> tuple[int, str, str]:
 
 
 def _fingerprint(paths: list[Path]) -> dict[str, str]:
-    """sha256 of every file under ``paths`` (files or folders), by path."""
-    files = [f for p in paths for f in ([p] if p.is_file() else sorted(p.rglob("*"))) if f.is_file()]
+    """sha256 of every file under ``paths`` (files or folders), by path; not ``run.log``, the
+    folder's journal, to which every job, a refused one too, appends (docs/user-guide.md)."""
+    files = [
+        f
+        for p in paths
+        for f in ([p] if p.is_file() else sorted(p.rglob("*")))
+        if f.is_file() and f.name != "run.log"
+    ]
     return {str(f): hashlib.sha256(f.read_bytes()).hexdigest() for f in files}
 
 

@@ -4,6 +4,7 @@ import json
 from pathlib import Path
 
 import pytest
+import warp_device  # noqa: F401 - skips without Warp, picks the device (before peridyn)
 
 from peridyn.cli import main
 from peridyn.jobs.bench import benchmark_grid, bytes_per_bond

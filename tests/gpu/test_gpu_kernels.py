@@ -8,6 +8,7 @@ a few unit roundoffs of the magnitudes summed: ``TOL64 = 1e-12`` of that scale i
 
 import numpy as np
 import pytest
+import warp_device  # noqa: F401 - skips without Warp, picks the device (before peridyn)
 from kernel_inputs import (
     TOL,
     TOL64,

@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import warp_device  # noqa: F401 - skips without Warp, picks the device (before peridyn)
 
 from peridyn.cli import main
 from peridyn.errors import InputError

@@ -34,12 +34,13 @@ class _Stderr(logging.StreamHandler):
 
 
 def configure_logging() -> None:
-    """The ``peridyn`` loggers' INFO records as plain lines on stderr (once per process)."""
+    """The ``peridyn`` loggers' INFO records on stderr (once per process), each line starting
+    ``peridyn:`` as every line the command writes there does."""
     package = logging.getLogger("peridyn")
     if any(isinstance(h, _Stderr) for h in package.handlers):
         return
     handler = _Stderr()
-    handler.setFormatter(logging.Formatter("%(message)s"))
+    handler.setFormatter(logging.Formatter("peridyn: %(message)s"))
     package.addHandler(handler)
     package.setLevel(logging.INFO)
 

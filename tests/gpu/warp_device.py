@@ -1,6 +1,9 @@
-"""The GPU-backend tests run Warp's kernels on its CPU device (``PERIDYN_GPU_ON_CPU=1``), or on
-the GPU when one is there and the variable is not set (``benchmarks/gpu_check.sh``); they are
-skipped, with the reason, where Warp is not installed."""
+"""Imported by every GPU-backend test module before peridyn: the tests run Warp's kernels on its CPU device
+(``PERIDYN_GPU_ON_CPU=1``), or on the GPU when one is there and the variable is not set
+(``benchmarks/gpu_check.sh``); they are skipped, with the reason, where Warp is not installed.
+
+Not a ``conftest.py``: a second module named ``conftest`` would shadow ``tests/conftest.py`` for
+the test modules that import from it."""
 
 import os
 import sys
