@@ -99,8 +99,9 @@ CHUNK_BUFFER = 4 * CHUNK
 #:   vectorised and scalar loops rounded differently under it (``lps_pair_force_cf``);
 #: - "reassoc": reorders sums (and rounded differently after the cache's second optimisation).
 #:
-#: The force throughput without them: ``benchmarks/RESULTS.md``. numba's cache does not notice a
-#: change here (see ``bond_differences``).
+#: Without them the force kernels run within 4 % of their earlier speed (``benchmarks/RESULTS.md``,
+#: ``benchmarks/kernel_fastmath.py``). numba's cache does not notice a change here (see
+#: ``bond_differences``).
 FASTMATH = {"nsz"}
 
 
