@@ -400,6 +400,9 @@ def check_precracks(case: Case, body: Body) -> None:
             o, u, v = (np.asarray(pad3(p)) for p in (crack.origin, crack.edge_u, crack.edge_v))
             a, b = _samples(u, body.spacing), _samples(v, body.spacing)
             samples = o + a[:, None, None] * u + b[None, :, None] * v
+        elif crack.type == "surface":  # the triangles' corners and centroids
+            triangles = surface_triangles(crack.file)
+            samples = np.concatenate([triangles.reshape(-1, 3), triangles.mean(axis=1)])
         else:
             start, end = np.asarray(pad3(crack.start)), np.asarray(pad3(crack.end))
             samples = start + _samples(end - start, body.spacing)[:, None] * (end - start)
