@@ -65,6 +65,33 @@ def protected_points(body, names) -> np.ndarray:
     return protected
 
 
+def resolve_critical_stretch(model, critical_stretch=None, fracture_energy=None, critical_bond_stress=None):
+    """The critical stretch from exactly one of the three criteria: itself (a number or
+    (n_points,) values), a fracture energy (J/m^2, through ``model.critical_stretch``) or a
+    critical bond stress (Pa, ``stretch_from_bond_stress``).
+
+    Raises
+    ------
+    InputError
+        Not exactly one criterion given, or a value that is not positive.
+    """
+    given = [v is not None for v in (critical_stretch, fracture_energy, critical_bond_stress)]
+    if sum(given) != 1:
+        raise InputError(
+            "damage needs exactly one of critical_stretch, fracture_energy or "
+            f"critical_bond_stress (got {sum(given)})"
+        )
+    if critical_bond_stress is not None:
+        critical_stretch = stretch_from_bond_stress(critical_bond_stress, model.E)
+    if fracture_energy is not None:
+        if not fracture_energy > 0:
+            raise InputError(f"fracture_energy must be positive, got {fracture_energy!r}")
+        critical_stretch = model.critical_stretch(fracture_energy)
+    if not np.all(np.asarray(critical_stretch) > 0):
+        raise InputError(f"critical_stretch must be positive, got {critical_stretch!r}")
+    return critical_stretch
+
+
 class BondDamage:
     """Critical-stretch bond failure for one model.
 
@@ -111,20 +138,8 @@ class BondDamage:
         self.schedule = schedule
         if schedule is not None:
             critical_stretch = float(schedule(0.0))
-        given = [v is not None for v in (critical_stretch, fracture_energy, critical_bond_stress)]
-        if sum(given) != 1:
-            raise InputError(
-                "damage needs exactly one of critical_stretch, fracture_energy or "
-                f"critical_bond_stress (got {sum(given)})"
-            )
-        if critical_bond_stress is not None:
-            critical_stretch = stretch_from_bond_stress(critical_bond_stress, model.E)
-        if fracture_energy is not None:
-            if not fracture_energy > 0:
-                raise InputError(f"fracture_energy must be positive, got {fracture_energy!r}")
-            critical_stretch = model.critical_stretch(fracture_energy)
-        if not np.all(np.asarray(critical_stretch) > 0):
-            raise InputError(f"critical_stretch must be positive, got {critical_stretch!r}")
+        criteria = (critical_stretch, fracture_energy, critical_bond_stress)
+        critical_stretch = resolve_critical_stretch(model, *criteria)
         self.model = model
         bonds = model.bonds
         protected = protected_points(model.body, no_damage_sets) | (False if protected is None else protected)

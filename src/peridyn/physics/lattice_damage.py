@@ -15,9 +15,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from peridyn.errors import InputError
 from peridyn.kernels.lattice import lattice_scatter, lattice_stretch_test
-from peridyn.physics.damage import protected_points, stretch_from_bond_stress
+from peridyn.physics.damage import protected_points, resolve_critical_stretch
 
 #: Relative slack on the room (of the largest critical length) for the roundings of |Y|.
 ROUNDING_SLACK = 1e-9
@@ -37,20 +36,8 @@ class LatticeDamage:
         no_damage_sets=(),
         critical_bond_stress: float | None = None,
     ):
-        given = [v is not None for v in (critical_stretch, fracture_energy, critical_bond_stress)]
-        if sum(given) != 1:
-            raise InputError(
-                "damage needs exactly one of critical_stretch, fracture_energy or "
-                f"critical_bond_stress (got {sum(given)})"
-            )
-        if critical_bond_stress is not None:
-            critical_stretch = stretch_from_bond_stress(critical_bond_stress, model.E)
-        if fracture_energy is not None:
-            if not fracture_energy > 0:
-                raise InputError(f"fracture_energy must be positive, got {fracture_energy!r}")
-            critical_stretch = model.critical_stretch(fracture_energy)
-        if not critical_stretch > 0:
-            raise InputError(f"critical_stretch must be positive, got {critical_stretch!r}")
+        criteria = (critical_stretch, fracture_energy, critical_bond_stress)
+        critical_stretch = resolve_critical_stretch(model, *criteria)
         self.model = model
         self.value = float(critical_stretch)
         lattice = model.lattice
