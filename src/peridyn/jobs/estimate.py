@@ -28,6 +28,7 @@ from peridyn.discretization import geometry
 from peridyn.errors import CaseFileError, InputError
 from peridyn.io.case import Case
 from peridyn.jobs.storage import lattice_refusals
+from peridyn.physics.materials.registry import model_class
 
 #: Resident bytes of the interpreter with numpy, scipy, numba (and its loaded kernels), h5py
 #: and peridyn imported, before the first array: measured with ``/usr/bin/time -v`` on a
@@ -264,8 +265,8 @@ def modal_factor_bytes(case: Case, base_dir, points: float, horizon: float) -> f
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         body = build_points(case, base_dir)
-    models = {m.model for m in case.block_materials().values()}  # one model, blocks or not
-    unknowns = 4 if models & {"lps", "linear_lps"} else 3  # state-based: theta too
+    model = next(iter(case.block_materials().values())).model  # one model, blocks or not
+    unknowns = 4 if model_class(model).state_based else 3  # state-based: theta too
     needed = FACTOR_ENTRY_BYTES * estimated_factor_entries(body.points, horizon, unknowns)
     if method == "auto" and needed > min(FACTOR_BUDGET, MEMORY_SHARE * geometry.memory_limit()):
         return 0.0

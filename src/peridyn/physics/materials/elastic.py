@@ -11,11 +11,14 @@ from peridyn.errors import InputError
 
 def check_elastic(E, nu, rho) -> None:
     """Raise InputError unless 0 < E, -1 < nu < 1/2 and 0 < rho (SI units); each a number or,
-    for a body of several blocks, an (n_points,) array checked point by point."""
+    for a body of several blocks, an (n_points,) array checked point by point; ``nu`` None
+    (not given) is not checked."""
     for name, value in (("E", E), ("rho", rho)):
         bad = ~(np.isfinite(value) & (np.asarray(value) > 0))
         if np.any(bad):
             raise InputError(f"material {name} must be positive and finite, got {_first(value, bad)!r}")
+    if nu is None:
+        return
     bad = ~(np.isfinite(nu) & (np.asarray(nu) > -1.0) & (np.asarray(nu) < 0.5))
     if np.any(bad):
         raise InputError(f"material nu must lie in (-1, 0.5), got {_first(nu, bad)!r}")
