@@ -40,6 +40,8 @@ class ConicalBondModel(Model):
     implied ratio, ``surface_correction`` "none" only, dtype float64 or float32.
     """
 
+    bond_bytes = 16.0  # bond_stiffness and inv_length
+
     def __init__(self, body, bonds, E, density, nu=None, surface_correction="none", dtype=np.float64):
         implied = self.implied_poisson_ratio(body.dim, body.plane)
         check_elastic(E, implied if nu is None else nu, density)

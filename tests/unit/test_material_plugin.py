@@ -81,11 +81,14 @@ def test_a_case_file_names_the_registered_material_and_its_class_checks_its_keys
 def test_the_estimates_of_a_conical_case_are_its_models(tmp_path):
     """The bond count of the estimate and its stable step equal the conical model's own: the
     continuum bound of a bond-based material (B = 2 sum k / |xi|) is exactly the block-Gershgorin
-    bound of a grid point whose whole family is in the body (jobs/stable_step.py), to round-off."""
+    bound of a grid point whose whole family is in the body (jobs/stable_step.py), to round-off.
+    Its memory counts the class's own per-bond arrays (``bond_bytes``: 16 B against PMB's 24 B)."""
     case = load_case(_case_file(tmp_path))
     model = _model()
     estimate = estimate_case(case)
     assert estimate.bonds == model.bonds.n_bonds
+    pmb = estimate_case(load_case(_case_file(tmp_path), ["material.model=pmb"]))
+    assert pmb.parts["bonds"] - estimate.parts["bonds"] == pytest.approx(8.0 * model.bonds.n_bonds, rel=1e-12)
     assert estimated_stable_step(case) == pytest.approx(model.critical_time_step(), rel=1e-12)
 
 

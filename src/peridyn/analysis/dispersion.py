@@ -78,12 +78,7 @@ from peridyn.discretization import geometry
 from peridyn.discretization.body import in_sphere
 from peridyn.discretization.bonds import HORIZON_RTOL, cell_fraction_in_ball, find_bonds, influence_function
 from peridyn.errors import InputError
-from peridyn.physics.materials.elastic import (
-    bulk_modulus,
-    check_elastic,
-    plane_bulk_modulus,
-    shear_modulus,
-)
+from peridyn.physics.materials.elastic import check_elastic, dilatational_modulus, shear_modulus
 from peridyn.physics.materials.family import PointFamily
 from peridyn.physics.materials.registry import model_class
 
@@ -159,11 +154,7 @@ class Medium:
 
     def dilatational_modulus(self, dim: int, plane: str = "stress") -> float:
         """kappa of a dim-dimensional LPS, Pa: K (3D), in-plane bulk modulus (2D), E (1D)."""
-        if dim == 3:
-            return bulk_modulus(self.E, self.nu)
-        if dim == 2:
-            return plane_bulk_modulus(self.E, self.nu, plane)
-        return self.E
+        return dilatational_modulus(self.E, self.nu, dim, plane)
 
     def as_modelled(self, model: str, dim: int, plane: str = "stress") -> Medium:
         """The medium a ``model`` represents: a bond-based material keeps E and takes the

@@ -70,6 +70,9 @@ COSTS = {
     "fatigue": Costs(per_point=600.0, per_bond=2400.0),
     "modal": Costs(per_point=600.0, per_bond=500.0),
 }
+#: The bytes per directed bond of the model's own arrays that ``COSTS`` count (PMB, LPS); the
+#: material's ``Model.bond_bytes`` takes their place.
+COSTS_MODEL_BYTES = 24.0
 
 #: An explicit run on lattice storage (``discretization.storage``, docs/user-guide.md) holds no
 #: per-bond array: per point the body and state as bond lists (350 B), the grid index, the grid's
@@ -231,9 +234,9 @@ def estimate_case(case: Case, base_dir=".", job: str | None = None) -> Estimate:
     points = float(np.prod(counts.astype(float))) * share
     bonds = lattice_bonds(counts, cell, horizon, d.partial_volumes, dim) * share
     costs = COSTS[job]
-    per_bond = costs.per_bond - (
-        FLOAT32_SAVING if job == "explicit" and case.solver.dtype == "float32" else 0
-    )
+    model = model_class(next(iter(case.block_materials().values())).model)  # one model, blocks or not
+    per_bond = costs.per_bond - COSTS_MODEL_BYTES + model.bond_bytes
+    per_bond -= FLOAT32_SAVING if job == "explicit" and case.solver.dtype == "float32" else 0
     parts = {"base": BASE_BYTES, "points": points * costs.per_point, "bonds": bonds * per_bond}
     storage = "lattice" if job == "explicit" and runs_on_lattice(case) else "bonds"
     if storage == "lattice":

@@ -87,6 +87,10 @@ class Model:
     #: reaches two horizons and a factorisation carries one more unknown per point (asked of
     #: the class; a bound model answers :attr:`has_dilatation` from its linearisation).
     state_based = False
+    #: Bytes per directed bond of the model's own arrays in float64 (the memory estimate of a
+    #: case, ``jobs.estimate``): PMB 1/length, stiffness and surface factor; LPS weight,
+    #: deviatoric coefficient and the shear factor's share.
+    bond_bytes = 24.0
     #: The ``surface_correction`` names the material takes (case key ``material.surface_correction``).
     surface_corrections: tuple[str, ...] = ("none",)
 

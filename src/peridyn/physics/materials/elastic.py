@@ -48,6 +48,16 @@ def plane_bulk_modulus(E: float, nu: float, plane: str) -> float:
     raise InputError(f"plane must be 'stress' or 'strain', got {plane!r}")
 
 
+def dilatational_modulus(E, nu, dim: int, plane: str | None = None):
+    """kappa of a dim-dimensional LPS, Pa: the bulk modulus K (3D), the in-plane one (2D, plane
+    ``"stress"`` or ``"strain"``), E (1D: a bar of unit cross-section)."""
+    if dim == 3:
+        return bulk_modulus(E, nu)
+    if dim == 2:
+        return plane_bulk_modulus(E, nu, plane)
+    return E
+
+
 def radial_moment(influence: str, horizon: float, power: int) -> float:
     """Integral of omega(r) r^power over [0, horizon] (m^(power+1))."""
     omega = influence_function(influence)

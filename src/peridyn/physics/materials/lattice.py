@@ -30,7 +30,7 @@ from peridyn.kernels.lattice import (
     lattice_scatter,
 )
 from peridyn.physics.materials.base import Model
-from peridyn.physics.materials.elastic import bulk_modulus, plane_bulk_modulus, shear_modulus
+from peridyn.physics.materials.elastic import dilatational_modulus, shear_modulus
 from peridyn.physics.materials.lps import LPSModel, shear_correction_factor
 from peridyn.physics.materials.pmb import PMBModel, pmb_micromodulus
 
@@ -172,7 +172,7 @@ class LatticeLPS(LatticeModel):
         s = lattice.stencil
         self.dim, self.nu = dim, float(nu)
         self.shear = shear_modulus(E, nu)
-        self.bulk = bulk_modulus(E, nu) if dim == 3 else plane_bulk_modulus(E, nu, body.plane)
+        self.bulk = dilatational_modulus(E, nu, dim, body.plane)
         self._weight64 = s.influence * s.volume_factor
         m = lattice.bond_sum(self._weight64 * s.length**2)
         occupied = lattice.volume > 0

@@ -47,8 +47,7 @@ from peridyn.kernels.lps import (
 )
 from peridyn.physics.materials.base import Model, ParameterError
 from peridyn.physics.materials.elastic import (
-    bulk_modulus,
-    plane_bulk_modulus,
+    dilatational_modulus,
     shear_modulus,
 )
 from peridyn.physics.materials.linearisation import BondLinearisation
@@ -119,7 +118,7 @@ class LPSModel(Model):
         length, w, dim = family.length, family.weight, family.dim
         m = float(np.sum(w * length**2))
         alpha = dim * (dim + 2) * shear_modulus(E, nu) / m
-        kappa = _dilatational_modulus(E, nu, dim, family.plane)
+        kappa = dilatational_modulus(E, nu, dim, family.plane)
         return 2.0 * alpha * w, dim / m * w * length, kappa - alpha * m / dim**2
 
     @classmethod
@@ -129,7 +128,7 @@ class LPSModel(Model):
         the neighbours' alpha, m and S equal to the point's own."""
         xi, w, dim = family.length, family.weight, family.dim
         mu = max(shear_modulus(e, n) for e, n in zip(E, nu, strict=True))
-        bulk = max(_dilatational_modulus(e, n, dim, family.plane) for e, n in zip(E, nu, strict=True))
+        bulk = max(dilatational_modulus(e, n, dim, family.plane) for e, n in zip(E, nu, strict=True))
         m = np.sum(w * xi**2)
         alpha = (15.0 if dim == 3 else 8.0) * mu / m
         s = dim / m * np.sum(w * xi)
@@ -150,7 +149,7 @@ class LPSModel(Model):
         dim = body.dim
         self.nu, self.dim = (float(nu) if np.ndim(nu) == 0 else np.asarray(nu, dtype=float)), dim
         self.shear = shear_modulus(E, nu)
-        self.bulk = _dilatational_modulus(E, nu, dim, body.plane)
+        self.bulk = dilatational_modulus(E, nu, dim, body.plane)
         b = bonds
         w = b.influence * self.bond_volume
         self.weighted_volume = family_sums(b.offsets, np.where(b.intact, w * b.length**2, 0.0))
@@ -441,13 +440,3 @@ def shear_correction_factor(points, dim: int, weighted_volume, dilatation, devia
         largest = np.maximum(largest, deviatoric_norm(u, dilatation(u)))
     bulk = 4.0 * gamma**2 * weighted_volume / (15.0 if dim == 3 else 8.0)
     return bulk / largest
-
-
-def _dilatational_modulus(E, nu, dim: int, plane: str | None):
-    """kappa of a dim-dimensional LPS, Pa: the bulk modulus K (3D), the in-plane one (2D, plane
-    stress or strain), E (1D)."""
-    if dim == 3:
-        return bulk_modulus(E, nu)
-    if dim == 2:
-        return plane_bulk_modulus(E, nu, plane)
-    return E
