@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 import yaml
 
+from peridyn.analysis.bloch import BlochLattice, bloch_cell
 from peridyn.analysis.dispersion import MARAGING_STEEL, Medium, dispersion_relation
 from peridyn.analysis.measured_dispersion import measure_dispersion
 from peridyn.cli import main
@@ -128,3 +129,19 @@ def test_the_conical_dispersion_relation():
     discrete = dispersion_relation(*args, dim=2, discrete=True, wavenumbers=k)
     for name, error in measured.relative_error(discrete).items():
         assert np.max(np.abs(error)) < 1e-6, name
+
+
+def test_the_bloch_cell_of_a_conical_case_is_its_plane_wave_relation(tmp_path):
+    """The Bloch cell of the case (the conical model on tiles, its stiffness assembled from
+    ``Model.linearisation``, docs/bloch.md) and the discrete relation of the class's plane-wave
+    coefficients are one acoustic tensor of the simple cubic lattice: equal frequencies (to
+    round-off, measured 2e-16)."""
+    disc = BlochLattice.from_case(load_case(_case_file(tmp_path)))
+    cell = bloch_cell(disc)
+    k = np.array([200.0, 800.0, 1500.0])
+    relation = dispersion_relation(
+        "conical", Medium(E, 0.25, DENSITY), disc.horizon, disc.spacing, discrete=True, wavenumbers=k
+    )
+    for i, kk in enumerate(k):
+        expected = sorted(relation.branches[name].frequency[i] for name in relation.branches)
+        assert cell.frequencies(np.array([kk, 0.0, 0.0])) == pytest.approx(expected, rel=1e-10)
