@@ -29,7 +29,7 @@ from peridyn.errors import CaseFileError, InputError, did_you_mean
 from peridyn.io.exodus_write import PERIDIGM_VARIABLES
 from peridyn.io.text_file import read_input_text
 from peridyn.physics.loads import parse_components
-from peridyn.physics.materials.base import ParameterError
+from peridyn.physics.materials.base import Model, ParameterError
 from peridyn.physics.materials.registry import MODELS, model_class
 
 #: Deepest nesting of collections a YAML text may have (a case nests 5 levels; PyYAML composes
@@ -970,6 +970,10 @@ class Case(Strict):
             except InputError as exc:
                 raise ValueError(f"{where}: {exc}") from None
         return self
+
+    def material_class(self) -> type[Model]:
+        """The registered class of the case's material model (one model for every block)."""
+        return model_class(next(iter(self.block_materials().values())).model)
 
     def block_materials(self) -> dict[str, Material]:
         """Every material of the case by the key it is given under: ``{"material": material}``

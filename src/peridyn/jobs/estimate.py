@@ -28,7 +28,6 @@ from peridyn.discretization import geometry
 from peridyn.errors import CaseFileError, InputError
 from peridyn.io.case import Case
 from peridyn.jobs.storage import lattice_refusals
-from peridyn.physics.materials.registry import model_class
 
 #: Resident bytes of the interpreter with numpy, scipy, numba (and its loaded kernels), h5py
 #: and peridyn imported, before the first array: measured with ``/usr/bin/time -v`` on a
@@ -234,8 +233,7 @@ def estimate_case(case: Case, base_dir=".", job: str | None = None) -> Estimate:
     points = float(np.prod(counts.astype(float))) * share
     bonds = lattice_bonds(counts, cell, horizon, d.partial_volumes, dim) * share
     costs = COSTS[job]
-    model = model_class(next(iter(case.block_materials().values())).model)  # one model, blocks or not
-    per_bond = costs.per_bond - COSTS_MODEL_BYTES + model.bond_bytes
+    per_bond = costs.per_bond - COSTS_MODEL_BYTES + case.material_class().bond_bytes
     per_bond -= FLOAT32_SAVING if job == "explicit" and case.solver.dtype == "float32" else 0
     parts = {"base": BASE_BYTES, "points": points * costs.per_point, "bonds": bonds * per_bond}
     storage = "lattice" if job == "explicit" and runs_on_lattice(case) else "bonds"
@@ -268,8 +266,7 @@ def modal_factor_bytes(case: Case, base_dir, points: float, horizon: float) -> f
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         body = build_points(case, base_dir)
-    model = next(iter(case.block_materials().values())).model  # one model, blocks or not
-    unknowns = 4 if model_class(model).state_based else 3  # state-based: theta too
+    unknowns = 4 if case.material_class().state_based else 3  # state-based: theta too
     needed = FACTOR_ENTRY_BYTES * estimated_factor_entries(body.points, horizon, unknowns)
     if method == "auto" and needed > min(FACTOR_BUDGET, MEMORY_SHARE * geometry.memory_limit()):
         return 0.0

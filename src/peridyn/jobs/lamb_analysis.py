@@ -17,7 +17,6 @@ from peridyn.analysis.lamb import dispersion_curves, lamb_modes
 from peridyn.discretization.body import Body
 from peridyn.errors import CaseFileError, InputError
 from peridyn.io.case import Case
-from peridyn.physics.materials.registry import model_class
 
 #: Modes whose wavenumber is picked by default.
 FUNDAMENTAL_MODES = ("S0", "A0")
@@ -31,7 +30,7 @@ def plate_theory(case: Case) -> tuple[float, float, float, float]:
     if case.geometry.type != "plate":
         raise CaseFileError(case.name, "analysis", None, "a plate geometry for Lamb-wave analysis")
     mat = case.material
-    implied = model_class(mat.model).implied_poisson_ratio(3)
+    implied = case.material_class().implied_poisson_ratio(3)
     nu = mat.nu if implied is None else implied
     return mat.E, nu, mat.density, case.geometry.size[2]
 

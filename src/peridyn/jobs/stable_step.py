@@ -35,7 +35,6 @@ from peridyn.discretization.bonds import influence_function
 from peridyn.io.case import Case
 from peridyn.jobs.estimate import grid_shape, neighbour_offsets
 from peridyn.physics.materials.family import PointFamily
-from peridyn.physics.materials.registry import model_class
 
 #: The estimate is at most this much longer than ``critical_time_step`` on the shipped cases.
 STEP_MARGIN = 0.15
@@ -80,12 +79,10 @@ def _row_bound(case: Case, xi_vec: np.ndarray, factor: np.ndarray, horizon, volu
     (k, 3) m and volume factors (k,), asked of the case's material class with the constants
     of all its materials (``Model.family_stiffness_bound``)."""
     d, g = case.discretization, case.geometry
-    mats = list(case.block_materials().values())  # one model, blocks or not
+    mats = list(case.block_materials().values())
     xi = np.linalg.norm(xi_vec, axis=1)
     w = influence_function(d.influence)(xi, horizon) * volume * factor
     family = PointFamily(
         xi, w, dim, horizon, d.influence, g.plane if dim == 2 else None, g.thickness if dim == 2 else None
     )
-    return model_class(mats[0].model).family_stiffness_bound(
-        family, [m.E for m in mats], [m.nu for m in mats]
-    )
+    return case.material_class().family_stiffness_bound(family, [m.E for m in mats], [m.nu for m in mats])
