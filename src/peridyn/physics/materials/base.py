@@ -18,7 +18,8 @@ with ``peridyn.physics.materials.registry.register_material``. It implements
 and, if its constructor does not take the case parameters as keywords, :meth:`from_parameters`.
 What is asked of the class before any body exists (a case being validated, estimated or
 analysed) it answers as class methods and attributes: :meth:`Model.check_parameters` (the case
-file's material keys), :attr:`Model.state_based`, :meth:`Model.implied_poisson_ratio`,
+file's material keys), :attr:`Model.state_based`, :attr:`Model.bond_bytes` (the memory
+estimate), :meth:`Model.implied_poisson_ratio`,
 :meth:`Model.plane_wave_coefficients` (its linearisation on the family of one lattice point:
 dispersion) and :meth:`Model.family_stiffness_bound` (the continuum stable step).
 Code outside this package asks the model only through these methods and the attributes
