@@ -40,6 +40,8 @@ class ConicalBondModel(Model):
     implied ratio, ``surface_correction`` "none" only, dtype float64 or float32.
     """
 
+    bond_bytes = 16.0  # bond_stiffness and inv_length
+
     def __init__(self, body, bonds, E, density, nu=None, surface_correction="none", dtype=np.float64):
         implied = self.implied_poisson_ratio(body.dim, body.plane)
         check_elastic(E, implied if nu is None else nu, density)
@@ -53,10 +55,9 @@ class ConicalBondModel(Model):
                 f"the conical bond material has no surface correction, got {surface_correction!r}"
             )
         super().__init__(body, bonds, E=E, density=density, dtype=dtype)
-        delta, influence, dim = bonds.horizon, bonds.influence_name, body.dim
-        pmb_c0 = pmb_micromodulus(E, dim, delta, influence, body.plane, body.thickness)
+        delta = bonds.horizon
         #: c0, N/m^6 (3D)
-        self.c0 = pmb_c0 * radial_moment(influence, delta, dim) / self._cone_moment(dim)
+        self.c0 = self._c0(E, body.dim, delta, bonds.influence_name, body.plane, body.thickness)
         stiffness = self.c0 * (1.0 - bonds.length / delta) * bonds.influence * self.bond_volume
         self.bond_stiffness = stiffness.astype(self.dtype)
         self.inv_length = (1.0 / bonds.length).astype(self.dtype)
@@ -65,10 +66,26 @@ class ConicalBondModel(Model):
     def implied_poisson_ratio(cls, dim, plane=None):
         return pmb_poisson_ratio(dim, plane)
 
+    @classmethod
+    def _c0(cls, E, dim, delta, influence, plane, thickness) -> float:
+        """c0 (module docstring); in 1D, for a bar of unit cross-section, E / int omega (1 - r /
+        delta) r dr as PMB's 1D analogue (``PMBModel.plane_wave_coefficients``)."""
+        if dim == 1:
+            return E / _cone_moment(influence, delta, 1)
+        pmb_c0 = pmb_micromodulus(E, dim, delta, influence, plane, thickness)
+        return pmb_c0 * radial_moment(influence, delta, dim) / _cone_moment(influence, delta, dim)
+
+    @classmethod
+    def plane_wave_coefficients(cls, family, E, nu):
+        """Pair c(xi) w / |xi| = c0 (1 - |xi| / delta) w / |xi|, no dilatation: PMB's with the
+        cone's profile (``Model.plane_wave_coefficients``)."""
+        c0 = cls._c0(E, family.dim, family.horizon, family.influence, family.plane, family.thickness)
+        pair = c0 * (1.0 - family.length / family.horizon) * family.weight / family.length
+        return pair, np.zeros_like(pair), 0.0
+
     def _cone_moment(self, power: int) -> float:
-        """int_0^delta omega(r) (1 - r / delta) r^power dr, m^(power + 1)."""
-        delta, influence = self.bonds.horizon, self.bonds.influence_name
-        return radial_moment(influence, delta, power) - radial_moment(influence, delta, power + 1) / delta
+        """int_0^delta omega(r) (1 - r / delta) r^power dr of the bonds, m^(power + 1)."""
+        return _cone_moment(self.bonds.influence_name, self.bonds.horizon, power)
 
     def force(self, u, out=None):
         out = np.empty_like(self.x) if out is None else out
@@ -104,3 +121,8 @@ class ConicalBondModel(Model):
     def _linearise(self):
         per_length = self.bond_stiffness.astype(np.float64) / self.bonds.length
         return BondLinearisation(extension=per_length, pair=per_length)
+
+
+def _cone_moment(influence: str, delta: float, power: int) -> float:
+    """int_0^delta omega(r) (1 - r / delta) r^power dr, m^(power + 1)."""
+    return radial_moment(influence, delta, power) - radial_moment(influence, delta, power + 1) / delta

@@ -1,5 +1,6 @@
 """Materials are asked, never named: outside ``peridyn.physics.materials`` no module tests for a
-concrete material class or reads a private attribute of a material model.
+concrete material class, compares a value with a material's registered name or reads a private
+attribute of a material model.
 
 Everything stiffness assembly, the tangent, modal analysis and fatigue need from a material
 goes through the interface of ``peridyn.physics.materials.base.Model`` (``linearisation()``,
@@ -13,7 +14,7 @@ import ast
 from pathlib import Path
 
 import peridyn
-from peridyn.physics.materials import Model
+from peridyn.physics.materials import MODELS, Model
 
 SOURCE = Path(peridyn.__file__).parent
 MATERIALS_PACKAGE = SOURCE / "physics" / "materials"
@@ -102,6 +103,40 @@ def test_no_concrete_material_is_tested_for_outside_the_materials_package():
     assert not found, (
         "code outside peridyn.physics.materials branches on a concrete material; ask the model "
         "through the Model interface instead (linearisation(), has_dilatation, ...):\n" + "\n".join(found)
+    )
+
+
+#: Modules that name materials for what they are, not to branch on what a material can do:
+#: the kernel benchmark's rows (a grid of the named materials' kernels) and the Peridigm deck's
+#: material types translated to registered names.
+NAMING_MODULES = {"jobs/bench.py", "jobs/bench_gpu.py", "io/peridigm_case.py"}
+
+
+def _compared_names(node: ast.Compare, names: set[str]) -> set[str]:
+    """Registered material names among the constants a comparison reads (``x == "pmb"``,
+    ``x in ("lps", "linear_lps")``)."""
+    found = set()
+    for operand in (node.left, *node.comparators):
+        items = operand.elts if isinstance(operand, ast.Tuple | ast.List | ast.Set) else [operand]
+        found |= {i.value for i in items if isinstance(i, ast.Constant) and i.value in names}
+    return found
+
+
+def test_no_material_name_is_branched_on_outside_the_materials_package():
+    """What a material can do (state-based, its Poisson ratio, stable step, dispersion) is asked
+    of its class (``peridyn.physics.materials.registry.model_class``), never read off its name."""
+    names = {name for name, cls in MODELS.items() if cls.__module__.startswith("peridyn.")}  # shipped
+    assert {"pmb", "lps", "linear_lps"} <= names
+    found = []
+    for path in _outside_materials():
+        if path.relative_to(SOURCE).as_posix() in NAMING_MODULES:
+            continue
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.Compare) and (named := _compared_names(node, names)):
+                found.append(f"{path.relative_to(SOURCE)}:{node.lineno}: {ast.unparse(node)} {sorted(named)}")
+    assert not found, (
+        "code outside peridyn.physics.materials branches on a material's name; ask its class "
+        "(Model.state_based, implied_poisson_ratio, family_stiffness_bound, ...):\n" + "\n".join(found)
     )
 
 

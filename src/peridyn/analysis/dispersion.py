@@ -24,7 +24,8 @@ acoustic tensor of an isotropic solid whenever the family is isotropic to
 fourth order, i.e. exactly for the continuous relations and for every
 influence function: 3D LPS ``rho cL^2 = K + 4 mu / 3``, ``rho cS^2 = mu``.
 
-Constants are those of the running code (``peridyn.physics.materials``): PMB
+Constants are those of the running code, given by each material class
+(``Model.plane_wave_coefficients``, ``peridyn.physics.materials``): PMB
 ``c0 = pmb_micromodulus(E, ...)`` (3D and 2D; it implies nu = 1/4, or 1/3 in
 plane stress, so a PMB's long-wave speeds are those of (E, that nu)); LPS
 ``kappa = K`` (3D) or the in-plane bulk modulus (2D, plane stress or strain).
@@ -77,14 +78,9 @@ from peridyn.discretization import geometry
 from peridyn.discretization.body import in_sphere
 from peridyn.discretization.bonds import HORIZON_RTOL, cell_fraction_in_ball, find_bonds, influence_function
 from peridyn.errors import InputError
-from peridyn.physics.materials.elastic import (
-    bulk_modulus,
-    check_elastic,
-    plane_bulk_modulus,
-    radial_moment,
-    shear_modulus,
-)
-from peridyn.physics.materials.pmb import pmb_micromodulus, pmb_poisson_ratio
+from peridyn.physics.materials.elastic import check_elastic, dilatational_modulus, shear_modulus
+from peridyn.physics.materials.family import PointFamily
+from peridyn.physics.materials.registry import model_class
 
 __all__ = [
     "BRANCHES",
@@ -108,7 +104,6 @@ __all__ = [
 
 #: Branch names, in the order of the polarisation basis (longitudinal first).
 BRANCHES = ("longitudinal", "shear_1", "shear_2")
-DISPERSION_MODELS = ("pmb", "lps")
 #: Wavenumber (times the horizon) of the long-wave limit: D(k)/k^2 is exact to O((k delta)^2).
 _LONG_WAVE_K_DELTA = 1e-6
 #: Group velocities below this fraction of the long-wave speed count as negative
@@ -159,18 +154,16 @@ class Medium:
 
     def dilatational_modulus(self, dim: int, plane: str = "stress") -> float:
         """kappa of a dim-dimensional LPS, Pa: K (3D), in-plane bulk modulus (2D), E (1D)."""
-        if dim == 3:
-            return bulk_modulus(self.E, self.nu)
-        if dim == 2:
-            return plane_bulk_modulus(self.E, self.nu, plane)
-        return self.E
+        return dilatational_modulus(self.E, self.nu, dim, plane)
 
     def as_modelled(self, model: str, dim: int, plane: str = "stress") -> Medium:
-        """The medium a ``model`` represents: a PMB keeps E and takes the Poisson ratio it
-        implies (1/4; 1/3 in plane stress; 1D has none)."""
-        if model != "pmb" or dim == 1:
+        """The medium a ``model`` represents: a bond-based material keeps E and takes the
+        Poisson ratio it implies (``Model.implied_poisson_ratio``: PMB 1/4; 1/3 in plane
+        stress; 1D has none)."""
+        implied = None if dim == 1 else model_class(model).implied_poisson_ratio(dim, plane)
+        if implied is None:
             return self
-        return Medium(self.E, pmb_poisson_ratio(dim, plane), self.density)
+        return Medium(self.E, implied, self.density)
 
     def classical_speeds(self, dim: int, plane: str = "stress") -> tuple[float, float]:
         """Classical (longitudinal, shear) speeds, m/s; 1D: the bar speed and 0.
@@ -250,23 +243,18 @@ class LinearModel:
 
 
 def linear_model(model: str, family: Family, medium: Medium, plane: str = "stress") -> LinearModel:
-    """The linearised ``model`` ("pmb" or "lps") of ``medium`` on ``family``."""
-    if model not in DISPERSION_MODELS:
-        raise InputError(f"model must be one of {DISPERSION_MODELS}, got {model!r}")
-    length, dim = family.length, family.dim
-    w = family.influence * family.volume
-    if model == "pmb":
-        if dim == 1:
-            c0 = medium.E / radial_moment(family.influence_name, family.horizon, 1)
-        else:
-            c0 = pmb_micromodulus(
-                medium.E, dim, family.horizon, family.influence_name, plane, family.thickness
-            )
-        return LinearModel(c0 * w / length, np.zeros_like(w), 0.0)
-    m = family.weighted_volume
-    alpha = dim * (dim + 2) * medium.shear / m
-    kappa = medium.dilatational_modulus(dim, plane)
-    return LinearModel(2.0 * alpha * w, dim / m * w * length, kappa - alpha * m / dim**2)
+    """The linearised ``model`` (a registered material name) of ``medium`` on ``family``, as
+    the material class gives it (``Model.plane_wave_coefficients``)."""
+    point = PointFamily(
+        family.length,
+        family.influence * family.volume,
+        family.dim,
+        family.horizon,
+        family.influence_name,
+        plane,
+        family.thickness,
+    )
+    return LinearModel(*model_class(model).plane_wave_coefficients(point, medium.E, medium.nu))
 
 
 # -- directions and polarisations ---------------------------------------------------------
@@ -642,7 +630,9 @@ def dispersion_relation(
 
     Parameters
     ----------
-    model : {"pmb", "lps"}
+    model : str
+        A registered material ("pmb", "lps", "linear_lps", ...): the class gives its
+        linearisation (``Model.plane_wave_coefficients``).
     medium : Medium
     horizon : float, m
     spacing : float, m

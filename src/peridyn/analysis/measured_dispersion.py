@@ -39,6 +39,7 @@ from peridyn.discretization import geometry
 from peridyn.discretization.bonds import find_bonds
 from peridyn.errors import InputError
 from peridyn.physics.materials import Model, make_model
+from peridyn.physics.materials.registry import model_class
 
 __all__ = ["MeasuredDispersion", "lattice_block_model", "measure_dispersion"]
 
@@ -112,7 +113,8 @@ def lattice_block_model(
             side, side, spacing, thickness=spacing, plane=plane, origin=(-side / 2,) * 2
         )
     bonds = find_bonds(body, horizon, influence, partial_volumes=partial_volumes)
-    nu = None if model == "pmb" else medium.nu
+    implied = model_class(model).implied_poisson_ratio(dim, plane)
+    nu = medium.nu if implied is None else None  # a bond-based material takes none
     built = make_model(model, body, bonds, E=medium.E, density=medium.density, nu=nu)
     reach = np.abs(body.points[:, :dim])
     inside = np.all(reach <= reach.max() - margin, axis=1)
@@ -135,7 +137,8 @@ def measure_dispersion(
 
     Parameters
     ----------
-    model : {"pmb", "lps"}
+    model : str
+        A registered material ("pmb", "lps", ...).
     medium : Medium
     horizon, spacing : float, m
     wavenumbers : (n_k,) array, rad/m

@@ -8,11 +8,12 @@ import sys
 
 import numpy as np
 
-from peridyn.analysis.dispersion import DISPERSION_MODELS, Medium, dispersion_relation, parse_direction
+from peridyn.analysis.dispersion import Medium, dispersion_relation, parse_direction
 from peridyn.cli.errors import writing
 from peridyn.cli.options import add_common_flags, add_set_flag
 from peridyn.discretization.bonds import INFLUENCE_FUNCTIONS
 from peridyn.errors import InputError
+from peridyn.physics.materials.registry import MODELS
 
 #: Rows of the human-readable table per branch.
 TABLE_ROWS = 8
@@ -40,7 +41,7 @@ def register(subparsers) -> None:
     add_set_flag(
         parser, "with a case: override a case entry, e.g. discretization.spacing=0.0004 (repeatable)"
     )
-    parser.add_argument("--model", help=f"material model: {' or '.join(DISPERSION_MODELS)}")
+    parser.add_argument("--model", help=f"material model: {' or '.join(sorted(MODELS))}")
     parser.add_argument("--rho", help="density, kg/m^3")
     parser.add_argument("--bulk-modulus", help="bulk modulus K, Pa (with --shear-modulus)")
     parser.add_argument("--shear-modulus", help="shear modulus G, Pa (with --bulk-modulus)")
@@ -83,7 +84,7 @@ def run(args: argparse.Namespace) -> dict:
         return run_case_file(args)
     dim = _choice("--dimension", args.dimension, ("1", "2", "3"))
     relation = dispersion_relation(
-        _choice("--model", args.model, DISPERSION_MODELS),
+        _choice("--model", args.model, tuple(sorted(MODELS))),
         medium_from_args(args),
         horizon=_positive("--horizon", args.horizon),
         spacing=_positive("--spacing", args.spacing),

@@ -152,16 +152,6 @@ def horizon_metres(horizon_m: float | None, horizon_factor: float | None, spacin
     return horizon_m if horizon_m is not None else horizon_factor * spacing
 
 
-def resolve_horizon(body: Body, horizon: float | None = None, horizon_factor: float | None = None) -> float:
-    """The horizon in metres from either metres or a multiple of ``body.spacing``."""
-    if (horizon is None) == (horizon_factor is None):
-        raise InputError("give exactly one of horizon (m) or horizon_factor (multiple of spacing)")
-    delta = horizon_metres(horizon, horizon_factor, body.spacing)
-    if not (np.isfinite(delta) and delta > 0):
-        raise InputError(f"the horizon must be positive, got {delta!r} m")
-    return float(delta)
-
-
 def find_bonds(
     body: Body,
     horizon: float,

@@ -177,15 +177,6 @@ def grid_layout(body: Body) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndar
     return shape, spacing, origin, grid_index
 
 
-def is_grid(body: Body) -> bool:
-    """Whether :func:`grid_layout` takes the body."""
-    try:
-        grid_layout(body)
-    except InputError:
-        return False
-    return True
-
-
 def make_stencil(
     spacing: np.ndarray,
     horizon: float,

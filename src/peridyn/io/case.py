@@ -29,6 +29,8 @@ from peridyn.errors import CaseFileError, InputError, did_you_mean
 from peridyn.io.exodus_write import PERIDIGM_VARIABLES
 from peridyn.io.text_file import read_input_text
 from peridyn.physics.loads import parse_components
+from peridyn.physics.materials.base import Model, ParameterError
+from peridyn.physics.materials.registry import MODELS, model_class
 
 #: Deepest nesting of collections a YAML text may have (a case nests 5 levels; PyYAML composes
 #: each level by recursion, so a deeper text would exhaust Python's recursion limit).
@@ -383,11 +385,30 @@ class Damage(Strict):
         return self
 
 
-class Material(Strict):
-    """Material model, elastic constants (Pa, kg/m^3) and optional damage."""
+def _registered_material(name: str) -> str:
+    """``name`` if a material is registered under it, else ValueError listing the registered ones."""
+    try:
+        model_class(name)
+    except InputError as exc:
+        raise ValueError(str(exc)) from None
+    return name
 
-    model: Literal["pmb", "lps", "linear_lps"] = described(
-        ..., "material model: pmb (bond-based), lps (state-based) or linear_lps"
+
+def _registered_names(schema: dict) -> None:
+    """The JSON schema of ``material.model``: the names registered when it is generated."""
+    schema["enum"] = sorted(MODELS)
+
+
+class Material(Strict):
+    """Material model, elastic constants (Pa, kg/m^3) and optional damage. What a model takes
+    (nu required or implied, its surface corrections) is checked by its class
+    (``Model.check_parameters``)."""
+
+    model: Annotated[str, AfterValidator(_registered_material)] = Field(
+        ...,
+        description="material model, a registered material: pmb (bond-based), lps (state-based), "
+        "linear_lps, or one a plugin registers (peridyn.physics.materials.registry)",
+        json_schema_extra=_registered_names,
     )
     E: Positive = described(..., "Young's modulus", "Pa")
     nu: Annotated[float, NotBool, Field(gt=-1, lt=0.5)] | None = described(
@@ -396,8 +417,8 @@ class Material(Strict):
     density: Positive = described(..., "mass density", "kg/m^3")
     surface_correction: str = described(
         "none",
-        "surface correction of the stiffness near free surfaces (none, or a method of "
-        "peridyn.physics.surface)",
+        "surface correction of the stiffness near free surfaces: none, or one the model takes "
+        "(pmb: energy; lps, linear_lps: shear-factor, energy)",
     )
     damage: Damage | None = described(None, "bond failure (none: bonds never break)")
 
@@ -926,8 +947,6 @@ class Case(Strict):
                         f"{getattr(first, key)!r}: the blocks of a body share one model and surface "
                         "correction (docs/blocks.md)"
                     )
-            if mat.model in ("lps", "linear_lps") and mat.nu is None:
-                raise ValueError(f"materials.{name}.nu: an LPS material needs Poisson's ratio nu")
         for name, block in self.blocks.items():
             try:
                 check_horizon(None, block.horizon_m, self.discretization.spacing)
@@ -937,6 +956,24 @@ class Case(Strict):
             if getattr(self, key) is not None:
                 raise ValueError(f"{key}: not available for a body of several blocks (yet); use one material")
         return self
+
+    @model_validator(mode="after")
+    def _material_parameters(self):
+        for name, mat in self.block_materials().items():
+            where = name if self.material is not None else f"materials.{name}"
+            try:
+                model_class(mat.model).check_parameters(
+                    E=mat.E, density=mat.density, nu=mat.nu, surface_correction=mat.surface_correction
+                )
+            except ParameterError as exc:
+                raise ValueError(f"{where}.{exc.key}: {exc}") from None
+            except InputError as exc:
+                raise ValueError(f"{where}: {exc}") from None
+        return self
+
+    def material_class(self) -> type[Model]:
+        """The registered class of the case's material model (one model for every block)."""
+        return model_class(next(iter(self.block_materials().values())).model)
 
     def block_materials(self) -> dict[str, Material]:
         """Every material of the case by the key it is given under: ``{"material": material}``

@@ -29,6 +29,7 @@ from peridyn.io.exodus_write import PERIDIGM_VARIABLES
 from peridyn.io.mesh_text import read_text_mesh
 from peridyn.io.peridigm_deck import is_peridigm_deck, read_deck
 from peridyn.physics.expressions import SpaceTime
+from peridyn.physics.materials.registry import model_class
 
 #: Peridigm's material models that peridyn runs: name -> peridyn model ("Linear LPS": LPS
 #: linearised about the reference configuration, ``peridyn.physics.materials.linear_lps``;
@@ -929,7 +930,7 @@ def _exodus_file(deck: _Deck, where: str, model: str, sums: dict) -> dict:
     for name in names:
         if name not in PERIDIGM_VARIABLES:
             raise deck.error(f"{where}.Output Variables.{name}", True, f"one of {sorted(PERIDIGM_VARIABLES)}")
-        if model == "pmb" and name in ("Dilatation", "Weighted_Volume"):
+        if not model_class(model).state_based and name in ("Dilatation", "Weighted_Volume"):
             raise deck.error(f"{where}.Output Variables.{name}", True, "a state-based material's variable")
     every = deck.get(f"{where}.Output Frequency", int, 1)
     if every < 1:

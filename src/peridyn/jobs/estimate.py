@@ -69,6 +69,9 @@ COSTS = {
     "fatigue": Costs(per_point=600.0, per_bond=2400.0),
     "modal": Costs(per_point=600.0, per_bond=500.0),
 }
+#: The bytes per directed bond of the model's own arrays that ``COSTS`` count (PMB, LPS); the
+#: material's ``Model.bond_bytes`` takes their place.
+COSTS_MODEL_BYTES = 24.0
 
 #: An explicit run on lattice storage (``discretization.storage``, docs/user-guide.md) holds no
 #: per-bond array: per point the body and state as bond lists (350 B), the grid index, the grid's
@@ -230,9 +233,8 @@ def estimate_case(case: Case, base_dir=".", job: str | None = None) -> Estimate:
     points = float(np.prod(counts.astype(float))) * share
     bonds = lattice_bonds(counts, cell, horizon, d.partial_volumes, dim) * share
     costs = COSTS[job]
-    per_bond = costs.per_bond - (
-        FLOAT32_SAVING if job == "explicit" and case.solver.dtype == "float32" else 0
-    )
+    per_bond = costs.per_bond - COSTS_MODEL_BYTES + case.material_class().bond_bytes
+    per_bond -= FLOAT32_SAVING if job == "explicit" and case.solver.dtype == "float32" else 0
     parts = {"base": BASE_BYTES, "points": points * costs.per_point, "bonds": bonds * per_bond}
     storage = "lattice" if job == "explicit" and runs_on_lattice(case) else "bonds"
     if storage == "lattice":
@@ -264,8 +266,7 @@ def modal_factor_bytes(case: Case, base_dir, points: float, horizon: float) -> f
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         body = build_points(case, base_dir)
-    models = {m.model for m in case.block_materials().values()}  # one model, blocks or not
-    unknowns = 4 if models & {"lps", "linear_lps"} else 3  # state-based: theta too
+    unknowns = 4 if case.material_class().state_based else 3  # state-based: theta too
     needed = FACTOR_ENTRY_BYTES * estimated_factor_entries(body.points, horizon, unknowns)
     if method == "auto" and needed > min(FACTOR_BUDGET, MEMORY_SHARE * geometry.memory_limit()):
         return 0.0

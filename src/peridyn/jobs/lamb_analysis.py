@@ -1,7 +1,8 @@
 """What a case's ``analysis:`` section asks for after the run: f-k peaks, (kx, ky) rings, plots.
 
 The theory (Rayleigh-Lamb) uses the case's material and plate thickness; a
-bond-based material is compared with nu = 1/4, the ratio it implies.
+bond-based material is compared with the Poisson ratio it implies (1/4 in 3D,
+``Model.implied_poisson_ratio``).
 """
 
 from __future__ import annotations
@@ -29,7 +30,8 @@ def plate_theory(case: Case) -> tuple[float, float, float, float]:
     if case.geometry.type != "plate":
         raise CaseFileError(case.name, "analysis", None, "a plate geometry for Lamb-wave analysis")
     mat = case.material
-    nu = mat.nu if (mat.model == "lps" and mat.nu is not None) else 0.25
+    implied = case.material_class().implied_poisson_ratio(3)
+    nu = mat.nu if implied is None else implied
     return mat.E, nu, mat.density, case.geometry.size[2]
 
 

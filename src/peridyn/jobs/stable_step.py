@@ -3,17 +3,15 @@
 The models' bound (``Model.critical_time_step``) is dt = 2 / sqrt(max_i B_i / rho), with B_i
 the block-Gershgorin bound of point i's row of the stiffness. For a point of a regular grid
 whose whole family is on the grid, B_i depends only on E, nu, the cell, the horizon and the
-influence function, so it is summed here over the lattice offsets of the family
-(``estimate.neighbour_offsets``) with the model's own constants:
+influence function, so it is summed over the lattice offsets of the family
+(``estimate.neighbour_offsets``) by the material class itself
+(``Model.family_stiffness_bound``: PMB ``B = 2 sum_j c0 omega_j V_j / |xi_j|``, LPS its
+dilatation terms as well).
 
-- PMB: B = 2 sum_j c0 omega_j V_j / |xi_j|;
-- LPS (weights w_j = omega_j V_j, m = sum w |xi|^2, alpha = 15 mu / m (8 mu / m in 2D),
-  theta coefficient d / m, S = (d / m) sum w |xi|):
-  B = sum_j (4 alpha w_j + 2 K (d / m) w_j |xi_j| S) + 2 K S^2.
-
-A body of several blocks (docs/blocks.md) is bounded with the largest E (PMB), mu and K (LPS)
-of its materials and divided by the smallest density: a point at an interface has bonds of
-both blocks' constants, and these bound them all; with blocks of different horizons, the
+A body of several blocks (docs/blocks.md) is bounded with the constants of all its materials
+(the material takes the largest: E for PMB, mu and K for LPS) and divided by the smallest
+density: a point at an interface has bonds of both blocks' constants, and these bound them
+all; with blocks of different horizons, the
 largest bound over the horizons is taken (an interface between horizons is not estimated:
 ``validate --build`` computes it).
 
@@ -36,8 +34,7 @@ import numpy as np
 from peridyn.discretization.bonds import influence_function
 from peridyn.io.case import Case
 from peridyn.jobs.estimate import grid_shape, neighbour_offsets
-from peridyn.physics.materials.elastic import bulk_modulus, plane_bulk_modulus, shear_modulus
-from peridyn.physics.materials.pmb import pmb_micromodulus
+from peridyn.physics.materials.family import PointFamily
 
 #: The estimate is at most this much longer than ``critical_time_step`` on the shipped cases.
 STEP_MARGIN = 0.15
@@ -47,7 +44,6 @@ def estimated_stable_step(case: Case, base_dir=".") -> float:
     """Estimated largest stable explicit step of ``case``, s (undamped, without contact)."""
     counts, cell, dim = grid_shape(case, base_dir)
     d, g = case.discretization, case.geometry
-    stiffest = _stiffest(case, dim)
     spacing = float(cell[0]) if g.type == "plate" else float(np.max(cell[:dim]))
     default = d.horizon_metres(spacing)
     volume = float(np.prod(cell)) if not g.is_mesh else spacing**3
@@ -57,9 +53,7 @@ def estimated_stable_step(case: Case, base_dir=".") -> float:
         for low in itertools.product(*(_positions(offsets[:, a], int(counts[a])) for a in range(3))):
             lo, hi = np.array([p[0] for p in low]), np.array([p[1] for p in low])
             keep = np.all((offsets >= lo) & (offsets <= hi), axis=1)
-            bound = max(
-                bound, _row_bound(case, stiffest, offsets[keep] * cell, factor[keep], horizon, volume, dim)
-            )
+            bound = max(bound, _row_bound(case, offsets[keep] * cell, factor[keep], horizon, volume, dim))
     density = min(m.density for m in case.block_materials().values())
     return float(2.0 / np.sqrt(bound / density))
 
@@ -68,19 +62,6 @@ def _horizons(case: Case, default: float, spacing: float) -> list[float]:
     """The distinct horizons (m) of the case: ``default``, or those of its blocks."""
     found = {b.horizon_metres(spacing, default) for b in case.blocks.values()}
     return sorted(found) or [default]
-
-
-def _stiffest(case: Case, dim: int) -> tuple[str, float, float, float]:
-    """(model, E, mu, K) of the case's materials, each the largest over them, Pa (K: the 2D
-    bulk modulus in 2D; mu and K nan for PMB)."""
-    plane = case.geometry.plane if dim == 2 else None
-    mats = list(case.block_materials().values())
-    E = max(m.E for m in mats)
-    if mats[0].model == "pmb":
-        return "pmb", E, np.nan, np.nan
-    mu = max(shear_modulus(m.E, m.nu) for m in mats)
-    bulk = max(bulk_modulus(m.E, m.nu) if dim == 3 else plane_bulk_modulus(m.E, m.nu, plane) for m in mats)
-    return "lps", E, mu, bulk
 
 
 def _positions(offsets: np.ndarray, count: int) -> list[tuple[int, int]]:
@@ -93,19 +74,15 @@ def _positions(offsets: np.ndarray, count: int) -> list[tuple[int, int]]:
     return sorted(limits)
 
 
-def _row_bound(case: Case, constants, xi_vec: np.ndarray, factor: np.ndarray, horizon, volume, dim) -> float:
+def _row_bound(case: Case, xi_vec: np.ndarray, factor: np.ndarray, horizon, volume, dim) -> float:
     """Block-Gershgorin bound B (N/m^5) of a point whose family has bond vectors ``xi_vec``
-    (k, 3) m and volume factors (k,), with the ``constants`` (model, E, mu, K) of ``_stiffest``;
-    LPS takes the neighbours' alpha, m and S equal to the point's own."""
+    (k, 3) m and volume factors (k,), asked of the case's material class with the constants
+    of all its materials (``Model.family_stiffness_bound``)."""
     d, g = case.discretization, case.geometry
-    model, E, mu, bulk = constants
-    plane = g.plane if dim == 2 else None
+    mats = list(case.block_materials().values())
     xi = np.linalg.norm(xi_vec, axis=1)
     w = influence_function(d.influence)(xi, horizon) * volume * factor
-    if model == "pmb":
-        c0 = pmb_micromodulus(E, dim, horizon, d.influence, plane, g.thickness if dim == 2 else None)
-        return float(2.0 * np.sum(c0 * w / xi))
-    m = np.sum(w * xi**2)
-    alpha = (15.0 if dim == 3 else 8.0) * mu / m
-    s = dim / m * np.sum(w * xi)
-    return float(np.sum(4.0 * alpha * w + 2.0 * bulk * (dim / m) * w * xi * s) + 2.0 * bulk * s**2)
+    family = PointFamily(
+        xi, w, dim, horizon, d.influence, g.plane if dim == 2 else None, g.thickness if dim == 2 else None
+    )
+    return case.material_class().family_stiffness_bound(family, [m.E for m in mats], [m.nu for m in mats])

@@ -39,9 +39,6 @@ from peridyn.io.text_file import read_input_text
 from peridyn.jobs.run import case_identity
 from peridyn.physics.expressions import evaluate
 
-#: The jobs a sweep's runs can be (``bloch``: only the Bloch prediction of the case's
-#: discretisation, no simulation).
-COMMANDS = ("run", "modal", "fatigue", "bloch")
 #: Characters of the case hash that name a run's folder.
 ID_LENGTH = 16
 

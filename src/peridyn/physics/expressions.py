@@ -197,10 +197,6 @@ def _eval(node, lookup, text, deadline):
     )
 
 
-#: The names of a space-time expression.
-SPACE_TIME_NAMES = ("x", "y", "z", "t")
-
-
 @dataclass(frozen=True)
 class SpaceTime:
     """A value given by an expression ``text`` in the coordinates x, y, z (m) of a point and

@@ -16,6 +16,12 @@ with ``peridyn.physics.materials.registry.register_material``. It implements
   (PMB, LPS); a material of another form overrides it;
 
 and, if its constructor does not take the case parameters as keywords, :meth:`from_parameters`.
+What is asked of the class before any body exists (a case being validated, estimated or
+analysed) it answers as class methods and attributes: :meth:`Model.check_parameters` (the case
+file's material keys), :attr:`Model.state_based`, :attr:`Model.bond_bytes` (the memory
+estimate), :meth:`Model.implied_poisson_ratio`,
+:meth:`Model.plane_wave_coefficients` (its linearisation on the family of one lattice point:
+dispersion) and :meth:`Model.family_stiffness_bound` (the continuum stable step).
 Code outside this package asks the model only through these methods and the attributes
 documented on :class:`Model`; it never tests for a concrete material class
 (``tests/unit/test_architecture.py``).
@@ -32,7 +38,18 @@ from peridyn.kernels.bond_search import initial_bond_vectors
 from peridyn.kernels.damage import damage_index
 from peridyn.kernels.lps import lps_dilatation
 from peridyn.kernels.stress import partial_stress
+from peridyn.physics.materials.elastic import check_elastic
+from peridyn.physics.materials.family import PointFamily
 from peridyn.physics.materials.linearisation import BondLinearisation
+
+
+class ParameterError(InputError):
+    """A material parameter the material cannot take; ``key`` names it (``nu``,
+    ``surface_correction``, ...), as the case file's ``material`` section spells it."""
+
+    def __init__(self, key: str, message: str):
+        self.key = key
+        super().__init__(message)
 
 
 class Model:
@@ -67,6 +84,16 @@ class Model:
     # a material whose force is linear in u (linear_lps) sets it: its tangent stiffness is the
     # same at every state (linalg.tangent takes it at rest)
     is_linear = False
+    #: True when points couple through a dilatation (a state-based law): the stiffness then
+    #: reaches two horizons and a factorisation carries one more unknown per point (asked of
+    #: the class; a bound model answers :attr:`has_dilatation` from its linearisation).
+    state_based = False
+    #: Bytes per directed bond of the model's own arrays in float64 (the memory estimate of a
+    #: case, ``jobs.estimate``): PMB 1/length, stiffness and surface factor; LPS weight,
+    #: deviatoric coefficient and the shear factor's share.
+    bond_bytes = 24.0
+    #: The ``surface_correction`` names the material takes (case key ``material.surface_correction``).
+    surface_corrections: tuple[str, ...] = ("none",)
 
     def __init__(self, body: Body, bonds: Bonds, E, density, dtype=np.float64):
         self.body = body
@@ -108,6 +135,59 @@ class Model:
         return cls(
             body, bonds, E=E, density=density, nu=nu, surface_correction=surface_correction, dtype=dtype
         )
+
+    @classmethod
+    def check_parameters(cls, *, E, density, nu=None, surface_correction: str = "none") -> None:
+        """Refuse case parameters the material cannot take whatever the body: E (Pa) and density
+        (kg/m^3) positive, nu (None: not given) in (-1, 1/2) (``elastic.check_elastic``), a
+        surface correction among :attr:`surface_corrections`. Asked when a case file is
+        validated (``io.case``); a material with other needs (nu required, ...) extends it.
+
+        Raises
+        ------
+        InputError
+            Naming the parameter and what it must be (a :class:`ParameterError`, with the
+            parameter's ``key``, for what the case file's schema alone does not refuse).
+        """
+        check_elastic(E, nu, density)
+        if surface_correction not in cls.surface_corrections:
+            raise ParameterError(
+                "surface_correction",
+                f"{cls.name} surface_correction must be one of {cls.surface_corrections}, "
+                f"got {surface_correction!r}",
+            )
+
+    @classmethod
+    def plane_wave_coefficients(cls, family: PointFamily, E: float, nu: float | None):
+        """The material's linearisation on one point's ``family`` of an infinite homogeneous
+        medium of Young's modulus ``E`` (Pa) and Poisson ratio ``nu``: the coefficients of its
+        acoustic tensor (``peridyn.analysis.dispersion``),
+
+            D(k) = sum pair n n^T (1 - cos k x) + dilatation_modulus g g^T,
+            g(k) = sum dilatation n sin(k x),
+
+        Returns
+        -------
+        pair : (n,) float64, Pa/m^2
+        dilatation : (n,) float64, 1/m (zeros for a bond-based material)
+        dilatation_modulus : float, Pa (0 for a bond-based material)
+        """
+        raise InputError(f"material {cls.name!r} gives no plane-wave coefficients (dispersion)")
+
+    @classmethod
+    def family_stiffness_bound(cls, family: PointFamily, E, nu) -> float:
+        """Block-Gershgorin bound B (N/m^5 in 3D) of the stiffness row of a point whose bonds
+        are ``family``, the continuum form of :meth:`stiffness_bound` (``jobs.stable_step``:
+        dt = 2 / sqrt(B / rho)). ``E`` (Pa) and ``nu`` are sequences, one value per material of
+        the body (its blocks); the bound holds for all of them.
+
+        This default is that of a bond-based law, B = 2 sum pair (``plane_wave_coefficients``
+        with the largest E); a state-based material overrides it.
+        """
+        if cls.state_based:
+            raise InputError(f"material {cls.name!r} gives no stable-step estimate without its bonds")
+        pair = cls.plane_wave_coefficients(family, max(E), None)[0]
+        return float(2.0 * np.sum(pair))
 
     @classmethod
     def implied_poisson_ratio(cls, dim: int, plane: str | None = None) -> float | None:

@@ -11,11 +11,14 @@ from peridyn.errors import InputError
 
 def check_elastic(E, nu, rho) -> None:
     """Raise InputError unless 0 < E, -1 < nu < 1/2 and 0 < rho (SI units); each a number or,
-    for a body of several blocks, an (n_points,) array checked point by point."""
+    for a body of several blocks, an (n_points,) array checked point by point; ``nu`` None
+    (not given) is not checked."""
     for name, value in (("E", E), ("rho", rho)):
         bad = ~(np.isfinite(value) & (np.asarray(value) > 0))
         if np.any(bad):
             raise InputError(f"material {name} must be positive and finite, got {_first(value, bad)!r}")
+    if nu is None:
+        return
     bad = ~(np.isfinite(nu) & (np.asarray(nu) > -1.0) & (np.asarray(nu) < 0.5))
     if np.any(bad):
         raise InputError(f"material nu must lie in (-1, 0.5), got {_first(nu, bad)!r}")
@@ -43,6 +46,16 @@ def plane_bulk_modulus(E: float, nu: float, plane: str) -> float:
     if plane == "strain":
         return E / (2.0 * (1.0 + nu) * (1.0 - 2.0 * nu))
     raise InputError(f"plane must be 'stress' or 'strain', got {plane!r}")
+
+
+def dilatational_modulus(E, nu, dim: int, plane: str | None = None):
+    """kappa of a dim-dimensional LPS, Pa: the bulk modulus K (3D), the in-plane one (2D, plane
+    ``"stress"`` or ``"strain"``), E (1D: a bar of unit cross-section)."""
+    if dim == 3:
+        return bulk_modulus(E, nu)
+    if dim == 2:
+        return plane_bulk_modulus(E, nu, plane)
+    return E
 
 
 def radial_moment(influence: str, horizon: float, power: int) -> float:

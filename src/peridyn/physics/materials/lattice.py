@@ -30,9 +30,9 @@ from peridyn.kernels.lattice import (
     lattice_scatter,
 )
 from peridyn.physics.materials.base import Model
-from peridyn.physics.materials.elastic import bulk_modulus, check_elastic, plane_bulk_modulus, shear_modulus
+from peridyn.physics.materials.elastic import dilatational_modulus, shear_modulus
 from peridyn.physics.materials.lps import LPSModel, shear_correction_factor
-from peridyn.physics.materials.pmb import PMBModel, check_pmb_parameters, pmb_micromodulus
+from peridyn.physics.materials.pmb import PMBModel, pmb_micromodulus
 
 #: Surface corrections lattice storage computes, per material (the others keep bond lists).
 LATTICE_SURFACE_CORRECTIONS = {"pmb": ("none",), "lps": ("none", "shear-factor")}
@@ -114,7 +114,8 @@ class LatticePMB(LatticeModel):
     critical_stretch = PMBModel.critical_stretch
 
     def __init__(self, body, lattice, E, density, nu=None, surface_correction="none", dtype=np.float64):
-        check_pmb_parameters(body, E, nu, density, surface_correction)
+        PMBModel.check_parameters(E=E, density=density, nu=nu, surface_correction=surface_correction)
+        PMBModel.check_nu(nu, body.dim, body.plane)
         check_lattice_correction("pmb", surface_correction)
         super().__init__(body, lattice, E, density, dtype)
         s = lattice.stencil
@@ -164,16 +165,14 @@ class LatticeLPS(LatticeModel):
     critical_stretch = LPSModel.critical_stretch
 
     def __init__(self, body, lattice, E, density, nu=None, surface_correction="none", dtype=np.float64):
-        if nu is None:
-            raise InputError("an LPS material needs Poisson's ratio nu")
-        check_elastic(E, nu, density)
+        LPSModel.check_parameters(E=E, density=density, nu=nu, surface_correction=surface_correction)
         check_lattice_correction("lps", surface_correction)
         super().__init__(body, lattice, E, density, dtype)
         dim = body.dim
         s = lattice.stencil
         self.dim, self.nu = dim, float(nu)
         self.shear = shear_modulus(E, nu)
-        self.bulk = bulk_modulus(E, nu) if dim == 3 else plane_bulk_modulus(E, nu, body.plane)
+        self.bulk = dilatational_modulus(E, nu, dim, body.plane)
         self._weight64 = s.influence * s.volume_factor
         m = lattice.bond_sum(self._weight64 * s.length**2)
         occupied = lattice.volume > 0

@@ -45,11 +45,9 @@ from peridyn.kernels.lps import (
     lps_pair_force_cf,
     lps_stiffness_bound,
 )
-from peridyn.physics.materials.base import Model
+from peridyn.physics.materials.base import Model, ParameterError
 from peridyn.physics.materials.elastic import (
-    bulk_modulus,
-    check_elastic,
-    plane_bulk_modulus,
+    dilatational_modulus,
     shear_modulus,
 )
 from peridyn.physics.materials.linearisation import BondLinearisation
@@ -100,6 +98,42 @@ class LPSModel(Model):
         stiffness read by every force and stiffness routine
     """
 
+    state_based = True
+    surface_corrections = SURFACE_CORRECTIONS
+
+    @classmethod
+    def check_parameters(cls, *, E, density, nu=None, surface_correction="none"):
+        """As ``Model.check_parameters``; nu is required (an LPS material has any Poisson ratio
+        in (-1, 1/2))."""
+        if nu is None:
+            raise ParameterError("nu", "an LPS material needs Poisson's ratio nu")
+        super().check_parameters(E=E, density=density, nu=nu, surface_correction=surface_correction)
+
+    @classmethod
+    def plane_wave_coefficients(cls, family, E, nu):
+        """Pair ``2 alpha w``, dilatation ``(dim / m) w |xi|`` and ``kappa - alpha m / dim^2``
+        (``Model.plane_wave_coefficients``): alpha = dim (dim + 2) mu / m (15 mu / m in 3D,
+        8 mu / m in 2D, 3 mu / m in 1D), m = sum w |xi|^2, kappa the bulk modulus (3D), the
+        in-plane one (2D) or E (1D: a bar of unit cross-section)."""
+        length, w, dim = family.length, family.weight, family.dim
+        m = float(np.sum(w * length**2))
+        alpha = dim * (dim + 2) * shear_modulus(E, nu) / m
+        kappa = dilatational_modulus(E, nu, dim, family.plane)
+        return 2.0 * alpha * w, dim / m * w * length, kappa - alpha * m / dim**2
+
+    @classmethod
+    def family_stiffness_bound(cls, family, E, nu):
+        """B = sum_j (4 alpha w_j + 2 K (d / m) w_j |xi_j| S) + 2 K S^2, S = (d / m) sum w |xi|
+        (``Model.family_stiffness_bound``), with the largest mu and K over the materials and
+        the neighbours' alpha, m and S equal to the point's own."""
+        xi, w, dim = family.length, family.weight, family.dim
+        mu = max(shear_modulus(e, n) for e, n in zip(E, nu, strict=True))
+        bulk = max(dilatational_modulus(e, n, dim, family.plane) for e, n in zip(E, nu, strict=True))
+        m = np.sum(w * xi**2)
+        alpha = (15.0 if dim == 3 else 8.0) * mu / m
+        s = dim / m * np.sum(w * xi)
+        return float(np.sum(4.0 * alpha * w + 2.0 * bulk * (dim / m) * w * xi * s) + 2.0 * bulk * s**2)
+
     def __init__(
         self,
         body: Body,
@@ -110,18 +144,12 @@ class LPSModel(Model):
         surface_correction: str = "none",
         dtype=np.float64,
     ):
-        if nu is None:
-            raise InputError("an LPS material needs Poisson's ratio nu")
-        check_elastic(E, nu, density)
-        if surface_correction not in SURFACE_CORRECTIONS:
-            raise InputError(
-                f"LPS surface_correction must be one of {SURFACE_CORRECTIONS}, got {surface_correction!r}"
-            )
+        self.check_parameters(E=E, density=density, nu=nu, surface_correction=surface_correction)
         super().__init__(body, bonds, E=E, density=density, dtype=dtype)
         dim = body.dim
         self.nu, self.dim = (float(nu) if np.ndim(nu) == 0 else np.asarray(nu, dtype=float)), dim
         self.shear = shear_modulus(E, nu)
-        self.bulk = bulk_modulus(E, nu) if dim == 3 else plane_bulk_modulus(E, nu, body.plane)
+        self.bulk = dilatational_modulus(E, nu, dim, body.plane)
         b = bonds
         w = b.influence * self.bond_volume
         self.weighted_volume = family_sums(b.offsets, np.where(b.intact, w * b.length**2, 0.0))

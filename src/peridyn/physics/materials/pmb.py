@@ -27,14 +27,13 @@ import numpy as np
 from peridyn.discretization.body import Body
 from peridyn.discretization.bonds import Bonds
 from peridyn.discretization.pairs import block_split, half_list, index_bandwidth, row_blocks
-from peridyn.errors import InputError
 from peridyn.kernels.pmb import pmb_energy, pmb_force, pmb_force_cf, pmb_pair_force
 from peridyn.physics.materials.base import Model
 from peridyn.physics.materials.elastic import (
     bulk_modulus,
-    check_elastic,
     mean_fourth_power,
     plane_bulk_modulus,
+    radial_moment,
     radial_moments,
 )
 from peridyn.physics.materials.linearisation import BondLinearisation
@@ -63,18 +62,6 @@ def pmb_micromodulus(
         return 18.0 * bulk_modulus(E, nu) / (4.0 * np.pi * radial_moments(influence, horizon, 3))
     kappa = plane_bulk_modulus(E, nu, plane)
     return 8.0 * kappa / (thickness * 2.0 * np.pi * radial_moments(influence, horizon, 2))
-
-
-def check_pmb_parameters(body: Body, E, nu, density, surface_correction: str) -> None:
-    """Refuse PMB constants a body cannot take: E and density as ``check_elastic``, a ``nu``
-    other than the implied Poisson ratio (``pmb_poisson_ratio``), an unknown surface correction."""
-    implied = pmb_poisson_ratio(body.dim, body.plane)
-    check_elastic(E, implied if nu is None else nu, density)
-    PMBModel.check_nu(nu, body.dim, body.plane)
-    if surface_correction not in SURFACE_CORRECTIONS:
-        raise InputError(
-            f"PMB surface_correction must be one of {SURFACE_CORRECTIONS}, got {surface_correction!r}"
-        )
 
 
 def bond_micromodulus(c0, bonds: Bonds):
@@ -120,7 +107,8 @@ class PMBModel(Model):
         surface_correction: str = "none",
         dtype=np.float64,
     ):
-        check_pmb_parameters(body, E, nu, density, surface_correction)
+        self.check_parameters(E=E, density=density, nu=nu, surface_correction=surface_correction)
+        self.check_nu(nu, body.dim, body.plane)
         super().__init__(body, bonds, E=E, density=density, dtype=dtype)
         self.c0 = pmb_micromodulus(
             E, body.dim, bonds.horizons(), bonds.influence_name, body.plane, body.thickness
@@ -139,10 +127,24 @@ class PMBModel(Model):
         self._pairs_h: np.ndarray | None = None
         self._pairs_tried = False
 
+    surface_corrections = SURFACE_CORRECTIONS
+
     @classmethod
     def implied_poisson_ratio(cls, dim, plane=None):
         """1/3 in plane stress, else 1/4 (``pmb_poisson_ratio``)."""
         return pmb_poisson_ratio(dim, plane)
+
+    @classmethod
+    def plane_wave_coefficients(cls, family, E, nu):
+        """Pair ``c0 w / |xi|``, no dilatation (``Model.plane_wave_coefficients``): c0 of
+        ``pmb_micromodulus`` in 3D and 2D; in 1D, for a bar of unit cross-section,
+        c0 = E / int_0^delta omega r dr (2 E / delta^2 for a constant omega, Silling 2000)."""
+        w, dim = family.weight, family.dim
+        if dim == 1:
+            c0 = E / radial_moment(family.influence, family.horizon, 1)
+        else:
+            c0 = pmb_micromodulus(E, dim, family.horizon, family.influence, family.plane, family.thickness)
+        return c0 * w / family.length, np.zeros_like(w), 0.0
 
     def force(self, u, out=None):
         """Internal force density (see ``Model.force``).
