@@ -68,6 +68,7 @@ def variable_values(model: Model, variables, sums=None, loading=None, force=None
             "Weighted_Volume": lambda: model.weighted_volume,
             "Stored_Elastic_Energy": lambda: model.energy_density(state.u) * body.volumes,
             "Number_Of_Neighbors": lambda: np.diff(model.bonds.offsets).astype(np.float64),
+            "Horizon": lambda: np.broadcast_to(model.bonds.horizons(), (body.n_points,)).astype(np.float64),
             "Damage": lambda: damage_field(model),
         }
         out = {"nodal": {}, "element": {}, "global_": {}}
