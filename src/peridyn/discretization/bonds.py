@@ -203,11 +203,13 @@ def find_bonds(
     Raises
     ------
     InputError
-        When a required point has no neighbour (the horizon is smaller than the spacing).
+        When a required point has no neighbour (the horizon is smaller than the spacing; an
+        empty ``required``: none must have one).
     """
     omega = influence_function(influence)
     x = body.points
-    if horizon < 0.5 * float(np.min(body.cells[:, : body.dim])):
+    must_have = required is None or len(required) > 0  # some point must have a neighbour
+    if must_have and horizon < 0.5 * float(np.min(body.cells[:, : body.dim])):
         raise InputError(
             f"horizon {horizon:g} m is smaller than half the spacing "
             f"{np.min(body.cells[:, : body.dim]):g} m: points would have no neighbours"

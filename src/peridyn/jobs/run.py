@@ -505,7 +505,8 @@ def _run_explicit(
         )
     if d.size > 1 and tensors is not None:
         tensors = gathered.tensor_fields
-    fields = exodus_values(case, setup, spec, solver.internal_force)
+    # the explicit solver's own force (Peridigm's order: from its deformed positions); Newmark's: None
+    fields = exodus_values(case, setup, spec, getattr(solver, "internal_force", None))
     probes = Probes.of(setup.whole_body, spec)  # every rank: under MPI, gathered at a series record
     recorder = d.on_root(
         Recorder,
