@@ -502,7 +502,7 @@ def _elastic_constants(deck: _Deck, where: str, bond_based: bool) -> tuple[float
         bulk, shear = given["Bulk Modulus"], given["Shear Modulus"]
         # E and nu of the bulk and shear moduli (LPS turns them back into K and mu)
         E = 9.0 * bulk * shear / (3.0 * bulk + shear)
-        return bulk, *_exact_inverse(
+        return bulk, *exact_moduli_pair(
             E, (3.0 * bulk - 2.0 * shear) / (2.0 * (3.0 * bulk + shear)), bulk, shear
         )
     if set(given) == {"Young's Modulus", "Poisson's Ratio"}:
@@ -513,11 +513,11 @@ def _elastic_constants(deck: _Deck, where: str, bond_based: bool) -> tuple[float
     )
 
 
-#: Floats on either side of E and nu searched by ``_exact_inverse``.
+#: Floats on either side of E and nu searched by ``exact_moduli_pair``.
 INVERSE_ULPS = 4
 
 
-def _exact_inverse(E: float, nu: float, bulk: float, shear: float) -> tuple[float, float]:
+def exact_moduli_pair(E: float, nu: float, bulk: float, shear: float) -> tuple[float, float]:
     """(E, nu) whose bulk and shear moduli, as peridyn's LPS forms them from E and nu
     (``physics.materials.elastic``), are ``bulk`` and ``shear`` to the last bit: the given pair,
     or the nearest such pair within ``INVERSE_ULPS`` floats of each (Peridigm's forces use its

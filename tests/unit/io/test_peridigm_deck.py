@@ -18,6 +18,7 @@ from peridyn.io.exodus import read_exodus
 from peridyn.io.peridigm_case import convert_deck, deck_case, load_deck
 from peridyn.io.peridigm_deck import is_peridigm_deck, read_deck
 from peridyn.jobs.build import build
+from peridyn.physics.materials.elastic import bulk_modulus, shear_modulus
 from peridyn.physics.timefunctions import from_spec
 
 DATA = Path(__file__).parents[2] / "data" / "peridigm"
@@ -322,3 +323,17 @@ def test_critical_stretch_damage():
     _refusal(deck, "Damage Models.My Damage.Damage Model")
     deck["Blocks"]["My Group of Blocks"]["Damage Model"] = "Other"
     _refusal(deck, "Damage Models.Other")
+
+
+def test_moduli_reach_lps_to_the_bit():
+    """A deck's bulk and shear moduli reach peridyn's LPS unchanged: the plain conversion of
+    K = 130 GPa, mu = 78 GPa (Peridigm's Compression decks) to E and nu comes back 1 ulp off
+    in both, the translated material's E and nu give them back exactly (a modulus one bit off
+    is a force one bit off, above those decks' 1e-9 N tolerance on 1e8 N)."""
+    K, mu = 130.0e9, 78.0e9
+    E, nu = 9.0 * K * mu / (3.0 * K + mu), (3.0 * K - 2.0 * mu) / (2.0 * (3.0 * K + mu))
+    assert (bulk_modulus(E, nu), shear_modulus(E, nu)) != (K, mu)
+    material = deck_case(read_deck(COMPRESSION), "c")["material"]
+    assert bulk_modulus(material["E"], material["nu"]) == K
+    assert shear_modulus(material["E"], material["nu"]) == mu
+    assert material["E"] == pytest.approx(E, rel=1e-15) and material["nu"] == pytest.approx(nu, rel=1e-15)
