@@ -618,6 +618,12 @@ def _stretch_in_time(deck: _Deck, key: str) -> dict:
 
 
 def _solver(deck: _Deck) -> dict:
+    if "Time Steps" in deck.get("Solver.QuasiStatic", dict, {}):
+        raise deck.error(
+            "Solver.QuasiStatic.Time Steps",
+            deck.get("Solver.QuasiStatic.Time Steps"),
+            "Final Time and Number of Load Steps (peridyn's load steps are uniform in time)",
+        )
     initial = deck.get("Solver.Initial Time", float, 0.0)
     if initial != 0.0:
         raise deck.error("Solver.Initial Time", initial, "0 (runs start at t = 0 s)")
