@@ -88,6 +88,8 @@ class ExplicitSolver:
     ):
         if arithmetic not in ("peridyn", "peridigm"):
             raise InputError(f"arithmetic must be 'peridyn' or 'peridigm', got {arithmetic!r}")
+        if beyond_bound not in ("refuse", "warn"):
+            raise InputError(f"beyond_bound must be 'refuse' or 'warn', got {beyond_bound!r}")
         if prescribed_velocity not in ("rate", "difference"):
             raise InputError(
                 f"prescribed_velocity must be 'rate' or 'difference', got {prescribed_velocity!r}"
