@@ -13,7 +13,7 @@ from peridyn.errors import CaseFileError
 from peridyn.io.case import validate_case
 from peridyn.io.exodus import read_exodus
 from peridyn.io.mesh_text import read_text_mesh
-from peridyn.io.peridigm_case import convert_deck
+from peridyn.io.peridigm_case import convert_deck, exact_moduli_pair
 from peridyn.jobs.run import run_case
 
 DECKS = Path(__file__).parents[1] / "data" / "decks"
@@ -32,15 +32,13 @@ def _deck(tmp_path: Path, edit=lambda text: text) -> Path:
 
 def _hand_case(mesh: Path, horizons: tuple[float, float]) -> dict:
     """The deck written as a peridyn case by hand (docs/blocks.md): the text mesh's blocks
-    ``block_1`` and ``block_2`` of two LPS materials from the deck's bulk and shear moduli."""
+    ``block_1`` and ``block_2`` of two LPS materials from the deck's bulk and shear moduli
+    (E and nu picked as ``exact_moduli_pair`` picks them)."""
 
-    def lps(K, mu, rho):
-        return {
-            "model": "lps",
-            "E": 9.0 * K * mu / (3.0 * K + mu),
-            "nu": (3.0 * K - 2.0 * mu) / (2.0 * (3.0 * K + mu)),
-            "density": rho,
-        }
+    def lps(K, mu, rho):  # E and nu whose K and mu are the deck's to the bit, as decks take them
+        E, nu = 9.0 * K * mu / (3.0 * K + mu), (3.0 * K - 2.0 * mu) / (2.0 * (3.0 * K + mu))
+        E, nu = exact_moduli_pair(E, nu, K, mu)
+        return {"model": "lps", "E": E, "nu": nu, "density": rho}
 
     def ids(name):
         return sorted(int(i) - 1 for i in (DECKS / name).read_text().split())

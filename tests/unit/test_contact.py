@@ -6,6 +6,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from scipy.spatial import cKDTree
 
 from peridyn.discretization import geometry
 from peridyn.discretization.bonds import crossing_segment, cut_bonds, find_bonds
@@ -191,6 +192,31 @@ def test_contact_lowers_the_stable_step_by_its_stiffness_bound():
 def test_bad_contact_input(kwargs, message):
     with pytest.raises(InputError, match=message):
         Contact(cut_square(n=6), **kwargs)
+
+
+def test_contact_beyond_the_horizon_when_allowed():
+    """A contact distance above the horizon is refused unless allowed (Peridigm's decks): then
+    every unbonded pair within d_c = 4.95 h (between lattice distances) touches, those beyond
+    the horizon 3.015 h too (counted here from the points), and the forces on the body sum to
+    zero (each pair's are equal and opposite)."""
+    model = cut_square(n=6)
+    with pytest.raises(InputError, match="larger than the horizon"):
+        Contact(model, radius=5 * H)
+    contact = Contact(model, radius=4.95 * H, beyond_horizon=True)
+    body, bonds = model.body, model.bonds
+    f = np.zeros((body.n_points, 3))
+    contact.add_force(np.zeros((body.n_points, 3)), f)
+    near = cKDTree(body.points).query_pairs(4.95 * H, output_type="ndarray")
+    intact = {
+        (int(i), int(j))
+        for i, j, ok in zip(bonds.owners(), bonds.neighbours, bonds.intact, strict=True)
+        if ok
+    }
+    unbonded = [p for p in map(tuple, near) if p not in intact]
+    assert contact.touching == len(unbonded) > 0
+    assert any(np.linalg.norm(body.points[i] - body.points[j]) > 3.015 * H for i, j in unbonded)
+    total = np.abs(f * body.volumes[:, None]).sum()
+    assert np.abs((f * body.volumes[:, None]).sum(axis=0)).max() < 1e-12 * total
 
 
 def breathing_case(**contact):

@@ -193,11 +193,13 @@ def find_bonds(
     Raises
     ------
     InputError
-        When a required point has no neighbour (the horizon is smaller than the spacing).
+        When a required point has no neighbour (the horizon is smaller than the spacing; an
+        empty ``required``: none must have one).
     """
     omega = influence_function(influence)
     x = body.points
-    if horizon < 0.5 * float(np.min(body.cells[:, : body.dim])):
+    must_have = required is None or len(required) > 0  # some point must have a neighbour
+    if must_have and horizon < 0.5 * float(np.min(body.cells[:, : body.dim])):
         raise InputError(
             f"horizon {horizon:g} m is smaller than half the spacing "
             f"{np.min(body.cells[:, : body.dim]):g} m: points would have no neighbours"
@@ -470,6 +472,12 @@ def crossing_segment(x_from: np.ndarray, x_to: np.ndarray, start, end) -> np.nda
     return (s1 * s2 < 0) & (s3 * s4 < 0)
 
 
+def _dot3(rows: np.ndarray, vector: np.ndarray) -> np.ndarray:
+    """(n,) ``rows . vector`` of (n, 3) rows, summed x + y then + z, each product and sum rounded
+    once (as Peridigm's bond filters write them; a matrix product may fuse or reorder them)."""
+    return (rows[:, 0] * vector[0] + rows[:, 1] * vector[1]) + rows[:, 2] * vector[2]
+
+
 def crossing_finite_plane(
     x_from: np.ndarray,
     x_to: np.ndarray,
@@ -487,17 +495,18 @@ def crossing_finite_plane(
     whose coordinates a = (x - corner) . (bottom x normal) and b = (x - corner) . bottom
     satisfy -tol < a < (1 + tol) ``side_length`` and -tol < b < (1 + tol) ``bottom_length``
     (Peridigm's tolerance, 1e-15). ``normal`` and ``bottom`` are taken as given (Peridigm does
-    not normalise them). A bond that meets an edge exactly is decided by the rounding of its
-    points' coordinates."""
+    not normalise them). Every quantity is rounded as Peridigm's ``FinitePlane`` rounds it, so a
+    bond that meets an edge exactly (decided by the last bits of its points' coordinates) is
+    decided as there."""
     r0, n, ub = (np.asarray(v, float) for v in (corner, normal, bottom))
     ua = np.cross(ub, n)
-    numerator = (r0 - x_from) @ n
-    denominator = (x_to - x_from) @ n
+    numerator = _dot3(r0 - x_from, n)
+    denominator = _dot3(x_to - x_from, n)
     parallel = np.abs(denominator) < 1e-14
     t = np.where(parallel, np.inf, numerator / np.where(parallel, 1.0, denominator))
     meets = (t >= 0.0) & (t <= 1.0)
-    hit = x_from + np.where(meets, t, 0.0)[:, None] * (x_to - x_from) - r0
-    a, b = hit @ ua, hit @ ub
+    hit = (x_from + np.where(meets, t, 0.0)[:, None] * (x_to - x_from)) - r0
+    a, b = _dot3(hit, ua), _dot3(hit, ub)
     inside = (-tolerance < a) & (a / side_length < 1 + tolerance)
     inside &= (-tolerance < b) & (b / bottom_length < 1 + tolerance)
     return meets & inside

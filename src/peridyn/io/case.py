@@ -311,6 +311,12 @@ class Discretization(Strict):
     bonds_between_blocks: bool = described(
         True, "false: no bond joins two blocks (Peridigm's Omit Bonds Between Blocks: All)"
     )
+    points_without_bonds: Literal["refuse", "warn"] = described(
+        "refuse",
+        "a point with no neighbour within the horizon (e.g. a horizon below the spacing): refused, or "
+        "kept with a warning naming the points (it then moves freely, touched by contact only: "
+        "Peridigm decks)",
+    )
 
     def horizon_metres(self, spacing: float) -> float:
         """The horizon (m) on a grid of ``spacing`` (m): ``horizon_m``, or ``horizon`` spacings."""
@@ -320,6 +326,8 @@ class Discretization(Strict):
     def _one_horizon(self):
         if (self.horizon is None) == (self.horizon_m is None):
             raise ValueError("give exactly one of horizon (multiple of the spacing) or horizon_m")
+        if self.points_without_bonds == "warn":
+            return self  # the points without neighbours are named when the bonds are found
         if self.neighbourhood == "box" and self.horizon_m is not None:
             check_box_horizon(self.horizon_m, self.spacing)
         else:
@@ -706,6 +714,12 @@ class Solver(Strict):
         "explicit: peridyn's (the model's stable step; ceil(time / dt) steps) or Peridigm's time step "
         "conventions (bond-based stable step; floor(time / dt) steps)",
     )
+    arithmetic: Literal["peridyn", "peridigm"] = described(
+        "peridyn",
+        "explicit: peridyn's order of operations, or Peridigm's (deformed positions x + u formed "
+        "first, its LPS force loop, a = f / rho: its last bits; cpu backend, one process; "
+        "docs/peridigm.md)",
+    )
     eigensolver: Literal["auto", "shift-invert", "lobpcg"] = described(
         "auto",
         "modal: shift-invert (factorised), lobpcg (matrix-free) or auto (by the estimated factor size)",
@@ -720,6 +734,8 @@ class Solver(Strict):
     def _backend(self):
         if self.backend == "gpu" and self.type != "explicit":
             raise ValueError(f"backend gpu runs explicit solvers only, not {self.type}: use backend cpu")
+        if self.arithmetic == "peridigm" and self.type != "explicit":
+            raise ValueError(f"arithmetic peridigm is an explicit solver's, not {self.type}'s")
         return self
 
     @model_validator(mode="after")
@@ -870,6 +886,10 @@ class ContactSpec(Strict):
     )
     radius_m: Positive | None = described(None, "contact distance in metres", "m")
     stiffness_factor: Positive = described(15.0, "short-range constant as a multiple of the PMB micromodulus")
+    beyond_horizon: Literal["refuse", "allow"] = described(
+        "refuse",
+        "a contact distance above the horizon: refused, or allowed (Peridigm's decks; one process)",
+    )
 
     @model_validator(mode="after")
     def _one_radius(self):

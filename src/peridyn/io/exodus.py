@@ -42,8 +42,9 @@ from peridyn.discretization.body import Body
 from peridyn.errors import InputError
 from peridyn.io.mesh_text import volume_cells
 
-#: HEX8 faces, nodes in cyclic order with outward normals (Exodus node numbering, 0-based).
-HEX_FACES = np.array([[0, 1, 5, 4], [1, 2, 6, 5], [2, 3, 7, 6], [3, 0, 4, 7], [0, 3, 2, 1], [4, 5, 6, 7]])
+#: HEX8 faces (Exodus node numbering, 0-based), in the order and with the nodes Peridigm's
+#: ``hexCentroidAndVolume`` sums for each face's barycentre.
+HEX_FACES = [(0, 1, 4, 5), (1, 2, 5, 6), (2, 3, 6, 7), (0, 3, 4, 7), (0, 1, 2, 3), (4, 5, 6, 7)]
 
 
 @dataclass(frozen=True)
@@ -387,21 +388,42 @@ def tet_centroid_volume(nodes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return nodes.mean(axis=1), volume
 
 
+def _tet_volume(p0, p1, p2, p3) -> np.ndarray:
+    """(n,) signed volumes of the tetrahedra p0 p1 p2 p3 (each (n, 3), m), m^3: the scalar
+    triple product a . (b x c) / 6 of the edges from p0, term by term as Peridigm's
+    ``scalarTripleProduct``."""
+    a, b, c = p1 - p0, p2 - p0, p3 - p0
+    triple = a[:, 0] * (b[:, 1] * c[:, 2] - b[:, 2] * c[:, 1])
+    triple = triple + a[:, 1] * (b[:, 2] * c[:, 0] - b[:, 0] * c[:, 2])
+    triple = triple + a[:, 2] * (b[:, 0] * c[:, 1] - b[:, 1] * c[:, 0])
+    return triple / 6.0
+
+
+#: The 24 tetrahedra of a hexahedron as Peridigm's ``hexCentroidAndVolume`` orders them: (first
+#: node, second node, face) with the face's barycentre and the hexahedron's as the last two.
+HEX_TETRAHEDRA = [
+    (1, 0, 0), (5, 1, 0), (4, 5, 0), (0, 4, 0), (2, 1, 1), (6, 2, 1), (5, 6, 1), (1, 5, 1),
+    (3, 2, 2), (7, 3, 2), (6, 7, 2), (2, 6, 2), (0, 3, 3), (3, 7, 3), (7, 4, 3), (4, 0, 3),
+    (0, 1, 4), (1, 2, 4), (2, 3, 4), (3, 0, 4), (5, 4, 5), (4, 7, 5), (7, 6, 5), (6, 5, 5),
+]  # fmt: skip
+
+
 def hex_centroid_volume(nodes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Centroids (n, 3) and signed volumes (n,) of hexahedra ``nodes`` (n, 8, 3) in Exodus
-    order, m and m^3, from 24 tetrahedra (face edge, face barycentre, hexahedron barycentre)."""
-    centre = nodes.mean(axis=1)
+    order, m and m^3, from 24 tetrahedra (face edge, face barycentre, hexahedron barycentre),
+    operation by operation as Peridigm's ``hexCentroidAndVolume`` (its GeometryUtils): the
+    points of a deck's mesh are Peridigm's to the last bit (a bond filter's plane through mesh
+    points' bonds then decides them as Peridigm does)."""
+    n = [nodes[:, k] for k in range(8)]
+    faces = [0.25 * (((n[a] + n[b]) + n[c]) + n[d]) for a, b, c, d in HEX_FACES]
+    centre = 0.5 * (faces[4] + faces[5])
     volume = np.zeros(len(nodes))
     moment = np.zeros((len(nodes), 3))
-    for face in HEX_FACES:
-        corners = nodes[:, face]
-        face_centre = corners.mean(axis=1)
-        for k in range(4):
-            tet = np.stack([corners[:, k], corners[:, (k + 1) % 4], face_centre, centre], axis=1)
-            # the face's outward normal points away from the centre: that orientation is negative
-            c, vol = tet_centroid_volume(tet)
-            volume -= vol
-            moment -= vol[:, None] * c
+    for first, second, face in HEX_TETRAHEDRA:
+        p = (n[first], n[second], faces[face], centre)
+        v = _tet_volume(*p)
+        volume = volume + v
+        moment = moment + ((((p[0] + p[1]) + p[2]) + p[3]) * 0.25) * v[:, None]
     return moment / volume[:, None], volume
 
 

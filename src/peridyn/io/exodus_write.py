@@ -55,6 +55,7 @@ PERIDIGM_VARIABLES = {
     "Weighted_Volume": ("element", False),
     "Stored_Elastic_Energy": ("element", False),
     "Number_Of_Neighbors": ("element", False),
+    "Horizon": ("element", False),
     "Damage": ("element", False),
     "Lambda": ("element", False),
     "Global_Kinetic_Energy": ("global", False),

@@ -29,6 +29,7 @@ from peridyn.io.exodus_write import PERIDIGM_VARIABLES
 from peridyn.io.mesh_text import read_text_mesh
 from peridyn.io.peridigm_deck import is_peridigm_deck, read_deck
 from peridyn.physics.expressions import SpaceTime
+from peridyn.physics.materials.elastic import bulk_modulus, shear_modulus
 from peridyn.physics.materials.registry import model_class
 
 #: Peridigm's material models that peridyn runs: name -> peridyn model ("Linear LPS": LPS
@@ -183,6 +184,8 @@ def deck_case(params: dict, name: str, source: str = "<deck>", deck_dir=".") -> 
     if "Contact" in params:
         case["contact"] = _contact(deck, groups, case.get("material") or case["materials"])
     model = (case.get("material") or next(iter(case["materials"].values())))["model"]
+    if solver["type"] == "explicit" and model == "lps" and plane is None:
+        solver["arithmetic"] = "peridigm"  # Peridigm's order of operations (docs/peridigm.md)
     case["output"] = _output(deck, model, _compute_classes(deck))
     for exodus in [case["output"].get("exodus"), *case["output"].get("exodus_more", [])]:
         if exodus is not None:  # Peridigm's numbering of a grid; three components in 2D
@@ -344,7 +347,13 @@ def _discretization(deck: _Deck, deck_dir: Path, horizon: float) -> tuple[dict, 
     """Geometry and discretisation sections, and the PdQuickGrid's (nx, ny, nz) (None for a mesh)."""
     kind = deck.get("Discretization.Type", str)
     neighbourhood = deck.get("Discretization.NeighborhoodType", str, "")
-    discretization = {"horizon_m": horizon, "partial_volumes": False, **_bond_options(deck)}
+    # Peridigm keeps a point without neighbours (it moves freely, touched by contact only)
+    discretization = {
+        "horizon_m": horizon,
+        "partial_volumes": False,
+        "points_without_bonds": "warn",
+        **_bond_options(deck),
+    }
     if kind == "PdQuickGrid":
         where = "Discretization.TensorProduct3DMeshGenerator"
         deck.get(where, dict)
@@ -494,13 +503,39 @@ def _elastic_constants(deck: _Deck, where: str, bond_based: bool) -> tuple[float
         bulk, shear = given["Bulk Modulus"], given["Shear Modulus"]
         # E and nu of the bulk and shear moduli (LPS turns them back into K and mu)
         E = 9.0 * bulk * shear / (3.0 * bulk + shear)
-        return bulk, E, (3.0 * bulk - 2.0 * shear) / (2.0 * (3.0 * bulk + shear))
+        return bulk, *exact_moduli_pair(
+            E, (3.0 * bulk - 2.0 * shear) / (2.0 * (3.0 * bulk + shear)), bulk, shear
+        )
     if set(given) == {"Young's Modulus", "Poisson's Ratio"}:
         E, nu = given["Young's Modulus"], given["Poisson's Ratio"]
         return E / (3.0 * (1.0 - 2.0 * nu)), E, nu
     raise deck.error(
         where, sorted(given), "Bulk Modulus and Shear Modulus, or Young's Modulus and Poisson's Ratio"
     )
+
+
+#: Floats on either side of E and nu searched by ``exact_moduli_pair``.
+INVERSE_ULPS = 4
+
+
+def exact_moduli_pair(E: float, nu: float, bulk: float, shear: float) -> tuple[float, float]:
+    """(E, nu) whose bulk and shear moduli, as peridyn's LPS forms them from E and nu
+    (``physics.materials.elastic``), are ``bulk`` and ``shear`` to the last bit: the given pair,
+    or the nearest such pair within ``INVERSE_ULPS`` floats of each (Peridigm's forces use its
+    K and mu themselves; a modulus one bit off is a force one bit off). The given pair when
+    none is found."""
+
+    def moved(value: float, steps: int) -> float:
+        for _ in range(abs(steps)):
+            value = math.nextafter(value, math.copysign(math.inf, steps))
+        return value
+
+    steps = sorted(range(-INVERSE_ULPS, INVERSE_ULPS + 1), key=abs)
+    for i, j in sorted(((i, j) for i in steps for j in steps), key=lambda ij: abs(ij[0]) + abs(ij[1])):
+        e, n = moved(E, i), moved(nu, j)
+        if bulk_modulus(e, n) == bulk and shear_modulus(e, n) == shear:
+            return e, n
+    return E, nu
 
 
 #: E / K of peridyn's 2D bond-based model whose plane bulk modulus is K: kappa = E / (2 (1 - nu))
@@ -584,6 +619,12 @@ def _stretch_in_time(deck: _Deck, key: str) -> dict:
 
 
 def _solver(deck: _Deck) -> dict:
+    if "Time Steps" in deck.get("Solver.QuasiStatic", dict, {}):
+        raise deck.error(
+            "Solver.QuasiStatic.Time Steps",
+            deck.get("Solver.QuasiStatic.Time Steps"),
+            "Final Time and Number of Load Steps (peridyn's load steps are uniform in time)",
+        )
     initial = deck.get("Solver.Initial Time", float, 0.0)
     if initial != 0.0:
         raise deck.error("Solver.Initial Time", initial, "0 (runs start at t = 0 s)")
@@ -828,7 +869,8 @@ def _contact(deck: _Deck, groups: list[_Group], materials: dict) -> dict:
         raise deck.error(
             where, sorted(moduli), "materials of one Young's modulus (the contact constant's reference)"
         )
-    return {"radius_m": radius, "stiffness_factor": 1.5 * spring / moduli.pop()}
+    # Peridigm's contact reaches beyond the horizon where the radius does
+    return {"radius_m": radius, "stiffness_factor": 1.5 * spring / moduli.pop(), "beyond_horizon": "allow"}
 
 
 def _lists_node_zero(deck: _Deck) -> bool:

@@ -4,6 +4,7 @@ half-way (e.g. to inspect the bonds)."""
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -229,11 +230,29 @@ def build_bonds(case: Case, body: Body, required=None, of_block=None) -> Bonds:
     point_horizon = block_horizons(case, body, of_block)
     horizon = case_horizon(case, body) if point_horizon is None else float(np.max(point_horizon))
     box = neighbourhood_box(case, body, horizon)
+    if d.points_without_bonds == "warn":
+        required = np.zeros(0, dtype=np.int64)
     bonds = find_bonds(
         body, horizon, d.influence, d.partial_volumes, required=required, box=box, point_horizon=point_horizon
     )
+    if d.points_without_bonds == "warn":
+        warn_points_without_bonds(case, body, bonds)
     cut_precracks(case, body, bonds, in_weighted_volume=False)
     return filtered(case, body, bonds, of_block)
+
+
+def warn_points_without_bonds(case: Case, body: Body, bonds: Bonds) -> None:
+    """Warn of the points that have no neighbour within the horizon
+    (``discretization.points_without_bonds: warn``), naming the first few."""
+    alone = np.flatnonzero(np.diff(bonds.offsets) == 0)
+    if len(alone):
+        named = ", ".join(f"{int(p)} at {body.points[p].tolist()}" for p in alone[:3])
+        more = f" and {len(alone) - 3} more" if len(alone) > 3 else ""
+        warnings.warn(
+            f"{case.name}: {len(alone)} points have no neighbour within the horizon ({named}{more}): "
+            "no bond holds them (discretization.points_without_bonds: warn)",
+            stacklevel=3,
+        )
 
 
 def cut_precracks(case: Case, body: Body, bonds: Bonds, in_weighted_volume: bool) -> None:
@@ -746,6 +765,6 @@ def build_contact(
     try:
         if domain is not None and domain.size > 1:
             return RankContact(model, domain, whole_body, radius, c.stiffness_factor)
-        return Contact(model, radius, c.stiffness_factor)
+        return Contact(model, radius, c.stiffness_factor, beyond_horizon=c.beyond_horizon == "allow")
     except InputError as exc:
         raise CaseFileError(case.name, "contact", c.model_dump(exclude_none=True), str(exc)) from None

@@ -26,7 +26,7 @@ def check_variables(case_name: str, model: Model, variables) -> None:
             )
 
 
-def variable_values(model: Model, variables, sums=None, loading=None):
+def variable_values(model: Model, variables, sums=None, loading=None, force=None):
     """A function of a state (u, v, a: (n_points, 3)) giving the ``variables``' values as
     ``ExodusWriter.append`` takes them: ``{"nodal": {...}, "element": {...}, "global_":
     {...}}``, vectors (n_points, dim), scalars (n_points,), and per ``sums`` entry (name ->
@@ -35,14 +35,18 @@ def variable_values(model: Model, variables, sums=None, loading=None):
     is the internal force density (N/m^3) at u, force that times the point's volume (N);
     acceleration the solver's; external force density the body-force density (N/m^3) of
     ``loading`` (a ``Loading``, needed for it) at the state's time; ``Lambda`` Peridigm's
-    plastic multiplier, zero (peridyn's materials are elastic)."""
+    plastic multiplier, zero (peridyn's materials are elastic). ``force``: a function of the
+    state giving the internal force density (the solver's ``internal_force``), else
+    ``model.force(state.u)``."""
     sums = sums or {}
     needed = set(variables) | {variable for variable, *_ in sums.values()}
     body = model.body
     dim = body.dim
 
     def values(state: State) -> dict:
-        force_density = model.force(state.u)[:, :dim] if {"Force", "Force_Density"} & needed else None
+        force_density = None
+        if {"Force", "Force_Density"} & needed:
+            force_density = (model.force(state.u) if force is None else force(state))[:, :dim]
         computed = {
             "Displacement": lambda: state.u[:, :dim],
             "Velocity": lambda: state.v[:, :dim],
@@ -64,6 +68,7 @@ def variable_values(model: Model, variables, sums=None, loading=None):
             "Weighted_Volume": lambda: model.weighted_volume,
             "Stored_Elastic_Energy": lambda: model.energy_density(state.u) * body.volumes,
             "Number_Of_Neighbors": lambda: np.diff(model.bonds.offsets).astype(np.float64),
+            "Horizon": lambda: np.broadcast_to(model.bonds.horizons(), (body.n_points,)).astype(np.float64),
             "Damage": lambda: damage_field(model),
         }
         out = {"nodal": {}, "element": {}, "global_": {}}

@@ -6,8 +6,11 @@ of a block of bulk modulus K (Pa), density rho (kg/m^3) and horizon delta (m),
 
     dt_i = sqrt(2 rho / sum_j V_j c / |xi_ij|),   c = 18 K / (pi delta^4)
 
-over the points j of its family (V_j their cell volumes, m^3, without partial volumes), with
-pi written as 3.14159265 as Peridigm does; a point without neighbours does not bound the step.
+over the points j of its family (V_j their cell volumes, m^3, without partial volumes); a point
+without neighbours does not bound the step. Peridigm's source writes pi as 3.14159265, but the
+binary that wrote its gold files used pi itself: the output times of its Contact_Cubes test
+(the corpus deck on this step, tests/data/peridigm_corpus) are those of pi to 5e-16 s, and
+5.5e-10 s off with 3.14159265.
 The run's step is the smallest dt_i over the body times ``solver.safety`` (Peridigm's
 ``Safety Factor``).
 """
@@ -21,9 +24,6 @@ from peridyn.io.case import Case
 from peridyn.jobs.build import Setup, block_index
 from peridyn.physics.materials.elastic import bulk_modulus
 from peridyn.physics.materials.registry import model_class
-
-#: pi as Peridigm's estimate writes it.
-PERIDIGM_PI = 3.14159265
 
 
 def peridigm_stable_step(case: Case, setup: Setup) -> float:
@@ -41,7 +41,7 @@ def peridigm_stable_step(case: Case, setup: Setup) -> float:
     bulk = np.array([bulk_modulus(m.E, nu) for m, nu in zip(materials, nus, strict=True)])[of_point]
     density = np.array([m.density for m in materials])[of_point]
     horizon = bonds.horizon if bonds.point_horizon is None else bonds.point_horizon
-    spring = 18.0 * bulk / (PERIDIGM_PI * horizon * horizon * horizon * horizon)
+    spring = 18.0 * bulk / (np.pi * horizon * horizon * horizon * horizon)
     row = np.repeat(np.arange(body.n_points), np.diff(bonds.offsets))
     denominator = np.bincount(
         row, body.volumes[bonds.neighbours] * spring[row] / bonds.length, minlength=body.n_points

@@ -11,6 +11,7 @@ import json
 import logging
 import shutil
 import time
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -249,17 +250,18 @@ def point_tensors(setup: Setup, spec: RecorderSpec):
     return fields
 
 
-def exodus_values(case: Case, setup: Setup, spec: RecorderSpec):
+def exodus_values(case: Case, setup: Setup, spec: RecorderSpec, force=None):
     """The recorder's ``fields``: the values of the named Exodus variables (``output.exodus``
     as a mapping) at a state, or None without them; under MPI a ``GatheredVariables``, whose
-    ``collect`` every rank calls at the states recorded."""
+    ``collect`` every rank calls at the states recorded. ``force``: the internal force density
+    at a state (``variable_values``; one process)."""
     if not spec.exodus_named:
         return None
     variables, sums = spec.all_exodus_variables()
     check_variables(case.name, setup.model, variables)
     if setup.domain.size > 1:  # each rank's owned values, gathered on rank 0 (``collect``)
         return GatheredVariables(setup.domain, setup.model, variables, sums, setup.whole_body, setup.loading)
-    return variable_values(setup.model, variables, sums, setup.loading)
+    return variable_values(setup.model, variables, sums, setup.loading, force)
 
 
 def step_count(case: Case, solver) -> int:
@@ -431,26 +433,36 @@ def time_stepper(case, setup):
         damping = damping[setup.domain.global_ids]
     peridigm_dt = s.dt is None and s.step_rule == "peridigm"
     solver_class = GPUExplicitSolver if s.backend == "gpu" else ExplicitSolver
-    try:
-        return solver_class(
-            setup.model,
-            setup.loading,
-            dt=s.safety * peridigm_stable_step(case, setup) if peridigm_dt else s.dt,
-            safety=s.safety,
-            damping=damping,
-            damage=setup.damage,
-            contact=setup.contact,
-            domain=setup.domain,
-            prescribed_velocity=s.prescribed_velocity,
+    return solver_class(
+        setup.model,
+        setup.loading,
+        dt=s.safety * peridigm_stable_step(case, setup) if peridigm_dt else s.dt,
+        safety=s.safety,
+        damping=damping,
+        damage=setup.damage,
+        contact=setup.contact,
+        domain=setup.domain,
+        prescribed_velocity=s.prescribed_velocity,
+        **({"arithmetic": "peridigm"} if _peridigm_arithmetic(case, setup) else {}),
+        **({"beyond_bound": "warn"} if peridigm_dt and s.backend == "cpu" else {}),  # as Peridigm runs it
+    )
+
+
+def _peridigm_arithmetic(case, setup) -> bool:
+    """True for ``solver.arithmetic: peridigm`` on the CPU in one process, where it runs; on
+    the GPU backend or under MPI the run takes peridyn's order of operations, with a warning
+    (the results then differ from Peridigm's in their last bits, docs/peridigm.md)."""
+    s = case.solver
+    if s.arithmetic != "peridigm":
+        return False
+    if s.backend == "gpu" or setup.domain.halo is not None:
+        warnings.warn(
+            f"{case.name}: solver.arithmetic peridigm runs on the cpu backend in one process: this "
+            "run takes peridyn's order of operations (its last bits differ from Peridigm's)",
+            stacklevel=3,
         )
-    except InputError as exc:
-        if not peridigm_dt:
-            raise
-        raise InputError(
-            f"Peridigm's time step (its bond-based stable step times solver.safety, a deck's "
-            f"Safety Factor) is too long for this model: {exc}; give a deck's Solver.Verlet "
-            "'Fixed dt' or a smaller 'Safety Factor' (solver.dt or solver.safety)"
-        ) from None
+        return False
+    return True
 
 
 #: Seconds of running after which an interrupted run writes a checkpoint even unasked.
@@ -493,7 +505,8 @@ def _run_explicit(
         )
     if d.size > 1 and tensors is not None:
         tensors = gathered.tensor_fields
-    fields = exodus_values(case, setup, spec)
+    # the explicit solver's own force (Peridigm's order: from its deformed positions); Newmark's: None
+    fields = exodus_values(case, setup, spec, getattr(solver, "internal_force", None))
     probes = Probes.of(setup.whole_body, spec)  # every rank: under MPI, gathered at a series record
     recorder = d.on_root(
         Recorder,

@@ -28,6 +28,8 @@ def lattice_refusals(case: Case, comm=None) -> list[str]:
         why.append(f"a {s.type} solver (lattice storage runs explicit solvers)")
     if s.step_rule == "peridigm":
         why.append("solver.step_rule peridigm")
+    if s.arithmetic == "peridigm":
+        why.append("solver.arithmetic peridigm")
     if out.stress or out.strain:
         why.append("the stress and strain outputs")
     if out.exodus:

@@ -22,25 +22,27 @@ def kick_drift(u, v, a, half_dt, dt):
 
 
 @numba.njit(cache=True)
-def acceleration(f, b, inv_rho, damping, v, constrained, a, kick, half_dt):
-    """``a = (f + b) * inv_rho``, then ``a -= damping * v``, then ``a[constrained] = 0``, and
-    with ``kick`` ``v += half_dt * a`` (OUT ``a``, IN/OUT ``v``).
+def acceleration(f, b, rho, damping, v, constrained, a, kick, half_dt, divide=False):
+    """``a = (f + b) * rho`` (or with ``divide`` ``a = (f + b) / rho``, Peridigm's order), then
+    ``a -= damping * v``, then ``a[constrained] = 0``, and with ``kick`` ``v += half_dt * a``
+    (OUT ``a``, IN/OUT ``v``).
 
     ``f`` the force density (N/m^3, float64 or float32, taken as float64), ``b`` the body
-    force density (N/m^3), ``inv_rho`` (n_points,) 1 / density (m^3/kg), ``damping`` the
-    mass-proportional damping (1/s): (0,) none, (1,) one for all points or (n_points,) one
-    per point; ``constrained`` (n_points, 3) bool.
+    force density (N/m^3), ``rho`` (n_points,) 1 / density (m^3/kg), or with ``divide`` the
+    density (kg/m^3), ``damping`` the mass-proportional damping (1/s): (0,) none, (1,) one for
+    all points or (n_points,) one per point; ``constrained`` (n_points, 3) bool.
     """
     n_damping = damping.shape[0]
     for i in range(f.shape[0]):
-        r = inv_rho[i]
+        r = rho[i]
         c = 0.0
         if n_damping == 1:
             c = damping[0]
         elif n_damping > 1:
             c = damping[i]
         for k in range(3):
-            ak = (np.float64(f[i, k]) + b[i, k]) * r
+            ak = np.float64(f[i, k]) + b[i, k]
+            ak = ak / r if divide else ak * r
             if n_damping:
                 ak = ak - c * v[i, k]
             if constrained[i, k]:

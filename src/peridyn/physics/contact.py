@@ -47,11 +47,14 @@ class Contact:
         at every call, so bonds broken during a run start to take part in contact) and
         Young's modulus ``model.E`` for the short-range constant.
     radius : float, m
-        Contact distance d_c: 0 < d_c <= horizon.
+        Contact distance d_c: 0 < d_c <= horizon, or with ``beyond_horizon`` any positive one.
     stiffness_factor : float
         c_sr as a multiple of the PMB micromodulus (default 15, Peridigm).
     skin : float or None, m
         Verlet skin added to d_c for the candidate list (default 0.5 d_c).
+    beyond_horizon : bool
+        Allow d_c above the horizon (Peridigm's decks: every unbonded pair within d_c repels,
+        points farther apart than the horizon too). One process only.
     """
 
     def __init__(
@@ -60,12 +63,13 @@ class Contact:
         radius: float,
         stiffness_factor: float = DEFAULT_STIFFNESS_FACTOR,
         skin: float | None = None,
+        beyond_horizon: bool = False,
     ):
         body, bonds = model.body, model.bonds
         delta = bonds.horizon
         if not (np.isfinite(radius) and radius > 0):
             raise InputError(f"contact radius must be positive, got {radius!r} m")
-        if radius > delta * (1 + 1e-12):
+        if radius > delta * (1 + 1e-12) and not beyond_horizon:
             raise InputError(
                 f"contact radius {radius:g} m is larger than the horizon {delta:g} m: "
                 "short-range forces act within the horizon (use radius <= horizon)"
@@ -132,15 +136,17 @@ class Contact:
             self.rebuild(saved["u_built"])
             self.rebuilds = int(saved["rebuilds"])
 
-    def add_force(self, u: np.ndarray, out: np.ndarray) -> np.ndarray:
+    def add_force(self, u: np.ndarray, out: np.ndarray, positions: np.ndarray | None = None) -> np.ndarray:
         """Add the contact force density (N/m^3) at displacement ``u`` (m) to ``out`` in place.
 
-        Both arrays are (n_points, 3); ``out`` may be float32 or float64. Returns ``out``.
+        Both arrays are (n_points, 3); ``out`` may be float32 or float64. ``positions``: the
+        deformed positions (n_points, 3) m as the solver formed them (Peridigm's order,
+        ``ExplicitSolver``), else x + u. Returns ``out``.
         """
         u = np.asarray(u, dtype=np.float64)
         if self.needs_rebuild(u):
             self.rebuild(u)
-        y = self.x + u
+        y = self.x + u if positions is None else positions
         self.touching = add_contact_force(
             y,
             self._first,

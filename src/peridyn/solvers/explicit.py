@@ -14,6 +14,7 @@ contact's stiffness bounds, 2 / sqrt(max((s_model + s_contact) / rho)) (Gershgor
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Sequence
 
 import numpy as np
@@ -58,6 +59,16 @@ class ExplicitSolver:
         of its time function (peridyn's); ``difference``, Peridigm's (u(n+1) - u(n)) / dt +
         dt/2 a(n+1), a the acceleration of the forces on the point (zero at t = 0, where it
         keeps its initial velocity). Either way the motion of every point is the same.
+    arithmetic : {"peridyn", "peridigm"}
+        ``peridigm``: Peridigm's order of operations (docs/peridigm.md, Rounding): each step
+        forms the deformed positions y = (x + u) + dt v(n + 1/2) before u is updated, the
+        material's force comes from y (``Model.force_from_positions``: LPS) and
+        a = (f + b) / rho. The prescribed DOFs take y = x + u. One process, float64.
+    beyond_bound : {"refuse", "warn"}
+        A ``dt`` above the stable step's Gershgorin bound (an upper bound of the largest
+        frequency, so a sufficient condition only): refused, or run with a warning (Peridigm's
+        own step, ``solver.step_rule: peridigm``); the state checks still stop a run that
+        diverges.
     """
 
     def __init__(
@@ -72,7 +83,13 @@ class ExplicitSolver:
         contact: Contact | None = None,
         domain: Domain | None = None,
         prescribed_velocity: str = "rate",
+        arithmetic: str = "peridyn",
+        beyond_bound: str = "refuse",
     ):
+        if arithmetic not in ("peridyn", "peridigm"):
+            raise InputError(f"arithmetic must be 'peridyn' or 'peridigm', got {arithmetic!r}")
+        if beyond_bound not in ("refuse", "warn"):
+            raise InputError(f"beyond_bound must be 'refuse' or 'warn', got {beyond_bound!r}")
         if prescribed_velocity not in ("rate", "difference"):
             raise InputError(
                 f"prescribed_velocity must be 'rate' or 'difference', got {prescribed_velocity!r}"
@@ -92,10 +109,13 @@ class ExplicitSolver:
         elif not dt > 0:
             raise InputError(f"time step must be positive, got {dt!r}")
         elif dt > self.stable_dt:
-            raise InputError(
+            message = (
                 f"time step {dt:.4g} s exceeds the stable step {self.stable_dt:.4g} s of this "
-                f"model (Gershgorin bound): use dt <= {self.stable_dt:.4g} s or leave dt unset"
+                "model (Gershgorin bound)"
             )
+            if beyond_bound != "warn":
+                raise InputError(f"{message}: use dt <= {self.stable_dt:.4g} s or leave dt unset")
+            warnings.warn(f"{message}: run as asked; a diverging state stops the run", stacklevel=2)
         self.dt = float(dt)
         self.damping = float(damping[0]) if damping.size == 1 else damping
         self._damping = damping if damping.any() else np.zeros(0)  # (0,): undamped
@@ -107,6 +127,12 @@ class ExplicitSolver:
         self._force = np.zeros((n, 3), dtype=model.dtype)
         self._body_force = np.zeros((n, 3))
         self._inv_rho = 1.0 / model.density
+        #: Peridigm's order: the deformed positions y (n_points, 3) m, else None
+        self._positions = None
+        if arithmetic == "peridigm":
+            if self.domain.halo is not None:
+                raise InputError("solver.arithmetic: peridigm runs in one process (not under MPI)")
+            self._positions = np.empty((n, 3))
         #: the DOFs whose velocity is Peridigm's difference, and their force acceleration
         self._differenced = self.loading.displaced if prescribed_velocity == "difference" else None
         self._free = None
@@ -124,6 +150,8 @@ class ExplicitSolver:
         state = State.zeros(self.model.body.n_points)
         self.loading.apply_start(self.dt, state.u, state.v, rates=self._differenced is None)
         self.domain.exchange(state.u)
+        if self._positions is not None:
+            np.add(self.model.body.points, state.u, out=self._positions)
         self._acceleration(state)
         return state
 
@@ -132,29 +160,43 @@ class ExplicitSolver:
         ``kick`` followed by the closing half step of the velocity, ``v += dt/2 a``.
         ``overlapped``: the exchange of u's ghost rows has been started, and is finished during
         the force (``Model.force_overlapped``)."""
-        if overlapped:
+        if self._positions is not None:
+            f = self.model.force_from_positions(self._positions, self._force)
+            if self.contact is not None:
+                f = f.copy()  # self._force keeps the material's own (``internal_force``)
+        elif overlapped:
             d = self.domain
             f = self.model.force_overlapped(state.u, self._force, d.clear_rows, d.n_owned, d.finish_exchange)
         else:
             f = self.model.force(state.u, out=self._force)
-        if self.contact is not None:
-            self.contact.add_force(state.u, f)
+        if self.contact is not None:  # Peridigm's order: at its deformed positions
+            extra = () if self._positions is None else (self._positions,)
+            self.contact.add_force(state.u, f, *extra)
         b = self._body_force
         if self.loading.body_force:  # else b stays zero
             self.loading.body_force_density(state.time, b)
         acceleration(
             f,
             b,
-            self._inv_rho,
+            self._inv_rho if self._positions is None else self.model.density,
             self._damping,
             state.v,
             self.loading.constrained,
             state.a,
             kick,
             0.5 * self.dt,
+            self._positions is not None,
         )
         if self._differenced is not None:
             self._free = self._free_acceleration(f, b, state.v)
+
+    def internal_force(self, state: State) -> np.ndarray:
+        """The material's force density (n_points, 3), N/m^3, at ``state``: with Peridigm's
+        order the one its last step (or ``initial_state``) computed from the deformed positions,
+        else ``model.force(state.u)``."""
+        if self._positions is not None:
+            return self._force
+        return self.model.force(state.u)
 
     def _free_acceleration(self, f: np.ndarray, b: np.ndarray, v: np.ndarray) -> np.ndarray:
         """The acceleration (m/s^2) of the DOFs with Peridigm's differenced velocity, as
@@ -162,7 +204,11 @@ class ExplicitSolver:
         the order of ``v[self._differenced]``."""
         mask = self._differenced
         rows = np.nonzero(mask)[0]
-        a = (f[mask].astype(np.float64) + b[mask]) * self._inv_rho[rows]
+        a = f[mask].astype(np.float64) + b[mask]
+        if self._positions is None:
+            a *= self._inv_rho[rows]
+        else:
+            a /= self.model.density[rows]
         if self._damping.size:
             a -= (self._damping if self._damping.size == 1 else self._damping[rows]) * v[mask]
         return a
@@ -173,10 +219,18 @@ class ExplicitSolver:
         differenced = self._differenced
         if differenced is not None:
             u_before = state.u[differenced]
+        y = self._positions
+        if y is not None:  # Peridigm's y = (x + u(n)) + dt v(n + 1/2)
+            np.add(self.model.body.points, state.u, out=y)
         kick_drift(state.u, state.v, state.a, 0.5 * dt, dt)
+        if y is not None:
+            y += dt * state.v
         state.time += dt
         state.step += 1
         self.loading.apply_kinematics(state.time, dt, state.u, state.v, rates=differenced is None)
+        if y is not None and self.loading.constrained.any():
+            fixed = self.loading.constrained
+            y[fixed] = self.model.body.points[fixed] + state.u[fixed]
         if self.overlap:
             self.domain.start_exchange(state.u)
             broken = 0

@@ -11,12 +11,15 @@ def kick_drift(u, v, a, half_dt, dt):
     return u + dt * v, v
 
 
-def acceleration(f, b, inv_rho, damping, v, constrained, kick, half_dt):
-    """``(a, v')``: ``a = (f + b) * inv_rho[:, None] - damping * v`` (no damping term for an
-    empty ``damping``), zero where ``constrained``; ``v' = v + half_dt * a`` with ``kick``,
-    else ``v``."""
+def acceleration(f, b, rho, damping, v, constrained, kick, half_dt, divide=False):
+    """``(a, v')``: ``a = (f + b) * rho[:, None] - damping * v`` (``/ rho[:, None]`` with
+    ``divide``; no damping term for an empty ``damping``), zero where ``constrained``;
+    ``v' = v + half_dt * a`` with ``kick``, else ``v``."""
     a = np.add(f, b, dtype=np.float64)
-    a *= inv_rho[:, None]
+    if divide:
+        a /= rho[:, None]
+    else:
+        a *= rho[:, None]
     if len(damping):
         a -= (damping if len(damping) == 1 else damping[:, None]) * v
     a[constrained] = 0.0

@@ -246,6 +246,15 @@ class Model:
         """Internal force density (n_points, 3), N/m^3, at displacement ``u`` (n_points, 3), m."""
         raise NotImplementedError
 
+    def force_from_positions(self, y: np.ndarray, out: np.ndarray) -> np.ndarray:
+        """Internal force density (n_points, 3), N/m^3, into ``out`` from the deformed positions
+        ``y`` (n_points, 3), m, in Peridigm's order of operations (``solver.arithmetic:
+        peridigm``, docs/peridigm.md). A material without that order refuses it."""
+        raise InputError(
+            f"solver.arithmetic: peridigm takes Peridigm's force order, which the {self.name} "
+            "material lacks (it has the LPS one): use arithmetic peridyn"
+        )
+
     def force_overlapped(
         self, u: np.ndarray, out: np.ndarray, clear_rows, n_owned: int, finish
     ) -> np.ndarray:

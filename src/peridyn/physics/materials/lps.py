@@ -45,6 +45,7 @@ from peridyn.kernels.lps import (
     lps_pair_force_cf,
     lps_stiffness_bound,
 )
+from peridyn.kernels.peridigm import peridigm_lps_force
 from peridyn.physics.materials.base import Model, ParameterError
 from peridyn.physics.materials.elastic import (
     dilatational_modulus,
@@ -153,12 +154,18 @@ class LPSModel(Model):
         b = bonds
         w = b.influence * self.bond_volume
         self.weighted_volume = family_sums(b.offsets, np.where(b.intact, w * b.length**2, 0.0))
-        m = self.weighted_volume
-        if np.any(m <= 0):
-            lonely = int(np.flatnonzero(m <= 0)[0])
-            raise InputError(f"point {lonely} has no intact bond: its weighted volume is zero")
-        self.alpha = (15.0 if dim == 3 else 8.0) * self.shear / m
-        self.theta_coef = dim / m
+        # a point without any bond (``discretization.points_without_bonds: warn``) has no force
+        # and no dilatation: its coefficients are 0 (divided by m = 1 and zeroed); one whose
+        # bonds are all cut has no weighted volume to divide by: refused
+        alone = np.diff(b.offsets) == 0
+        cut = (self.weighted_volume <= 0) & ~alone
+        if np.any(cut):
+            raise InputError(
+                f"point {int(np.flatnonzero(cut)[0])} has no intact bond: its weighted volume is zero"
+            )
+        m = np.where(alone, 1.0, self.weighted_volume)
+        self.alpha = np.where(alone, 0.0, (15.0 if dim == 3 else 8.0) * self.shear / m)
+        self.theta_coef = np.where(alone, 0.0, dim / m)
         self.shear_factor = np.ones(body.n_points)
         if surface_correction == "shear-factor":
             self.shear_factor = self._shear_correction_factor(w)
@@ -207,6 +214,7 @@ class LPSModel(Model):
         self._p = np.zeros(body.n_points, dtype=self.dtype)
         self._rows_read_cache: dict[int, int] = {}
         self._fused_cache: dict = {}
+        self._peridigm_p = None  # Peridigm's p of force_from_positions, made on its first call
 
     def _shear_correction_factor(self, w: np.ndarray) -> np.ndarray:
         """Peridigm's shear correction factor (``shear_correction_factor``) over the bonds."""
@@ -274,6 +282,40 @@ class LPSModel(Model):
             np.multiply(self._dilatation(u), self._p_coef, out=self._p)
             return self._pair_force(u, out)
         return self._force_fused(u, n, out)
+
+    def force_from_positions(self, y, out):
+        """See ``Model.force_from_positions``: ``kernels.peridigm.peridigm_lps_force`` with this
+        model's weighted volumes and alpha (shear correction included) and Peridigm's
+        p = 3 K / m - alpha / 3 of the dilatation term. 3D float64 bodies without partial
+        volumes nor the energy surface correction (Peridigm has neither); the dilatation it
+        forms is kept in ``self._theta``."""
+        if self._peridigm_p is None:
+            if self.dim != 3 or self.dtype != np.float64:
+                raise InputError("solver.arithmetic: peridigm takes a 3D float64 LPS body (Peridigm's)")
+            if np.any(self.bonds.volume_factor != 1.0) or np.any(self.dev_factor != 1.0):
+                raise InputError(
+                    "solver.arithmetic: peridigm takes an LPS body without partial volumes and "
+                    "without the energy surface correction (Peridigm's force has neither)"
+                )
+            m, bulk = self.weighted_volume, np.broadcast_to(self.bulk, (self.body.n_points,))
+            alone = m == 0.0  # a point without bonds: p is never read
+            self._peridigm_p = np.where(alone, 0.0, 3.0 * bulk / np.where(alone, 1.0, m) - self.alpha / 3.0)
+        b = self.bonds
+        peridigm_lps_force(
+            self.x,
+            np.ascontiguousarray(y, dtype=np.float64),
+            b.offsets,
+            b.neighbours,
+            self.body.volumes,
+            b.influence,
+            b.intact,
+            self.weighted_volume,
+            np.ascontiguousarray(np.broadcast_to(self.alpha, (self.body.n_points,))),
+            self._peridigm_p,
+            self._theta,
+            out,
+        )
+        return out
 
     def _force_fused(self, u: np.ndarray, rows: int, out: np.ndarray) -> np.ndarray:
         """The fused kernel's theta, p and force of the first ``rows`` rows (where :meth:`_fused`
