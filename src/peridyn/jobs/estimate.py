@@ -71,10 +71,14 @@ COSTS = {
 }
 
 #: An explicit run on lattice storage (``discretization.storage``, docs/user-guide.md) holds no
-#: per-bond array: per point the body and state as bond lists (350 B), the grid index, the grid's
-#: volume, displacement and force (float64: 56 B), the per-point LPS coefficients, dilatation
-#: and set-up sums (about 100 B) and the damage's grid displacement and reference (48 B); per
-#: point and offset of the stencil one broken bit (``LATTICE_BIT_BYTES``).
+#: per-bond array: per point the body (points, volumes; one cell size seen by every point), the
+#: state and force (96 B), the grid index, the grid's volume, displacement and force (float64:
+#: 56 B), the per-point LPS coefficients and dilatation (about 70 B) and, with damage, the
+#: damage's grid displacement and reference (48 B); per point and offset of the stencil one
+#: broken bit (``LATTICE_BIT_BYTES``). Measured beyond the bits: 321 B a point while stepping
+#: without damage, but writing a VTU snapshot (meshio) takes about 300 B a point more for its
+#: moment (peak RSS of a 3-layer LPS plate at 240 267 and 480 000 points, benchmarks/RESULTS.md);
+#: 560 B covers a run with snapshots (the 1.03 M-point cube: 910 MB estimated, 808 MB measured).
 LATTICE_PER_POINT = 560.0
 LATTICE_BIT_BYTES = 1.0 / 8.0
 
