@@ -26,9 +26,10 @@ class Body:
         Reference positions (z = 0 for 2D bodies).
     volumes : (n_points,) float64, m^3
         Volume of each point's cell.
-    cells : (n_points, 3) float64, m
+    cells : (n_points, 3) or (3,) float64, m
         Side lengths of each point's (box) cell, used for partial volumes.
-        For 2D bodies the third side is the thickness.
+        For 2D bodies the third side is the thickness. One row (a grid) is kept as a
+        read-only (n_points, 3) view of it.
     dim : {2, 3}
         Spatial dimension of the model.
     spacing : float, m
@@ -70,7 +71,14 @@ class Body:
         if not np.all(volumes > 0):
             bad = int(np.flatnonzero(~(volumes > 0))[0])
             raise InputError(f"volume of point {bad} must be positive, got {volumes[bad]!r}")
-        cells = np.ascontiguousarray(np.broadcast_to(self.cells, (n, 3)), dtype=np.float64)
+        cells = np.asarray(self.cells, dtype=np.float64)
+        # one cell for every point (a grid) stays one row seen n times: a read-only view that
+        # spares 24 bytes a point; cells of their own are an (n, 3) array
+        cells = (
+            np.broadcast_to(cells, (n, 3))
+            if cells.ndim == 1
+            else np.ascontiguousarray(np.broadcast_to(cells, (n, 3)))
+        )
         if self.dim not in (2, 3):
             raise InputError(f"dim must be 2 or 3, got {self.dim!r}")
         if self.dim == 2:

@@ -3,6 +3,7 @@ file) and .pvd time collections."""
 
 from __future__ import annotations
 
+import base64
 import math
 import os
 import xml.etree.ElementTree as ET
@@ -52,12 +53,73 @@ def write_vtu(
         raise InputError(f"write_vtu: points must have shape (n_points, 2 or 3), got {points.shape}")
     n = points.shape[0]
     fields = {name: _vtk_field(name, values, n) for name, values in point_data.items()}
+    if compression == "none":
+        _write_streamed_vtu(Path(path), points, fields, time)
+        return
     cells = [("vertex", np.arange(n, dtype=np.int64).reshape(-1, 1))]
     mesh = meshio.Mesh(points, cells, point_data=fields)
     meshio.vtu.write(os.fspath(path), mesh, compression=VTU_COMPRESSIONS[compression])
     if time is not None:  # meshio writes no field data: the time goes in after it
         grid, path = b"<UnstructuredGrid>", Path(path)
         path.write_bytes(path.read_bytes().replace(grid, grid + _time_value(time), 1))
+
+
+#: Bytes of an array encoded at a time (a multiple of 3, so that the base64 pieces join).
+ENCODE_CHUNK = 3 << 20
+
+#: VTK's cell type of a vertex.
+VTK_VERTEX = 1
+
+
+def _write_streamed_vtu(path: Path, points: np.ndarray, fields: dict, time: float | None) -> None:
+    """An uncompressed .vtu file (base64 binary data arrays, as meshio writes them) whose arrays
+    are encoded a few MiB at a time from their own memory, the vertex cells' arrays made in
+    chunks: where meshio encodes each array whole, holding about 300 bytes a point while it
+    writes (benchmarks/RESULTS.md), this holds a few MiB."""
+    n = len(points)
+    chunk = ENCODE_CHUNK // 8
+
+    def counting(start):  # connectivity (0 ... n-1) or offsets (1 ... n) of the vertex cells
+        return (np.arange(i + start, min(i + chunk, n) + start, dtype="<i8") for i in range(0, n, chunk))
+
+    with open(path, "wb") as file:
+        file.write(
+            b'<?xml version="1.0"?>\n<VTKFile type="UnstructuredGrid" version="1.0" '
+            b'byte_order="LittleEndian" header_type="UInt64">\n<UnstructuredGrid>'
+            + (b"" if time is None else _time_value(time))
+            + f'\n<Piece NumberOfPoints="{n}" NumberOfCells="{n}">\n<Points>\n'.encode()
+        )
+        points = points.astype("<f8", copy=False)
+        _write_array(file, "", [points], points.nbytes, "Float64", 3)
+        file.write(b"</Points>\n<Cells>\n")
+        _write_array(file, "connectivity", counting(0), 8 * n, "Int64", None)
+        _write_array(file, "offsets", counting(1), 8 * n, "Int64", None)
+        types = (np.full(min(chunk, n - i), VTK_VERTEX, "u1") for i in range(0, n, chunk))
+        _write_array(file, "types", types, n, "UInt8", None)
+        file.write(b"</Cells>\n<PointData>\n")
+        for name, values in fields.items():
+            dtype = values.dtype.newbyteorder("<")
+            components = None if values.ndim == 1 else values.shape[1]
+            values = values.astype(dtype, copy=False)
+            _write_array(file, name, [values], values.nbytes, VTK_TYPES[dtype.name], components)
+        file.write(b"</PointData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n")
+
+
+def _write_array(file, name: str, parts, size: int, vtk_type: str, components: int | None) -> None:
+    """One inline binary DataArray: base64 of its byte count ``size`` (UInt64) and the bytes of
+    ``parts`` (contiguous arrays, in order), encoded ``ENCODE_CHUNK`` bytes at a time."""
+    label = f' Name="{name}"' if name else ""
+    label += "" if components is None else f' NumberOfComponents="{components}"'
+    file.write(f'<DataArray type="{vtk_type}"{label} format="binary">\n'.encode())
+    carry = np.uint64(size).astype("<u8").tobytes()
+    for part in parts:
+        data = memoryview(np.ascontiguousarray(part)).cast("B")
+        for start in range(0, len(data), ENCODE_CHUNK):
+            block = carry + data[start : start + ENCODE_CHUNK]
+            whole = len(block) - len(block) % 3
+            file.write(base64.b64encode(block[:whole]))
+            carry = block[whole:]
+    file.write(base64.b64encode(carry) + b"\n</DataArray>\n")
 
 
 #: ``write_vtu``'s compressions: the case's ``output.vtu_compression`` -> meshio's argument.

@@ -74,11 +74,16 @@ COSTS = {
 COSTS_MODEL_BYTES = 24.0
 
 #: An explicit run on lattice storage (``discretization.storage``, docs/user-guide.md) holds no
-#: per-bond array: per point the body and state as bond lists (350 B), the grid index, the grid's
-#: volume, displacement and force (float64: 56 B), the per-point LPS coefficients, dilatation
-#: and set-up sums (about 100 B) and the damage's grid displacement and reference (48 B); per
-#: point and offset of the stencil one broken bit (``LATTICE_BIT_BYTES``).
-LATTICE_PER_POINT = 560.0
+#: per-bond array: per point the body (points, volumes; one cell size seen by every point), the
+#: state and force (96 B), the grid index, the grid's volume, displacement and force (float64:
+#: 56 B), the per-point LPS coefficients and dilatation (about 70 B) and, with damage, the
+#: damage's grid displacement and reference (48 B); per point and offset of the stencil one
+#: broken bit (``LATTICE_BIT_BYTES``). Measured beyond the bits: 346-360 B a point, with or
+#: without a VTU snapshot (written a few MiB at a time), no damage (``python
+#: benchmarks/lattice_memory.py``, benchmarks/RESULTS.md); with the damage's 48 B and a margin for
+#: the recorders, 450 B (the 1.03 M-point cube with partial volumes: 797 MB estimated, 776 MB
+#: measured).
+LATTICE_PER_POINT = 450.0
 LATTICE_BIT_BYTES = 1.0 / 8.0
 
 #: Bytes per directed bond an explicit run saves with float32 kernels: half of the model's 32 B,

@@ -125,8 +125,12 @@ class ExplicitSolver:
         self.max_displacement = self.domain.runaway_limit(model.body.points)
         n = model.body.n_points
         self._force = np.zeros((n, 3), dtype=model.dtype)
-        self._body_force = np.zeros((n, 3))
-        self._inv_rho = 1.0 / model.density
+        # without body forces b is a read-only zero row seen n times, and one density's
+        # 1 / rho one value seen n times: 32 bytes a point that a large body does not pay
+        self._body_force = (
+            np.zeros((n, 3)) if self.loading.body_force else np.broadcast_to(np.zeros(3), (n, 3))
+        )
+        self._inv_rho = _reciprocal(model.density)
         #: Peridigm's order: the deformed positions y (n_points, 3) m, else None
         self._positions = None
         if arithmetic == "peridigm":
@@ -301,3 +305,11 @@ def _damping_coefficients(damping, n_points: int) -> np.ndarray:
             "damping must be non-negative and finite (1/s)" + (f", got {damping!r}" if c.size == 1 else "")
         )
     return c
+
+
+def _reciprocal(density: np.ndarray) -> np.ndarray:
+    """``1 / density`` (n_points,), m^3/kg: one value seen n times (a read-only view) where every
+    point has the same density, the same bits as the division point by point."""
+    if np.all(density == density[0]):
+        return np.broadcast_to(1.0 / density[0], density.shape)
+    return 1.0 / density

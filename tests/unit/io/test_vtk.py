@@ -25,7 +25,7 @@ def test_vtu_round_trip_3d(tmp_path, compression):
     }
     path = tmp_path / "out.vtu"
     write_vtu(path, points, fields, compression)
-    assert ('compressor="vtkZLibDataCompressor"' in path.read_text()) == (compression == "zlib")
+    assert (b'compressor="vtkZLibDataCompressor"' in path.read_bytes()) == (compression == "zlib")
     mesh = meshio.read(path)
     np.testing.assert_array_equal(mesh.points, points)
     assert [(block.type, len(block)) for block in mesh.cells] == [("vertex", 8)]
@@ -34,6 +34,24 @@ def test_vtu_round_trip_3d(tmp_path, compression):
     for name, values in fields.items():
         np.testing.assert_array_equal(mesh.point_data[name], values)
         assert mesh.point_data[name].dtype == values.dtype
+
+
+def test_vtu_encoded_in_pieces_is_the_file_encoded_whole(tmp_path, monkeypatch):
+    """An uncompressed VTU file's arrays are base64-encoded a few MiB at a time; with pieces of
+    15 bytes (7 points: every array's bytes end mid-piece, the cells' arrays made in chunks of one
+    point) the file is byte for byte the one written in one piece (base64 of whole 3-byte groups
+    joins), and meshio reads back what was written."""
+    rng = np.random.default_rng(5)
+    points, fields = rng.random((7, 3)), {"u": rng.random((7, 3)), "damage": rng.random(7).astype(np.float32)}
+    write_vtu(tmp_path / "whole.vtu", points, fields, time=1.5e-6)
+    monkeypatch.setattr("peridyn.io.vtk.ENCODE_CHUNK", 15)
+    write_vtu(tmp_path / "pieces.vtu", points, fields, time=1.5e-6)
+    assert (tmp_path / "pieces.vtu").read_bytes() == (tmp_path / "whole.vtu").read_bytes()
+    mesh = meshio.read(tmp_path / "pieces.vtu")
+    np.testing.assert_array_equal(mesh.points, points)
+    np.testing.assert_array_equal(mesh.cells[0].data.ravel(), np.arange(7))
+    for name, values in fields.items():
+        np.testing.assert_array_equal(mesh.point_data[name], values)
 
 
 def test_vtu_pads_2d_points_and_vectors(tmp_path):

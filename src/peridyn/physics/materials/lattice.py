@@ -55,10 +55,10 @@ class LatticeModel(Model):
         self.E = float(E)
         self.dtype = np.dtype(dtype)
         self.x = np.ascontiguousarray(body.points, dtype=self.dtype)
-        self.density = np.full(body.n_points, float(density))
+        self.density = np.broadcast_to(float(density), (body.n_points,))  # one material: a view
         s = lattice.stencil
         self._cf = self.dtype == np.float32  # the cancellation-free extension in float32
-        self._vol = lattice.volume.astype(self.dtype)
+        self._vol = lattice.volume.astype(self.dtype, copy=False)
         self._xi = s.xi.astype(self.dtype)
         self._length = s.length.astype(self.dtype)
         self._ug = np.zeros((3, lattice.n_grid), dtype=self.dtype)  # holes stay 0
@@ -189,9 +189,9 @@ class LatticeLPS(LatticeModel):
             self.alpha[lattice.grid_index] *= self.shear_factor
         self.p_coef = np.where(occupied, dim * self.bulk / safe - self.alpha / dim, 0.0)
         self._weight = self._offset_table(self._weight64)
-        self._alpha = self.alpha.astype(self.dtype)
-        self._theta_coef = self.theta_coef.astype(self.dtype)
-        self._p_coef = self.p_coef.astype(self.dtype)
+        self._alpha = self.alpha.astype(self.dtype, copy=False)
+        self._theta_coef = self.theta_coef.astype(self.dtype, copy=False)
+        self._p_coef = self.p_coef.astype(self.dtype, copy=False)
         self._theta = np.zeros(lattice.n_grid, dtype=self.dtype)
         self._p = np.zeros(lattice.n_grid, dtype=self.dtype)
 

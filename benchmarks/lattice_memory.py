@@ -1,0 +1,60 @@
+"""Peak memory per point of explicit runs on lattice storage: the shipped Lamb plate case
+(3 surface layers, LPS with the shear factor, horizon 3.015 spacings) enlarged to two plate
+sizes, 3 steps, each in its own process; the difference of the peaks over the difference of the
+points is the memory a point costs, free of the interpreter's and the compiled kernels' share.
+With and without VTU snapshots (the one written at the end). One Markdown table row each
+(benchmarks/RESULTS.md). Run from the repository root: ``python benchmarks/lattice_memory.py``."""
+
+import json
+import subprocess
+import sys
+import tempfile
+
+#: plate sides (m) of the two runs: about 240 000 and 480 000 points
+SIDES = (0.34, 0.48)
+
+
+def peak_bytes(side: float, vtu: bool) -> tuple[int, int]:
+    """(points, peak RSS in bytes) of one shortened run in a fresh process."""
+    out = tempfile.mkdtemp()
+    command = [sys.executable, "-m", "peridyn", "run", "cases/lamb_plate.yaml", "-o", out, "--json"]
+    for key, value in {
+        "geometry.size": f"[{side},{side},0.002]",
+        "actuators.pzt.center": f"[{side / 2},{side / 2}]",
+        "discretization.storage": "lattice",
+        "solver.steps": "3",
+        "solver.time": "null",
+        "output.plots": "false",
+        "output.sensors": "{}",
+        "output.lines": "{}",
+        "output.planes": "{}",
+        "output.pzt_sensors": "{}",
+        "output.snapshot_times": "[]",
+        "output.vtu": str(vtu).lower(),
+        "analysis": "null",
+    }.items():
+        command += ["--set", f"{key}={value}"]
+    # a fresh parent per run, so that its children's peak is this run's alone
+    wrapper = (
+        "import resource, subprocess, sys; "
+        "done = subprocess.run(sys.argv[1:], capture_output=True, text=True, check=True); "
+        "print(done.stdout.strip()); print(resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss)"
+    )
+    lines = subprocess.run(
+        [sys.executable, "-c", wrapper, *command], capture_output=True, text=True, check=True
+    )
+    summary, peak_kib = lines.stdout.strip().rsplit("\n", 1)
+    return int(json.loads(summary)["points"]), int(peak_kib) * 1024
+
+
+def main() -> None:
+    print("| snapshots | points | peak RSS (MB) | bytes a point (marginal) |")
+    print("|---|---|---|---|")
+    for vtu in (False, True):
+        (n0, p0), (n1, p1) = (peak_bytes(side, vtu) for side in SIDES)
+        kind = "VTU at the end" if vtu else "none"
+        print(f"| {kind} | {n0} / {n1} | {p0 / 1e6:.0f} / {p1 / 1e6:.0f} | {(p1 - p0) / (n1 - n0):.0f} |")
+
+
+if __name__ == "__main__":
+    main()
