@@ -59,6 +59,31 @@ def deferred() -> Iterator[None]:
             _pending.clear()
 
 
+@contextmanager
+def raised_outside_jobs() -> Iterator[None]:
+    """Within the block, SIGTERM and SIGHUP left at their default action (the process dies with
+    no word) raise :class:`~peridyn.errors.Interrupted` instead, as SIGINT raises
+    ``KeyboardInterrupt``: a signal while a command starts (imports, reading the case) ends it
+    with one line and 128 + the signal. A job's :func:`deferred` block notes them as usual."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = {
+        sig: signal.signal(sig, _raise)
+        for sig in (signal.SIGTERM, signal.SIGHUP)
+        if signal.getsignal(sig) is signal.SIG_DFL
+    }
+    try:
+        yield
+    finally:
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+
+
+def _raise(signum, frame) -> None:
+    raise Interrupted(signal.Signals(signum).name, where="starting")
+
+
 def check(step: int | None = None, where: str = "", agree=None) -> None:
     """Raise :class:`~peridyn.errors.Interrupted` if a stop signal arrived since the block began.
 

@@ -113,6 +113,14 @@ _NEGATIVE_TOL = 1e-8
 _PURE_MODE_TOL = 1e-3
 #: Quadrature nodes of the continuous families beyond k_max * delta.
 _EXTRA_NODES = 32
+#: Bytes held per wavenumber and family bond by ``acoustic_tensor``: the phases, their sines and
+#: cosines and the products with the bond terms (32.4 B measured with ``tracemalloc``, 3D
+#: continuum, 400 wavenumbers, 7 056 quadrature bonds).
+TENSOR_BYTES = 36.0
+#: Bytes per bond of the lattice block searched by ``lattice_family`` (``find_bonds``: the
+#: neighbour index, the volume factor and the search's temporaries; about 14 B measured for a
+#: horizon of 6 spacings in 3D).
+SEARCH_BYTES = 16.0
 
 
 @dataclass(frozen=True)
@@ -661,7 +669,11 @@ def dispersion_relation(
     _check_arguments(horizon, spacing, dim, points)
     d = parse_direction(direction, dim)
     zone_edge = float(np.pi / (spacing * np.max(np.abs(d))))
-    k = _wavenumbers(wavenumbers, k_max or zone_edge, points)
+    k = None if wavenumbers is None else _wavenumbers(wavenumbers, k_max or zone_edge, points)
+    n_k, largest = (int(points), k_max or zone_edge) if k is None else (len(k), k[-1])
+    if np.isfinite(largest) and largest > 0:  # else _wavenumbers refuses it
+        check_relation_fits(horizon, spacing, dim, n_k, bool(discrete), float(largest))
+    k = _wavenumbers(wavenumbers, k_max or zone_edge, points) if k is None else k
     if discrete:
         family = lattice_family(spacing, horizon, influence, dim, partial_volumes)
     else:
@@ -735,6 +747,40 @@ def _branch(
 
             onset = float(brentq(shifted_group, k[i - 1], k[i], xtol=1e-10 * k[i]))
     return Branch(name, polarisation, k, omega, omega / k, group, float(limit), onset)
+
+
+def relation_bytes(horizon: float, spacing: float, dim: int, n_k: int, discrete: bool, k_max: float) -> float:
+    """Peak bytes of :func:`dispersion_relation` for ``n_k`` wavenumbers up to ``k_max`` (rad/m),
+    estimated before anything is allocated: the acoustic tensor (``TENSOR_BYTES`` per wavenumber
+    and family bond) and, for the lattice, the bond search of its block (``SEARCH_BYTES``)."""
+    ball = (2.0, np.pi, 4.0 / 3.0 * np.pi)[dim - 1]
+    if discrete:
+        family = ball * (horizon / spacing + 0.5) ** dim
+        reach = horizon / spacing + np.sqrt(dim) / 2.0 + 1.0
+        block = ball * reach**dim if dim > 1 else 0.0  # 1D: the chain, no search
+        search = SEARCH_BYTES * block * family
+    else:
+        nodes = np.ceil(k_max * horizon) + _EXTRA_NODES
+        family, search = (2.0 * nodes, nodes**2, 4.0 * nodes**2)[dim - 1], 0.0
+    return TENSOR_BYTES * float(n_k) * family + search
+
+
+def check_relation_fits(horizon: float, spacing: float, dim: int, n_k: int, discrete: bool, k_max: float):
+    """Refuse, before allocating, a relation whose arrays would not fit in memory
+    (:func:`relation_bytes` against ``geometry.memory_limit``).
+
+    Raises
+    ------
+    InputError
+        Naming the wavenumbers, the family's bonds, the bytes needed and those available.
+    """
+    needed, available = relation_bytes(horizon, spacing, dim, n_k, discrete, k_max), geometry.memory_limit()
+    if needed > available:
+        raise InputError(
+            f"the dispersion relation at {n_k:.3g} wavenumbers with a horizon of {horizon / spacing:.3g} "
+            f"spacings needs about {needed / 1e9:.3g} GB, more than the {available / 1e9:.3g} GB of this "
+            "machine: fewer points (--points), a smaller horizon or a larger spacing"
+        )
 
 
 def _check_arguments(horizon: float, spacing: float, dim: int, points: int) -> None:

@@ -22,6 +22,7 @@ from peridyn.cli.errors import ArgumentParser, report, writing
 from peridyn.cli.logs import configure_logging, plain_warnings
 from peridyn.cli.streams import usable_streams
 from peridyn.errors import InputError
+from peridyn.interrupts import raised_outside_jobs
 
 #: Subcommand modules, in the order ``peridyn --help`` lists them.
 COMMAND_MODULES = (
@@ -71,7 +72,7 @@ def main(argv: list[str] | None = None) -> int:
     _quiet_unless_first_rank()
     configure_logging()
     args = None
-    with plain_warnings(), usable_streams():
+    with plain_warnings(), usable_streams(), raised_outside_jobs():
         try:
             parser = build_parser()
             args = _parse(parser, argv)

@@ -101,8 +101,10 @@ def load_checkpoint(
             parts = {
                 name: {key: ds[()] for key, ds in group.items()} for name, group in f.get("parts", {}).items()
             }
-    except (OSError, KeyError) as exc:
-        raise InputError(
+    except InputError:
+        raise
+    except (OSError, KeyError, TypeError, ValueError, RuntimeError) as exc:  # damaged: HDF5 objects
+        raise InputError(  # of another kind, attributes that do not parse
             f"checkpoint {str(path)!r} is not readable ({exc}): start again with --overwrite"
         ) from None
     if state.u.shape != (n_points, 3) or intact.shape != (n_bonds,):

@@ -156,14 +156,23 @@ def read_exodus(path: str | os.PathLike) -> ExodusMesh:
         f = scipy.io.netcdf_file(path, "r", mmap=False)
     except FileNotFoundError:
         raise InputError(f"Exodus file {path!r} does not exist") from None
-    except (OSError, TypeError, ValueError) as exc:
+    except MemoryError:  # the sizes its header gives do not fit in memory
         raise InputError(
-            f"{path}: not a netCDF-3 Exodus II file ({exc}); convert a netCDF-4 file with `nccopy -k classic`"
+            f"{path}: the variables its header declares do not fit in memory (a damaged file?)"
+        ) from None
+    except (OSError, TypeError, ValueError, KeyError, IndexError) as exc:  # a damaged header too
+        raise InputError(
+            f"{path}: not a netCDF-3 Exodus II file ({type(exc).__name__}: {exc}); convert a netCDF-4 "
+            "file with `nccopy -k classic`"
         ) from None
     try:
         return _read(f, path)
     except KeyError as exc:
         raise InputError(f"{path}: not an Exodus II file, it lacks {exc.args[0]!r}") from None
+    except InputError:
+        raise
+    except (ValueError, IndexError) as exc:  # variables whose sizes disagree with the dimensions
+        raise InputError(f"{path}: a damaged Exodus II file ({type(exc).__name__}: {exc})") from None
     finally:
         f.close()
 
@@ -312,8 +321,8 @@ def mesh_points(mesh: ExodusMesh) -> MeshPoints:
     ------
     InputError
         The mesh is not 3-D, has no elements, a block has another element type or too few
-        nodes per element, an element has a non-positive volume (inverted node order), or two
-        sets share a name.
+        nodes per element, an element has a non-finite node coordinate or a non-positive
+        volume (inverted node order), or two sets share a name.
     """
     if mesh.coordinates.shape[1] != 3:
         raise InputError(f"an Exodus mesh for points must be 3-D, this one has {mesh.coordinates.shape[1]}")
@@ -321,6 +330,11 @@ def mesh_points(mesh: ExodusMesh) -> MeshPoints:
         raise InputError("the Exodus mesh has no elements")
     centroids, volumes = zip(*(_block_points(mesh.coordinates, b) for b in mesh.blocks), strict=True)
     points, volumes = np.concatenate(centroids), np.concatenate(volumes)
+    bad = np.flatnonzero(~np.isfinite(points).all(axis=1))
+    if bad.size:
+        raise InputError(
+            f"element {bad[0] + 1} has a non-finite node coordinate (its point {points[bad[0]].tolist()})"
+        )
     bad = np.flatnonzero(~(volumes > 0))
     if bad.size:
         raise InputError(
@@ -436,7 +450,11 @@ def body_from_exodus(
     "strain"): one layer of elements, every point at the same z (else an InputError), placed
     at z = 0; cells squares of area volume / thickness, as Peridigm's 2D decks read a one-layer
     hex mesh."""
-    pts = mesh_points(read_exodus(path))
+    mesh = read_exodus(path)
+    try:
+        pts = mesh_points(mesh)
+    except InputError as exc:  # a block the points cannot be made of: which file's
+        raise InputError(f"{os.fspath(path)}: {exc}") from None
     points = pts.points
     if dim == 2:
         z = points[:, 2]

@@ -26,6 +26,7 @@ import numpy as np
 import scipy.io
 
 from peridyn.errors import InputError
+from peridyn.io.reserve import as_disk_error, ensure_room
 
 #: Exodus API version written in the file (the attributes ``api_version`` and ``version``).
 EXODUS_VERSION = np.float32(8.06)
@@ -162,12 +163,31 @@ class ExodusWriter:
         for _, _, idx in self.blocks:
             record += [c[idx].astype(">f8") for c in values["element"]]
         record.append(np.array(values["global"], dtype=">f8"))
-        with open(self.path, "r+b") as f:
-            f.seek(self._begin + self.n_steps * self.record_size)
-            f.write(b"".join(r.tobytes() for r in record))
-            self.n_steps += 1
-            f.seek(NUMRECS_OFFSET)
-            f.write(np.array(self.n_steps, dtype=">i4").tobytes())
+        data = b"".join(r.tobytes() for r in record)
+        at = self._begin + self.n_steps * self.record_size
+        ensure_room(self.path, len(data))  # refused whole rather than failed half-way
+        try:
+            with open(self.path, "r+b") as f:
+                f.seek(at)
+                f.write(data)
+                f.flush()  # the record on disk before the count that makes it part of the file
+                f.seek(NUMRECS_OFFSET)
+                f.write(np.array(self.n_steps + 1, dtype=">i4").tobytes())
+        except OSError as exc:  # a full or failing disk: the steps written stay the file's
+            self._drop_from(at)
+            raise as_disk_error(exc, self.path) from exc
+        self.n_steps += 1
+
+    def _drop_from(self, at: int) -> None:
+        """Cut a record that failed to be written at byte ``at`` and restore the step count
+        (as far as the disk lets: a record past the count is never read)."""
+        try:
+            with open(self.path, "r+b") as f:
+                f.truncate(at)
+                f.seek(NUMRECS_OFFSET)
+                f.write(np.array(self.n_steps, dtype=">i4").tobytes())
+        except OSError:
+            pass
 
     def resume(self, time: float) -> None:
         """Continue an existing file written by this layout, dropping its steps after ``time``
@@ -214,6 +234,8 @@ class ExodusWriter:
                 self._fixed(f)
                 self._records(f, time, values)
             os.replace(tmp, self.path)
+        except OSError as exc:  # a full or failing disk, named as the file it was for
+            raise as_disk_error(exc, self.path) from exc
         finally:
             tmp.unlink(missing_ok=True)
         self._begin = self.path.stat().st_size - self.record_size

@@ -106,7 +106,7 @@ def verify(dataset: h5py.Dataset, path: str, keep: int | None = None) -> int | N
     ------
     InputError
         Naming the file and the dataset: the checksum differs, the dataset holds fewer rows
-        than its checksum covers, or a checksummed file's dataset has none.
+        than its checksum covers, cannot be read, or a checksummed file's dataset has none.
     """
     name = dataset.name
     rows = covered_rows(dataset)
@@ -118,7 +118,12 @@ def verify(dataset: h5py.Dataset, path: str, keep: int | None = None) -> int | N
             "covers: the file is truncated or damaged"
         )
     ends = [rows] if keep is None else [rows, keep]
-    crcs = prefix_crcs(dataset, ends)
+    try:
+        crcs = prefix_crcs(dataset, ends)
+    except (OSError, RuntimeError, ValueError, TypeError) as exc:  # HDF5 finds a damaged structure
+        raise InputError(
+            f"{path}: dataset {name} cannot be read ({exc}): the file is damaged; it is not used"
+        ) from None
     if crcs[rows] != int(dataset.attrs[CRC_ATTR]):
         raise InputError(
             f"{path}: dataset {name} does not match its checksum (CRC-32): the file is corrupted; "
@@ -133,7 +138,12 @@ def verify_file(f: h5py.File, path: str) -> None:
     if not is_marked(f):
         return
     datasets = []
-    f.visititems(lambda _, obj: datasets.append(obj) if isinstance(obj, h5py.Dataset) else None)
+    try:
+        f.visititems(lambda _, obj: datasets.append(obj) if isinstance(obj, h5py.Dataset) else None)
+    except (OSError, RuntimeError, KeyError, ValueError) as exc:  # HDF5 finds a damaged structure
+        raise InputError(
+            f"{path}: its groups cannot be read ({exc}): the file is damaged; it is not used"
+        ) from None
     for dataset in datasets:
         verify(dataset, path)
 

@@ -208,6 +208,10 @@ def from_text_mesh(path, dim: int = 3, thickness: float | None = None, plane: st
     in 2D); node sets ``block_<id>`` hold the points of each block.
     """
     points, blocks, volumes = read_text_mesh(path)
+    if dim == 2:
+        line = _first_bad_line(os.fspath(path), points[:, 2] != 0.0)
+        if line is not None:
+            raise InputError(f"{path}, line {line}: a 2D body's points need z = 0")
     cells, side = volume_cells(volumes, dim, thickness, "text mesh")
     sets = {f"block_{b}": np.flatnonzero(blocks == b) for b in np.unique(blocks)}
     return Body(

@@ -105,6 +105,8 @@ class _Deck:
             node = float(node)
         if kind is not None and (not isinstance(node, kind) or (kind is not bool and isinstance(node, bool))):
             raise self.error(key, node, f"a {getattr(kind, '__name__', kind)}")
+        if kind is float and not math.isfinite(node):
+            raise self.error(key, node, "a finite number")
         return node
 
 
@@ -305,7 +307,7 @@ def _mesh_blocks(deck: _Deck, deck_dir: Path) -> list[str]:
     """Names of the blocks of the deck's mesh (an Exodus mesh's, ``block_<id>`` of a text mesh)."""
     kind = deck.get("Discretization.Type", str)
     mesh = deck_dir / deck.get("Discretization.Input Mesh File", str, "")
-    if kind not in ("Exodus", "Text File") or not mesh.is_file():
+    if kind not in ("Exodus", "Text File") or not _is_file(mesh):
         raise deck.error("Blocks", "default", "a mesh whose blocks the default block takes")
     if kind == "Exodus":
         return [b.name for b in read_exodus(mesh).blocks]
@@ -343,6 +345,18 @@ def _block_materials(deck: _Deck, groups: list[_Group], horizon: float) -> tuple
     return materials, blocks
 
 
+#: The most points of a PdQuickGrid along one axis (a C int's range).
+MAX_GRID_POINTS = 2**31 - 1
+
+
+def _is_file(path: Path) -> bool:
+    """``path.is_file()``, False for a name the system refuses (too long, a NUL in it)."""
+    try:
+        return path.is_file()
+    except (OSError, ValueError):
+        return False
+
+
 def _discretization(deck: _Deck, deck_dir: Path, horizon: float) -> tuple[dict, dict, np.ndarray | None]:
     """Geometry and discretisation sections, and the PdQuickGrid's (nx, ny, nz) (None for a mesh)."""
     kind = deck.get("Discretization.Type", str)
@@ -361,8 +375,8 @@ def _discretization(deck: _Deck, deck_dir: Path, horizon: float) -> tuple[dict, 
         size = [deck.get(f"{where}.{a} Length", float) for a in "XYZ"]
         counts = [deck.get(f"{where}.Number Points {a}", int) for a in "XYZ"]
         for a, n in zip("XYZ", counts, strict=True):
-            if n < 1:
-                raise deck.error(f"{where}.Number Points {a}", n, "at least 1 point")
+            if not 1 <= n <= MAX_GRID_POINTS:
+                raise deck.error(f"{where}.Number Points {a}", n, f"from 1 to {MAX_GRID_POINTS} points")
         spacing = [s / n for s, n in zip(size, counts, strict=True)]
         if neighbourhood and neighbourhood.lower() != "spherical":
             raise deck.error(
@@ -378,7 +392,7 @@ def _discretization(deck: _Deck, deck_dir: Path, horizon: float) -> tuple[dict, 
     if kind not in ("Exodus", "Text File"):
         raise deck.error("Discretization.Type", kind, "one of 'PdQuickGrid', 'Exodus', 'Text File'")
     mesh = deck_dir / deck.get("Discretization.Input Mesh File", str)
-    if not mesh.is_file():
+    if not _is_file(mesh):
         raise deck.error("Discretization.Input Mesh File", str(mesh), "an existing mesh file")
     geometry = {"type": "exodus" if kind == "Exodus" else "mesh", "file": str(mesh.resolve())}
     return geometry, discretization, None
@@ -812,7 +826,7 @@ def _initial_damage(deck: _Deck, groups: list[_Group], deck_dir: Path) -> list[d
             if kind != "Exodus Mesh":
                 raise deck.error(f"{at}.Type", kind, "'Exodus Mesh' (a surface of triangles)")
             path = deck_dir / deck.get(f"{at}.File Name", str)
-            if not path.is_file():
+            if not _is_file(path):
                 raise deck.error(f"{at}.File Name", str(path), "an existing Exodus file")
             cracks.append({"type": "surface", "file": str(path.resolve()), "in_weighted_volume": True})
     return cracks
@@ -905,13 +919,13 @@ def _set_indices(deck: _Deck, key: str, deck_dir: Path, grid, first_id: int) -> 
     counted = f"{first_id}-based node ids"
     text = deck.get(key, str)
     path = deck_dir / text
-    if not text.split()[0].isdigit() or path.is_file():
-        if not path.is_file():
+    if not text.split() or not text.split()[0].isdigit() or _is_file(path):
+        if not _is_file(path):
             raise deck.error(key, text, f"{counted}, or a file of them")
         text = path.read_text(encoding="utf-8")
     try:
         ids = np.array([int(t) for t in text.split()], dtype=np.int64)
-    except ValueError:
+    except (ValueError, OverflowError):  # not whole numbers, or beyond 64 bits
         raise deck.error(key, text[:80], f"whitespace-separated {counted}") from None
     if len(ids) == 0 or ids.min() < first_id:
         raise deck.error(key, text[:80], f"{counted} (at least one)")

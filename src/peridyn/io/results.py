@@ -193,7 +193,12 @@ class Results:
         except OSError as exc:
             raise InputError(f"{self.path}: not a readable HDF5 file ({exc})") from None
         with f:
-            yield f
+            try:
+                yield f
+            except InputError:
+                raise
+            except (OSError, RuntimeError, KeyError, TypeError) as exc:  # HDF5 finds a damaged structure
+                raise InputError(f"{self.path}: cannot be read ({exc}): the file is damaged") from None
 
     @contextmanager
     def _series(self, name: str) -> Iterator[h5py.Group]:

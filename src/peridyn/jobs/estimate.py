@@ -90,6 +90,11 @@ LATTICE_BIT_BYTES = 1.0 / 8.0
 #: and the 24 B of bond vectors that only the float64 kernels read.
 FLOAT32_SAVING = 40.0
 
+#: ``modal``: bytes per point and mode asked for (``solver.modes``): the mode shapes (3 float64)
+#: and LOBPCG's blocks of as many vectors (X, AX, R, AR, P, AP and the Rayleigh-Ritz basis), ten
+#: of them; a request of many modes is refused with this part named.
+MODE_BYTES = 240.0
+
 #: Bytes per entry of a sparse factor (8-byte value, 4-byte index), as ``jobs.modal`` counts.
 FACTOR_ENTRY_BYTES = 12.0
 
@@ -249,6 +254,7 @@ def estimate_case(case: Case, base_dir=".", job: str | None = None) -> Estimate:
         parts.update(points=points * LATTICE_PER_POINT, bonds=grid * max(words, offsets * LATTICE_BIT_BYTES))
     if job == "modal":
         parts["factor"] = modal_factor_bytes(case, base_dir, points, horizon)
+        parts["modes"] = MODE_BYTES * points * case.solver.modes
     return Estimate(job, int(round(points)), int(round(bonds)), float(sum(parts.values())), parts, storage)
 
 
@@ -293,7 +299,12 @@ def check_memory(case: Case, max_memory: float | None = None, base_dir=".", job:
 
 
 def _suggestion(case: Case, est: Estimate, limit: float) -> str:
-    """``"; a spacing of about X m fits"`` from the points' and bonds' scaling with spacing."""
+    """``"; a spacing of about X m fits"`` from the points' and bonds' scaling with spacing
+    (``"; ask for fewer modes"`` where the modes asked for take most of it)."""
+    modes = est.parts.get("modes", 0.0)
+    if modes > 0.5 * est.peak_bytes:
+        asked = case.solver.modes
+        return f"; the {asked} modes asked for take ~{modes / 1e9:.3g} GB: ask for fewer (--modes)"
     budget = limit - est.parts["base"]
     varying = est.peak_bytes - est.parts["base"]
     if budget <= 0:
