@@ -102,3 +102,4 @@ def test_results_examples_read_a_pulse_that_arrives_no_faster_than_sound(tmp_pat
     exec(compile(xarray_block, "user-guide: xarray", "exec"), scope)
     assert scope["u"].dims == ("time", "sensor", "component") and scope["u"].attrs["units"] == "m"
     np.testing.assert_array_equal(scope["u"].values, u)
+    np.testing.assert_array_equal(scope["root"]["sensor_u"].values, u)
