@@ -38,10 +38,11 @@ def test_matrix_free_cg_gives_the_lu_increment(rng, mass_dominated):
     assert krylov.preconditioner_kind == ("mass" if mass_dominated else "amg")
 
 
-def test_auto_factorises_a_small_body_and_refuses_a_factor_beyond_the_memory(monkeypatch):
+def test_auto_factorises_a_small_body_and_refuses_a_factor_beyond_the_memory(monkeypatch, caplog):
     """``auto`` takes the LU when its estimated factor is under the budget (a 6^3 cube: about
     a megabyte); an explicit ``lu`` whose factor exceeds 70% of the memory is refused in one
-    line naming the factor's size and the memory, and ``auto`` then takes CG."""
+    line naming the factor's size and the memory, and ``auto`` then takes CG, saying why in
+    the log."""
     model = small_model("lps", 3, n=6)
     needed = factor_bytes(model)
     assert 0 < needed < tangent_solve.DIRECT_BUDGET
@@ -49,7 +50,9 @@ def test_auto_factorises_a_small_body_and_refuses_a_factor_beyond_the_memory(mon
     monkeypatch.setattr(tangent_solve, "memory_limit", lambda: needed)
     with pytest.raises(InputError, match=r"sparse LU of this tangent would hold about .* GiB; 0 GiB here"):
         choose_linear_solver(model, "lu")
-    assert choose_linear_solver(model, "auto") == "cg"
+    with caplog.at_level("INFO", logger="peridyn.linalg.tangent_solve"):
+        assert choose_linear_solver(model, "auto") == "cg"
+    assert "linear solver: cg (the tangent's LU factor would take" in caplog.text
     with pytest.raises(InputError, match="unknown linear solver 'lsu'"):
         choose_linear_solver(model, "lsu")
 

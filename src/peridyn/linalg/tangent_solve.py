@@ -21,6 +21,8 @@ a few thousand points, wide horizons), where the factor grows much faster than t
 
 from __future__ import annotations
 
+import logging
+
 import numpy as np
 from scipy.sparse.linalg import LinearOperator
 
@@ -38,6 +40,8 @@ from peridyn.linalg.ordering import estimated_factor_entries
 from peridyn.linalg.shift_invert import ordered_lu
 from peridyn.linalg.tangent import tangent_operator, tangent_stiffness
 from peridyn.physics.materials.base import Model
+
+logger = logging.getLogger(__name__)
 
 #: Linear solvers of the Newton and Newmark systems (see the module docstring).
 LINEAR_SOLVERS = ("auto", "lu", "cg")
@@ -94,7 +98,15 @@ def choose_linear_solver(model: Model, requested: str = "auto") -> str:
         return "cg"
     needed = factor_bytes(model)
     if requested == "auto":
-        return "lu" if needed <= min(DIRECT_BUDGET, MEMORY_SHARE * memory_limit()) else "cg"
+        budget = min(DIRECT_BUDGET, MEMORY_SHARE * memory_limit())
+        if needed <= budget:
+            return "lu"
+        logger.info(
+            "linear solver: cg (the tangent's LU factor would take ~%.2f GiB, over %.2f GiB)",
+            needed / 2**30,
+            budget / 2**30,
+        )
+        return "cg"
     available = memory_limit()
     if needed > MEMORY_SHARE * available:
         raise InputError(
