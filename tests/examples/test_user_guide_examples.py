@@ -124,3 +124,24 @@ def test_case_file_reference_is_a_valid_case_with_a_stable_step_below_the_cfl_li
     E, nu, rho = 68.9e9, 0.33, 2700.0
     c_p = np.sqrt(E * (1 - nu) / (rho * (1 + nu) * (1 - 2 * nu)))
     assert 0 < found["estimated_stable_dt_s"] < 1.2e-3 / c_p
+
+
+def test_crack_path_example_finds_the_angle_of_a_straight_crack():
+    """The "Fracture" block on a damage field whose crack is known: a 1 mm grid, a pre-crack
+    along y = 50 mm up to the tip at x = 30 mm, and damage 1 within one spacing of a 40 mm
+    crack leaving the tip at 30 degrees: the block's departure angle is 30 degrees to within
+    2 (the band of damaged grid points is one to two spacings wide around the line; measured
+    29.75)."""
+    spacing = 1e-3
+    x, y = np.meshgrid(np.arange(0.0, 0.1, spacing), np.arange(0.0, 0.1, spacing), indexing="ij")
+    points = np.column_stack([x.ravel(), y.ravel()])
+    tip = np.array([0.030, 0.050])
+    direction = np.array([np.cos(np.radians(30.0)), np.sin(np.radians(30.0))])
+    along = (points - tip) @ direction
+    across = np.abs((points - tip) @ [-direction[1], direction[0]])
+    phi = ((along >= 0) & (along <= 0.040) & (across <= spacing)).astype(float)
+    (x0, y0), (x1, y1) = (0.0, 0.050), tip
+    scope = {"points": points, "phi": phi, "spacing": spacing, "tip": tip}
+    scope.update(x0=x0, y0=y0, x1=x1, y1=y1)
+    exec(compile(python_block("departure_angle(crack, tip"), "user-guide: Fracture", "exec"), scope)
+    assert scope["angle"] == pytest.approx(30.0, abs=2.0)
