@@ -145,3 +145,16 @@ def test_crack_path_example_finds_the_angle_of_a_straight_crack():
     scope.update(x0=x0, y0=y0, x1=x1, y1=y1)
     exec(compile(python_block("departure_angle(crack, tip"), "user-guide: Fracture", "exec"), scope)
     assert scope["angle"] == pytest.approx(30.0, abs=2.0)
+
+
+def test_console_example_prints_what_the_command_prints():
+    """The console block of "Commands" (a refused density, ``--json``) shows the exact line the
+    command writes, run from the repository as it is shown; exit status 1 (an input error)."""
+    block = re.search(r"```console\n\$ (.*?)\n(.*?)\n```", GUIDE.read_text(), flags=re.S)
+    command, shown = block.group(1).split(), block.group(2)
+    assert command[0] == "peridyn"
+    run = subprocess.run(
+        [sys.executable, "-m", "peridyn", *command[1:]], cwd=CASES.parent, capture_output=True, text=True
+    )
+    assert run.returncode == 1
+    assert json.loads(run.stdout) == json.loads(shown)
