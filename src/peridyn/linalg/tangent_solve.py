@@ -38,6 +38,7 @@ from peridyn.linalg.amg import (
 from peridyn.linalg.krylov import solve_spd
 from peridyn.linalg.ordering import estimated_factor_entries
 from peridyn.linalg.shift_invert import ordered_lu
+from peridyn.linalg.stiffness import mass_matrix
 from peridyn.linalg.tangent import tangent_operator, tangent_stiffness
 from peridyn.physics.materials.base import Model
 
@@ -137,9 +138,9 @@ class TangentSolver:
         self.model = model
         self.method = choose_linear_solver(model, method)
         self.mass_shift = float(mass_shift)
-        self.mass = np.repeat(model.density * model.body.volumes, 3)
+        self.mass = mass_matrix(model).diagonal()
         self._preconditioner = None
-        self.preconditioner_kind = None  # "mass" or "amg" once CG has set one up
+        self.preconditioner_kind = None
         self._built_for = (None, -1)  # (active dofs, intact bonds) of the preconditioner
 
     def solve(self, u: np.ndarray, free: np.ndarray, rhs: np.ndarray) -> np.ndarray:
