@@ -12,7 +12,7 @@ from importlib import import_module
 #: public name -> the module that defines it. Imported on first use (PEP 562), so that
 #: ``import peridyn.kernels`` or any other lower layer loads nothing above it.
 _PUBLIC = {
-    "geometry": "peridyn.discretization",
+    "geometry": "peridyn.discretization.geometry",
     "Body": "peridyn.discretization.body",
     "Bonds": "peridyn.discretization.bonds",
     "find_bonds": "peridyn.discretization.bonds",
@@ -44,7 +44,8 @@ def __getattr__(name: str):
 
         value = package_version()
     elif name in _PUBLIC:
-        value = getattr(import_module(_PUBLIC[name]), name)
+        module = import_module(_PUBLIC[name])
+        value = module if module.__name__.endswith(f".{name}") else getattr(module, name)
     else:
         raise AttributeError(f"module 'peridyn' has no attribute {name!r}")
     globals()[name] = value

@@ -49,7 +49,7 @@ def test_newton_matches_adr_on_a_free_bar(linear_solver):
     """A free 20 x 5 x 5 mm PMB bar under end forces: Newton (3-2-1 support, no reactions)
     and adaptive dynamic relaxation find the same centre strain to 1e-5 (measured ~1e-6;
     both solve V f + V b = 0 to 1e-8..1e-10), in at most three Newton iterations, with
-    the sparse LU and with Jacobi-preconditioned CG alike."""
+    the sparse LU and with AMG-preconditioned matrix-free CG alike."""
     model, loading = _bar((0.020, 0.005, 0.005))
     result = newton(model, loading, tolerance=1e-10, linear_solver=linear_solver)
     reference = relax(model, loading, tolerance=1e-8)

@@ -651,7 +651,7 @@ class Solver(Strict):
     bonds break); ``newmark``: implicit dynamics (average
     acceleration) with ``steps`` or ``time``, ``dt`` (s, required), ``displacement_tolerance``
     (m, Newton increment; Martowicz: 0.1 nm), ``newton_iterations`` and ``damping``; both take
-    ``linear_solver`` (``lu``, or ``cg`` for large 3D bodies)."""
+    ``linear_solver`` (``auto``, ``lu`` or ``cg``)."""
 
     type: Literal["explicit", "static", "modal", "newton", "newmark"] = described(
         "explicit",
@@ -698,8 +698,11 @@ class Solver(Strict):
         "newmark: instead of displacement_tolerance (Peridigm's Absolute Tolerance)",
         "N",
     )
-    linear_solver: Literal["lu", "cg"] = described(
-        "lu", "newton, newmark: sparse LU, or conjugate gradients for large 3D bodies"
+    linear_solver: Literal["auto", "lu", "cg"] = described(
+        "auto",
+        "newton, newmark: lu (sparse LU, refused when its estimated factor exceeds the memory), cg "
+        "(conjugate gradients on the matrix-free tangent, AMG-preconditioned) or auto (lu while the "
+        "estimated factor stays under 256 MiB, cg beyond: large 3D bodies)",
     )
     initial_acceleration: Literal["balance", "zero"] = described(
         "balance", "newmark: the acceleration at t = 0, balance (of the initial forces) or zero (Peridigm's)"

@@ -9,6 +9,8 @@ Layout of a results file::
                             (time, *the record's), ``units`` and ``long_name``
     /series/<name>/time     (n_records,) float64, s: the coordinate of the time dimension
     /series/<name>/step     (n_records,) int64, strictly increasing
+    /<series>, /time, ...   the root's view of one series (``peridyn.io.netcdf.write_root_view``):
+                            virtual datasets of its data, time and step along ``record``
     /summary/json           the job's summary, JSON text (docs/user-guide.md, "Summaries and
                             results files")
     /<any>/<name>           one-off arrays, e.g. /final/damage
@@ -39,7 +41,7 @@ import numpy as np
 
 from peridyn.errors import InputError, did_you_mean
 from peridyn.io import integrity
-from peridyn.io.netcdf import COMPONENTS, describe, label
+from peridyn.io.netcdf import COMPONENTS, describe, drop_root_view, label, root_series, write_root_view
 from peridyn.io.reserve import as_disk_error, ensure_room
 
 CHUNK_BYTES = 1 << 20
@@ -159,6 +161,7 @@ class HDF5Writer:
             _write_attrs(self._file.attrs, provenance, f"{self.path}: provenance")
             self._file.attrs[SCHEMA_ATTR] = SCHEMA_VERSION if self.labelled else version
             self._open_existing_series()
+            drop_root_view(self._file)  # written again, for the records then, on closing
             self._file.flush()
         except BaseException:
             self._file.close()
@@ -175,6 +178,9 @@ class HDF5Writer:
         when the flush fails (whose error is raised)."""
         if self._file.id.valid:
             try:
+                shown = root_series(self._series) if self.labelled else None
+                if shown is not None:
+                    write_root_view(self._file, shown)
                 self.flush()
             finally:
                 self._file.close()

@@ -3,8 +3,8 @@ cannot do is written here once.
 
 - :func:`solve_spd`: a symmetric positive definite sparse system by scipy's conjugate gradients
   (``scipy.sparse.linalg.cg``), preconditioned by the diagonal or by pyamg's smoothed
-  aggregation, with the interrupt check in its callback (Newton and Newmark steps with
-  ``linear_solver: cg``).
+  aggregation or by the caller's operator (``linalg.amg``), with the interrupt check in its
+  callback (the Newton and Newmark systems of ``linalg.tangent_solve``).
 - :func:`pcg`: preconditioned CG for what scipy's cannot do: inner products and norms over the
   dofs of every MPI rank (``dot`` and ``residual_norm`` given by the caller, summed in rank
   order), deflation by a subspace ``W`` (Saad, Yeung, Erhel and Guyomarc'h 2000, "A deflated
@@ -114,26 +114,36 @@ def pcg(
     return KrylovResult(x, maxiter, False, directions)
 
 
-def solve_spd(a: sp.spmatrix, rhs: np.ndarray, rtol: float, preconditioner: str = "jacobi") -> np.ndarray:
+def solve_spd(
+    a: sp.spmatrix | LinearOperator,
+    rhs: np.ndarray,
+    rtol: float,
+    preconditioner: str | LinearOperator = "jacobi",
+) -> np.ndarray:
     """x with ``a x = rhs`` to ``||rhs - a x|| <= rtol ||rhs||`` by scipy's CG.
 
     Parameters
     ----------
-    a : (n, n) symmetric positive definite sparse matrix
+    a : (n, n) symmetric positive definite sparse matrix, or an operator (e.g. the matrix-free
+        tangent of ``linalg.tangent``)
     rhs : (n,)
     preconditioner : ``"jacobi"`` (the inverse diagonal) or ``"amg"`` (one V-cycle of pyamg's
-        smoothed aggregation, for large 3D bodies)
+        smoothed aggregation) of the matrix ``a``, or an SPD operator approximating a^-1
+        (``linalg.amg.amg_preconditioner``)
 
     Raises InputError when CG does not converge in 10 n iterations (an indefinite matrix).
     """
-    if preconditioner not in PRECONDITIONERS:
-        raise InputError(f"unknown preconditioner {preconditioner!r}; choose one of {PRECONDITIONERS}")
-    a = sp.csr_matrix(a)
     n = a.shape[0]
-    if preconditioner == "amg":
-        m = pyamg.smoothed_aggregation_solver(a, symmetry="symmetric").aspreconditioner(cycle="V")
+    if isinstance(preconditioner, LinearOperator):
+        m = preconditioner
+    elif preconditioner not in PRECONDITIONERS:
+        raise InputError(f"unknown preconditioner {preconditioner!r}; choose one of {PRECONDITIONERS}")
+    elif preconditioner == "amg":
+        m = pyamg.smoothed_aggregation_solver(sp.csr_matrix(a), symmetry="symmetric").aspreconditioner(
+            cycle="V"
+        )
     else:
-        inv_diag = 1.0 / a.diagonal()
+        inv_diag = 1.0 / sp.csr_matrix(a).diagonal()
         m = LinearOperator((n, n), matvec=lambda v: inv_diag * v.ravel(), dtype=np.float64)
     x, info = cg(
         a,

@@ -3,7 +3,8 @@
 For LPS the stiffness is kept factored, K = K_pair + G^T diag(c) G (``linalg.stiffness``), and
 the augmented system [[K_pair + s M, G^T], [G, -diag(1 / c)]] is factorised instead: its Schur
 complement on the dofs is K + s M, and it is as sparse as the bonds, where K reaches two
-horizons. Used by the shift-invert eigensolver (``solvers.modal``) and the fatigue statics.
+horizons. Used by the shift-invert eigensolver (``solvers.modal``) and the fatigue statics;
+``ordered_lu`` by the Newton and Newmark systems too (``linalg.tangent_solve``).
 """
 
 from __future__ import annotations
@@ -61,6 +62,19 @@ def factorise_shifted(
         SG = sp.diags(scale) @ parts.G[active][:, dofs]  # unknowns y' = y / scale
         A = sp.bmat([[P, SG.T], [SG, sp.diags(-(scale**2) / parts.dilatation[active])]])
         unknown_points = np.concatenate([unknown_points, active])
+    return ordered_lu(A, unknown_points, points, reach)
+
+
+def ordered_lu(A: sp.spmatrix, unknown_points: np.ndarray, points: np.ndarray, reach: float):
+    """Sparse LU of the symmetric ``A`` in the nested-dissection order of its unknowns' points
+    (``linalg.ordering``; ``unknown_points`` (m,) the point of each unknown, ``points`` (n, 3) m,
+    ``reach`` m the longest coupling), pivoting on the diagonal where it can.
+
+    Returns
+    -------
+    lu : scipy SuperLU of the permuted matrix A[perm][:, perm]
+    perm : (m,) int64
+    """
     perm = order_unknowns(unknown_points, points, reach)
     lu = splu(
         A.tocsr()[perm][:, perm].tocsc(),

@@ -28,17 +28,46 @@ P). This term reaches two horizons.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 import scipy.sparse as sp
+from scipy.sparse.linalg import LinearOperator
 
-from peridyn.kernels.tangent import bond_blocks_csr
+from peridyn.kernels.tangent import bond_blocks_csr, deformed_bonds, tangent_action, tangent_extension
 from peridyn.physics.materials.base import Model
-from peridyn.physics.materials.linearisation import BondLinearisation
 
 
-def tangent_stiffness(model: Model, u: np.ndarray) -> sp.csr_matrix:
-    """Consistent tangent K(u) = -d(V f)/du (3 n, 3 n), N/m, at displacement ``u`` (n, 3), m;
-    of a material linear in u (``Model.is_linear``) its one tangent, the one at rest."""
+@dataclass(frozen=True)
+class BondTangent:
+    """The tangent's per-bond quantities at one displacement (all (n_bonds,) float64 unless said).
+
+    Attributes
+    ----------
+    bond : (n_bonds, 3) deformed bond vectors Y, m
+    r : deformed bond lengths |Y|, m
+    stretch : dT/dr (0 on broken bonds), N/m^4
+    geometric : T / r, the rotation term (0 on broken bonds), N/m^4
+    axial : w |xi| on intact bonds (m^4), or None without dilatation
+    dilatation : (n_points,) p_coef theta_coef, or None without dilatation
+    """
+
+    bond: np.ndarray
+    r: np.ndarray
+    stretch: np.ndarray
+    geometric: np.ndarray
+    axial: np.ndarray | None
+    dilatation: np.ndarray | None
+
+    @property
+    def n_vec(self) -> np.ndarray:
+        """(n_bonds, 3) deformed unit vectors Y / r."""
+        return self.bond / self.r[:, None]
+
+
+def bond_tangent(model: Model, u: np.ndarray) -> BondTangent:
+    """The ``BondTangent`` of ``model`` at displacement ``u`` (n, 3), m (of a material linear in
+    u, ``Model.is_linear``, the one at rest)."""
     if model.is_linear:
         u = np.zeros_like(u, dtype=np.float64)
     b = model.bonds
@@ -46,24 +75,68 @@ def tangent_stiffness(model: Model, u: np.ndarray) -> sp.csr_matrix:
     nbr = b.neighbours.astype(np.int64)
     x = model.body.points
     u = np.asarray(u, dtype=np.float64)
-    y = x[nbr] - x[owners] + u[nbr] - u[owners]
-    r = np.linalg.norm(y, axis=1)
-    n_vec = y / r[:, None]
+    bond = deformed_bonds(x, u, b.offsets, nbr, np.empty((len(nbr), 3)))
+    r = np.linalg.norm(bond, axis=1)
     length = b.length
     lin = model.linearisation()
     e = r - length
     k = np.where(b.intact, lin.extension, 0.0)
     force = k * e
+    axial = dilatation = None
     if lin.has_dilatation:
-        w = np.where(b.intact, lin.weight, 0.0)
-        theta = lin.theta_coef * np.bincount(owners, weights=w * length * e, minlength=len(x))
-        p = theta * lin.p_coef
-        force = w * length * (p[owners] + p[nbr]) + force
-    jacobian = _bond_blocks(b.offsets, nbr, n_vec, k, force / r)
-    if lin.has_dilatation:
-        jacobian = jacobian + _dilatation_jacobian(lin, length, owners, nbr, n_vec, w)
+        axial = np.where(b.intact, lin.weight, 0.0) * length
+        dilatation = lin.p_coef * lin.theta_coef
+        p = lin.theta_coef * np.bincount(owners, weights=axial * e, minlength=len(x)) * lin.p_coef
+        force = axial * (p[owners] + p[nbr]) + force
+    return BondTangent(bond, r, k, force / r, axial, dilatation)
+
+
+def tangent_stiffness(model: Model, u: np.ndarray) -> sp.csr_matrix:
+    """Consistent tangent K(u) = -d(V f)/du (3 n, 3 n), N/m, at displacement ``u`` (n, 3), m;
+    of a material linear in u (``Model.is_linear``) its one tangent, the one at rest."""
+    t = bond_tangent(model, u)
+    b = model.bonds
+    nbr = b.neighbours.astype(np.int64)
+    n_vec = t.n_vec
+    jacobian = _bond_blocks(b.offsets, nbr, n_vec, t.stretch, t.geometric)
+    if t.axial is not None:
+        jacobian = jacobian + _dilatation_jacobian(t, n_vec, b.owners(), nbr)
     vol = sp.diags(np.repeat(model.body.volumes, 3))
     return (-(vol @ jacobian)).tocsr()
+
+
+def tangent_operator(model: Model, u: np.ndarray, dofs: np.ndarray) -> LinearOperator:
+    """K(u)[dofs][:, dofs] (N/m) applied matrix-free: two passes over the bonds per product
+    (``kernels.tangent.tangent_extension`` and ``tangent_action``), nothing assembled, so the
+    memory is the bonds' whatever the horizon (the assembled LPS tangent reaches two horizons:
+    85 million entries for a 38 400-point plate at a horizon of two spacings).
+
+    d f_i = sum_j [dT n + (T / r) (dY - n (n . dY))] with dT = stretch (n . dY) + axial (dP_i + dP_j)
+    (module docstring): bond forces along the deformed directions with the coefficient
+    stretch - T / r, plus T / r times the difference of the two ends' dY."""
+    t = bond_tangent(model, u)
+    b = model.bonds
+    n = model.body.n_points
+    vol = model.body.volumes[:, None]
+    n_vec = t.n_vec
+    along = t.stretch - t.geometric
+    axial = np.zeros(b.n_bonds) if t.axial is None else t.axial
+    dilatation = np.zeros(n) if t.dilatation is None else t.dilatation
+    nbr = b.neighbours
+    extension, theta, df = np.empty(b.n_bonds), np.empty(n), np.empty((n, 3))
+    size = len(dofs)
+
+    def matvec(v):
+        full = np.zeros(3 * n)
+        full[dofs] = np.ravel(v)
+        dv = full.reshape(n, 3)
+        tangent_extension(b.offsets, nbr, n_vec, axial, dv, extension, theta)
+        tangent_action(
+            b.offsets, nbr, n_vec, axial, along, t.geometric, dilatation * theta, extension, dv, df
+        )
+        return (-vol * df).reshape(-1)[dofs].reshape(np.shape(v))
+
+    return LinearOperator((size, size), matvec=matvec, rmatvec=matvec, dtype=np.float64)
 
 
 def _bond_blocks(offsets, nbr, n_vec, stretch, geometric) -> sp.csr_matrix:
@@ -74,18 +147,19 @@ def _bond_blocks(offsets, nbr, n_vec, stretch, geometric) -> sp.csr_matrix:
     return sp.csr_matrix((data, indices, indptr), shape=(3 * n, 3 * n))
 
 
-def _dilatation_jacobian(lin: BondLinearisation, length, owners, nbr, n_vec, w) -> sp.csr_matrix:
-    """d f_i = sum_j w_ij L_ij n_ij (dP_i + dP_j) as the product H G (see module); ``w`` the
-    intact bonds' weights (n_bonds,), m^3, ``length`` L (n_bonds,), m."""
-    n = len(lin.theta_coef)
-    wl = w * length
+def _dilatation_jacobian(t: BondTangent, n_vec, owners, nbr) -> sp.csr_matrix:
+    """d f_i = sum_j w_ij L_ij n_ij (dP_i + dP_j) as the product H G (see module) at the
+    ``BondTangent`` ``t``; ``n_vec`` (n_bonds, 3) its unit vectors, ``owners`` and ``nbr``
+    (n_bonds,) the bonds' end points."""
+    n = len(t.dilatation)
+    wl = t.axial
     a = np.arange(3)
     h_rows = (3 * owners[:, None] + a).ravel()
     h_vals = (wl[:, None] * n_vec).ravel()
     to_j = sp.coo_matrix((h_vals, (h_rows, np.repeat(nbr, 3))), shape=(3 * n, n))
     to_i = sp.coo_matrix((h_vals, (h_rows, np.repeat(owners, 3))), shape=(3 * n, n))
     h = (to_j + to_i).tocsr()
-    g_vals = ((lin.p_coef * lin.theta_coef)[owners] * wl)[:, None] * n_vec
+    g_vals = (t.dilatation[owners] * wl)[:, None] * n_vec
     g_vals = g_vals.ravel()
     g_cols_j = (3 * nbr[:, None] + a).ravel()
     g_cols_i = (3 * owners[:, None] + a).ravel()

@@ -7,7 +7,8 @@ damping c:
     R(u') = V (f(u') + b(t + dt)) - M (a' + c v') = 0  at the free dofs,
 
 solved by Newton with the consistent tangent ``K`` (``peridyn.linalg.tangent``):
-``(K + (4 / dt^2 + 2 c / dt) M) du = R``, until the largest displacement increment
+``(K + (4 / dt^2 + 2 c / dt) M) du = R`` (``peridyn.linalg.tangent_solve``: sparse LU, or
+AMG-preconditioned CG on the matrix-free tangent for large bodies), until the largest displacement increment
 |du| is below ``tolerance`` (m; Martowicz: dt = 20 ns, 0.1 nm) or, given ``residual_tolerance``
 (N), |R| is below that. Prescribed displacements
 are imposed at t + dt, prescribed velocities integrated by the trapezoidal rule, and
@@ -29,11 +30,10 @@ from peridyn.discretization.state import State, check_state
 from peridyn.errors import InputError
 from peridyn.linalg.dofs import free_dofs
 from peridyn.linalg.stiffness import mass_matrix
-from peridyn.linalg.tangent import tangent_stiffness
+from peridyn.linalg.tangent_solve import TangentSolver
 from peridyn.physics.damage import BondDamage
 from peridyn.physics.loads import Loading
 from peridyn.physics.materials.base import Model
-from peridyn.solvers.newton import check_linear_solver, solve_held
 from peridyn.solvers.stepping import advance
 
 
@@ -60,9 +60,10 @@ class NewmarkSolver:
         Mass-proportional damping coefficient c.
     damage : BondDamage or None
         Over-stretched bonds break after each converged step.
-    linear_solver : {"lu", "cg"}
-        Sparse LU, or Jacobi-preconditioned conjugate gradients (the mass term makes the
-        effective tangent well conditioned, so CG needs few iterations on large bodies).
+    linear_solver : {"auto", "lu", "cg"}
+        Sparse LU, conjugate gradients on the matrix-free tangent preconditioned by AMG (the
+        mass term makes the effective tangent well conditioned: a few iterations), or
+        ``auto``: LU where its estimated factor is small (``linalg.tangent_solve``).
     """
 
     def __init__(
@@ -74,7 +75,7 @@ class NewmarkSolver:
         max_iterations: int = 20,
         damping: float = 0.0,
         damage: BondDamage | None = None,
-        linear_solver: str = "lu",
+        linear_solver: str = "auto",
         residual_tolerance: float | None = None,
         initial_acceleration: str = "balance",
     ):
@@ -86,11 +87,9 @@ class NewmarkSolver:
             raise InputError(f"Newmark max_iterations must be a positive integer, got {max_iterations!r}")
         if damping < 0:
             raise InputError(f"damping must be non-negative, got {damping!r}")
-        check_linear_solver(linear_solver)
         if initial_acceleration not in ("balance", "zero"):
             raise InputError(f"initial_acceleration {initial_acceleration!r}: use 'balance' or 'zero'")
         self.initial_acceleration = initial_acceleration
-        self.linear_solver = linear_solver
         self.model = model
         self.loading = loading if loading is not None else Loading(model.body)
         self.dt = float(dt)
@@ -99,6 +98,7 @@ class NewmarkSolver:
         self.max_iterations = int(max_iterations)
         self.damping = float(damping)
         self.damage = damage
+        self.linear = TangentSolver(model, linear_solver, 4.0 / self.dt**2 + 2.0 * self.damping / self.dt)
         self.stable_dt = model.critical_time_step()  # the explicit limit, for comparison
         self.mass = mass_matrix(model).diagonal()
         self.free = free_dofs(model, self.loading.constrained)
@@ -139,7 +139,6 @@ class NewmarkSolver:
         u[held] = state.u[held] + 0.5 * dt * (state.v[held] + v_new[held])
         self.loading.apply_kinematics(t1, dt, u, v_new)
         mass = self.mass
-        shift = (4.0 / dt**2 + 2.0 * c / dt) * mass[free]
         uf, u0f, v0f, a0f = u.reshape(-1), u_star.reshape(-1), state.v.reshape(-1), state.a.reshape(-1)
         taken = 0
         for _ in range(self.max_iterations):
@@ -149,9 +148,7 @@ class NewmarkSolver:
             r = self._out_of_balance(u, t1).reshape(-1)[free] - mass[free] * (a1 + c * v1)
             if self.residual_tolerance is not None and np.linalg.norm(r) < self.residual_tolerance:
                 break
-            k_eff = tangent_stiffness(self.model, u)[free][:, free]
-            k_eff.setdiag(k_eff.diagonal() + shift)
-            du = solve_held(k_eff, r, self.linear_solver)
+            du = self.linear.solve(u, free, r)
             uf[free] += du
             if np.max(np.abs(du), initial=0.0) < self.tolerance:
                 break

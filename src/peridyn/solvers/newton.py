@@ -6,9 +6,10 @@ out-of-balance force (N) is
     r(u) = V f(u) + V b,
 
 and each iteration solves ``K(u) du = r(u)`` with the consistent tangent
-``K = -d(V f)/du`` (``peridyn.linalg.tangent``) by a sparse LU factorisation (or
-Jacobi-preconditioned conjugate gradients to 1e-12 for large 3D systems), the
-prescribed dofs held at their values (elimination). Near the solution the
+``K = -d(V f)/du`` (``peridyn.linalg.tangent``) by a sparse LU factorisation where its
+estimated size fits, or by AMG-preconditioned conjugate gradients on the matrix-free tangent
+to 1e-12 (``peridyn.linalg.tangent_solve``), the prescribed dofs held at their values
+(elimination). Near the solution the
 residual falls quadratically, r_(k+1) ~ C r_k^2. Converged when
 ``|r| / max(|V b|, |reactions|) < tolerance`` (the reactions are the internal
 forces on the prescribed dofs), the criterion of ``relax`` with integrated forces.
@@ -28,14 +29,11 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.sparse as sp
-from scipy.sparse.linalg import splu
 
 from peridyn import interrupts
-from peridyn.errors import InputError, did_you_mean
+from peridyn.errors import InputError
 from peridyn.linalg.dofs import free_dofs
-from peridyn.linalg.krylov import solve_spd
-from peridyn.linalg.tangent import tangent_stiffness
+from peridyn.linalg.tangent_solve import TangentSolver
 from peridyn.physics.damage import BondDamage
 from peridyn.physics.loads import Loading
 from peridyn.physics.materials.base import Model
@@ -97,7 +95,7 @@ def newton(
     max_iterations: int = 30,
     damage: BondDamage | None = None,
     max_breaking_rounds: int = 100,
-    linear_solver: str = "lu",
+    linear_solver: str = "auto",
     absolute_tolerance: float | None = None,
     on_step=None,
 ) -> NewtonResult:
@@ -115,8 +113,9 @@ def newton(
         Break over-stretched bonds after each converged step and re-equilibrate.
     max_breaking_rounds : int
         Re-equilibrations allowed per load step.
-    linear_solver : {"lu", "cg"}
-        Sparse LU, or Jacobi-preconditioned conjugate gradients for large systems.
+    linear_solver : {"auto", "lu", "cg"}
+        Sparse LU, AMG-preconditioned conjugate gradients on the matrix-free tangent, or
+        ``auto``: LU where its estimated factor is small (``linalg.tangent_solve``).
     absolute_tolerance : float or None, N
         Converged when the norm of the out-of-balance force at the free dofs is below it
         (Peridigm's "Absolute Tolerance"), instead of the relative ``tolerance``.
@@ -134,13 +133,13 @@ def newton(
     ):
         if int(value) != value or value < 1:
             raise InputError(f"Newton {name} must be a positive integer, got {value!r}")
-    check_linear_solver(linear_solver)
     if not time > 0:
         raise InputError(f"Newton end time must be positive, got {time!r}")
     n = model.body.n_points
     u = np.zeros((n, 3)) if u0 is None else np.array(u0, dtype=float)
     if u.shape != (n, 3):
         raise InputError(f"u0 must have shape ({n}, 3), got {u.shape}")
+    solver = TangentSolver(model, linear_solver)
     v = np.zeros((n, 3))
     loading.apply_initial(u, v)
     steps, iterations, broken_total, residual = [], 0, 0, np.inf
@@ -151,7 +150,7 @@ def newton(
         step = NewtonStep(t)
         for _ in range(max_breaking_rounds + 1):
             u, history, converged = equilibrate(
-                model, u, b, loading.constrained, tolerance, max_iterations, linear_solver, absolute_tolerance
+                model, u, b, loading.constrained, tolerance, max_iterations, solver, absolute_tolerance
             )
             step.residuals.append(history)
             iterations += len(history) - 1
@@ -180,15 +179,19 @@ def equilibrate(
     constrained: np.ndarray,
     tolerance: float,
     max_iterations: int,
-    linear_solver: str = "lu",
+    linear_solver: str | TangentSolver = "auto",
     absolute_tolerance: float | None = None,
 ) -> tuple[np.ndarray, list, bool]:
-    """Newton iterations at fixed loads from ``u`` (n, 3), m; ``b`` body force density N/m^3.
+    """Newton iterations at fixed loads from ``u`` (n, 3), m; ``b`` body force density N/m^3;
+    ``linear_solver`` a name of ``linalg.tangent_solve.LINEAR_SOLVERS`` or a ``TangentSolver``
+    (kept between calls: its preconditioner is set up once).
 
     Returns the displacement, the relative residual before each iteration and at the
     end, and whether it converged (the relative residual below ``tolerance`` or, when
     ``absolute_tolerance`` (N) is given, the residual force's norm below it).
     """
+    if isinstance(linear_solver, str):
+        linear_solver = TangentSolver(model, linear_solver)
     u = u.copy()
     vol = np.repeat(model.body.volumes, 3)
     support = constrained if constrained.any() else rigid_support(model)
@@ -211,43 +214,9 @@ def equilibrate(
             return u, history, True
         if it == max_iterations:
             break
-        du = solve_held(tangent_stiffness(model, u)[free][:, free], r, linear_solver)
+        du = linear_solver.solve(u, free, r)
         u.ravel()[free] += du
     return u, history, False
-
-
-#: Linear solvers for the Newton systems: sparse LU, or conjugate gradients with a Jacobi
-#: preconditioner (for large 3D systems, where the LU fill-in grows fast).
-LINEAR_SOLVERS = ("lu", "cg")
-
-#: Relative residual at which the conjugate gradients stop (Newton needs accurate solves).
-CG_RTOL = 1e-12
-
-
-def check_linear_solver(name: str) -> None:
-    """Raise InputError unless ``name`` is one of ``LINEAR_SOLVERS``."""
-    if name not in LINEAR_SOLVERS:
-        raise InputError(
-            f"unknown linear solver {name!r}{did_you_mean(name, LINEAR_SOLVERS)}; "
-            f"choose one of {LINEAR_SOLVERS}"
-        )
-
-
-def solve_held(k_ff: sp.spmatrix, rhs: np.ndarray, method: str = "lu") -> np.ndarray:
-    """x with ``k_ff x = rhs`` by sparse LU or Jacobi-preconditioned CG (``method``); rows and
-    columns with a zero diagonal (dofs without stiffness, e.g. of a point whose bonds all
-    broke) get x = 0."""
-    k_ff = k_ff.tocsc() if method == "lu" else k_ff.tocsr()
-    active = np.flatnonzero(k_ff.diagonal() != 0)
-    x = np.zeros(len(rhs))
-    if len(active) == 0:
-        return x
-    k_aa = k_ff[active][:, active]
-    if method == "lu":
-        x[active] = splu(k_aa.tocsc()).solve(rhs[active])
-    else:
-        x[active] = solve_spd(k_aa, rhs[active], CG_RTOL, "jacobi")
-    return x
 
 
 def rigid_support(model: Model) -> np.ndarray:

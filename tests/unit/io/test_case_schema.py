@@ -33,8 +33,8 @@ def test_the_reference_lists_every_key_of_every_section_once_per_place():
     assert listed >= {name for section in SECTIONS for name in section.model_fields}
     by_path = {row.path: row for row in rows}
     assert by_path["material.E"].unit == "Pa" and by_path["material.E"].default == "required"
-    assert by_path["solver.linear_solver"].type == 'one of "lu", "cg"'
-    assert by_path["solver.linear_solver"].default == '"lu"'
+    assert by_path["solver.linear_solver"].type == 'one of "auto", "lu", "cg"'
+    assert by_path["solver.linear_solver"].default == '"auto"'
     assert by_path["output.lines.<name>.points"].type == "integer"
     assert by_path["precracks[].origin"].unit == "m"
 

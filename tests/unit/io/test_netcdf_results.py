@@ -16,6 +16,7 @@ import xarray as xr
 from peridyn.cli import main
 from peridyn.errors import InputError
 from peridyn.io.hdf5 import SCHEMA_ATTR, HDF5Writer
+from peridyn.io.integrity import verify_file
 from peridyn.io.results import Results
 
 BAR = str(Path(__file__).resolve().parents[3] / "cases" / "bar_pulse.yaml")
@@ -58,6 +59,64 @@ def test_every_group_of_a_run_opens_labelled_in_xarray(bar_run):
     # one group on its own, as plain xarray opens it
     line = xr.open_dataset(path, group="series/line_axis")
     assert line["data"].dims == ("time", "point", "component") and line["data"].attrs["units"] == "m"
+
+
+def test_the_root_opens_labelled_without_a_group(bar_run):
+    """``xarray.open_dataset(path)`` with no group reads the sensors' displacement at the root:
+    named dimensions, time (s) and step as coordinates of the records, sensor and component
+    labels, units; the values are the series' (virtual datasets of it), and the whole file still
+    opens as one tree (the root's records are ``record``, not each series' ``time``)."""
+    path = bar_run / "results.h5"
+    root = xr.open_dataset(path)
+    assert root["sensor_u"].dims == ("record", "sensor", "component")
+    assert root["sensor_u"].attrs["units"] == "m" and root["time"].attrs["units"] == "s"
+    assert root["component"].values.tolist() == ["x", "y", "z"]
+    assert root["sensor"].values.tolist() == ["x50", "x100", "x150"]
+    steps, times, u = Results(path).series("sensor_u")
+    np.testing.assert_array_equal(root["time"].values, times)
+    np.testing.assert_array_equal(root["step"].values, steps)
+    np.testing.assert_array_equal(root["sensor_u"].values, u)
+    by_time = root.swap_dims(record="time")["sensor_u"]
+    assert by_time.sel(time=times[-1], sensor="x50", component="x") == u[-1, 0, 0]
+    assert set(xr.open_datatree(path, engine="h5netcdf").children) >= {"series", "geometry", "final"}
+
+
+def test_a_root_axis_another_group_labels_otherwise_is_prefixed(tmp_path):
+    """Without sensors the root shows the first series by name; its ``point`` axis (a line's
+    3 points) would clash with the geometry's 5 points, which every group inherits from the
+    root: it is ``line_a_point`` at the root, and the file opens as one tree."""
+    path = tmp_path / "r.h5"
+    with HDF5Writer(path, np.zeros((5, 3)), np.ones(5), {}) as out:
+        out.create_series(
+            "line_a", (3, 3), dims=("point", "component"), coords={"point": [0, 2, 4]}, units="m"
+        )
+        out.create_series("plane_b", (2, 3), dims=("point", "component"), units="m")
+        out.append("line_a", 0, 0.0, np.ones((3, 3)))
+        out.append("line_a", 4, 1e-6, 2 * np.ones((3, 3)))
+    root = xr.open_dataset(path)
+    assert root["line_a"].dims == ("record", "line_a_point", "component")
+    assert root["line_a_point"].values.tolist() == [0, 2, 4]
+    np.testing.assert_array_equal(root["time"].values, [0.0, 1e-6])
+    xr.open_datatree(path, engine="h5netcdf")
+
+
+def test_a_continued_file_shows_every_record_at_the_root(tmp_path):
+    """A run continued from a checkpoint (``mode="a"``) drops the root's view when it opens the
+    file and writes it again on closing, for all the records then; the file's checksums hold."""
+    path = tmp_path / "r.h5"
+    with HDF5Writer(path, np.zeros((2, 3)), np.ones(2), {}) as out:
+        out.create_series("sensor_u", (1, 3), dims=("sensor", "component"), coords={"sensor": ["s"]})
+        out.append("sensor_u", 0, 0.0, np.zeros((1, 3)))
+        out.append("sensor_u", 1, 1e-7, np.ones((1, 3)))
+    with HDF5Writer(path, np.zeros((2, 3)), np.ones(2), {}, mode="a") as out:
+        out.truncate(0)
+        out.append("sensor_u", 1, 1e-7, 3 * np.ones((1, 3)))
+        out.append("sensor_u", 2, 2e-7, 4 * np.ones((1, 3)))
+    root = xr.open_dataset(path)
+    np.testing.assert_array_equal(root["step"].values, [0, 1, 2])
+    np.testing.assert_array_equal(root["sensor_u"].values[:, 0, 0], [0.0, 3.0, 4.0])
+    with h5py.File(path) as f:
+        verify_file(f, str(path))
 
 
 def test_to_xarray_names_the_variable_and_keeps_steps_and_units(bar_run):

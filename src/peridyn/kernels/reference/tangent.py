@@ -29,3 +29,30 @@ def bond_blocks_csr(offsets, nbr, n_vec, stretch, geometric):
     rows, cols = np.nonzero(np.kron(pattern, np.ones((3, 3), dtype=bool)))
     indptr = np.concatenate([[0], np.cumsum(np.bincount(rows, minlength=3 * n))])
     return indptr, cols, dense[rows, cols]
+
+
+def deformed_bonds(x, u, offsets, nbr):
+    """(n_bonds, 3): x_j - x_i + u_j - u_i of every directed bond, rounded in that order."""
+    i, j = owners(offsets), np.asarray(nbr, dtype=np.int64)
+    return x[j] - x[i] + u[j] - u[i]
+
+
+def tangent_extension(offsets, nbr, n_vec, axial, v):
+    """``(e, theta)``: e_b = n_b . (v_j - v_i) per bond, theta_i = sum over i's bonds of
+    axial_b e_b."""
+    i, j = owners(offsets), np.asarray(nbr, dtype=np.int64)
+    n_vec, axial, v = as64(n_vec, axial, v)
+    e = np.einsum("ba,ba->b", n_vec, v[j] - v[i])
+    return e, np.bincount(i, weights=axial * e, minlength=len(offsets) - 1)
+
+
+def tangent_action(offsets, nbr, n_vec, axial, along, geometric, p, e, v):
+    """(n, 3): sum over each point i's bonds b = (i, j) of (axial_b (p_i + p_j) + along_b e_b) n_b
+    + geometric_b (v_j - v_i)."""
+    i, j = owners(offsets), np.asarray(nbr, dtype=np.int64)
+    n_vec, axial, along, geometric, p, e, v = as64(n_vec, axial, along, geometric, p, e, v)
+    t = axial * (p[i] + p[j]) + along * e
+    terms = t[:, None] * n_vec + geometric[:, None] * (v[j] - v[i])
+    out = np.zeros((len(offsets) - 1, 3))
+    np.add.at(out, i, terms)
+    return out
