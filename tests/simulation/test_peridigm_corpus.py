@@ -42,7 +42,8 @@ def test_deck_outcome_is_documented(tmp_path, deck):
 
 #: Decks of several kinds (quasi-static on a grid, two blocks without bonds between them, bond
 #: filters, an implicit solver, a critical stretch in time, two output files, Peridigm's order of
-#: operations, points without bonds in contact beyond the horizon) converted.
+#: operations, points without bonds in contact beyond the horizon, a quasi-static solver then a
+#: Verlet one) converted.
 CONVERTED = [
     "Compression_QS_3x2x2/Compression_QS_3x2x2.xml",
     "Bar_TwoDisconnectedPieces_QS/Bar.xml",
@@ -53,6 +54,7 @@ CONVERTED = [
     "MultipleOutputFiles/MultipleOutputFiles.xml",
     "Compression_2x1x1/Compression_2x1x1.yaml",
     "Contact_2x1x1/Contact_2x1x1.xml",
+    "Compression_QS_Explicit_MultiFreqOutput_3x2x2/Compression_QS_Explicit_MultiFreqOutput_3x2x2.xml",
 ]
 
 
