@@ -71,7 +71,8 @@ def _gold(folder: Path, written: Path) -> tuple[Path, Path]:
 
 
 def conjoined(meshes: list[ExodusMesh]) -> ExodusMesh:
-    """Exodus files of one mesh joined in time as SEACAS ``conjoin`` joins them: in the order
+    """Exodus files of one mesh joined in time as SEACAS ``conjoin`` joins them (Sjaardema, "A
+    Collection of Exodus Utilities: Exodiff, EPU, EJoin, and Conjoin", Sandia): in the order
     of their first times, each file's steps before the next file's first time, then the next
     file's (where their times overlap, the later file's steps are kept). The variables are
     those of the first file; the ``node_status`` and ``elem_status`` that conjoin adds are
