@@ -662,10 +662,10 @@ class Solver(Strict):
     their dofs; free-free otherwise); ``newton``: Newton-Raphson equilibrium with ``tolerance``
     (relative residual), ``load_steps`` (the loads at t = ``time``, default 1 s, ramped),
     ``newton_iterations`` per solve and ``breaking_rounds`` (re-equilibrations per step after
-    bonds break); ``newmark``: implicit dynamics (average
-    acceleration) with ``steps`` or ``time``, ``dt`` (s, required), ``displacement_tolerance``
-    (m, Newton increment; Martowicz: 0.1 nm), ``newton_iterations`` and ``damping``; both take
-    ``linear_solver`` (``lu``, or ``cg`` for large 3D bodies)."""
+    bonds break), then optionally an explicit stage (``then``, ``ExplicitStage``); ``newmark``:
+    implicit dynamics (average acceleration) with ``steps`` or ``time``, ``dt`` (s, required),
+    ``displacement_tolerance`` (m, Newton increment; Martowicz: 0.1 nm), ``newton_iterations``
+    and ``damping``; both take ``linear_solver`` (``lu``, or ``cg`` for large 3D bodies)."""
 
     type: Literal["explicit", "static", "modal", "newton", "newmark"] = described(
         "explicit",
