@@ -80,3 +80,38 @@ def test_implicit_solver_keys_are_checked(solver, message):
     """Bad implicit-solver keys are refused with a message naming the problem."""
     with pytest.raises(CaseFileError, match=message):
         _case(solver)
+
+
+def test_explicit_stage_continues_the_newton_run(tmp_path):
+    """``solver.then``: an explicit stage after Newton's last load step starts from its state
+    (the displacement, and the velocity of the last load step, (u_4 - u_3) / (T / 4)) at
+    its time T, its steps numbered on from the load steps (its start one step after the last
+    load step) and the loads' time functions read on: the pulled end holds the ramp's end
+    value, 1e-6 m, at every step of the stage."""
+    from peridyn.io.exodus import read_exodus
+
+    T, dt, steps = 1e-6, 2e-8, 30
+    raw = copy.deepcopy(BAR)
+    raw["boundary_conditions"].append(
+        {"set": "clamp", "kind": "displacement", "components": "xyz", "value": 0.0}
+    )
+    raw["solver"] = {
+        "type": "newton",
+        "time": T,
+        "load_steps": 4,
+        "tolerance": 1e-10,
+        "then": {"dt": dt, "steps": steps},
+    }
+    raw["output"]["exodus"] = {"file": "bar.e", "every": 1, "variables": ["Displacement", "Velocity"]}
+    summary = run_case(validate_case(raw), tmp_path / "run")
+    assert summary["steps"] == 4 + 1 + steps
+    mesh = read_exodus(tmp_path / "run" / "bar.e")
+    # records: t = 0, the 4 load steps, the stage's start (at T again) and its steps
+    expected = np.concatenate([np.arange(5) * T / 4, T + np.arange(steps + 1) * dt])
+    np.testing.assert_allclose(mesh.times, expected, rtol=0, atol=1e-20)
+    ux, vx = mesh.nodal_variables["DisplacementX"], mesh.nodal_variables["VelocityX"]
+    assert np.array_equal(ux[5], ux[4])  # the stage starts from the last load step's u ...
+    np.testing.assert_allclose(vx[5], (ux[4] - ux[3]) / (T / 4), rtol=1e-12, atol=0)  # ... and v
+    assert np.abs(vx[5]).max() > 0
+    end = np.isclose(mesh.coordinates[:, 0], mesh.coordinates[:, 0].max())
+    np.testing.assert_allclose(ux[5:, end], 1e-6, rtol=1e-12)

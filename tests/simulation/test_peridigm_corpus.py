@@ -5,9 +5,11 @@ outcome is the one docs/peridigm.md shows (match; differs, the items over their 
 why; refused, with the one line naming what peridyn lacks), so that a deck whose outcome
 changes fails here until the table is written again (``python tests/peridigm_corpus.py``)."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
-from peridigm_corpus import CORPUS, decks, documented, run
+from peridigm_corpus import CORPUS, conjoined, decks, documented, run
 
 from peridyn.cli import main
 from peridyn.io.exodus import read_exodus
@@ -40,9 +42,25 @@ def test_deck_outcome_is_documented(tmp_path, deck):
     assert outcome.row() == documented()[deck]
 
 
+def test_files_are_joined_in_time_as_conjoin_joins_them():
+    """Two files of one mesh whose times overlap (0, 1, 2 s and 1.5, 3 s): joined, the steps of
+    the first before 1.5 s and then the second's, the later file's data where they overlap, as
+    SEACAS conjoin's manual states (first 0 to 5 s, second 4 to 10 s: 0 to 4 s of the first)."""
+    mesh = read_exodus(CORPUS / "Compression_QS_3x2x2" / "Compression_QS_3x2x2_gold.e")
+
+    def at(times, value):
+        nodal = {"DisplacementX": np.full((len(times), len(mesh.coordinates)), value)}
+        return replace(mesh, times=np.array(times), nodal_variables=nodal, element_variables={})
+
+    joined = conjoined([at([1.5, 3.0], 2.0), at([0.0, 1.0, 2.0], 1.0)])
+    assert np.array_equal(joined.times, [0.0, 1.0, 1.5, 3.0])
+    assert np.array_equal(joined.nodal_variables["DisplacementX"][:, 0], [1.0, 1.0, 2.0, 2.0])
+
+
 #: Decks of several kinds (quasi-static on a grid, two blocks without bonds between them, bond
 #: filters, an implicit solver, a critical stretch in time, two output files, Peridigm's order of
-#: operations, points without bonds in contact beyond the horizon) converted.
+#: operations, points without bonds in contact beyond the horizon, a quasi-static solver then a
+#: Verlet one) converted.
 CONVERTED = [
     "Compression_QS_3x2x2/Compression_QS_3x2x2.xml",
     "Bar_TwoDisconnectedPieces_QS/Bar.xml",
@@ -53,6 +71,7 @@ CONVERTED = [
     "MultipleOutputFiles/MultipleOutputFiles.xml",
     "Compression_2x1x1/Compression_2x1x1.yaml",
     "Contact_2x1x1/Contact_2x1x1.xml",
+    "Compression_QS_Explicit_MultiFreqOutput_3x2x2/Compression_QS_Explicit_MultiFreqOutput_3x2x2.xml",
 ]
 
 

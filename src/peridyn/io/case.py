@@ -640,6 +640,20 @@ class Analysis(Strict):
     kxky: KxKyAnalysis | None = described(None, "wavenumber maps of a plane probe")
 
 
+class ExplicitStage(Strict):
+    """An explicit (velocity Verlet) stage run after a ``newton`` solver's last load step, from
+    its state (u, and the velocity of its last load step), as Peridigm runs a sequence of
+    solvers: ``steps`` steps of ``dt`` from the newton solver's ``time``, the loads' time
+    functions read on; its steps numbered on from the load steps, its first state (the
+    stage's start) one step after the last load step."""
+
+    dt: Positive = described(..., "time step", "s")
+    steps: Annotated[int, NotBool, Field(ge=1)] = described(..., "number of time steps")
+    prescribed_velocity: Literal["rate", "difference"] = described(
+        "rate", "the reported velocity of a DOF with a prescribed displacement (as the explicit solver's)"
+    )
+
+
 class Solver(Strict):
     """``explicit``: ``steps`` or ``time`` (s), optional ``dt`` (s; default safety x stable),
     damping (1/s), kernel dtype; ``static``: adaptive dynamic relaxation with ``tolerance``,
@@ -648,10 +662,10 @@ class Solver(Strict):
     their dofs; free-free otherwise); ``newton``: Newton-Raphson equilibrium with ``tolerance``
     (relative residual), ``load_steps`` (the loads at t = ``time``, default 1 s, ramped),
     ``newton_iterations`` per solve and ``breaking_rounds`` (re-equilibrations per step after
-    bonds break); ``newmark``: implicit dynamics (average
-    acceleration) with ``steps`` or ``time``, ``dt`` (s, required), ``displacement_tolerance``
-    (m, Newton increment; Martowicz: 0.1 nm), ``newton_iterations`` and ``damping``; both take
-    ``linear_solver`` (``auto``, ``lu`` or ``cg``)."""
+    bonds break), then optionally an explicit stage (``then``, ``ExplicitStage``); ``newmark``:
+    implicit dynamics (average acceleration) with ``steps`` or ``time``, ``dt`` (s, required),
+    ``displacement_tolerance`` (m, Newton increment; Martowicz: 0.1 nm), ``newton_iterations``
+    and ``damping``; both take ``linear_solver`` (``auto``, ``lu`` or ``cg``)."""
 
     type: Literal["explicit", "static", "modal", "newton", "newmark"] = described(
         "explicit",
@@ -727,6 +741,9 @@ class Solver(Strict):
         "auto",
         "modal: shift-invert (factorised), lobpcg (matrix-free) or auto (by the estimated factor size)",
     )
+    then: ExplicitStage | None = described(
+        None, "newton: an explicit stage run after the last load step, from its state"
+    )
     backend: Literal["cpu", "gpu"] = described(
         "cpu",
         "explicit: where the time loop runs, cpu (numba kernels) or gpu (a CUDA device through NVIDIA Warp, "
@@ -737,6 +754,8 @@ class Solver(Strict):
     def _backend(self):
         if self.backend == "gpu" and self.type != "explicit":
             raise ValueError(f"backend gpu runs explicit solvers only, not {self.type}: use backend cpu")
+        if self.then is not None and self.type != "newton":
+            raise ValueError(f"then: an explicit stage follows a newton solver, not {self.type}")
         if self.arithmetic == "peridigm" and self.type != "explicit":
             raise ValueError(f"arithmetic peridigm is an explicit solver's, not {self.type}'s")
         return self
@@ -818,9 +837,17 @@ class ExodusOutput(Strict):
         "peridyn", "the body's point order, or grid (x fastest, then y, then z, as Peridigm numbers a grid)"
     )
     three_d: bool = described(False, "a 2D body written with three coordinates and components (z = 0)")
+    first_step: Annotated[int, NotBool, Field(ge=0)] = described(
+        0, "the first step written (Peridigm's Initial Output Step)"
+    )
+    last_step: Annotated[int, NotBool, Field(ge=0)] | None = described(
+        None, "the last step written (Peridigm's Final Output Step; default: the run's last)"
+    )
 
     @model_validator(mode="after")
     def _known(self):
+        if self.last_step is not None and self.last_step < self.first_step:
+            raise ValueError(f"last_step {self.last_step}: at least first_step {self.first_step}")
         if not self.variables and not self.sums:
             raise ValueError("variables: at least one variable or sum to write")
         for name in self.variables:

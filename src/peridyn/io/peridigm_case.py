@@ -133,13 +133,8 @@ def deck_case(params: dict, name: str, source: str = "<deck>", deck_dir=".") -> 
     """
     deck = _Deck(params, source)
     deck_dir = Path(deck_dir)
-    sequence = [k for k in params if re.fullmatch(r"Solver\d+", k)]
-    if sequence:
-        raise deck.error(
-            sequence[0], None, "one Solver list (peridyn does not run a sequence of solvers)", False
-        )
     for key in params:
-        if key not in SECTIONS and not key.startswith("Output"):
+        if key not in SECTIONS and not key.startswith("Output") and not re.fullmatch(r"Solver\d+", key):
             raise deck.error(key, None, f"one of the sections peridyn reads: {sorted(SECTIONS)}", False)
     for group in deck.get("Blocks", dict):  # the material models first: what peridyn lacks
         _material(deck, deck.get(f"Blocks.{group}.Material", str))
@@ -154,7 +149,7 @@ def deck_case(params: dict, name: str, source: str = "<deck>", deck_dir=".") -> 
                 "Blocks", [g.name for g in groups], "one block group on a PdQuickGrid (its one block)"
             )
         materials = dict(zip(("materials", "blocks"), _block_materials(deck, groups, horizon), strict=True))
-    solver = _solver(deck)
+    solver = _solvers(deck)
     planes = {_plane(deck, g.material) for g in groups}
     if len(planes) > 1:
         raise deck.error("Materials", sorted(g.material for g in groups), "materials of one dimension")
@@ -632,30 +627,60 @@ def _stretch_in_time(deck: _Deck, key: str) -> dict:
     return {"type": "step", **step}
 
 
-def _solver(deck: _Deck) -> dict:
-    if "Time Steps" in deck.get("Solver.QuasiStatic", dict, {}):
+def _solvers(deck: _Deck) -> dict:
+    """The deck's ``Solver``, or its sequence ``Solver1``, ``Solver2``: a quasi-static solver
+    and then, from its last load step on, a Verlet one with a ``Fixed dt`` (``solver.then``),
+    the sequence that peridyn runs."""
+    sequence = sorted((k for k in deck.params if re.fullmatch(r"Solver\d+", k)), key=lambda k: int(k[6:]))
+    if not sequence:
+        return _solver(deck)
+    if "Solver" in deck.params:
+        raise deck.error("Solver", None, f"one Solver list or the sequence {sequence}, not both", False)
+    expected = "two solvers: a QuasiStatic or NOXQuasiStatic one, then a Verlet one"
+    if len(sequence) != 2:
+        raise deck.error(sequence[-1], None, expected, False)
+    first, second = sequence
+    solver = _solver(deck, first)
+    if solver["type"] != "newton":
+        raise deck.error(first, None, expected, False)
+    kinds = [k for k, v in deck.get(second, dict).items() if isinstance(v, dict)]
+    if kinds != ["Verlet"]:
+        raise deck.error(second, kinds, expected)
+    initial = deck.get(f"{second}.Initial Time", float, 0.0)
+    if initial != solver["time"]:
+        raise deck.error(f"{second}.Initial Time", initial, f"{first}'s Final Time, {solver['time']:g} s")
+    stage = _verlet(deck, deck.get(f"{second}.Final Time", float), second, initial)
+    if "dt" not in stage:
+        raise deck.error(f"{second}.Verlet.Fixed dt", None, "a Fixed dt (after a quasi-static solver)", False)
+    solver["then"] = {"dt": stage["dt"], "steps": stage["steps"], "prescribed_velocity": "difference"}
+    return solver
+
+
+def _solver(deck: _Deck, name: str = "Solver") -> dict:
+    """The solver of the deck's solver list ``name``, from t = 0."""
+    if "Time Steps" in deck.get(f"{name}.QuasiStatic", dict, {}):
         raise deck.error(
-            "Solver.QuasiStatic.Time Steps",
-            deck.get("Solver.QuasiStatic.Time Steps"),
+            f"{name}.QuasiStatic.Time Steps",
+            deck.get(f"{name}.QuasiStatic.Time Steps"),
             "Final Time and Number of Load Steps (peridyn's load steps are uniform in time)",
         )
-    initial = deck.get("Solver.Initial Time", float, 0.0)
+    initial = deck.get(f"{name}.Initial Time", float, 0.0)
     if initial != 0.0:
-        raise deck.error("Solver.Initial Time", initial, "0 (runs start at t = 0 s)")
-    final = deck.get("Solver.Final Time", float)
-    solver = deck.get("Solver", dict)
+        raise deck.error(f"{name}.Initial Time", initial, "0 (runs start at t = 0 s)")
+    final = deck.get(f"{name}.Final Time", float)
+    solver = deck.get(name, dict)
     kinds = [k for k in solver if isinstance(solver[k], dict)]
     if kinds in (["QuasiStatic"], ["NOXQuasiStatic"]):
-        return _quasi_static(deck, final, kinds[0])
+        return _quasi_static(deck, final, kinds[0], name)
     if kinds == ["Implicit"]:
         return _implicit(deck, final)
     if kinds != ["Verlet"]:
         raise deck.error(
-            "Solver",
+            name,
             kinds,
             "one 'Verlet', 'QuasiStatic', 'NOXQuasiStatic' or 'Implicit' solver list",
         )
-    return _verlet(deck, final)
+    return _verlet(deck, final, name)
 
 
 #: Implicit parameters read.
@@ -697,11 +722,12 @@ def _implicit(deck: _Deck, final: float) -> dict:
     }
 
 
-def _verlet(deck: _Deck, final: float) -> dict:
-    """Peridigm's Verlet solver: its step is ``Fixed dt``, or its bond-based stable step
-    (``peridyn.jobs.peridigm_step``), times ``Safety Factor`` (default 1); floor(final / dt)
-    steps; the velocity of prescribed points as Peridigm reports it."""
-    where = "Solver.Verlet"
+def _verlet(deck: _Deck, final: float, name: str = "Solver", initial: float = 0.0) -> dict:
+    """Peridigm's Verlet solver (the list ``name``, from the time ``initial``, s): its step is
+    ``Fixed dt``, or its bond-based stable step (``peridyn.jobs.peridigm_step``), times
+    ``Safety Factor`` (default 1); floor((final - initial) / dt) steps; the velocity of
+    prescribed points as Peridigm reports it."""
+    where = f"{name}.Verlet"
     for key in deck.get(where, dict):
         if key not in ("Fixed dt", "Safety Factor"):
             raise deck.error(f"{where}.{key}", None, "only the parameters Fixed dt and Safety Factor", False)
@@ -713,7 +739,7 @@ def _verlet(deck: _Deck, final: float) -> dict:
     fixed = deck.get(f"{where}.Fixed dt", float, None)
     if fixed is None:  # Peridigm's stable step times the safety factor, found once the bonds are
         if not final > 0:
-            raise deck.error("Solver.Final Time", final, "a positive time (s)")
+            raise deck.error(f"{name}.Final Time", final, "a positive time (s)")
         return {
             "type": "explicit",
             "time": final,
@@ -724,9 +750,9 @@ def _verlet(deck: _Deck, final: float) -> dict:
     if not fixed > 0:
         raise deck.error(f"{where}.Fixed dt", fixed, "a positive time step (s)")
     dt = fixed * safety  # Peridigm multiplies a fixed step by the factor too
-    steps = math.floor(final / dt)  # Peridigm's step count (the initial time is 0)
+    steps = math.floor((final - initial) / dt)  # Peridigm's step count
     if steps < 1:
-        raise deck.error("Solver.Final Time", final, f"at least one step of {dt:g} s after the initial time")
+        raise deck.error(f"{name}.Final Time", final, f"at least one step of {dt:g} s after the initial time")
     return {"type": "explicit", "dt": dt, "steps": steps, "prescribed_velocity": "difference"}
 
 
@@ -735,11 +761,11 @@ def _verlet(deck: _Deck, final: float) -> dict:
 NOX_IGNORED = {"Nonlinear Solver", "Max Age Of Prec", "Direction", "Line Search"}
 
 
-def _quasi_static(deck: _Deck, final: float, kind: str = "QuasiStatic") -> dict:
-    """Peridigm's QuasiStatic (or NOXQuasiStatic) solver as Newton load steps to the final
-    time, converged on the absolute residual (N), velocities the change of u over a load
-    step's time."""
-    where = f"Solver.{kind}"
+def _quasi_static(deck: _Deck, final: float, kind: str = "QuasiStatic", name: str = "Solver") -> dict:
+    """Peridigm's QuasiStatic (or NOXQuasiStatic) solver (of the list ``name``) as Newton load
+    steps to the final time, converged on the absolute residual (N), velocities the change of
+    u over a load step's time."""
+    where = f"{name}.{kind}"
     nox = kind == "NOXQuasiStatic"
     iterations_key = "Max Solver Iterations" if nox else "Maximum Solver Iterations"
     known = {"Number of Load Steps", "Absolute Tolerance", iterations_key} | (NOX_IGNORED if nox else set())
@@ -747,7 +773,7 @@ def _quasi_static(deck: _Deck, final: float, kind: str = "QuasiStatic") -> dict:
         if key not in known:
             raise deck.error(f"{where}.{key}", None, f"only the parameters {sorted(known)}", False)
     if not final > 0:
-        raise deck.error("Solver.Final Time", final, "a positive time (s)")
+        raise deck.error(f"{name}.Final Time", final, "a positive time (s)")
     steps = deck.get(f"{where}.Number of Load Steps", int)
     iterations = deck.get(f"{where}.{iterations_key}", int, 10)
     tolerance = deck.get(f"{where}.Absolute Tolerance", float)
@@ -943,6 +969,8 @@ def _set_indices(deck: _Deck, key: str, deck_dir: Path, grid, first_id: int) -> 
 
 #: Output list parameters read (``Output Format`` and ``Parallel Write`` change how, not what).
 OUTPUT = {"Output File Type", "Output Format", "Output Filename", "Output Frequency", "Parallel Write"}
+#: Output list parameters of the steps written: deck name -> ``ExodusOutput`` key.
+OUTPUT_STEPS = {"Initial Output Step": "first_step", "Final Output Step": "last_step"}
 
 
 def _output(deck: _Deck, model: str, sums: dict) -> dict:
@@ -962,6 +990,11 @@ def _output(deck: _Deck, model: str, sums: dict) -> dict:
             raise deck.error(
                 f"{where}.Output Frequency", exodus["every"], f"{same['every']}, as the file's other list"
             )
+        for key, field in OUTPUT_STEPS.items():
+            if same.get(field) != exodus.get(field):
+                raise deck.error(
+                    f"{where}.{key}", exodus.get(field), f"{same.get(field)}, as the file's other list"
+                )
         same["variables"] += [v for v in exodus["variables"] if v not in same["variables"]]
         same.setdefault("sums", {}).update(exodus.get("sums", {}))
     if merged:
@@ -975,8 +1008,9 @@ def _exodus_file(deck: _Deck, where: str, model: str, sums: dict) -> dict:
     """``ExodusOutput`` of one output list: ``<Output Filename>.e``, or of global variables and
     compute classes only a history file, ``.h``, as Peridigm names them."""
     for key in deck.get(where, dict):
-        if key not in OUTPUT and key != "Output Variables":
-            raise deck.error(f"{where}.{key}", None, f"only the parameters {sorted(OUTPUT)}", False)
+        if key not in OUTPUT and key not in OUTPUT_STEPS and key != "Output Variables":
+            known = sorted(OUTPUT | set(OUTPUT_STEPS))
+            raise deck.error(f"{where}.{key}", None, f"only the parameters {known}", False)
     fmt = deck.get(f"{where}.Output File Type", str, "ExodusII")
     if fmt != "ExodusII":
         raise deck.error(f"{where}.Output File Type", fmt, "ExodusII")
@@ -994,6 +1028,12 @@ def _exodus_file(deck: _Deck, where: str, model: str, sums: dict) -> dict:
     history = all(PERIDIGM_VARIABLES[n][0] == "global" for n in names)  # Peridigm's ".h" file
     suffix = ".h" if history else ".e"
     exodus = {"file": deck.get(f"{where}.Output Filename", str) + suffix, "every": every, "variables": names}
+    for key, field in OUTPUT_STEPS.items():  # a step is counted across a sequence of solvers
+        step = deck.get(f"{where}.{key}", int, None)
+        if step is not None and step < 0:
+            raise deck.error(f"{where}.{key}", step, "a step >= 0")
+        if step is not None:
+            exodus[field] = step
     if asked_sums:
         exodus["sums"] = asked_sums
     return exodus

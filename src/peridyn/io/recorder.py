@@ -67,6 +67,14 @@ FINAL_TENSORS = {
 SNAPSHOT_VALUES = 22
 
 
+def _every_due(step: int, settings: dict) -> bool:
+    """True when an Exodus file of ``settings`` (``exodus_every``, and optionally
+    ``exodus_first`` and ``exodus_last``: ``RecorderSpec``'s) gets a record at ``step``."""
+    last = settings.get("exodus_last")
+    within = settings.get("exodus_first", 0) <= step and (last is None or step <= last)
+    return within and step % settings["exodus_every"] == 0
+
+
 @dataclass
 class RecorderSpec:
     """What to record and how often.
@@ -100,6 +108,9 @@ class RecorderSpec:
     exodus_every : int or None
         Steps between Exodus records, written at these steps only (step 0 included); None:
         at every snapshot.
+    exodus_first, exodus_last : int, int or None
+        The first and last steps that may get an Exodus record (Peridigm's ``Initial Output
+        Step`` and ``Final Output Step``; None: no last), with ``exodus_every``.
     exodus_variables : tuple of str
         Peridigm's names of the variables written (``peridyn.io.exodus_write.PERIDIGM_VARIABLES``),
         their values from the recorder's ``fields``; empty: ``snapshot_exodus``'s fields.
@@ -133,6 +144,8 @@ class RecorderSpec:
     exodus: bool = False
     exodus_file: str = "results.e"
     exodus_every: int | None = None
+    exodus_first: int = 0
+    exodus_last: int | None = None
     exodus_variables: tuple = ()
     exodus_sums: dict = field(default_factory=dict)
     exodus_order: str = "peridyn"
@@ -152,7 +165,7 @@ class RecorderSpec:
 
     def exodus_due(self, step: int) -> bool:
         """True when an Exodus file gets a record at ``step``."""
-        if any(step % more["exodus_every"] == 0 for more in self.exodus_more):
+        if any(_every_due(step, more) for more in self.exodus_more):
             return True
         return self.main_exodus_due(step)
 
@@ -160,7 +173,16 @@ class RecorderSpec:
         """True when the first Exodus file (``exodus_file``) gets a record at ``step``."""
         if not self.exodus:
             return False
-        return self.snapshot_due(step) if self.exodus_every is None else step % self.exodus_every == 0
+        if self.exodus_every is None:
+            return self.snapshot_due(step)
+        return _every_due(
+            step,
+            {
+                "exodus_every": self.exodus_every,
+                "exodus_first": self.exodus_first,
+                "exodus_last": self.exodus_last,
+            },
+        )
 
     def all_exodus_variables(self) -> tuple[list, dict]:
         """The named variables and global sums of every Exodus file, each once."""
@@ -496,7 +518,7 @@ class Recorder:
                 **arranged(chosen(values, spec.exodus_variables, spec.exodus_sums), self._rows, self._dim),
             )
         for more, writer in self._more:
-            if state.step % more["exodus_every"] == 0:
+            if _every_due(state.step, more):
                 picked = chosen(values, more["exodus_variables"], more["exodus_sums"])
                 writer.append(state.time, **arranged(picked, self._rows, self._dim))
 

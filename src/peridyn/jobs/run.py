@@ -83,6 +83,8 @@ def exodus_spec(exodus) -> dict:
         "exodus": True,
         "exodus_file": exodus.file,
         "exodus_every": exodus.every,
+        "exodus_first": exodus.first_step,
+        "exodus_last": exodus.last_step,
         "exodus_variables": tuple(exodus.variables),
         "exodus_sums": {k: (v.variable, v.set, v.calculation) for k, v in exodus.sums.items()},
         "exodus_order": exodus.point_order,
@@ -793,11 +795,17 @@ def _record_equilibrium(case, setup, out, case_path, u, results: dict, recorder=
         return _record_distributed_equilibrium(case, setup, out, case_path, state, results)
     if recorder is None:
         recorder = _equilibrium_recorder(case, setup, out, case_path)
+    return _record_last(setup, recorder, state, results)
+
+
+def _record_last(setup, recorder: Recorder, state: State, results: dict) -> dict:
+    """Record ``state`` as the run's last (series, snapshot, final fields) and close
+    ``recorder``; the run's summary, ``results`` added (one process)."""
     recorder.record_series(state)
     recorder.snapshot(state)
     summary = _base_summary(setup)
     summary.update(results)
-    summary["strain_energy_j"] = setup.model.strain_energy(u)
+    summary["strain_energy_j"] = setup.model.strain_energy(state.u)
     recorder.finish(state)
     return summary
 
@@ -853,7 +861,8 @@ def _run_newton(case, setup, out, case_path) -> dict:
     s = case.solver
     end = s.time if s.time is not None else 1.0
     recorder = _equilibrium_recorder(case, setup, out, case_path)
-    on_step = _load_step_records(recorder, setup.loading, end / s.load_steps)
+    last: dict = {}  # the last load step's u and v (``_load_step_records``)
+    on_step = _load_step_records(recorder, setup.loading, end / s.load_steps, last)
     result = newton(
         setup.model,
         setup.loading,
@@ -875,42 +884,67 @@ def _run_newton(case, setup, out, case_path) -> dict:
             f"{s.breaking_rounds} breaking rounds): raise solver.load_steps or "
             "solver.newton_iterations"
         )
-    return _record_equilibrium(
-        case,
-        setup,
-        out,
-        case_path,
-        result.u,
-        {
-            "steps": s.load_steps,
-            "iterations": result.iterations,
-            "residual": result.residual,
-            "residual_history": [step.residuals for step in result.steps],
-        },
-        recorder,
-        end,
+    results = {
+        "steps": s.load_steps,
+        "iterations": result.iterations,
+        "residual": result.residual,
+        "residual_history": [step.residuals for step in result.steps],
+    }
+    if s.then is None:
+        return _record_equilibrium(case, setup, out, case_path, result.u, results, recorder, end)
+    state = _explicit_stage(setup, recorder, s.then, result.u, last["v"], end, s.load_steps + 1)
+    return _record_last(setup, recorder, state, results | {"steps": state.step, "time_s": state.time})
+
+
+def _explicit_stage(setup, recorder: Recorder, stage, u, v, time: float, first_step: int) -> State:
+    """Run ``stage`` (``ExplicitStage``) from displacement ``u`` and velocity ``v``
+    (n_points, 3; m, m/s) at ``time`` (s), its first state numbered ``first_step``, writing the
+    Exodus records due at its steps; its last state."""
+    stepper = ExplicitSolver(
+        setup.model,
+        setup.loading,
+        dt=stage.dt,
+        damage=setup.damage,
+        contact=setup.contact,
+        prescribed_velocity=stage.prescribed_velocity,
     )
+    state = stepper.continued_state(u, v, time, first_step)
+    records = _ExodusRecords(recorder)
+    records.observe(state)
+    return stepper.run(state, stage.steps, [records])
 
 
-def _load_step_records(recorder: Recorder, loading, step_time: float):
+class _ExodusRecords:
+    """A time stepper's observer writing the Exodus records due at each step
+    (``RecorderSpec.exodus_due``)."""
+
+    def __init__(self, recorder: Recorder):
+        self.recorder = recorder
+
+    def observe(self, state: State, solver=None) -> None:
+        if self.recorder.spec.exodus_due(state.step):
+            self.recorder.write_exodus(state)
+
+
+def _load_step_records(recorder: Recorder, loading, step_time: float, last: dict):
     """Newton's ``on_step`` writing the Exodus records that ``output.exodus`` asks at its load
     steps (with the state at t = 0 first), as Peridigm's quasi-static solver writes them: the
     load step as the step, velocity the displacement's change over the step's time
-    ``step_time`` (s), acceleration zero; at t = 0 the initial conditions. None when the
-    Exodus file is written at the end only."""
+    ``step_time`` (s), acceleration zero; at t = 0 the initial conditions. ``last`` (IN/OUT,
+    ``u`` and ``v``, (n_points, 3)) holds the last load step's displacement and velocity (an
+    Exodus file written at the end only gets no records here)."""
     spec = recorder.spec
-    if spec.exodus_every is None:
-        return None
     u0, v0, zero = (np.zeros((loading.body.n_points, 3)) for _ in range(3))
     loading.apply_initial(u0, v0)
-    recorder.write_exodus(State(u0, v0, zero, 0.0, 0))
-    last = {"u": u0}
+    if spec.exodus_every is not None:
+        recorder.write_exodus(State(u0, v0, zero, 0.0, 0))
+    last["u"] = u0
 
     def on_step(step, u):
         k = int(round(step.time / step_time))
-        if spec.exodus_due(k):
-            v = (u - last["u"]) / step_time
-            recorder.write_exodus(State(u, v, zero, step.time, k))
+        last["v"] = (u - last["u"]) / step_time
+        if spec.exodus_every is not None and spec.exodus_due(k):
+            recorder.write_exodus(State(u, last["v"], zero, step.time, k))
         last["u"] = u.copy()
 
     return on_step

@@ -159,6 +159,19 @@ class ExplicitSolver:
         self._acceleration(state)
         return state
 
+    def continued_state(self, u: np.ndarray, v: np.ndarray, time: float, step: int) -> State:
+        """The state that continues another solver's run (a quasi-static one's last load
+        step): displacement ``u`` (n_points, 3) m and velocity ``v`` (n_points, 3) m/s at
+        ``time`` (s), numbered ``step``, its accelerations computed from its forces (copies:
+        ``u`` and ``v`` are left as they are)."""
+        u, v = np.array(u, dtype=np.float64), np.array(v, dtype=np.float64)
+        state = State(u, v, np.zeros_like(u), time, step)
+        self.domain.exchange(state.u)
+        if self._positions is not None:
+            np.add(self.model.body.points, state.u, out=self._positions)
+        self._acceleration(state)
+        return state
+
     def _acceleration(self, state: State, kick: bool = False, overlapped: bool = False) -> None:
         """``state.a`` from the forces at ``state.u`` (one fused pass: ``kernels.verlet``), with
         ``kick`` followed by the closing half step of the velocity, ``v += dt/2 a``.

@@ -337,3 +337,66 @@ def test_moduli_reach_lps_to_the_bit():
     assert bulk_modulus(material["E"], material["nu"]) == K
     assert shear_modulus(material["E"], material["nu"]) == mu
     assert material["E"] == pytest.approx(E, rel=1e-15) and material["nu"] == pytest.approx(nu, rel=1e-15)
+
+
+SEQUENCE = (
+    Path(__file__).parents[2]
+    / "data"
+    / "peridigm_corpus"
+    / "Compression_QS_Explicit_MultiFreqOutput_3x2x2"
+    / "Compression_QS_Explicit_MultiFreqOutput_3x2x2.xml"
+)
+
+
+def test_translation_of_a_sequence_of_solvers():
+    """Compression_QS_Explicit_MultiFreqOutput_3x2x2 (Peridigm's corpus): Solver1 QuasiStatic,
+    20 load steps to 5e-5 s, then Solver2 Verlet from 5e-5 s to 1e-4 s in steps of 1e-7 s as
+    ``solver.then`` (floor(5e-5 / 1e-7) = 500 steps, Peridigm's count); Output1 and Output2
+    with their Initial and Final Output Steps as the files' step windows."""
+    case = load_deck(SEQUENCE)
+    s = case.solver
+    assert (s.type, s.time, s.load_steps) == ("newton", 5e-5, 20)
+    assert (s.then.dt, s.then.steps, s.then.prescribed_velocity) == (1e-7, 500, "difference")
+    qs, explicit = case.output.exodus, case.output.exodus_more[0]
+    assert (qs.file, qs.every, qs.first_step, qs.last_step) == (
+        "Compression_QS_Explicit_MultiFreqOutput_3x2x2_QS.e",
+        1,
+        0,
+        20,
+    )
+    assert (explicit.every, explicit.first_step, explicit.last_step) == (100, 21, None)
+
+
+def test_refused_sequences_name_the_solver_list():
+    """Only a quasi-static solver followed by a Verlet one with a fixed step, from the time
+    where the first ends, is run; other sequences are refused at the list that breaks it."""
+    folder = SEQUENCE.parent
+    base = read_deck(SEQUENCE)
+    deck = copy.deepcopy(base)
+    deck["Solver3"] = copy.deepcopy(deck["Solver2"])
+    _refusal(deck, "Solver3", folder)
+    deck = copy.deepcopy(base)
+    deck["Solver1"], deck["Solver2"] = deck["Solver2"], deck["Solver1"]
+    _refusal(deck, "Solver1.Initial Time", folder)  # a Verlet list first, from 5e-5 s
+    deck = copy.deepcopy(base)
+    deck["Solver2"]["Initial Time"] = 4e-5
+    _refusal(deck, "Solver2.Initial Time", folder)
+    deck = copy.deepcopy(base)
+    del deck["Solver2"]["Verlet"]["Fixed dt"]
+    _refusal(deck, "Solver2.Verlet.Fixed dt", folder)
+    deck = copy.deepcopy(base)
+    deck["Solver"] = deck.pop("Solver1")
+    _refusal(deck, "Solver", folder)
+    with pytest.raises(CaseFileError, match="then"):
+        validate_case(
+            {
+                **convert_deck(SEQUENCE),
+                "solver": {"type": "explicit", "steps": 1, "then": {"dt": 1e-7, "steps": 1}},
+            }
+        )
+    deck = copy.deepcopy(base)
+    deck["Output1"]["Final Output Step"] = -1
+    _refusal(deck, "Output1.Final Output Step", folder)
+    deck = copy.deepcopy(base)  # two lists of one file: one window
+    deck["Output2"].update({"Output Filename": deck["Output1"]["Output Filename"], "Output Frequency": 1})
+    _refusal(deck, "Output2.Initial Output Step", folder)
