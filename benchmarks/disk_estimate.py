@@ -7,8 +7,8 @@ import warnings
 from pathlib import Path
 
 from peridyn.io.case import load_case
-from peridyn.jobs.build import build
 from peridyn.jobs.run import recorder_spec, run_case, step_count, time_stepper
+from peridyn.setup.build import build
 
 #: (case file, spacing in m, overrides)
 RUNS = [

@@ -17,8 +17,8 @@ from peridyn.errors import InputError, InstabilityError, Interrupted
 from peridyn.io.case import load_case, validate_case
 from peridyn.io.outdir import json_job_status, read_status
 from peridyn.io.results import Results
-from peridyn.jobs.build import build
 from peridyn.jobs.run import run_case
+from peridyn.setup.build import build
 from peridyn.solvers import ExplicitSolver
 from peridyn.solvers.stepping import advance
 

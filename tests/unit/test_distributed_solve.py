@@ -98,8 +98,8 @@ def test_distributed_equilibrium_meets_the_serial_criterion(material):
     tolerance (1e-7): both solves are within the tolerance of the same equilibrium (measured:
     2.6e-7 PMB, 2.0e-7 LPS apart, and the CG one within 1.2e-9 of a relaxation to 1e-9)."""
     from peridyn.io.case import load_case
-    from peridyn.jobs.build import build
     from peridyn.linalg.distributed import rank_preconditioner
+    from peridyn.setup.build import build
     from peridyn.solvers.distributed_static import distributed_equilibrium
     from peridyn.solvers.relaxation import _relative_residual, relax
 
@@ -167,7 +167,7 @@ def test_relax_with_damage_leaves_every_intact_bond_within_its_critical_stretch(
     iterate), both copies of every broken bond broken, and ``broken_bonds`` the bonds it broke. Intact
     flags (booleans): compared exactly."""
     from peridyn.io.case import load_case
-    from peridyn.jobs.build import build
+    from peridyn.setup.build import build
     from peridyn.solvers.relaxation import relax
 
     root = Path(__file__).resolve().parents[2] / "cases"

@@ -11,8 +11,8 @@ import yaml
 from peridyn.cli import main
 from peridyn.errors import CaseFileError
 from peridyn.io.case import apply_override, validate_case
-from peridyn.jobs.build import build, build_body, check_placements
-from peridyn.jobs.stable_step import STEP_MARGIN, estimated_stable_step
+from peridyn.setup.build import build, build_body, check_placements
+from peridyn.setup.stable_step import STEP_MARGIN, estimated_stable_step
 
 BAR = {
     "name": "bar",
@@ -163,7 +163,7 @@ def test_validate_without_build_refuses(tmp_path, capsys, changes, message):
 def test_stable_step_estimate_against_the_model(changes):
     """The lattice estimate is the model's own Gershgorin bound for PMB without surface
     correction (to round-off) and never more than STEP_MARGIN longer otherwise
-    (jobs/stable_step.py)."""
+    (setup/stable_step.py)."""
     case = validate_case(_raw(**changes))
     est = estimated_stable_step(case)
     real = build(case).model.critical_time_step()
@@ -178,7 +178,7 @@ def test_stable_step_estimate_against_the_model(changes):
 
 
 def _plan(**changes):
-    from peridyn.jobs.run_checks import check_run_plan
+    from peridyn.setup.run_checks import check_run_plan
 
     case = validate_case(_raw(**changes))
     return lambda dt, steps: check_run_plan(case, dt, steps)
@@ -243,7 +243,7 @@ def test_duplicate_mesh_points_are_refused():
     import numpy as np
 
     from peridyn.errors import InputError
-    from peridyn.jobs.build import check_distinct_points
+    from peridyn.setup.build import check_distinct_points
 
     points = np.array([[0.0, 0, 0], [1e-3, 0, 0], [2e-3, 0, 0], [1e-3, 0, 0]])
     with pytest.raises(InputError, match=r"mesh.txt: points 1 and 3 are at the same place"):

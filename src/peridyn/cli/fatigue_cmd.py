@@ -78,8 +78,8 @@ def run(args) -> dict:
             )
         return calibrate(args)
     from peridyn.io.case import load_case
-    from peridyn.jobs.estimate import check_memory
     from peridyn.jobs.fatigue import run_fatigue_case
+    from peridyn.setup.estimate import check_memory
 
     case = load_case(args.case, args.overrides)
     check_memory(case, args.max_memory, Path(args.case).parent, job="fatigue")

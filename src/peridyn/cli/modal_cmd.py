@@ -34,9 +34,9 @@ def register(sub) -> None:
 
 def run(args) -> dict:
     """Solve and print the frequency table unless --json."""
-    from peridyn.jobs.estimate import check_memory
     from peridyn.jobs.run import run_case
     from peridyn.parallel.comm import world
+    from peridyn.setup.estimate import check_memory
 
     overrides = [*args.overrides, "solver.type=modal"]
     if args.modes is not None:

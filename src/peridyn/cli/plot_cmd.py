@@ -27,9 +27,9 @@ def run(args) -> dict:
     paths of the final damage for a run with damage)."""
     from peridyn.io.case import validate_case
     from peridyn.io.results import Results
-    from peridyn.jobs.build import add_actuators, build_body
     from peridyn.jobs.figures import draw_run_figures, redraw_crack_figures
     from peridyn.jobs.lamb_analysis import analyse
+    from peridyn.setup.build import add_actuators, build_body
 
     out = Path(args.run_dir)
     results = out / "results.h5"

@@ -66,8 +66,8 @@ def command_line(argv=None) -> str:
 def run(args) -> dict:
     """Run the case; print a readable summary unless --json. Under ``mpiexec -n N`` every rank
     runs its part (``peridyn.parallel``); only rank 0 prints (``peridyn.cli.main``)."""
-    from peridyn.jobs.estimate import check_memory
     from peridyn.jobs.run import run_case
+    from peridyn.setup.estimate import check_memory
 
     backend = getattr(args, "backend", None)  # demo: no flag
     overrides = [*args.overrides, *([f"solver.backend={backend}"] if backend else [])]

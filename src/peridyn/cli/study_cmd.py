@@ -87,8 +87,8 @@ def run(args) -> dict:
     """Run the grid, fit, write the tables and the figure; print the table unless --json."""
     from peridyn.io.case import load_case
     from peridyn.io.outdir import json_job_status
-    from peridyn.jobs.estimate import check_memory, largest_study_run
     from peridyn.jobs.study import SERIES
+    from peridyn.setup.estimate import check_memory, largest_study_run
 
     start = time.perf_counter()
     spacings = _positive_list("--spacing", args.spacing)

@@ -29,7 +29,7 @@ def run(args) -> dict:
     case = load_case_or_deck(args.case, args.overrides)
     summary = {"case": case.name, "valid": True, **check_without_bonds(case, Path(args.case).parent)}
     if args.build:
-        from peridyn.jobs.build import build
+        from peridyn.setup.build import build
         from peridyn.solvers import ExplicitSolver
 
         setup = build(case, Path(args.case).parent)
@@ -71,11 +71,11 @@ def check_without_bonds(case, base_dir) -> dict:
     import numpy as np
 
     from peridyn.errors import CaseFileError
-    from peridyn.jobs.build import add_actuators, build_body, build_loading, check_loading, check_placements
-    from peridyn.jobs.estimate import check_memory
     from peridyn.jobs.run import explicit_damping, step_count
-    from peridyn.jobs.run_checks import check_run_plan
-    from peridyn.jobs.stable_step import estimated_stable_step
+    from peridyn.setup.build import add_actuators, build_body, build_loading, check_loading, check_placements
+    from peridyn.setup.estimate import check_memory
+    from peridyn.setup.run_checks import check_run_plan
+    from peridyn.setup.stable_step import estimated_stable_step
     from peridyn.solvers.explicit import damped_stable_step
 
     est = check_memory(case, None, base_dir)
@@ -86,7 +86,7 @@ def check_without_bonds(case, base_dir) -> dict:
     loading = build_loading(case, body, actuation)
     check_loading(case, loading)
     if case.solver.type == "modal":
-        from peridyn.jobs.modal import check_mode_count
+        from peridyn.setup.eigensolver import check_mode_count
 
         check_mode_count(case, body.dim, bool(loading.constrained.any()))
     found = {"points": est.points, "estimated_bonds": est.bonds, "estimated_peak_bytes": est.peak_bytes}

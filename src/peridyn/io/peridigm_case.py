@@ -643,7 +643,7 @@ def _implicit(deck: _Deck, final: float) -> dict:
 
 def _verlet(deck: _Deck, final: float) -> dict:
     """Peridigm's Verlet solver: its step is ``Fixed dt``, or its bond-based stable step
-    (``peridyn.jobs.peridigm_step``), times ``Safety Factor`` (default 1); floor(final / dt)
+    (``peridyn.setup.peridigm_step``), times ``Safety Factor`` (default 1); floor(final / dt)
     steps; the velocity of prescribed points as Peridigm reports it."""
     where = "Solver.Verlet"
     for key in deck.get(where, dict):

@@ -37,10 +37,10 @@ from peridyn.io.case import Case, FatigueModal
 from peridyn.io.outdir import json_job_status, prepare_output
 from peridyn.io.run_log import run_log
 from peridyn.io.vtk import write_vtu
-from peridyn.jobs.build import build
 from peridyn.jobs.modal import case_modes, match_modes
 from peridyn.jobs.run import output_directory
 from peridyn.jobs.summary import finish_summary
+from peridyn.setup.build import build
 
 logger = logging.getLogger(__name__)
 

@@ -30,19 +30,19 @@ from peridyn.io.recorder import LineProbe, Probes, Recorder, RecorderSpec
 from peridyn.io.reserve import RESERVE_BYTES, RESERVE_FILE
 from peridyn.io.run_log import run_log
 from peridyn.io.vtu_pieces import VtuPieces
-from peridyn.jobs.build import Setup, build, pad3
-from peridyn.jobs.exodus_variables import GatheredVariables, check_variables, variable_values
 from peridyn.jobs.figure_worker import figure_worker_for, figures_of, submit
 from peridyn.jobs.figures import draw_crack_figures, draw_run_figures, final_crack_paths
 from peridyn.jobs.lamb_analysis import analyse
-from peridyn.jobs.peridigm_step import peridigm_stable_step
-from peridyn.jobs.run_checks import check_run_plan
 from peridyn.jobs.summary import finish_summary, peak_memory_bytes
 from peridyn.parallel.observers import RootObservers
 from peridyn.physics.absorbing import layer_damping
 from peridyn.physics.damage import damage_field
 from peridyn.physics.deformation import strain_field
 from peridyn.physics.transducers import pzt_sensor_weights
+from peridyn.setup.build import Setup, build, pad3
+from peridyn.setup.exodus_variables import GatheredVariables, check_variables, variable_values
+from peridyn.setup.peridigm_step import peridigm_stable_step
+from peridyn.setup.run_checks import check_run_plan
 from peridyn.solvers import ExplicitSolver, relax
 from peridyn.solvers.explicit_gpu import GPUExplicitSolver
 

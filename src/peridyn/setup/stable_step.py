@@ -35,9 +35,9 @@ import numpy as np
 
 from peridyn.discretization.bonds import influence_function
 from peridyn.io.case import Case
-from peridyn.jobs.estimate import grid_shape, neighbour_offsets
 from peridyn.physics.materials.elastic import bulk_modulus, plane_bulk_modulus, shear_modulus
 from peridyn.physics.materials.pmb import pmb_micromodulus
+from peridyn.setup.estimate import grid_shape, neighbour_offsets
 
 #: The estimate is at most this much longer than ``critical_time_step`` on the shipped cases.
 STEP_MARGIN = 0.15

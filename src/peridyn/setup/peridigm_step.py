@@ -18,9 +18,9 @@ import numpy as np
 
 from peridyn.errors import InputError
 from peridyn.io.case import Case
-from peridyn.jobs.build import Setup, block_index
 from peridyn.physics.materials.elastic import bulk_modulus
 from peridyn.physics.materials.registry import model_class
+from peridyn.setup.build import Setup, block_index
 
 #: pi as Peridigm's estimate writes it.
 PERIDIGM_PI = 3.14159265
