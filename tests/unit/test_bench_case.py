@@ -12,8 +12,9 @@ from peridyn.errors import InputError
 from peridyn.io.case import load_case
 from peridyn.jobs import bench_case
 from peridyn.jobs.bench_case import run_case_benchmark
-from peridyn.jobs.run import recorder_spec, step_count, time_stepper
 from peridyn.setup.build import build
+from peridyn.setup.recording import recorder_spec
+from peridyn.setup.solver_choice import step_count, time_stepper
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 BAR = CASES / "bar_pulse.yaml"

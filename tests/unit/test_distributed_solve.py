@@ -130,14 +130,14 @@ def test_distributed_equilibrium_meets_the_serial_criterion(material):
 )
 def test_what_an_mpi_run_cannot_do_is_refused_before_the_build(case_file, overrides, refused):
     """Newton runs and shift-invert (a factor of the whole body) are refused under MPI with one
-    clear error (jobs.run._check_parallel), before anything is built or written."""
+    clear error (setup.solver_choice.check_parallel), before anything is built or written."""
     from peridyn.errors import PeridynError
     from peridyn.io.case import load_case
-    from peridyn.jobs.run import _check_parallel
+    from peridyn.setup.solver_choice import check_parallel
 
     case = load_case(Path(__file__).resolve().parents[2] / "cases" / case_file, overrides)
     with pytest.raises(PeridynError, match=refused):
-        _check_parallel(case)
+        check_parallel(case)
 
 
 @pytest.mark.parametrize(
@@ -151,11 +151,11 @@ def test_static_mpi_runs_with_damage_or_contact_are_accepted(case_file, override
     """Static runs with bond breaking (plate2d_stretch) and with contact as well
     (plate2d_cyclic) run under MPI by dynamic relaxation on each rank's part: not refused."""
     from peridyn.io.case import load_case
-    from peridyn.jobs.run import _check_parallel
+    from peridyn.setup.solver_choice import check_parallel
 
     case = load_case(Path(__file__).resolve().parents[2] / "cases" / case_file, overrides)
     assert case.material.damage is not None
-    _check_parallel(case)
+    check_parallel(case)
 
 
 def test_relax_with_damage_leaves_every_intact_bond_within_its_critical_stretch():

@@ -4,6 +4,7 @@ a dt above the stable step, an empty node set, a horizon below the spacing, too 
 
 import copy
 import re
+from pathlib import Path
 
 import pytest
 import yaml
@@ -114,6 +115,34 @@ def test_max_memory_refuses_with_the_numbers(tmp_path, capsys):
     assert not out.exists()
     assert main(["modal", _file(tmp_path), "--max-memory", "lots"]) == 2
     assert "memory size 'lots'" in capsys.readouterr().err
+
+
+def test_jobs_called_from_python_check_their_memory_before_building(tmp_path, monkeypatch):
+    """``run_case`` and the fatigue job refuse, before building anything or touching the output
+    folder, a case whose estimated peak exceeds the memory: from Python as from the command
+    line. Python's 0.3 GB of interpreter and libraries (``setup.estimate.BASE_BYTES``) alone
+    exceed a 0.1 GB machine, so every case is refused on it."""
+    import peridyn.jobs.fatigue
+    import peridyn.jobs.run
+    from peridyn.discretization import geometry
+    from peridyn.errors import InputError
+    from peridyn.io.case import load_case
+
+    def build(*args, **kwargs):
+        raise AssertionError("the case was built before its memory was checked")
+
+    for job in (peridyn.jobs.run, peridyn.jobs.fatigue):
+        monkeypatch.setattr(job, "build", build)
+    monkeypatch.setattr(geometry, "memory_limit", lambda: 1e8)
+    out = tmp_path / "out"
+    with pytest.raises(InputError, match=r"2.16e\+03 points .* more than the 0.1 GB available"):
+        peridyn.jobs.run.run_case(validate_case(BAR), out)
+    with pytest.raises(InputError, match="more than the 1e-06 GB available"):
+        peridyn.jobs.run.run_case(validate_case(BAR), out, max_memory=1e3)
+    fatigue = load_case(Path(__file__).parents[2] / "cases" / "sen_fatigue_2d.yaml")
+    with pytest.raises(InputError, match="this fatigue job would hold"):
+        peridyn.jobs.fatigue.run_fatigue_case(fatigue, out)
+    assert not out.exists()
 
 
 @pytest.mark.parametrize(

@@ -79,10 +79,8 @@ def run(args) -> dict:
         return calibrate(args)
     from peridyn.io.case import load_case
     from peridyn.jobs.fatigue import run_fatigue_case
-    from peridyn.setup.estimate import check_memory
 
     case = load_case(args.case, args.overrides)
-    check_memory(case, args.max_memory, Path(args.case).parent, job="fatigue")
     summary = run_fatigue_case(
         case,
         args.output,
@@ -91,6 +89,7 @@ def run(args) -> dict:
         progress=progress_bar(args.progress, f"{case.name} fatigue steps"),
         overwrite=args.overwrite,
         comm=world(),
+        max_memory=args.max_memory,
     )
     if not args.json:
         print(

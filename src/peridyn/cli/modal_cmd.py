@@ -36,13 +36,11 @@ def run(args) -> dict:
     """Solve and print the frequency table unless --json."""
     from peridyn.jobs.run import run_case
     from peridyn.parallel.comm import world
-    from peridyn.setup.estimate import check_memory
 
     overrides = [*args.overrides, "solver.type=modal"]
     if args.modes is not None:
         overrides.append(f"solver.modes={args.modes}")
     case = load_case(args.case, overrides)
-    check_memory(case, args.max_memory, Path(args.case).parent)
     comm = world()  # under mpiexec -n N: the distributed LOBPCG, rank 0 writes
     summary = run_case(
         case,
@@ -51,6 +49,7 @@ def run(args) -> dict:
         base_dir=Path(args.case).parent,
         overwrite=args.overwrite,
         comm=comm,
+        max_memory=args.max_memory,
     )
     if args.compare and comm.rank == 0:
         from peridyn.jobs.modal import compare_with_run

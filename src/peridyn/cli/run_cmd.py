@@ -67,12 +67,10 @@ def run(args) -> dict:
     """Run the case; print a readable summary unless --json. Under ``mpiexec -n N`` every rank
     runs its part (``peridyn.parallel``); only rank 0 prints (``peridyn.cli.main``)."""
     from peridyn.jobs.run import run_case
-    from peridyn.setup.estimate import check_memory
 
     backend = getattr(args, "backend", None)  # demo: no flag
     overrides = [*args.overrides, *([f"solver.backend={backend}"] if backend else [])]
     case = load_case_or_deck(args.case, overrides)
-    check_memory(case, getattr(args, "max_memory", None), Path(args.case).parent)  # demo: no flag
     info = provenance()
     logger.info(
         f"peridyn {info['peridyn_version']} (commit {info['git_commit'][:12]}): case "
@@ -90,6 +88,7 @@ def run(args) -> dict:
         command=args.command_line if hasattr(args, "command_line") else command_line(),  # demo: ""
         comm=world(),
         figure_worker=True,
+        max_memory=getattr(args, "max_memory", None),  # demo: no flag
     )
     if not args.json:
         print_summary(summary)

@@ -38,9 +38,10 @@ from peridyn.io.outdir import json_job_status, prepare_output
 from peridyn.io.run_log import run_log
 from peridyn.io.vtk import write_vtu
 from peridyn.jobs.modal import case_modes, match_modes
-from peridyn.jobs.run import output_directory
 from peridyn.jobs.summary import finish_summary
 from peridyn.setup.build import build
+from peridyn.setup.estimate import check_memory
+from peridyn.setup.recording import output_directory
 
 logger = logging.getLogger(__name__)
 
@@ -157,17 +158,20 @@ def run_fatigue_case(
     progress=None,
     overwrite: bool = False,
     comm=None,
+    max_memory: float | None = None,
 ) -> dict:
     """Run a fatigue case; returns the summary (JSON keys of ``peridyn fatigue --json``, also in
     ``fatigue.json``; docs/user-guide.md, "Summaries and results files"). A folder holding an
     earlier ``fatigue.json`` is refused unless ``overwrite``; the job's status goes to
     ``status.json`` (``peridyn.io.outdir``). ``comm``: ``peridyn.parallel.comm.world()`` under
     ``mpiexec -n N`` (N > 1; see the module docstring), every rank returning the summary; None:
-    one process."""
+    one process. ``max_memory``: bytes the job may hold (default: the machine's); a case whose
+    estimated peak exceeds it is refused before it is built (``setup.estimate.check_memory``)."""
     start = time.perf_counter()
     check_fatigue_case(case)
     if comm is not None and comm.size > 1:
         check_parallel_fatigue(case)
+    check_memory(case, max_memory, base_dir, job="fatigue")
     setup = build(case, base_dir, comm)
     d = setup.domain
     out = d.on_root(prepare_output, output_directory(case, output_dir), "fatigue.json", overwrite)

@@ -5,104 +5,55 @@ runs are ``jobs.modal``), recording, checkpoints, crack history and the stored s
 from __future__ import annotations
 
 import contextlib
-import functools
-import hashlib
-import json
 import logging
-import shutil
 import time
 from pathlib import Path
 
 import numpy as np
 
 from peridyn import interrupts
-from peridyn.discretization import geometry
 from peridyn.discretization.body import Body
 from peridyn.discretization.state import State
-from peridyn.errors import CaseFileError, InputError, Interrupted
+from peridyn.errors import InputError, Interrupted
 from peridyn.io.case import Case
 from peridyn.io.checkpoint import Checkpointer, load_checkpoint
 from peridyn.io.hdf5 import HDF5Writer
 from peridyn.io.lock import OutputLock
 from peridyn.io.outdir import RUN_OUTPUTS, end_status, prepare_output
 from peridyn.io.provenance import package_version, provenance
-from peridyn.io.recorder import LineProbe, Probes, Recorder, RecorderSpec
-from peridyn.io.reserve import RESERVE_BYTES, RESERVE_FILE
+from peridyn.io.recorder import Probes, Recorder
+from peridyn.io.reserve import RESERVE_FILE
 from peridyn.io.run_log import run_log
 from peridyn.io.vtu_pieces import VtuPieces
 from peridyn.jobs.figure_worker import figure_worker_for, figures_of, submit
 from peridyn.jobs.figures import draw_crack_figures, draw_run_figures, final_crack_paths
 from peridyn.jobs.lamb_analysis import analyse
+from peridyn.jobs.observers import crack_observer
 from peridyn.jobs.summary import finish_summary, peak_memory_bytes
 from peridyn.parallel.observers import RootObservers
-from peridyn.physics.absorbing import layer_damping
 from peridyn.physics.damage import damage_field
-from peridyn.physics.deformation import strain_field
-from peridyn.physics.transducers import pzt_sensor_weights
-from peridyn.setup.build import Setup, build, pad3
-from peridyn.setup.exodus_variables import GatheredVariables, check_variables, variable_values
-from peridyn.setup.peridigm_step import peridigm_stable_step
+from peridyn.setup.build import Setup, build
+from peridyn.setup.estimate import check_memory
+from peridyn.setup.exodus_variables import GatheredVariables
+from peridyn.setup.identity import case_identity
+from peridyn.setup.recording import (
+    RESULTS,
+    check_output_fits,
+    exodus_values,
+    output_directory,
+    point_tensors,
+    recorder_spec,
+)
 from peridyn.setup.run_checks import check_run_plan
-from peridyn.solvers import ExplicitSolver, relax
+from peridyn.setup.solver_choice import (
+    check_parallel,
+    static_solver,
+    step_count,
+    time_stepper,
+)
 from peridyn.solvers.explicit_gpu import GPUExplicitSolver
 
 logger = logging.getLogger(__name__)
-
-#: The results file in a run's output folder.
-RESULTS = "results.h5"
-
-
-def recorder_spec(case: Case, body: Body, dt: float) -> RecorderSpec:
-    """What the case asks to record, with snapshot times turned into steps."""
-    out = case.output
-    planes = {name: body.node_set(set_name) for name, set_name in out.planes.items()}
-    return RecorderSpec(
-        every=out.every,
-        snapshot_every=out.snapshot_every,
-        snapshot_steps=[int(round(t / dt)) for t in out.snapshot_times],
-        sensors={k: pad3(v) for k, v in out.sensors.items()},
-        lines={k: LineProbe(pad3(v.start), pad3(v.end), v.points) for k, v in out.lines.items()},
-        planes=planes,
-        pzt_sensors={k: _pzt_weights(body, v) for k, v in out.pzt_sensors.items()},
-        series_dtype=out.series_dtype,
-        vtu=out.vtu,
-        vtu_compression=out.vtu_compression,
-        stress=out.stress,
-        strain=out.strain,
-        **exodus_spec(out.exodus),
-        exodus_more=tuple(exodus_spec(more) for more in out.exodus_more),
-    )
-
-
-def exodus_spec(exodus) -> dict:
-    """The recorder's Exodus settings of ``output.exodus`` (a bool or an ``ExodusOutput``)."""
-    if isinstance(exodus, bool):
-        return {"exodus": exodus}
-    return {
-        "exodus": True,
-        "exodus_file": exodus.file,
-        "exodus_every": exodus.every,
-        "exodus_variables": tuple(exodus.variables),
-        "exodus_sums": {k: (v.variable, v.set, v.calculation) for k, v in exodus.sums.items()},
-        "exodus_order": exodus.point_order,
-        "exodus_three_d": exodus.three_d,
-        "exodus_named": True,
-    }
-
-
-def _pzt_weights(body: Body, sensor) -> tuple[np.ndarray, np.ndarray]:
-    """Point indices and (n, 2) weights of a PZT sensor patch on its layer."""
-    idx = np.flatnonzero(geometry.layer(body, sensor.layer))
-    weights = pzt_sensor_weights(body.points[idx], sensor.center, sensor.size, sensor.shape)
-    used = np.any(weights != 0, axis=1)
-    return idx[used], weights[used]
-
-
-def output_directory(case: Case, override=None) -> Path:
-    """The run's output folder: the override, the case's ``output.directory`` or peridyn-out/NAME."""
-    if override is not None:
-        return Path(override)
-    return Path(case.output.directory or Path("peridyn-out") / case.name)
 
 
 @interrupts.deferred()
@@ -118,12 +69,16 @@ def run_case(
     command: str | None = None,
     comm=None,
     figure_worker: bool = False,
+    max_memory: float | None = None,
 ) -> dict:
     """Run a case and write its results; returns the summary (also stored in results.h5; keys
     in docs/user-guide.md, "Summaries and results files").
 
-    The case is built and every argument checked before the output folder is touched; a
-    folder holding an earlier run's results.h5 is refused unless ``overwrite`` or ``restart``.
+    The case and every argument are checked before anything of the case's size is allocated
+    (its memory estimate, ``setup.estimate.check_memory``), the case is built and its time step
+    and records checked (the model's stable step, the records against the free disk) before
+    the output folder is touched; a folder holding an earlier run's results.h5 is refused
+    unless ``overwrite`` or ``restart``.
     results.h5 carries the run's status (``peridyn.io.outdir``).
 
     Parameters
@@ -153,6 +108,9 @@ def run_case(
         ``MIN_POINTS`` or more). What ``peridyn run`` does; a script that asks for it must
         guard its own run with ``if __name__ == "__main__":``, as every program that starts
         processes by ``spawn`` must.
+    max_memory : float or None
+        Bytes the job may hold (default: the machine's, ``discretization.geometry.memory_limit``):
+        a case whose estimated peak exceeds it is refused before it is built.
 
     Raises
     ------
@@ -175,7 +133,8 @@ def run_case(
         raise InputError(f"--restart continues an explicit or newmark run, not a {case.solver.type} run")
     parallel = comm is not None and comm.size > 1
     if parallel:
-        _check_parallel(case)
+        check_parallel(case)
+    check_memory(case, max_memory, base_dir)
     wanted = figure_worker and _draws_run_figures(case) and not parallel
     with figure_worker_for(case, base_dir, wanted) as worker, contextlib.ExitStack() as held:
         setup = build(case, base_dir, comm)
@@ -216,95 +175,6 @@ def run_case(
                 raise Interrupted(exc.signal_name, exc.step, hint, exc.where) from None
             raise
         return domain.comm.bcast(summary)
-
-
-def _check_parallel(case: Case) -> None:
-    """Refuse what an MPI run cannot do yet."""
-    if case.solver.type not in ("explicit", "modal", "static"):
-        raise InputError(
-            "an MPI run (mpiexec -n N) is an explicit, static or modal run for now, not a "
-            f"{case.solver.type} run"
-        )
-    if case.solver.type == "modal" and case.solver.eigensolver == "shift-invert":
-        raise CaseFileError(case.name, "solver.eigensolver", "shift-invert", "lobpcg or auto in an MPI run")
-
-
-def point_tensors(setup: Setup, spec: RecorderSpec):
-    """The recorder's ``tensors``: u (n_points, 3) m -> the per-point ``stress`` (Pa) and
-    ``strain`` (with ``strain_valid``) that ``output.stress`` and ``output.strain`` ask for,
-    (n_points, dim, dim); None when neither is asked. Under MPI, of the rank's part (its owned
-    rows are the serial ones: ``RootObservers`` gathers them)."""
-    if not (spec.stress or spec.strain):
-        return None
-    dim = setup.body.dim
-
-    def fields(u: np.ndarray) -> dict:
-        out = {}
-        if spec.stress:
-            out["stress"] = setup.model.partial_stress(u)[:, :dim, :dim]
-        if spec.strain:
-            out["strain"], out["strain_valid"] = strain_field(setup.body, setup.model.bonds, u)
-        return out
-
-    return fields
-
-
-def exodus_values(case: Case, setup: Setup, spec: RecorderSpec):
-    """The recorder's ``fields``: the values of the named Exodus variables (``output.exodus``
-    as a mapping) at a state, or None without them; under MPI a ``GatheredVariables``, whose
-    ``collect`` every rank calls at the states recorded."""
-    if not spec.exodus_named:
-        return None
-    variables, sums = spec.all_exodus_variables()
-    check_variables(case.name, setup.model, variables)
-    if setup.domain.size > 1:  # each rank's owned values, gathered on rank 0 (``collect``)
-        return GatheredVariables(setup.domain, setup.model, variables, sums, setup.whole_body, setup.loading)
-    return variable_values(setup.model, variables, sums, setup.loading)
-
-
-def step_count(case: Case, solver) -> int:
-    """Time steps of a time-stepping run: ``solver.steps``, or ``solver.time`` in steps of dt
-    (ceil(time / dt), or floor(time / dt) with ``solver.step_rule: peridigm``)."""
-    s = case.solver
-    if s.steps is not None:
-        return s.steps
-    if s.step_rule == "peridigm":  # Peridigm's floor((final - initial) / dt)
-        steps = int(np.floor(s.time / solver.dt))
-        if steps < 1:
-            raise CaseFileError(
-                case.name, "solver.time", s.time, f"at least one step of dt = {solver.dt:.4g} s"
-            )
-        return steps
-    return int(np.ceil(s.time / solver.dt - 1e-9))
-
-
-def check_output_fits(
-    spec: RecorderSpec, body: Body, n_steps: int, dt: float, out: Path, damage: bool = False
-) -> None:
-    """Refuse a run whose records (``spec.output_bytes``, ``spec`` from ``recorder_spec``) would
-    not fit in the free space of the disk of its output folder, before anything is written.
-
-    Raises
-    ------
-    InputError
-        Naming the steps, the bytes and the free space.
-    """
-    need = spec.output_bytes(body.n_points, n_steps, body.dim, damage) + RESERVE_BYTES
-    folder = out.resolve()
-    while not folder.exists():
-        folder = folder.parent
-    free = shutil.disk_usage(folder).free
-    if need > free:
-        raise InputError(
-            f"the run's {n_steps:.3g} steps (dt = {dt:.3g} s) would write "
-            + (
-                f"about {need / 1e9:.3g} GB of results"
-                if np.isfinite(need)
-                else "more results than any disk holds"
-            )
-            + f", more than the {free / 1e9:.3g} GB free on {folder}: "
-            "shorten solver.time or record less (output.every, output.snapshot_every)"
-        )
 
 
 def _resume_hint(command: str | None) -> str:
@@ -364,19 +234,6 @@ def _finish_on_root(case, body, out, summary, plots, start, phi, worker=None) ->
     store_summary(out / RESULTS, body, summary, status="complete")
 
 
-def case_identity(case: Case, run_length: bool = False) -> tuple[str, str]:
-    """The validated case (after ``--set``) as JSON text without its output folder and, unless
-    ``run_length`` (a sweep's runs differ by it), without its run length (``solver.steps``,
-    ``solver.time``: a restart may extend a run), and the SHA-256 of that text."""
-    data = case.model_dump(mode="json")
-    if not run_length:
-        for key in ("steps", "time"):
-            data["solver"].pop(key, None)
-    data["output"].pop("directory", None)
-    text = json.dumps(data, sort_keys=True)
-    return text, hashlib.sha256(text.encode()).hexdigest()
-
-
 def _set_status(results: Path, body: Body, status: str) -> None:
     """Set the status of a results file (created if the job failed before writing one)."""
     with HDF5Writer(results, body.points[:, : body.dim], body.volumes, {}, mode="a") as h5:
@@ -419,38 +276,6 @@ def bond_state(setup: Setup) -> tuple[np.ndarray, np.ndarray]:
         words = setup.bonds.broken.reshape(-1)
         return words, np.array([0, len(words)])
     return setup.bonds.intact, setup.bonds.offsets
-
-
-def time_stepper(case, setup):
-    """The solver of an explicit or newmark case (velocity Verlet or implicit Newmark)."""
-    if case.solver.type == "newmark":
-        return _newmark_solver(case, setup)
-    s = case.solver
-    damping = explicit_damping(case, setup.whole_body)
-    if np.ndim(damping):  # per point: the rank's points
-        damping = damping[setup.domain.global_ids]
-    peridigm_dt = s.dt is None and s.step_rule == "peridigm"
-    solver_class = GPUExplicitSolver if s.backend == "gpu" else ExplicitSolver
-    try:
-        return solver_class(
-            setup.model,
-            setup.loading,
-            dt=s.safety * peridigm_stable_step(case, setup) if peridigm_dt else s.dt,
-            safety=s.safety,
-            damping=damping,
-            damage=setup.damage,
-            contact=setup.contact,
-            domain=setup.domain,
-            prescribed_velocity=s.prescribed_velocity,
-        )
-    except InputError as exc:
-        if not peridigm_dt:
-            raise
-        raise InputError(
-            f"Peridigm's time step (its bond-based stable step times solver.safety, a deck's "
-            f"Safety Factor) is too long for this model: {exc}; give a deck's Solver.Verlet "
-            "'Fixed dt' or a smaller 'Safety Factor' (solver.dt or solver.safety)"
-        ) from None
 
 
 #: Seconds of running after which an interrupted run writes a checkpoint even unasked.
@@ -678,34 +503,11 @@ def _checkpointer(
     return checkpointer, [(checkpointer.due, gather_whole)]
 
 
-def explicit_damping(case: Case, body: Body):
-    """``solver.damping`` (1/s), plus the absorbing layers' per-point damping when the case
-    has them: a number or an (n_points,) array for ``ExplicitSolver``."""
-    if case.absorbing is None:
-        return case.solver.damping
-    a = case.absorbing
-    try:
-        return case.solver.damping + layer_damping(body.points, a.width, a.damping, a.faces)
-    except InputError as exc:
-        raise CaseFileError(case.name, "absorbing", a.model_dump(), str(exc)) from None
-
-
-def crack_observer(case, setup, n_steps, damage):
-    """Crack length against time, sampled at the snapshots (or 100 times a run) of a case
-    with damage (``damage``: the whole body's damage index, a callable); None without damage."""
-    if setup.damage is None:
-        return None
-    from peridyn.jobs.observers import CrackLengthObserver
-
-    every = case.output.snapshot_every or max(1, n_steps // 100)
-    return CrackLengthObserver(setup.whole_body, damage, every)
-
-
 def _run_static(case, setup, out, case_path) -> dict:
     s = case.solver
     u = None
     iterations = 0
-    solve = _static_solver(setup)
+    solve = static_solver(setup)
     for k in range(1, s.load_steps + 1):
         result = solve(
             setup.model,
@@ -728,34 +530,6 @@ def _run_static(case, setup, out, case_path) -> dict:
     if setup.contact is not None:
         results["contact_rebuilds"] = setup.contact.rebuilds
     return _record_equilibrium(case, setup, out, case_path, u, results)
-
-
-def _static_solver(setup: Setup):
-    """The solve of each load step of a static run, called as ``relax``: ``relax`` itself in one
-    process; under MPI ``relax`` on the rank's part (the serial iterates bit for bit) when bonds
-    break or contact acts, else modified Newton with CG (``_distributed_static``)."""
-    d = setup.domain
-    if d.size == 1:
-        return relax
-    if setup.damage is not None or setup.contact is not None:
-        return functools.partial(relax, domain=d)
-    return _distributed_static(setup)
-
-
-def _distributed_static(setup: Setup):
-    """``relax``'s stand-in under MPI for a linear-elastic body (no damage, no contact): modified
-    Newton with CG (``solvers.distributed_static``) on the rank's dofs, its preconditioner built
-    once for every load step."""
-    from peridyn.linalg.distributed import RankDofs, rank_preconditioner
-    from peridyn.solvers.distributed_static import distributed_equilibrium
-
-    dofs = RankDofs(setup.model, setup.domain, setup.loading.constrained)
-    precond = rank_preconditioner(dofs)
-
-    def solve(model, loading, time, u0, tolerance, max_iterations, damage, contact):
-        return distributed_equilibrium(dofs, precond, loading, time, u0, tolerance, max_iterations)
-
-    return solve
 
 
 def _equilibrium_recorder(case, setup, out, case_path) -> Recorder:
@@ -812,25 +586,6 @@ def _record_distributed_equilibrium(case, setup, out, case_path, state: State, r
     summary["strain_energy_j"] = float(d.dot(setup.model.energy_density(state.u)[:n], setup.body.volumes[:n]))
     gathered.call(state, lambda whole: recorder.finish(whole), True)
     return summary
-
-
-def _newmark_solver(case, setup):
-    """The implicit Newmark solver of a ``newmark`` case."""
-    from peridyn.solvers.newmark import NewmarkSolver
-
-    s = case.solver
-    return NewmarkSolver(
-        setup.model,
-        setup.loading,
-        dt=s.dt,
-        tolerance=s.displacement_tolerance,
-        max_iterations=s.newton_iterations,
-        damping=s.damping,
-        damage=setup.damage,
-        linear_solver=s.linear_solver,
-        residual_tolerance=s.absolute_tolerance,
-        initial_acceleration=s.initial_acceleration,
-    )
 
 
 def _run_newton(case, setup, out, case_path) -> dict:

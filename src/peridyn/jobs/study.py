@@ -31,8 +31,8 @@ from peridyn.discretization.bonds import horizon_metres
 from peridyn.errors import CaseFileError, InputError
 from peridyn.io.case import load_case, parse_yaml
 from peridyn.io.results import Results
-from peridyn.jobs.run import RESULTS
 from peridyn.jobs.summary import finish_summary
+from peridyn.setup.recording import RESULTS
 
 #: The kinds of series a study can fit, see the module docstring.
 SERIES = ("delta-m", "delta", "m")
