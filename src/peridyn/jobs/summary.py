@@ -11,6 +11,7 @@ import time
 from pathlib import Path
 
 from peridyn.io.hdf5 import SCHEMA_VERSION
+from peridyn.physics.damage import damage_field
 
 #: The job kinds: the ``kind`` of their summaries.
 KINDS = ("run", "modal", "fatigue", "study")
@@ -47,3 +48,23 @@ def finish_summary(summary: dict, kind: str, out: Path, start: float, plots=()) 
 def peak_memory_bytes() -> int:
     """Peak resident memory of this process so far, bytes (Linux reports KiB)."""
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+
+
+def base_summary(setup) -> dict:
+    """Points, directed bonds, broken bonds and largest damage of the whole body of a built case
+    ``setup`` (``setup.build.Setup``; collective): the first keys of a run's summary."""
+    d = setup.domain
+    n = d.n_owned
+    phi = damage_field(setup.model)
+    if setup.storage == "lattice":  # one process
+        bonds, broken = setup.bonds.n_bonds, setup.bonds.n_broken()
+    else:
+        owned_bonds = int(setup.bonds.offsets[n])  # the owned points' families come first
+        bonds, broken = d.count(owned_bonds), d.count((~setup.bonds.intact[:owned_bonds]).sum())
+    return {
+        "points": setup.whole_body.n_points,
+        "bonds": bonds,
+        "broken_bonds": broken,
+        "max_damage": float(d.max(phi[:n].max())),
+        "storage": setup.storage,
+    }
