@@ -32,32 +32,33 @@ def run(args) -> dict:
     from peridyn.setup.build import add_actuators, build_body
 
     out = Path(args.run_dir)
-    results = out / "results.h5"
+    h5 = out / "results.h5"
     for marker, redraw in (("fatigue.json", _fatigue), ("study.json", _study), ("dataset.nc", _sweep)):
-        if not results.is_file() and (out / marker).is_file():
+        if not h5.is_file() and (out / marker).is_file():
             paths = [str(p) for p in redraw(out)]
             if not args.json:
                 for path in paths:
                     print(f"plot: {path}")
             return {"output_dir": str(out), "plots": paths}
-    if not results.is_file():
+    if not h5.is_file():
         raise InputError(
             f"{str(out)!r} holds no results.h5, fatigue.json, study.json or dataset.nc: "
             "not the output folder of a run, fatigue job, study or sweep"
         )
-    info = Results(results).provenance()
+    results = Results(h5)  # read once, handed to the analyses and figures
+    info = results.provenance()
     if "case_json" not in info:
         raise InputError(
-            f"{str(results)!r} does not record its case (written by an older peridyn): run the case again"
+            f"{str(h5)!r} does not record its case (written by an older peridyn): run the case again"
         )
-    case = validate_case(json.loads(info["case_json"]), str(results))
+    case = validate_case(json.loads(info["case_json"]), str(h5))
     if case.solver.type == "modal":
         raise InputError("modal runs draw their figures with `peridyn modal`; nothing to redraw")
     base = Path(info.get("case_file", ".")).parent
     body, _ = add_actuators(case, build_body(case, base))
-    analysis, figures = analyse(case, body, out, plots=True)
-    cracks, crack_figures = redraw_crack_figures(case, body, out)
-    paths = [str(p) for p in [*draw_run_figures(case, body, out), *figures, *crack_figures]]
+    analysis, figures = analyse(case, body, results, plots=True)
+    cracks, crack_figures = redraw_crack_figures(case, body, results)
+    paths = [str(p) for p in [*draw_run_figures(case, body, results), *figures, *crack_figures]]
     if not args.json:
         for path in paths:
             print(f"plot: {path}")

@@ -17,6 +17,7 @@ from peridyn.io.hdf5 import HDF5Writer
 from peridyn.io.lock import OutputLock
 from peridyn.io.outdir import RUN_OUTPUTS, end_status, prepare_output
 from peridyn.io.reserve import RESERVE_FILE
+from peridyn.io.results import Results
 from peridyn.io.run_log import run_log
 from peridyn.jobs.context import RunContext
 from peridyn.jobs.equilibrium import run_newton, run_static
@@ -206,16 +207,17 @@ def _finish_on_root(ctx: RunContext, body, summary: dict, plots, phi, worker=Non
     """``_finish`` on rank 0: ``body`` the whole body, ``phi`` its damage (None without damage)."""
     case, out = ctx.case, ctx.out
     draw = _draws_run_figures(case)
-    pending = submit(worker, draw_run_figures, case, body, out) if draw else None
-    analysis, figures = analyse(case, body, out, plots=case.output.plots)
+    results = Results(ctx.results) if draw or case.analysis is not None else None  # read once
+    pending = submit(worker, draw_run_figures, case, body, results) if draw else None
+    analysis, figures = analyse(case, body, results, plots=case.output.plots)
     summary.update(analysis)
     paths = final_crack_paths(case, body, phi) if phi is not None else None
     if paths is not None:
         summary["crack_paths"] = [p.summary() for p in paths]
     if draw:
-        plots = [*figures_of(pending, draw_run_figures, case, body, out), *figures]
+        plots = [*figures_of(pending, draw_run_figures, case, body, results), *figures]
         if paths is not None:
-            plots += draw_crack_figures(body, out, paths, summary)
+            plots += draw_crack_figures(body, results, paths, summary)
     finish_summary(summary, "modal" if case.solver.type == "modal" else "run", out, ctx.start, plots)
     store_summary(ctx.results, body, summary, status="complete")
 
