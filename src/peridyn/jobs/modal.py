@@ -126,6 +126,24 @@ def _write_modal(case, body, n_bonds, table: ModeTable, out, case_path) -> tuple
     return summary, plots
 
 
+def redraw_mode_shapes(body, results) -> Path:
+    """``modes.png`` of a finished modal run of ``body`` again, from its ``results``
+    (``peridyn.io.results.Results``: the frequencies, shapes and rigid modes, and the types and
+    residuals of its summary's rows)."""
+    from peridyn.analysis.modes import ModeType
+    from peridyn.plotting.modes import plot_mode_shapes
+
+    rows = results.summary()["modes"]
+    result = ModalResult(
+        results.array("modes/frequencies"),
+        results.array("modes/shapes"),
+        np.array([row["residual"] for row in rows]),
+        results.array("modes/rigid").astype(bool),
+    )
+    types = [ModeType(row["type"], row["order"]) for row in rows]
+    return plot_mode_shapes(body, result, types, Path(results.path).parent / "modes.png")
+
+
 def modal_table(model, n_modes: int, fixed=None, eigensolver: str = "auto"):
     """Modes of ``model`` (eigensolver chosen by ``choose_eigensolver``), classified:
     (ModalResult, types, rows), the rows being the JSON/CSV dicts index, frequency_hz, type,

@@ -7,15 +7,15 @@ from __future__ import annotations
 import contextlib
 import logging
 import time
-from pathlib import Path
 
 from peridyn import interrupts
 from peridyn.discretization.body import Body
 from peridyn.errors import InputError, Interrupted
 from peridyn.io.case import Case
 from peridyn.io.hdf5 import HDF5Writer
+from peridyn.io.job_files import write_provenance, write_summary
 from peridyn.io.lock import OutputLock
-from peridyn.io.outdir import RUN_OUTPUTS, end_status, prepare_output
+from peridyn.io.outdir import RUN_OUTPUTS, end_status, prepare_output, write_status
 from peridyn.io.reserve import RESERVE_FILE
 from peridyn.io.results import Results
 from peridyn.io.run_log import run_log
@@ -145,6 +145,9 @@ def run_case(
         logger.info(f"case {case.name!r} ({case.solver.type}, {setup.whole_body.n_points} points) into {out}")
         ctx = RunContext(case, out, case_path, start, progress, checkpoint_every, restart, command)
         written = not restart  # a restart writes once its checkpoint is accepted (the recorder's part)
+        if written and domain.is_root:
+            write_provenance(out, ctx.provenance())
+            write_status(out, "running")
         try:
             summary, plots = _solve(ctx, setup, solver, spec)
             written = True
@@ -155,7 +158,7 @@ def run_case(
             if written and domain.is_root:
                 (out / RESERVE_FILE).unlink(missing_ok=True)  # room for the status on a full disk
                 try:
-                    _set_status(out / RESULTS, setup.whole_body, end_status(exc))
+                    _record_end(ctx, setup.whole_body, end_status(exc))
                 except Exception:  # noqa: BLE001 - e.g. the full disk that failed the run: its error is the one to report
                     pass
             if isinstance(exc, Interrupted):
@@ -219,19 +222,20 @@ def _finish_on_root(ctx: RunContext, body, summary: dict, plots, phi, worker=Non
         if paths is not None:
             plots += draw_crack_figures(body, results, paths, summary)
     finish_summary(summary, "modal" if case.solver.type == "modal" else "run", out, ctx.start, plots)
-    store_summary(ctx.results, body, summary, status="complete")
+    _record_end(ctx, body, "complete", summary)
 
 
-def _set_status(results: Path, body: Body, status: str) -> None:
-    """Set the status of a results file (created if the job failed before writing one)."""
-    with HDF5Writer(results, body.points[:, : body.dim], body.volumes, {}, mode="a") as h5:
+def _record_end(ctx: RunContext, body: Body, status: str, summary: dict | None = None) -> None:
+    """The end of a run in its folder (rank 0): its ``status`` and ``summary`` (None: a job that
+    did not complete) in results.h5 (created if the job failed before writing one) and in the
+    output contract's files (``peridyn.io.job_files``; a restart's provenance too, written once
+    its checkpoint was accepted)."""
+    with HDF5Writer(ctx.results, body.points[:, : body.dim], body.volumes, {}, mode="a") as h5:
+        if summary is not None:
+            h5.write_summary(summary)
         h5.set_status(status)
-
-
-def store_summary(results, body: Body, summary: dict, status: str | None = None) -> None:
-    """(Re)write the run summary in ``/summary/json`` of a results file, and its status when
-    given."""
-    with HDF5Writer(results, body.points[:, : body.dim], body.volumes, {}, mode="a") as h5:
-        h5.write_summary(summary)
-        if status is not None:
-            h5.set_status(status)
+    if ctx.restart:
+        write_provenance(ctx.out, ctx.provenance())
+    if summary is not None:
+        write_summary(ctx.out, summary)
+    write_status(ctx.out, status)

@@ -15,11 +15,7 @@ is recorded and the sweep goes on; Ctrl-C stops starting runs and keeps every fi
 from __future__ import annotations
 
 import json
-import signal
-import threading
 import time
-from collections.abc import Iterator
-from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -27,7 +23,10 @@ import numpy as np
 from peridyn.errors import InputError, Interrupted
 from peridyn.io.case_schema import case_unit
 from peridyn.io.dataset import SeriesColumn, build_dataset, require_xarray, write_dataset
+from peridyn.io.job_files import job_files, write_summary
+from peridyn.io.provenance import provenance
 from peridyn.io.results import Results
+from peridyn.jobs.summary import finish_summary
 from peridyn.jobs.sweep_run import (
     EXECUTORS,
     RunTask,
@@ -36,6 +35,7 @@ from peridyn.jobs.sweep_run import (
     run_tasks,
     run_threads,
 )
+from peridyn.jobs.sweep_signals import Signals
 from peridyn.jobs.sweep_spec import Sweep, expand
 
 #: The dataset file in a sweep's output folder.
@@ -144,122 +144,86 @@ def run_sweep(
     if out.exists() and not out.is_dir():
         raise InputError(f"output folder {str(out)!r} is a file, not a folder: choose another --output")
     (out / "runs").mkdir(parents=True, exist_ok=True)
-    _write_manifest(sweep, out)
-    collector = Collector(sweep, out)
-    reference_dir = _reference(sweep, out, overwrite)
-    if reference_dir is not None:
-        collector.add_reference(Path(reference_dir))
-    tasks = []
-    for run in sweep.runs:
-        if not overwrite and collector.is_complete(run):
-            collector.skipped += 1
-            continue
-        tasks.append(
-            RunTask(
-                run.run_id,
-                run.index,
-                run.parameters,
-                run.case,
-                run.case_hash,
-                sweep.spec.command,
-                str(out / "runs" / run.run_id),
-                str(sweep.base.parent),
-                threads,
-                reference_dir,
-                tuple(sweep.spec.outputs.bloch),
+    with job_files(out, provenance(path)):
+        _write_manifest(sweep, out)
+        collector = Collector(sweep, out)
+        reference_dir = _reference(sweep, out, overwrite)
+        if reference_dir is not None:
+            collector.add_reference(Path(reference_dir))
+        tasks = []
+        for run in sweep.runs:
+            if not overwrite and collector.is_complete(run):
+                collector.skipped += 1
+                continue
+            tasks.append(
+                RunTask(
+                    run.run_id,
+                    run.index,
+                    run.parameters,
+                    run.case,
+                    run.case_hash,
+                    sweep.spec.command,
+                    str(out / "runs" / run.run_id),
+                    str(sweep.base.parent),
+                    threads,
+                    reference_dir,
+                    tuple(sweep.spec.outputs.bloch),
+                )
             )
-        )
-    collector.write(final=True)  # every run pending or done: the dataset exists from the start
-    bar = progress(len(tasks)) if progress is not None and tasks else None
-    interrupted = None
-    signals = Signals()
+        collector.write(final=True)  # every run pending or done: the dataset exists from the start
+        bar = progress(len(tasks)) if progress is not None and tasks else None
+        interrupted = None
+        signals = Signals()
 
-    def on_done(record: dict) -> bool:
-        nonlocal interrupted
-        with signals.deferred():
-            collector.add(record)
-            if on_record is not None:
-                on_record(record)
-            if bar is not None:
-                bar.update(1)
-            if record["status"].startswith("interrupted"):
-                interrupted = record["status"].partition("(")[2].rstrip(")") or "SIGINT"
-                return False
-            collector.write(final=False)
-        return True
-
-    with signals:
-        try:
-            run_tasks(tasks, on_done, executor, workers, scheduler)
-        except KeyboardInterrupt:
-            interrupted = signals.name or "SIGINT"
-        finally:
+        def on_done(record: dict) -> bool:
+            nonlocal interrupted
             with signals.deferred():
+                collector.add(record)
+                if on_record is not None:
+                    on_record(record)
                 if bar is not None:
-                    bar.close()
-                collector.read_finished()  # runs that workers finished after the interrupt
-                collector.write(final=True)
-    counts = collector.counts()
-    if interrupted is not None:
-        raise SweepInterrupted(
-            interrupted, counts["completed"], len(sweep.runs), command or f"run_sweep({str(path)!r}, ...)"
-        )
-    figures = draw_figures(sweep, collector.dataset(), out)
-    return {
-        "sweep": sweep.name,
-        "runs": len(sweep.runs),
-        **counts,
-        "skipped": collector.skipped,
-        "seconds": time.perf_counter() - start,
-        "dataset": str(out / DATASET),
-        "output_dir": str(out),
-        "figures": [str(p) for p in figures],
-        "executor": executor,
-        "workers": 1 if executor == "serial" else workers,
-        "threads": threads,
-    }
+                    bar.update(1)
+                if record["status"].startswith("interrupted"):
+                    interrupted = record["status"].partition("(")[2].rstrip(")") or "SIGINT"
+                    return False
+                collector.write(final=False)
+            return True
 
-
-class Signals:
-    """SIGINT and SIGTERM while a sweep runs (in the main thread): each raises KeyboardInterrupt
-    where it arrives (``name`` says which), except within ``deferred()`` (the dataset being
-    written), where it is raised when the block ends. A run's time stepping installs its own
-    handlers (``peridyn.solvers.stepping``) and ends the run with ``Interrupted`` instead."""
-
-    def __init__(self):
-        self.name = None
-        self._depth = 0
-        self._pending = False
-        self._previous = {}
-
-    def __enter__(self):
-        if threading.current_thread() is threading.main_thread():
-            self._previous = {sig: signal.signal(sig, self._note) for sig in (signal.SIGINT, signal.SIGTERM)}
-        return self
-
-    def __exit__(self, *exc):
-        for sig, handler in self._previous.items():
-            signal.signal(sig, signal.SIG_DFL if handler is None else handler)
-        return False
-
-    def _note(self, signum, frame):
-        self.name = signal.Signals(signum).name
-        if self._depth:
-            self._pending = True
-        else:
-            raise KeyboardInterrupt
-
-    @contextmanager
-    def deferred(self) -> Iterator[None]:
-        """A block that a signal does not cut short."""
-        self._depth += 1
-        try:
-            yield
-        finally:
-            self._depth -= 1
-        if self._pending and not self._depth:
-            self._pending = False
-            raise KeyboardInterrupt
+        with signals:
+            try:
+                run_tasks(tasks, on_done, executor, workers, scheduler)
+            except KeyboardInterrupt:
+                interrupted = signals.name or "SIGINT"
+            finally:
+                with signals.deferred():
+                    if bar is not None:
+                        bar.close()
+                    collector.read_finished()  # runs that workers finished after the interrupt
+                    collector.write(final=True)
+        counts = collector.counts()
+        if interrupted is not None:
+            raise SweepInterrupted(
+                interrupted,
+                counts["completed"],
+                len(sweep.runs),
+                command or f"run_sweep({str(path)!r}, ...)",
+            )
+        figures = draw_figures(sweep, collector.dataset(), out)
+        summary = {
+            "sweep": sweep.name,
+            "runs": len(sweep.runs),
+            **counts,
+            "skipped": collector.skipped,
+            "dataset": str(out / DATASET),
+            "output_dir": str(out),
+            "figures": [str(p) for p in figures],
+            "executor": executor,
+            "workers": 1 if executor == "serial" else workers,
+            "threads": threads,
+        }
+        finish_summary(summary, "sweep", out, start, summary["figures"])
+        write_summary(out, summary)
+    return summary
 
 
 def _reference(sweep: Sweep, out: Path, overwrite: bool) -> str | None:
