@@ -77,3 +77,18 @@ def test_every_job_leaves_its_status_provenance_and_summary(kind, tmp_path, caps
     assert main(["plot", str(out), "--json"]) == 0, capsys.readouterr().err
     redrawn = json.loads(capsys.readouterr().out)["plots"]
     assert all(Path(p).stat().st_size > 0 for p in redrawn)
+
+
+@pytest.mark.parametrize(
+    "job, message",
+    [("modal", "a modal job needs solver.type: modal, not 'explicit'"), ("bloch", "a job is one of")],
+)
+def test_the_job_dispatch_refuses_what_it_cannot_run(job, message, tmp_path):
+    """``run_job`` names the job it cannot run, before building or writing anything."""
+    from peridyn.errors import InputError
+    from peridyn.io.case import load_case
+    from peridyn.jobs.dispatch import run_job
+
+    with pytest.raises(InputError, match=message):
+        run_job(job, load_case(CASES / "bar_pulse.yaml"), tmp_path / "out")
+    assert not (tmp_path / "out").exists()

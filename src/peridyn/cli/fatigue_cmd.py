@@ -78,10 +78,11 @@ def run(args) -> dict:
             )
         return calibrate(args)
     from peridyn.io.case import load_case
-    from peridyn.jobs.fatigue import run_fatigue_case
+    from peridyn.jobs.dispatch import run_job
 
     case = load_case(args.case, args.overrides)
-    summary = run_fatigue_case(
+    summary = run_job(
+        "fatigue",
         case,
         args.output,
         base_dir=Path(args.case).parent,

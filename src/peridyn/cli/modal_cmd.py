@@ -34,7 +34,7 @@ def register(sub) -> None:
 
 def run(args) -> dict:
     """Solve and print the frequency table unless --json."""
-    from peridyn.jobs.run import run_case
+    from peridyn.jobs.dispatch import run_job
     from peridyn.parallel.comm import world
 
     overrides = [*args.overrides, "solver.type=modal"]
@@ -42,7 +42,8 @@ def run(args) -> dict:
         overrides.append(f"solver.modes={args.modes}")
     case = load_case(args.case, overrides)
     comm = world()  # under mpiexec -n N: the distributed LOBPCG, rank 0 writes
-    summary = run_case(
+    summary = run_job(
+        "modal",
         case,
         args.output,
         case_path=args.case,

@@ -66,7 +66,7 @@ def command_line(argv=None) -> str:
 def run(args) -> dict:
     """Run the case; print a readable summary unless --json. Under ``mpiexec -n N`` every rank
     runs its part (``peridyn.parallel``); only rank 0 prints (``peridyn.cli.main``)."""
-    from peridyn.jobs.run import run_case
+    from peridyn.jobs.dispatch import run_job
 
     backend = getattr(args, "backend", None)  # demo: no flag
     overrides = [*args.overrides, *([f"solver.backend={backend}"] if backend else [])]
@@ -76,7 +76,8 @@ def run(args) -> dict:
         f"peridyn {info['peridyn_version']} (commit {info['git_commit'][:12]}): case "
         f"{case.name!r} from {args.case}"
     )
-    summary = run_case(
+    summary = run_job(
+        "run",
         case,
         args.output,
         case_path=args.case,

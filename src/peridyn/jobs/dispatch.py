@@ -1,0 +1,34 @@
+"""The one dispatch from a job's name to the function that runs it: ``peridyn run``, ``peridyn
+modal``, ``peridyn fatigue`` and the runs of a sweep (its ``command``) all start their job here.
+Within a run, the case's ``solver.type`` picks the solver (``jobs.run``)."""
+
+from __future__ import annotations
+
+from peridyn.errors import InputError
+
+#: The jobs of a case, by name: ``run`` (the case's solver: explicit, static, Newton, Newmark or
+#: modal), ``modal`` (a run whose case has ``solver.type: modal``), ``fatigue``.
+JOBS = ("run", "modal", "fatigue")
+
+
+def run_job(job: str, case, output_dir=None, **options) -> dict:
+    """Run the validated ``case`` as ``job`` (one of :data:`JOBS`) into ``output_dir``; returns
+    its summary. ``options``: the keyword arguments of the job's function
+    (``jobs.run.run_case`` for run and modal, ``jobs.fatigue.run_fatigue_case`` for fatigue).
+
+    Raises
+    ------
+    InputError
+        An unknown job, or a modal job of a case whose solver is not modal.
+    """
+    if job == "fatigue":
+        from peridyn.jobs.fatigue import run_fatigue_case
+
+        return run_fatigue_case(case, output_dir, **options)
+    if job not in JOBS:
+        raise InputError(f"a job is one of {', '.join(JOBS)}, not {job!r}")
+    if job == "modal" and case.solver.type != "modal":
+        raise InputError(f"a modal job needs solver.type: modal, not {case.solver.type!r}")
+    from peridyn.jobs.run import run_case
+
+    return run_case(case, output_dir, **options)
