@@ -78,8 +78,9 @@ def run(args) -> dict:
             )
         return calibrate(args)
     from peridyn.io.case import load_case
-    from peridyn.jobs.dispatch import run_job
+    from peridyn.jobs.dispatch import job_function, run_job
 
+    job_function("fatigue")  # its modules loaded before the case is read, as before the dispatch
     case = load_case(args.case, args.overrides)
     summary = run_job(
         "fatigue",

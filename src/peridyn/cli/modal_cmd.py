@@ -34,9 +34,10 @@ def register(sub) -> None:
 
 def run(args) -> dict:
     """Solve and print the frequency table unless --json."""
-    from peridyn.jobs.dispatch import run_job
+    from peridyn.jobs.dispatch import job_function, run_job
     from peridyn.parallel.comm import world
 
+    job_function("modal")  # its modules loaded before the case is read, as before the dispatch
     overrides = [*args.overrides, "solver.type=modal"]
     if args.modes is not None:
         overrides.append(f"solver.modes={args.modes}")

@@ -66,7 +66,9 @@ def command_line(argv=None) -> str:
 def run(args) -> dict:
     """Run the case; print a readable summary unless --json. Under ``mpiexec -n N`` every rank
     runs its part (``peridyn.parallel``); only rank 0 prints (``peridyn.cli.main``)."""
-    from peridyn.jobs.dispatch import run_job
+    from peridyn.jobs.dispatch import job_function, run_job
+
+    job_function("run")  # its modules loaded before the banner: a signal after it finds the job running
 
     backend = getattr(args, "backend", None)  # demo: no flag
     overrides = [*args.overrides, *([f"solver.backend={backend}"] if backend else [])]

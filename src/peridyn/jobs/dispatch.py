@@ -11,24 +11,36 @@ from peridyn.errors import InputError
 JOBS = ("run", "modal", "fatigue")
 
 
+def job_function(job: str):
+    """The function that runs ``job`` (one of :data:`JOBS`), its module imported on first use:
+    ``jobs.run.run_case`` for run and modal, ``jobs.fatigue.run_fatigue_case`` for fatigue.
+
+    Raises
+    ------
+    InputError
+        An unknown job.
+    """
+    if job == "fatigue":
+        from peridyn.jobs.fatigue import run_fatigue_case
+
+        return run_fatigue_case
+    if job not in JOBS:
+        raise InputError(f"a job is one of {', '.join(JOBS)}, not {job!r}")
+    from peridyn.jobs.run import run_case
+
+    return run_case
+
+
 def run_job(job: str, case, output_dir=None, **options) -> dict:
     """Run the validated ``case`` as ``job`` (one of :data:`JOBS`) into ``output_dir``; returns
-    its summary. ``options``: the keyword arguments of the job's function
-    (``jobs.run.run_case`` for run and modal, ``jobs.fatigue.run_fatigue_case`` for fatigue).
+    its summary. ``options``: the keyword arguments of the job's function (``job_function``).
 
     Raises
     ------
     InputError
         An unknown job, or a modal job of a case whose solver is not modal.
     """
-    if job == "fatigue":
-        from peridyn.jobs.fatigue import run_fatigue_case
-
-        return run_fatigue_case(case, output_dir, **options)
-    if job not in JOBS:
-        raise InputError(f"a job is one of {', '.join(JOBS)}, not {job!r}")
+    run = job_function(job)
     if job == "modal" and case.solver.type != "modal":
         raise InputError(f"a modal job needs solver.type: modal, not {case.solver.type!r}")
-    from peridyn.jobs.run import run_case
-
-    return run_case(case, output_dir, **options)
+    return run(case, output_dir, **options)
