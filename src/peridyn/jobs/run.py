@@ -1,6 +1,8 @@
-"""Run a built case and write its results: explicit, static, Newton and Newmark runs (modal
-runs are ``jobs.modal``), recording, checkpoints, crack history and the stored summary.
-``run_case`` is what ``peridyn run`` calls."""
+"""Run a case and write its results: explicit and Newmark runs (the time loop with recording
+and checkpoints: ``jobs.explicit_run``), static and Newton runs (``jobs.equilibrium``), modal
+runs (``jobs.modal``); then the analyses, figures, crack paths and the stored summary, status
+and provenance. ``run_case`` is what ``peridyn run`` and ``peridyn modal`` call
+(``jobs.dispatch``)."""
 
 from __future__ import annotations
 
