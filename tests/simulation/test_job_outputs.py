@@ -68,6 +68,7 @@ def test_every_job_leaves_its_status_provenance_and_summary(kind, tmp_path, caps
     assert job["status"] == "complete"
     assert job["provenance"]["peridyn_version"] == peridyn.__version__
     assert job["provenance"]["command_line"]  # the command that made the results
+    assert job["provenance"]["case_file"] == JOBS[kind](tmp_path)[1]  # the case (sweep) file given
     assert job["summary"]["kind"] == kind
     assert job["summary"]["output_dir"] == printed["output_dir"] == str(out)
     assert {k: v for k, v in job["summary"].items() if k != "comparison"} == {

@@ -92,6 +92,7 @@ def run(args) -> dict:
         overwrite=args.overwrite,
         comm=world(),
         max_memory=args.max_memory,
+        case_path=args.case,
     )
     if not args.json:
         print(

@@ -162,6 +162,7 @@ def run_fatigue_case(
     overwrite: bool = False,
     comm=None,
     max_memory: float | None = None,
+    case_path=None,
 ) -> dict:
     """Run a fatigue case; returns the summary (JSON keys of ``peridyn fatigue --json``, also in
     ``fatigue.json``; docs/user-guide.md, "Summaries and results files"). A folder holding an
@@ -170,7 +171,8 @@ def run_fatigue_case(
     (``peridyn.io.job_files``). ``comm``: ``peridyn.parallel.comm.world()`` under
     ``mpiexec -n N`` (N > 1; see the module docstring), every rank returning the summary; None:
     one process. ``max_memory``: bytes the job may hold (default: the machine's); a case whose
-    estimated peak exceeds it is refused before it is built (``setup.estimate.check_memory``)."""
+    estimated peak exceeds it is refused before it is built (``setup.estimate.check_memory``).
+    ``case_path``: the case file, recorded in the provenance (None: a case made in Python)."""
     start = time.perf_counter()
     check_fatigue_case(case)
     if comm is not None and comm.size > 1:
@@ -179,7 +181,7 @@ def run_fatigue_case(
     setup = build(case, base_dir, comm)
     d = setup.domain
     out = d.on_root(prepare_output, output_directory(case, output_dir), "fatigue.json", overwrite)
-    files = job_files(out, provenance(case=case)) if d.is_root else nullcontext()
+    files = job_files(out, provenance(case_path, case=case)) if d.is_root else nullcontext()
     with files, run_log(out, d.is_root):
         logger.info(f"fatigue case {case.name!r} ({setup.whole_body.n_points} points) into {out}")
         summary = d.comm.bcast(_run_fatigue(case, setup, out, modal, progress, start))

@@ -217,6 +217,7 @@ def run_levels(
         overwrite=overwrite,
         command=command,
         on_record=None if progress is None else report,
+        job_files_of_its_own=False,  # the study's folder: its own status, provenance and summary
     )
     case = load_case(case_path, overrides)
     return runs_from_dataset(load_sweep(summary["dataset"]), out, case), summary

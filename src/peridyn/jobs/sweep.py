@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import json
 import time
+from contextlib import nullcontext
 from pathlib import Path
 
 import numpy as np
@@ -85,6 +86,7 @@ def run_sweep(
     first: int | None = None,
     on_record=None,
     threads: int | None = None,
+    job_files_of_its_own: bool = True,
 ) -> dict:
     """Run the sweep file ``path``; returns its summary.
 
@@ -116,6 +118,10 @@ def run_sweep(
         OpenMP). Default: ``cores // workers`` for processes and a local dask cluster, the
         process's own threads for serial, the workers' own setting on a ``scheduler``
         cluster (:func:`peridyn.jobs.sweep_run.run_threads`).
+    job_files_of_its_own : bool
+        Write the output contract's ``status.json``, ``provenance.json`` and ``summary.json``
+        (``peridyn.io.job_files``) in the output folder; False for a sweep that is part of
+        another job writing its own there (a convergence study: ``jobs.study.run_levels``).
 
     Returns
     -------
@@ -144,7 +150,7 @@ def run_sweep(
     if out.exists() and not out.is_dir():
         raise InputError(f"output folder {str(out)!r} is a file, not a folder: choose another --output")
     (out / "runs").mkdir(parents=True, exist_ok=True)
-    with job_files(out, provenance(path)):
+    with job_files(out, provenance(path)) if job_files_of_its_own else nullcontext():
         _write_manifest(sweep, out)
         collector = Collector(sweep, out)
         reference_dir = _reference(sweep, out, overwrite)
@@ -222,7 +228,8 @@ def run_sweep(
             "threads": threads,
         }
         finish_summary(summary, "sweep", out, start, summary["figures"])
-        write_summary(out, summary)
+        if job_files_of_its_own:
+            write_summary(out, summary)
     return summary
 
 
