@@ -17,9 +17,9 @@ import time
 
 from peridyn.discretization import geometry
 from peridyn.discretization.bonds import find_bonds
-from peridyn.jobs.modal import choose_eigensolver
 from peridyn.physics.materials import make_model
 from peridyn.physics.materials.lps import SURFACE_CORRECTIONS
+from peridyn.setup.eigensolver import choose_eigensolver
 from peridyn.solvers.modal import modal_analysis
 
 #: PMMA plate of VALIDATION.md V4: size (m), E (Pa), nu, density (kg/m^3).

@@ -110,8 +110,8 @@ def probe_points(case: Path, sets: list[str]) -> int:
     gather term."""
     from peridyn.io.case import load_case
     from peridyn.io.recorder import Probes
-    from peridyn.jobs.build import build_body
-    from peridyn.jobs.run import recorder_spec
+    from peridyn.setup.build import build_body
+    from peridyn.setup.recording import recorder_spec
 
     loaded = load_case(case, sets)
     body = build_body(loaded, case.parent)

@@ -27,7 +27,7 @@ def _worker(case: str, calls: int, ready, start, results) -> None:
     import numpy as np
 
     from peridyn.io.case import load_case
-    from peridyn.jobs.build import build
+    from peridyn.setup.build import build
 
     case_path = Path(case)
     setup = build(load_case(case_path), case_path.parent)

@@ -7,8 +7,10 @@ import warnings
 from pathlib import Path
 
 from peridyn.io.case import load_case
-from peridyn.jobs.build import build
-from peridyn.jobs.run import recorder_spec, run_case, step_count, time_stepper
+from peridyn.jobs.run import run_case
+from peridyn.setup.build import build
+from peridyn.setup.recording import recorder_spec
+from peridyn.setup.solver_choice import step_count, time_stepper
 
 #: (case file, spacing in m, overrides)
 RUNS = [

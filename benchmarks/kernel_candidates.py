@@ -407,7 +407,7 @@ def case_candidates(path: str, block_rows=(64, 256, 1024), seed: int = 0):
     """:func:`candidates` for the fused LPS candidates on the model of the LPS float64 case
     ``path``, at a random displacement of 1e-4 of its shortest bond."""
     from peridyn.io.case import load_case
-    from peridyn.jobs.build import build
+    from peridyn.setup.build import build
 
     setup = build(load_case(path), base_dir=Path(path).parent)
     lps, b = setup.model, setup.bonds

@@ -33,7 +33,7 @@ import peridyn.linalg.block_amg as block_amg
 import peridyn.solvers.eigen_iterative as eigen_iterative
 import peridyn.solvers.modal as modal
 from peridyn.io.case import load_case
-from peridyn.jobs.build import build
+from peridyn.setup.build import build
 
 MIB = 2**20
 

@@ -13,7 +13,7 @@ Prints the Markdown table (errors k / k0 - 1 in %, "simulation / Bloch", and the
 errors at 150 kHz of the x-axis line, ``fk_error``) and draws
 ``docs/figures/lamb_layers.png`` (S0 and A0 error against frequency: Bloch lines for all nine
 discretisations, simulation markers where run). The runs not simulated show the estimated
-peak memory (``peridyn validate``, :func:`peridyn.jobs.estimate.estimate_case`).
+peak memory (``peridyn validate``, :func:`peridyn.setup.estimate.estimate_case`).
 
     PYTHONPATH=src python docs/figures/lamb_layers.py LAYERS BLOCH [--doc]
 
@@ -33,9 +33,9 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from peridyn.io.dataset import load_sweep  # noqa: E402
-from peridyn.jobs.estimate import estimate_case  # noqa: E402
 from peridyn.jobs.sweep_run import read_record  # noqa: E402
 from peridyn.jobs.sweep_spec import expand  # noqa: E402
+from peridyn.setup.estimate import estimate_case  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
 SWEEP = ROOT / "sweeps" / "lamb_layers.yaml"

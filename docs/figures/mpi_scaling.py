@@ -35,7 +35,7 @@ g = (n^(1/3) + 12)^3 - n ghosts, 26 neighbour ranks, 24 bytes per ghost per step
 dilatation of every ghost at half the force's cost per bond (an estimate); the latency
 and bandwidth of a cluster interconnect (``CLUSTER``, stated, not measured here) and this
 machine's t_bond and t_point per core measured quietly (``QUIET``); plus the state check's
-allgather every 10 steps (2 log2(P) alpha / 10). Memory per rank: ``peridyn.jobs.estimate``'s
+allgather every 10 steps (2 log2(P) alpha / 10). Memory per rank: ``peridyn.setup.estimate``'s
 explicit costs (300 MB base, 350 B per point, 116 B per directed bond) on the rank's owned and
 ghost points, plus the whole body that every rank builds today (``WHOLE_BODY_BYTES`` per point
 of the whole body).
@@ -50,7 +50,7 @@ from pathlib import Path
 
 import numpy as np
 
-from peridyn.jobs.estimate import BASE_BYTES, COSTS
+from peridyn.setup.estimate import BASE_BYTES, COSTS
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parents[1]
@@ -61,9 +61,9 @@ CLUSTER = {"latency_s": 1.5e-6, "bandwidth_bytes_per_s": 12.5e9}
 BONDS_PER_POINT = 122
 #: thickness of the ghost shell in spacings: two layers of the search reach (3.015 spacings)
 SHELL = 6
-#: bytes per point of the whole body that every rank holds today (``jobs/build.py``
+#: bytes per point of the whole body that every rank holds today (``setup/build.py``
 #: ``_build_part`` builds the whole point cloud, then its part), counted: the body (points,
-#: volumes, cells, sets: 64 B, as ``peridyn.jobs.estimate`` counts it), the partition (8 B) and
+#: volumes, cells, sets: 64 B, as ``peridyn.setup.estimate`` counts it), the partition (8 B) and
 #: the ghost search's k-d tree on every point (a copy of the points and an index: 32 B), and the
 #: whole loading's per-point flags (about 6 B)
 WHOLE_BODY_BYTES = 110.0
@@ -134,7 +134,7 @@ def predicted_step(c: dict, run: dict) -> dict:
 
 def part_bytes(local_points: float, bonds_per_point: float) -> float:
     """Peak bytes of a rank's part of ``local_points`` (owned and ghosts), the explicit costs of
-    ``peridyn.jobs.estimate`` (which hold within 3 % of the measured serial Lamb runs)."""
+    ``peridyn.setup.estimate`` (which hold within 3 % of the measured serial Lamb runs)."""
     costs = COSTS["explicit"]
     return BASE_BYTES + (costs.per_point + costs.per_bond * bonds_per_point) * local_points
 

@@ -7,8 +7,8 @@ from pathlib import Path
 import numpy as np
 
 from peridyn.io.case import load_case
-from peridyn.jobs.build import build
 from peridyn.physics.damage import damage_field
+from peridyn.setup.build import build
 from peridyn.solvers import ExplicitSolver
 
 CASE = Path(__file__).parents[2] / "cases" / "plate2d_stretch.yaml"

@@ -13,8 +13,8 @@ from peridyn.cli import main
 from peridyn.io.case import load_case
 from peridyn.io.hdf5 import SCHEMA_VERSION
 from peridyn.io.results import Results
-from peridyn.jobs.build import build
 from peridyn.jobs.summary import peak_memory_bytes
+from peridyn.setup.build import build
 
 ROOT = Path(__file__).resolve().parents[2]
 CASES = sorted((ROOT / "cases").glob("*.yaml"))

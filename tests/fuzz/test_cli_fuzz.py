@@ -41,7 +41,7 @@ from hypothesis import HealthCheck, given, note, settings
 
 from peridyn.cli import main
 from peridyn.io.case import validate_case
-from peridyn.jobs.estimate import estimate_case
+from peridyn.setup.estimate import estimate_case
 
 #: ``validate`` examples start from the shipped cases coarsened to at most this many points.
 MAX_BASE_POINTS = 150_000

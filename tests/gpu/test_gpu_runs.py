@@ -17,9 +17,9 @@ from peridyn.errors import InputError
 from peridyn.io.case import load_case
 from peridyn.io.exodus import read_exodus
 from peridyn.io.results import Results
-from peridyn.jobs.build import build
 from peridyn.jobs.run import run_case
 from peridyn.kernels.gpu import unavailable
+from peridyn.setup.build import build
 from peridyn.solvers import gpu_force
 from peridyn.solvers.explicit_gpu import GPUExplicitSolver
 from peridyn.solvers.gpu_force import device_bytes

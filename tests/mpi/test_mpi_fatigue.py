@@ -56,7 +56,15 @@ CYCLES_RTOL = 4e-6
 #: and crack_length.csv's rounding to 6 significant digits
 CSV_RTOL = CYCLES_RTOL + 5e-6
 #: the files a serial fatigue run writes (output.plots off, no modal analyses)
-FILES = {"crack_length.csv", "damage.vtu", "fatigue.json", "run.log", "status.json"}
+FILES = {
+    "crack_length.csv",
+    "damage.vtu",
+    "fatigue.json",
+    "run.log",
+    "status.json",
+    "provenance.json",
+    "summary.json",
+}
 
 
 def _fatigue(out: Path, ranks: int, *extra: str, case: Path = CASE, sets=SETS, flags=()):

@@ -122,7 +122,7 @@ def test_mpi_static_reaches_the_serial_equilibrium(material, ranks, tmp_path):
         pytest.skip("mpiexec not installed")
     pytest.importorskip("mpi4py")
     from peridyn.io.case import load_case
-    from peridyn.jobs.build import build
+    from peridyn.setup.build import build
     from peridyn.solvers.relaxation import _relative_residual
 
     extra = [f"material.model={material}"]

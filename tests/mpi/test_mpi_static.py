@@ -113,7 +113,7 @@ def _datasets(folder: Path) -> dict:
 def _precrack_bonds(case: str) -> int:
     """Directed bonds the case's pre-crack cuts (broken before any load)."""
     from peridyn.io.case import load_case
-    from peridyn.jobs.build import build
+    from peridyn.setup.build import build
 
     path, sets = CASES[case]
     setup = build(load_case(ROOT / "cases" / path, sets), ROOT / "cases")

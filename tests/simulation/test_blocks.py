@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 from peridyn.io.case import validate_case
-from peridyn.jobs.build import build
 from peridyn.jobs.run import run_case
 from peridyn.linalg.stiffness import assemble_stiffness
+from peridyn.setup.build import build
 from peridyn.solvers import relax
 from peridyn.solvers.explicit import ExplicitSolver
 

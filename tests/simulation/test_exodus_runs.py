@@ -10,8 +10,8 @@ from peridyn.errors import InputError
 from peridyn.io.case import validate_case
 from peridyn.io.exodus import mesh_points, read_exodus
 from peridyn.io.results import Results
-from peridyn.jobs.build import build, build_body
 from peridyn.jobs.run import run_case
+from peridyn.setup.build import build, build_body
 
 MESH = Path(__file__).parents[1] / "data" / "peridigm" / "WaveInBar.g"
 

@@ -8,8 +8,8 @@ import pytest
 from peridyn.fatigue.loop import run_fatigue
 from peridyn.fatigue.mapping import CycleMapping
 from peridyn.io.case import FatigueTip, load_case
-from peridyn.jobs.build import build
 from peridyn.jobs.fatigue import fatigue_parameters, run_fatigue_case
+from peridyn.setup.build import build
 
 CASE = Path(__file__).resolve().parents[2] / "cases" / "dogbone_fatigue.yaml"
 NOTCH_ROOT = (0.030, 0.0080)  # the edge notch's root (x, y) of the case, m

@@ -68,3 +68,22 @@ def test_plot_command_redraws_the_crack_figures_from_the_results(tmp_path, capsy
     (path,) = redrawn["crack_paths"]
     assert path["length_m"] == pytest.approx(0.020, abs=2 * H)
     assert path["angle_deg"] == pytest.approx(0.0, abs=2.0)
+
+
+def test_a_run_reads_its_results_once_for_its_figures(tmp_path, monkeypatch):
+    """The results file of a run with damage is opened as one ``Results`` that the run's
+    figures, analyses and crack figures share (before, each drawing reopened it by path:
+    the field figures and the crack figures, twice here)."""
+    from peridyn.io import results as results_module
+
+    opened = []
+    real = results_module.Results.__init__
+
+    def counted(self, path):
+        opened.append(str(path))
+        real(self, path)
+
+    monkeypatch.setattr(results_module.Results, "__init__", counted)
+    summary = split_plate(tmp_path)
+    assert opened == [str(tmp_path / "results.h5")]
+    assert {"crack_paths.png", "damage.png"} <= {p.rsplit("/", 1)[-1] for p in summary["plots"]}

@@ -20,8 +20,8 @@ from conftest import results_datasets
 from peridyn.cli import main
 from peridyn.errors import CaseFileError
 from peridyn.io.case import load_case
-from peridyn.jobs.build import build, build_points
-from peridyn.jobs.storage import choose_storage
+from peridyn.setup.build import build, build_points
+from peridyn.setup.storage import choose_storage
 
 ROOT = Path(__file__).resolve().parents[2]
 RTOL = 1e-10

@@ -129,7 +129,7 @@ def test_too_large_factorisation_is_refused_with_its_size(monkeypatch):
     import os
 
     from peridyn.errors import InputError
-    from peridyn.jobs.modal import check_assembly_fits
+    from peridyn.setup.eigensolver import check_assembly_fits
 
     model = _plate_model(2e-3)
     pages = {"SC_PAGE_SIZE": 4096, "SC_PHYS_PAGES": 64 * 2**20 // 4096}

@@ -17,8 +17,8 @@ from peridyn.errors import InputError, InstabilityError, Interrupted
 from peridyn.io.case import load_case, validate_case
 from peridyn.io.outdir import json_job_status, read_status
 from peridyn.io.results import Results
-from peridyn.jobs.build import build
 from peridyn.jobs.run import run_case
+from peridyn.setup.build import build
 from peridyn.solvers import ExplicitSolver
 from peridyn.solvers.stepping import advance
 
@@ -235,7 +235,8 @@ def test_the_output_estimate_is_within_30_percent_of_what_a_run_writes(case_of, 
     now counts every series in whole chunks, the geometry and final fields, the VTU snapshots
     as written (base64, 3 components) and snapshot times after the end as none. Measured
     0.77-0.93 of the bytes written for the bar and the 2D plate at two spacings each."""
-    from peridyn.jobs.run import recorder_spec, step_count, time_stepper
+    from peridyn.setup.recording import recorder_spec
+    from peridyn.setup.solver_choice import step_count, time_stepper
 
     case = case_of()
     setup = build(case, ROOT / "cases")

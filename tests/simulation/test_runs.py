@@ -9,8 +9,8 @@ import pytest
 from peridyn.cli import main
 from peridyn.io.case import validate_case
 from peridyn.io.results import Results
-from peridyn.jobs.build import build
 from peridyn.jobs.run import run_case
+from peridyn.setup.build import build
 
 BAR = {
     "name": "bar",

@@ -15,11 +15,11 @@ from peridyn.discretization import geometry
 from peridyn.discretization.bonds import find_bonds
 from peridyn.errors import InputError, InstabilityError
 from peridyn.io.case import load_case
-from peridyn.jobs.build import build
-from peridyn.jobs.run import explicit_damping
 from peridyn.physics.absorbing import layer_damping
 from peridyn.physics.loads import InitialCondition, Loading
 from peridyn.physics.materials import make_model
+from peridyn.setup.build import build
+from peridyn.setup.solver_choice import explicit_damping
 from peridyn.solvers import ExplicitSolver
 from peridyn.solvers.explicit import damped_stable_step
 

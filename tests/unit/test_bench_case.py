@@ -12,8 +12,9 @@ from peridyn.errors import InputError
 from peridyn.io.case import load_case
 from peridyn.jobs import bench_case
 from peridyn.jobs.bench_case import run_case_benchmark
-from peridyn.jobs.build import build
-from peridyn.jobs.run import recorder_spec, step_count, time_stepper
+from peridyn.setup.build import build
+from peridyn.setup.recording import recorder_spec
+from peridyn.setup.solver_choice import step_count, time_stepper
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 BAR = CASES / "bar_pulse.yaml"
@@ -61,7 +62,7 @@ def test_case_benchmark_runs_the_case_as_peridyn_run(isolated):
     steps = 5
     result = run_case_benchmark(case, BAR.parent, BAR, steps=steps, repeat=2)
     assert set(result) == KEYS
-    # the counts are the built case's (jobs.build.build, as peridyn run builds it)
+    # the counts are the built case's (setup.build.build, as peridyn run builds it)
     setup = build(case, BAR.parent)
     solver = time_stepper(case, setup)
     assert result["points"] == setup.body.n_points

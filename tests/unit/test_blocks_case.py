@@ -10,11 +10,11 @@ from peridyn.analysis.bloch import BlochLattice
 from peridyn.errors import CaseFileError, InputError
 from peridyn.io.case import validate_case
 from peridyn.io.mesh_text import to_text_mesh
-from peridyn.jobs.build import build
-from peridyn.jobs.stable_step import STEP_MARGIN, estimated_stable_step
 from peridyn.physics.materials.blocks import assign_blocks
 from peridyn.physics.materials.elastic import check_elastic
 from peridyn.physics.materials.pmb import pmb_micromodulus
+from peridyn.setup.build import build
+from peridyn.setup.stable_step import STEP_MARGIN, estimated_stable_step
 
 STEEL = {"model": "pmb", "E": 200e9, "density": 7850}
 ALUMINIUM = {"model": "pmb", "E": 70e9, "density": 2700}

@@ -7,7 +7,7 @@ import pytest
 
 from peridyn.errors import CaseFileError, InputError
 from peridyn.io.case import apply_override, load_case, validate_case
-from peridyn.jobs.build import build
+from peridyn.setup.build import build
 from peridyn.solvers import ExplicitSolver
 
 GOOD = {

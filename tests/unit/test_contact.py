@@ -12,11 +12,11 @@ from peridyn.discretization import geometry
 from peridyn.discretization.bonds import crossing_segment, cut_bonds, find_bonds
 from peridyn.errors import CaseFileError, InputError
 from peridyn.io.case import load_case
-from peridyn.jobs.build import build
 from peridyn.physics.contact import Contact
 from peridyn.physics.loads import InitialCondition, Loading
 from peridyn.physics.materials import make_model
 from peridyn.physics.materials.pmb import pmb_micromodulus
+from peridyn.setup.build import build
 from peridyn.solvers import ExplicitSolver
 
 H = 1e-3

@@ -1,7 +1,7 @@
 """Dynamic relaxation over simulated MPI ranks in one process (``solvers.relaxation.relax`` with a
 ``Domain``, issue 20 item 5): the ranks are threads that take turns, joined by a communicator
 with MPI's semantics (``ThreadComm``: collectives and point-to-point messages, objects copied),
-so the whole distributed path (the rank's part as ``jobs.build`` makes it, the halo exchange,
+so the whole distributed path (the rank's part as ``setup.build`` makes it, the halo exchange,
 the damage of the part, contact with its own ghosts, the ordered reductions) runs without
 mpiexec. The runs under mpiexec are in tests/mpi/test_mpi_static.py.
 
@@ -22,8 +22,8 @@ import numpy as np
 import pytest
 
 from peridyn.io.case import load_case
-from peridyn.jobs.build import build
 from peridyn.parallel.comm import Traffic
+from peridyn.setup.build import build
 from peridyn.solvers.relaxation import relax
 
 CASES = Path(__file__).resolve().parents[2] / "cases"

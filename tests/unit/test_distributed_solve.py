@@ -98,8 +98,8 @@ def test_distributed_equilibrium_meets_the_serial_criterion(material):
     tolerance (1e-7): both solves are within the tolerance of the same equilibrium (measured:
     2.6e-7 PMB, 2.0e-7 LPS apart, and the CG one within 1.2e-9 of a relaxation to 1e-9)."""
     from peridyn.io.case import load_case
-    from peridyn.jobs.build import build
     from peridyn.linalg.distributed import rank_preconditioner
+    from peridyn.setup.build import build
     from peridyn.solvers.distributed_static import distributed_equilibrium
     from peridyn.solvers.relaxation import _relative_residual, relax
 
@@ -130,14 +130,14 @@ def test_distributed_equilibrium_meets_the_serial_criterion(material):
 )
 def test_what_an_mpi_run_cannot_do_is_refused_before_the_build(case_file, overrides, refused):
     """Newton runs and shift-invert (a factor of the whole body) are refused under MPI with one
-    clear error (jobs.run._check_parallel), before anything is built or written."""
+    clear error (setup.solver_choice.check_parallel), before anything is built or written."""
     from peridyn.errors import PeridynError
     from peridyn.io.case import load_case
-    from peridyn.jobs.run import _check_parallel
+    from peridyn.setup.solver_choice import check_parallel
 
     case = load_case(Path(__file__).resolve().parents[2] / "cases" / case_file, overrides)
     with pytest.raises(PeridynError, match=refused):
-        _check_parallel(case)
+        check_parallel(case)
 
 
 @pytest.mark.parametrize(
@@ -151,11 +151,11 @@ def test_static_mpi_runs_with_damage_or_contact_are_accepted(case_file, override
     """Static runs with bond breaking (plate2d_stretch) and with contact as well
     (plate2d_cyclic) run under MPI by dynamic relaxation on each rank's part: not refused."""
     from peridyn.io.case import load_case
-    from peridyn.jobs.run import _check_parallel
+    from peridyn.setup.solver_choice import check_parallel
 
     case = load_case(Path(__file__).resolve().parents[2] / "cases" / case_file, overrides)
     assert case.material.damage is not None
-    _check_parallel(case)
+    check_parallel(case)
 
 
 def test_relax_with_damage_leaves_every_intact_bond_within_its_critical_stretch():
@@ -167,7 +167,7 @@ def test_relax_with_damage_leaves_every_intact_bond_within_its_critical_stretch(
     iterate), both copies of every broken bond broken, and ``broken_bonds`` the bonds it broke. Intact
     flags (booleans): compared exactly."""
     from peridyn.io.case import load_case
-    from peridyn.jobs.build import build
+    from peridyn.setup.build import build
     from peridyn.solvers.relaxation import relax
 
     root = Path(__file__).resolve().parents[2] / "cases"

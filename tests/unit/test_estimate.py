@@ -11,8 +11,8 @@ from peridyn.discretization.bonds import find_bonds
 from peridyn.discretization.lattice import build_lattice
 from peridyn.errors import InputError
 from peridyn.io.case import apply_override, validate_case
-from peridyn.jobs import estimate
-from peridyn.jobs.build import build_bonds, build_points
+from peridyn.setup import estimate
+from peridyn.setup.build import build_bonds, build_points
 
 BASE = {
     "name": "tiny",

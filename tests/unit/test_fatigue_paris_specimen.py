@@ -13,7 +13,7 @@ from peridyn.errors import InputError
 from peridyn.fatigue.calibration import stress_intensity
 from peridyn.fatigue.specimen import compliance_energy, compliance_stress_intensity
 from peridyn.io.case import parse_yaml, validate_case
-from peridyn.jobs.build import build
+from peridyn.setup.build import build
 
 E, STRESS, T = 189.9e9, 50e6, 3e-3
 

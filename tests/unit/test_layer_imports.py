@@ -57,3 +57,28 @@ def test_a_layer_loads_only_the_layers_below_it(height):
         loaded = set(json.loads(done.stdout.splitlines()[-1]))
         siblings = LAYERS[height] - {name}
         assert loaded <= allowed - siblings, f"{name} loads {sorted(loaded - (allowed - siblings))}"
+
+
+def test_setup_sits_between_the_jobs_and_the_figures():
+    """``peridyn.setup`` (a case to the objects of a run) is the layer right below the jobs that
+    run them and above the figures, analyses and solvers it builds for (docs/architecture.md)."""
+    names = [sorted(layer) for layer in reversed(LAYERS)]
+    assert names[:3] == [["peridyn.cli"], ["peridyn.jobs"], ["peridyn.setup"]]
+
+
+#: Lines a module of ``peridyn.jobs`` may hold: a job and what only it needs (docs/architecture.md).
+JOB_MODULE_LINES = 500
+
+
+def test_jobs_are_small_and_share_nothing_through_the_run_job():
+    """No module of ``peridyn.jobs`` holds more than ``JOB_MODULE_LINES`` lines, and none imports
+    from ``jobs/run.py`` anything but the job itself (``run_case``, for the dispatch): what jobs
+    share lives in ``peridyn.setup`` or in a module of its own."""
+    import ast
+
+    for path in sorted((SRC / "peridyn" / "jobs").glob("*.py")):
+        source = path.read_text()
+        assert len(source.splitlines()) <= JOB_MODULE_LINES, f"{path.name}: {len(source.splitlines())} lines"
+        for node in ast.walk(ast.parse(source)):
+            if isinstance(node, ast.ImportFrom) and node.module == "peridyn.jobs.run":
+                assert [a.name for a in node.names] == ["run_case"], f"{path.name} imports from jobs.run"

@@ -25,9 +25,9 @@ from peridyn.discretization.bonds import find_bonds
 from peridyn.errors import CaseFileError
 from peridyn.io.case import load_case
 from peridyn.io.results import Results
-from peridyn.jobs.estimate import estimate_case
-from peridyn.jobs.stable_step import estimated_stable_step
 from peridyn.physics.materials import make_model
+from peridyn.setup.estimate import estimate_case
+from peridyn.setup.stable_step import estimated_stable_step
 
 SIZE, SPACING, HORIZON = (0.012, 0.004, 0.004), 1.0e-3, 3.015
 E, DENSITY = 200.0e9, 7850.0
@@ -82,7 +82,7 @@ def test_a_case_file_names_the_registered_material_and_its_class_checks_its_keys
 def test_the_estimates_of_a_conical_case_are_its_models(tmp_path):
     """The bond count of the estimate and its stable step equal the conical model's own: the
     continuum bound of a bond-based material (B = 2 sum k / |xi|) is exactly the block-Gershgorin
-    bound of a grid point whose whole family is in the body (jobs/stable_step.py), to round-off.
+    bound of a grid point whose whole family is in the body (setup/stable_step.py), to round-off.
     Its memory counts the class's own per-bond arrays (``bond_bytes``: 16 B against PMB's 24 B)."""
     case = load_case(_case_file(tmp_path))
     model = _model()

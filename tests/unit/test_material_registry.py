@@ -11,9 +11,9 @@ from conftest import MATERIALS, small_body, small_model
 
 from peridyn.discretization.bonds import find_bonds
 from peridyn.errors import InputError
-from peridyn.jobs.modal import factor_bytes
 from peridyn.linalg.stiffness import assemble_stiffness
 from peridyn.physics.materials import MODELS, LPSModel, Model, PMBModel, make_model, register_material
+from peridyn.setup.eigensolver import factor_bytes
 from peridyn.solvers.modal import modal_analysis
 
 

@@ -128,7 +128,7 @@ def test_auto_picks_lobpcg_when_the_factor_would_not_fit(monkeypatch):
     machine's memory share, LOBPCG beyond; a forced shift-invert that cannot fit is refused."""
     import os
 
-    from peridyn.jobs import modal as modal_run
+    from peridyn.setup import eigensolver as modal_run
 
     model = _plate(spacing=2e-3, horizon=1.4143)
     assert modal_run.factor_bytes(model) < modal_run.FACTOR_BUDGET
@@ -148,7 +148,7 @@ def test_unknown_eigensolver_is_refused():
     model = _plate(spacing=8e-3, horizon=1.4143)
     with pytest.raises(InputError, match=r"eigensolver must be one of .* got 'arpack'"):
         modal_analysis(model, 3, method="arpack")
-    from peridyn.jobs.modal import choose_eigensolver
+    from peridyn.setup.eigensolver import choose_eigensolver
 
     with pytest.raises(InputError, match="got 'arpack'"):
         choose_eigensolver(model, "arpack")

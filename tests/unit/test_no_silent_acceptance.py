@@ -4,6 +4,7 @@ a dt above the stable step, an empty node set, a horizon below the spacing, too 
 
 import copy
 import re
+from pathlib import Path
 
 import pytest
 import yaml
@@ -11,8 +12,8 @@ import yaml
 from peridyn.cli import main
 from peridyn.errors import CaseFileError
 from peridyn.io.case import apply_override, validate_case
-from peridyn.jobs.build import build, build_body, check_placements
-from peridyn.jobs.stable_step import STEP_MARGIN, estimated_stable_step
+from peridyn.setup.build import build, build_body, check_placements
+from peridyn.setup.stable_step import STEP_MARGIN, estimated_stable_step
 
 BAR = {
     "name": "bar",
@@ -116,6 +117,34 @@ def test_max_memory_refuses_with_the_numbers(tmp_path, capsys):
     assert "memory size 'lots'" in capsys.readouterr().err
 
 
+def test_jobs_called_from_python_check_their_memory_before_building(tmp_path, monkeypatch):
+    """``run_case`` and the fatigue job refuse, before building anything or touching the output
+    folder, a case whose estimated peak exceeds the memory: from Python as from the command
+    line. Python's 0.3 GB of interpreter and libraries (``setup.estimate.BASE_BYTES``) alone
+    exceed a 0.1 GB machine, so every case is refused on it."""
+    import peridyn.jobs.fatigue
+    import peridyn.jobs.run
+    from peridyn.discretization import geometry
+    from peridyn.errors import InputError
+    from peridyn.io.case import load_case
+
+    def build(*args, **kwargs):
+        raise AssertionError("the case was built before its memory was checked")
+
+    for job in (peridyn.jobs.run, peridyn.jobs.fatigue):
+        monkeypatch.setattr(job, "build", build)
+    monkeypatch.setattr(geometry, "memory_limit", lambda: 1e8)
+    out = tmp_path / "out"
+    with pytest.raises(InputError, match=r"2.16e\+03 points .* more than the 0.1 GB available"):
+        peridyn.jobs.run.run_case(validate_case(BAR), out)
+    with pytest.raises(InputError, match="more than the 1e-06 GB available"):
+        peridyn.jobs.run.run_case(validate_case(BAR), out, max_memory=1e3)
+    fatigue = load_case(Path(__file__).parents[2] / "cases" / "sen_fatigue_2d.yaml")
+    with pytest.raises(InputError, match="this fatigue job would hold"):
+        peridyn.jobs.fatigue.run_fatigue_case(fatigue, out)
+    assert not out.exists()
+
+
 @pytest.mark.parametrize(
     "changes, message",
     [
@@ -163,7 +192,7 @@ def test_validate_without_build_refuses(tmp_path, capsys, changes, message):
 def test_stable_step_estimate_against_the_model(changes):
     """The lattice estimate is the model's own Gershgorin bound for PMB without surface
     correction (to round-off) and never more than STEP_MARGIN longer otherwise
-    (jobs/stable_step.py)."""
+    (setup/stable_step.py)."""
     case = validate_case(_raw(**changes))
     est = estimated_stable_step(case)
     real = build(case).model.critical_time_step()
@@ -178,7 +207,7 @@ def test_stable_step_estimate_against_the_model(changes):
 
 
 def _plan(**changes):
-    from peridyn.jobs.run_checks import check_run_plan
+    from peridyn.setup.run_checks import check_run_plan
 
     case = validate_case(_raw(**changes))
     return lambda dt, steps: check_run_plan(case, dt, steps)
@@ -243,7 +272,7 @@ def test_duplicate_mesh_points_are_refused():
     import numpy as np
 
     from peridyn.errors import InputError
-    from peridyn.jobs.build import check_distinct_points
+    from peridyn.setup.build import check_distinct_points
 
     points = np.array([[0.0, 0, 0], [1e-3, 0, 0], [2e-3, 0, 0], [1e-3, 0, 0]])
     with pytest.raises(InputError, match=r"mesh.txt: points 1 and 3 are at the same place"):

@@ -22,12 +22,12 @@ from peridyn.discretization.pairs import index_bandwidth
 from peridyn.discretization.state import State, runaway_limit
 from peridyn.errors import InputError, InstabilityError
 from peridyn.io.case import load_case
-from peridyn.jobs.build import _build_part, build
 from peridyn.parallel.comm import SerialComm, launched_by_mpi
 from peridyn.parallel.domain import Domain
 from peridyn.parallel.halo import ghost_layers, plan_halo
 from peridyn.parallel.partition import rcb
 from peridyn.physics.materials.lps import LPSModel
+from peridyn.setup.build import _build_part, build
 
 CASES = Path(__file__).resolve().parents[2] / "cases"
 

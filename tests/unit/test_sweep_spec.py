@@ -12,10 +12,10 @@ import numpy as np
 import pytest
 import yaml
 
-from peridyn.cli.validate_cmd import check_without_bonds
 from peridyn.errors import CaseFileError, InputError
 from peridyn.jobs.sweep_spec import expand
 from peridyn.physics.expressions import evaluate
+from peridyn.setup.checks import check_without_bonds
 
 ROOT = Path(__file__).resolve().parents[2]
 BAR = str(ROOT / "cases" / "bar_pulse.yaml")

@@ -11,8 +11,8 @@ import pytest
 
 from peridyn.analysis.crack import crack_paths, departure_angle, path_from
 from peridyn.io.case import load_case
-from peridyn.jobs.build import build
 from peridyn.physics.damage import damage_field
+from peridyn.setup.build import build
 from peridyn.solvers import ExplicitSolver
 
 CASE = Path(__file__).parents[2] / "cases" / "kalthoff_winkler.yaml"

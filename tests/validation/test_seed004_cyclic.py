@@ -9,8 +9,8 @@ import pytest
 
 from peridyn.analysis.crack import crack_paths
 from peridyn.io.case import load_case
-from peridyn.jobs.build import build
 from peridyn.physics.damage import damage_field
+from peridyn.setup.build import build
 from peridyn.solvers import ExplicitSolver
 
 CASE = Path(__file__).parents[2] / "cases" / "plate2d_cyclic.yaml"

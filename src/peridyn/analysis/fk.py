@@ -119,13 +119,13 @@ def fk_transform(
     return freq[keep], k, np.abs(spectrum) / (wt.sum() * wx.sum())
 
 
-def line_fk(path: str | os.PathLike, series_name: str, spacing: float, component="z", **options):
+def line_fk(path: Results | str | os.PathLike, series_name: str, spacing: float, component="z", **options):
     """:func:`fk_transform` of a line-probe series of a results file.
 
     Parameters
     ----------
-    path : str or path-like
-        A ``results.h5``.
+    path : Results, str or path-like
+        A ``results.h5`` (``peridyn.io.results.Results`` or its path).
     series_name : str
         E.g. ``"line_axis"``: records (n_points, 3) along the line.
     spacing : float, m
@@ -139,7 +139,7 @@ def line_fk(path: str | os.PathLike, series_name: str, spacing: float, component
     freq, k, magnitude
         As :func:`fk_transform`.
     """
-    _, times, data = Results(path).series(series_name)
+    _, times, data = Results.of(path).series(series_name)
     return fk_transform(data[:, :, _component(component)], _uniform_step(times), spacing, **options)
 
 
@@ -179,7 +179,7 @@ def kxky_transform(
 
 
 def kxky_from_hdf5(
-    path: str | os.PathLike,
+    path: Results | str | os.PathLike,
     series_name: str,
     grid: PointGrid,
     frequencies,
@@ -192,8 +192,8 @@ def kxky_from_hdf5(
 
     Parameters
     ----------
-    path : str or path-like
-        A ``results.h5``.
+    path : Results, str or path-like
+        A ``results.h5`` (``peridyn.io.results.Results`` or its path).
     series_name : str
         A series of (n_points, 3) records, e.g. ``"plane_top"`` or ``"field_u"``.
     grid : PointGrid
@@ -212,7 +212,7 @@ def kxky_from_hdf5(
     """
     omega = _angular(frequencies)
     column = _component(component)
-    results = Results(path)
+    results = Results.of(path)
     wt = _window(window, results.n_records(series_name))
     projected, start = 0.0, 0
     for times, data in results.iter_series(series_name, chunk_records):
@@ -570,8 +570,8 @@ def line_mode_wavenumbers(
 
     Parameters
     ----------
-    path : str or path-like
-        A ``results.h5``.
+    path : Results, str or path-like
+        A ``results.h5`` (``peridyn.io.results.Results`` or its path).
     line : str
         Name of the top-face line (e.g. ``"x_axis"``).
     x : (n_x,) float, m
@@ -586,7 +586,7 @@ def line_mode_wavenumbers(
     dict "S0", "A0" to float, rad/m
     """
     records = {}
-    results = Results(path)
+    results = Results.of(path)
     for suffix in LINE_SUFFIXES:
         _, times, records[suffix] = results.series(f"line_{line}{suffix}")
         if records[suffix].shape != records[""].shape:

@@ -78,12 +78,12 @@ def run(args) -> dict:
             )
         return calibrate(args)
     from peridyn.io.case import load_case
-    from peridyn.jobs.estimate import check_memory
-    from peridyn.jobs.fatigue import run_fatigue_case
+    from peridyn.jobs.dispatch import job_function, run_job
 
+    job_function("fatigue")  # its modules loaded before the case is read, as before the dispatch
     case = load_case(args.case, args.overrides)
-    check_memory(case, args.max_memory, Path(args.case).parent, job="fatigue")
-    summary = run_fatigue_case(
+    summary = run_job(
+        "fatigue",
         case,
         args.output,
         base_dir=Path(args.case).parent,
@@ -91,6 +91,8 @@ def run(args) -> dict:
         progress=progress_bar(args.progress, f"{case.name} fatigue steps"),
         overwrite=args.overwrite,
         comm=world(),
+        max_memory=args.max_memory,
+        case_path=args.case,
     )
     if not args.json:
         print(

@@ -34,23 +34,24 @@ def register(sub) -> None:
 
 def run(args) -> dict:
     """Solve and print the frequency table unless --json."""
-    from peridyn.jobs.estimate import check_memory
-    from peridyn.jobs.run import run_case
+    from peridyn.jobs.dispatch import job_function, run_job
     from peridyn.parallel.comm import world
 
+    job_function("modal")  # its modules loaded before the case is read, as before the dispatch
     overrides = [*args.overrides, "solver.type=modal"]
     if args.modes is not None:
         overrides.append(f"solver.modes={args.modes}")
     case = load_case(args.case, overrides)
-    check_memory(case, args.max_memory, Path(args.case).parent)
     comm = world()  # under mpiexec -n N: the distributed LOBPCG, rank 0 writes
-    summary = run_case(
+    summary = run_job(
+        "modal",
         case,
         args.output,
         case_path=args.case,
         base_dir=Path(args.case).parent,
         overwrite=args.overwrite,
         comm=comm,
+        max_memory=args.max_memory,
     )
     if args.compare and comm.rank == 0:
         from peridyn.jobs.modal import compare_with_run

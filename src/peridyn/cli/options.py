@@ -119,7 +119,7 @@ def positive_int(text: str) -> int:
 def memory_bytes(text: str) -> int:
     """argparse type: a memory size in bytes, as a number ("4e9") or with a unit ("4GB", "512MiB")."""
     from peridyn.errors import InputError
-    from peridyn.jobs.estimate import parse_bytes
+    from peridyn.setup.estimate import parse_bytes
 
     try:
         return parse_bytes(text)

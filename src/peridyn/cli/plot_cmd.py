@@ -1,8 +1,8 @@
 """peridyn plot DIR: redraw the figures of a finished job from its files: a run's (and its
 analyses) from its results.h5, with the crack figures (damage map and crack paths, crack length
-against time) of a run with damage; a fatigue job's crack length against cycles
-(crack_length.csv); a convergence study's study.png (study.json); a sweep's figures
-(dataset.nc)."""
+against time) of a run with damage; a modal run's modes.png; a fatigue job's crack length
+against cycles (crack_length.csv); a convergence study's study.png (study.json); a sweep's
+figures (dataset.nc). The job's kind is its summary.json's (docs/user-guide.md)."""
 
 from __future__ import annotations
 
@@ -27,37 +27,38 @@ def run(args) -> dict:
     paths of the final damage for a run with damage)."""
     from peridyn.io.case import validate_case
     from peridyn.io.results import Results
-    from peridyn.jobs.build import add_actuators, build_body
     from peridyn.jobs.figures import draw_run_figures, redraw_crack_figures
     from peridyn.jobs.lamb_analysis import analyse
+    from peridyn.setup.build import add_actuators, build_body
 
     out = Path(args.run_dir)
-    results = out / "results.h5"
-    for marker, redraw in (("fatigue.json", _fatigue), ("study.json", _study), ("dataset.nc", _sweep)):
-        if not results.is_file() and (out / marker).is_file():
-            paths = [str(p) for p in redraw(out)]
-            if not args.json:
-                for path in paths:
-                    print(f"plot: {path}")
-            return {"output_dir": str(out), "plots": paths}
-    if not results.is_file():
-        raise InputError(
-            f"{str(out)!r} holds no results.h5, fatigue.json, study.json or dataset.nc: "
-            "not the output folder of a run, fatigue job, study or sweep"
-        )
-    info = Results(results).provenance()
+    h5 = out / "results.h5"
+    redraw = {"fatigue": _fatigue, "study": _study, "sweep": _sweep}.get(job_kind(out))
+    if redraw is not None:
+        paths = [str(p) for p in redraw(out)]
+        if not args.json:
+            for path in paths:
+                print(f"plot: {path}")
+        return {"output_dir": str(out), "plots": paths}
+    results = Results(h5)  # read once, handed to the analyses and figures
+    info = results.provenance()
     if "case_json" not in info:
         raise InputError(
-            f"{str(results)!r} does not record its case (written by an older peridyn): run the case again"
+            f"{str(h5)!r} does not record its case (written by an older peridyn): run the case again"
         )
-    case = validate_case(json.loads(info["case_json"]), str(results))
-    if case.solver.type == "modal":
-        raise InputError("modal runs draw their figures with `peridyn modal`; nothing to redraw")
+    case = validate_case(json.loads(info["case_json"]), str(h5))
     base = Path(info.get("case_file", ".")).parent
     body, _ = add_actuators(case, build_body(case, base))
-    analysis, figures = analyse(case, body, out, plots=True)
-    cracks, crack_figures = redraw_crack_figures(case, body, out)
-    paths = [str(p) for p in [*draw_run_figures(case, body, out), *figures, *crack_figures]]
+    if case.solver.type == "modal":
+        from peridyn.jobs.modal import redraw_mode_shapes
+
+        paths = [str(redraw_mode_shapes(body, results))]
+        if not args.json:
+            print(f"plot: {paths[0]}")
+        return {"output_dir": str(out), "plots": paths}
+    analysis, figures = analyse(case, body, results, plots=True)
+    cracks, crack_figures = redraw_crack_figures(case, body, results)
+    paths = [str(p) for p in [*draw_run_figures(case, body, results), *figures, *crack_figures]]
     if not args.json:
         for path in paths:
             print(f"plot: {path}")
@@ -65,6 +66,37 @@ def run(args) -> dict:
     if cracks is not None:
         result["crack_paths"] = [c.summary() for c in cracks]
     return result
+
+
+#: The file that marks each kind of job's folder written before the output contract's
+#: ``summary.json`` (``peridyn.io.job_files``), and the kind it marks.
+MARKERS = {"results.h5": "run", "fatigue.json": "fatigue", "study.json": "study", "dataset.nc": "sweep"}
+
+
+def job_kind(out: Path) -> str:
+    """The kind of the job whose output folder is ``out`` (``run``, ``modal``, ``fatigue``,
+    ``study``, ``sweep``): its ``summary.json``'s ``kind``, else the file that marks it.
+
+    Raises
+    ------
+    InputError
+        ``out`` is not the output folder of a job.
+    """
+    from peridyn.io.job_files import SUMMARY_FILE
+
+    summary = out / SUMMARY_FILE
+    if summary.is_file():
+        try:
+            return str(json.loads(summary.read_text())["kind"])
+        except (ValueError, KeyError, TypeError) as exc:
+            raise InputError(f"{str(summary)!r} is not a job summary ({exc})") from None
+    for marker, kind in MARKERS.items():
+        if (out / marker).is_file():
+            return kind
+    raise InputError(
+        f"{str(out)!r} holds no results.h5, fatigue.json, study.json or dataset.nc (nor a job's "
+        "summary.json): not the output folder of a run, fatigue job, study or sweep"
+    )
 
 
 def _fatigue(out: Path) -> list[Path]:

@@ -66,19 +66,20 @@ def command_line(argv=None) -> str:
 def run(args) -> dict:
     """Run the case; print a readable summary unless --json. Under ``mpiexec -n N`` every rank
     runs its part (``peridyn.parallel``); only rank 0 prints (``peridyn.cli.main``)."""
-    from peridyn.jobs.estimate import check_memory
-    from peridyn.jobs.run import run_case
+    from peridyn.jobs.dispatch import job_function, run_job
+
+    job_function("run")  # its modules loaded before the banner: a signal after it finds the job running
 
     backend = getattr(args, "backend", None)  # demo: no flag
     overrides = [*args.overrides, *([f"solver.backend={backend}"] if backend else [])]
     case = load_case_or_deck(args.case, overrides)
-    check_memory(case, getattr(args, "max_memory", None), Path(args.case).parent)  # demo: no flag
     info = provenance()
     logger.info(
         f"peridyn {info['peridyn_version']} (commit {info['git_commit'][:12]}): case "
         f"{case.name!r} from {args.case}"
     )
-    summary = run_case(
+    summary = run_job(
+        "run",
         case,
         args.output,
         case_path=args.case,
@@ -90,6 +91,7 @@ def run(args) -> dict:
         command=args.command_line if hasattr(args, "command_line") else command_line(),  # demo: ""
         comm=world(),
         figure_worker=True,
+        max_memory=getattr(args, "max_memory", None),  # demo: no flag
     )
     if not args.json:
         print_summary(summary)

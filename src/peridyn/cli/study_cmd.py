@@ -86,9 +86,10 @@ def register(sub) -> None:
 def run(args) -> dict:
     """Run the grid, fit, write the tables and the figure; print the table unless --json."""
     from peridyn.io.case import load_case
-    from peridyn.io.outdir import json_job_status
-    from peridyn.jobs.estimate import check_memory, largest_study_run
+    from peridyn.io.job_files import job_files
+    from peridyn.io.provenance import provenance
     from peridyn.jobs.study import SERIES
+    from peridyn.setup.estimate import check_memory, largest_study_run
 
     start = time.perf_counter()
     spacings = _positive_list("--spacing", args.spacing)
@@ -108,7 +109,7 @@ def run(args) -> dict:
     if out.exists() and not out.is_dir():
         raise InputError(f"output folder {str(out)!r} is a file, not a folder: choose another --output")
     out.mkdir(parents=True, exist_ok=True)
-    with json_job_status(out):
+    with job_files(out, provenance(args.case, case=case)):
         return _study(args, case, out, spacings, factors, series, references, start)
 
 

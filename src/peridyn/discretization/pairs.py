@@ -14,7 +14,7 @@ threads, so their order is fixed by row blocks instead of the family order alone
 The full-list kernel (``kernels.pmb.pmb_force`` with ``split``) sums in the same order, row by
 row: an MPI rank, which runs it on its own rows, gives the serial run's bits. A rank's part
 numbers its rows differently, so it takes the blocks and the split from the whole body's row
-numbers (``Bonds.global_rows``, ``Bonds.row_blocks``, set by ``jobs.build``).
+numbers (``Bonds.global_rows``, ``Bonds.row_blocks``, set by ``setup.build``).
 """
 
 from __future__ import annotations

@@ -378,7 +378,7 @@ class HDF5Writer:
         InputError
             A value JSON cannot hold (numpy scalars and arrays are stored as numbers and lists).
         """
-        self.write_array(SUMMARY, np.bytes_(_to_json(summary, f"{self.path}: summary")))
+        self.write_array(SUMMARY, np.bytes_(to_json(summary, f"{self.path}: summary")))
 
     def identity(self, step: int) -> dict:
         """The file's run id and each series' records before ``step``: what a checkpoint saved at
@@ -642,7 +642,7 @@ def _write_attrs(attrs: h5py.AttributeManager, values: dict, where: str) -> None
         if not isinstance(key, str) or key == JSON_KEYS_ATTR:
             raise InputError(f"{where}: invalid attribute name {key!r}")
         if isinstance(value, dict | list | tuple) or value is None:
-            attrs[key] = _to_json(value, f"{where}: {key!r}")
+            attrs[key] = to_json(value, f"{where}: {key!r}")
             json_keys.add(key)
         elif isinstance(value, str | bool | int | float | np.generic | np.ndarray):
             _set_attr(attrs, key, value, where)
@@ -668,7 +668,14 @@ def _set_attr(attrs: h5py.AttributeManager, key: str, value, where: str) -> None
         ) from None
 
 
-def _to_json(value, where: str) -> str:
+def to_json(value, where: str) -> str:
+    """``value`` as JSON text (numpy scalars and arrays as numbers and lists, keys sorted).
+
+    Raises
+    ------
+    InputError
+        A value JSON cannot hold, naming ``where`` it was to be stored.
+    """
     try:
         return json.dumps(value, default=_json_default, sort_keys=True)
     except (TypeError, ValueError) as exc:

@@ -5,10 +5,11 @@ that holds one (its ``results.h5``, or the JSON summary of a fatigue job) unless
 caller passes ``overwrite`` (start again) or ``restart`` (continue from its checkpoint).
 
 A job's status is one of ``running``, ``complete``, ``failed: <reason>``, ``interrupted at
-step N`` and (for a job without time steps) ``interrupted while <what it was doing>``. A run
-and a modal job keep it in the ``status`` root attribute of ``results.h5``
-(``HDF5Writer.set_status``, read with ``Results.status``); a fatigue or study job, which writes
-JSON, keeps it in ``status.json`` (``{"status": ...}``), written and read here.
+step N`` and (for a job without time steps) ``interrupted while <what it was doing>``. Every job
+keeps it in ``status.json`` (``{"status": ...}``), written and read here, beside its provenance
+and summary (``peridyn.io.job_files``, the output contract); a run and a modal job also keep it
+in the ``status`` root attribute of ``results.h5`` (``HDF5Writer.set_status``, read with
+``Results.status``).
 """
 
 from __future__ import annotations
@@ -89,6 +90,9 @@ RUN_OUTPUTS = (
     "damage.vtu",
     "mode_*.vtu",
     ".peridyn.reserve",
+    "status.json",
+    "provenance.json",
+    "summary.json",
 )
 
 

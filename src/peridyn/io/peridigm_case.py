@@ -724,7 +724,7 @@ def _implicit(deck: _Deck, final: float) -> dict:
 
 def _verlet(deck: _Deck, final: float, name: str = "Solver", initial: float = 0.0) -> dict:
     """Peridigm's Verlet solver (the list ``name``, from the time ``initial``, s): its step is
-    ``Fixed dt``, or its bond-based stable step (``peridyn.jobs.peridigm_step``), times
+    ``Fixed dt``, or its bond-based stable step (``peridyn.setup.peridigm_step``), times
     ``Safety Factor`` (default 1); floor((final - initial) / dt) steps; the velocity of
     prescribed points as Peridigm reports it."""
     where = f"{name}.Verlet"

@@ -68,6 +68,12 @@ class Results:
             self.schema_version = check_schema(f.attrs, self.path)
             _verify_once(f, self.path)
 
+    @classmethod
+    def of(cls, source: Results | str | os.PathLike) -> Results:
+        """``source`` itself when it is a ``Results`` (a file opened once and handed on, e.g. to
+        the figures of a run), else the ``Results`` of the file at that path."""
+        return source if isinstance(source, cls) else cls(source)
+
     def series(self, name: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """A whole series: steps (n_records,) int64, times (n_records,) float64 in s, and the
         records ``(n_records, *record_shape)`` in their stored dtype."""

@@ -1,8 +1,8 @@
 """Whole explicit steps of a case against its force kernel: ``peridyn bench --case CASE.yaml``.
 
-The case is built as ``peridyn run`` builds it (``jobs.build.build``, in one process), with
-the solver ``jobs.run.time_stepper`` makes and the observers ``peridyn run`` attaches: the
-recorder of ``jobs.run.recorder_spec`` (series and snapshots, written to a temporary folder
+The case is built as ``peridyn run`` builds it (``setup.build.build``, in one process), with
+the solver ``setup.solver_choice.time_stepper`` makes and the observers ``peridyn run`` attaches: the
+recorder of ``setup.recording.recorder_spec`` (series and snapshots, written to a temporary folder
 deleted afterwards) and, with damage, the crack-length observer; no checkpoints. Then:
 
 - the initial state and its first record, as a run makes them (not timed);
@@ -44,17 +44,11 @@ from peridyn.io.provenance import provenance
 from peridyn.io.recorder import Recorder
 from peridyn.jobs.bench import best_seconds
 from peridyn.jobs.bench_gpu import force_seconds
-from peridyn.jobs.build import build
-from peridyn.jobs.run import (
-    RESULTS,
-    check_output_fits,
-    crack_observer,
-    point_tensors,
-    recorder_spec,
-    step_count,
-    time_stepper,
-)
+from peridyn.jobs.observers import crack_observer
 from peridyn.parallel.observers import RootObservers
+from peridyn.setup.build import build
+from peridyn.setup.recording import RESULTS, check_output_fits, point_tensors, recorder_spec
+from peridyn.setup.solver_choice import step_count, time_stepper
 from peridyn.solvers.explicit_gpu import GPUExplicitSolver
 
 #: Timed steps when ``--steps`` is not given: the case's own step count, at most this.

@@ -14,7 +14,7 @@ import numpy as np
 
 from peridyn.errors import InputError
 from peridyn.io.case import Case, load_case
-from peridyn.jobs.build import build
+from peridyn.setup.build import build
 from peridyn.solvers import ExplicitSolver
 
 VARIANTS = {"breathing crack": {}, "no crack": {"precracks": []}, "open crack": {"contact": None}}

@@ -4,7 +4,8 @@ Outputs in the run folder: ``crack_length.csv`` (cycles, crack length, directed 
 the cycles),
 ``crack_length.png``, ``damage.vtu`` (final damage and first-break cycle), ``modal.json``
 (frequency tables before/after, MAC matrix, matched types) when ``modal_after`` is set,
-and ``fatigue.json`` (the summary).
+and ``fatigue.json`` (the summary), with the files of every job's folder (``status.json``,
+``provenance.json``, ``summary.json``: ``peridyn.io.job_files``).
 
 Under ``mpiexec -n N`` (N > 1) each rank builds its part of the body and runs the fatigue loop on
 it (``fatigue.loop``: the distributed CG for the equilibrium); the modal analyses before and after
@@ -34,13 +35,16 @@ from peridyn.fatigue.model import FatigueParameters, scale_A_II
 from peridyn.fatigue.specimen import compliance_energy, compliance_stress_intensity, straight_crack_cut
 from peridyn.fatigue.tip import AXES
 from peridyn.io.case import Case, FatigueModal
-from peridyn.io.outdir import json_job_status, prepare_output
+from peridyn.io.job_files import job_files, write_summary
+from peridyn.io.outdir import prepare_output
+from peridyn.io.provenance import provenance
 from peridyn.io.run_log import run_log
 from peridyn.io.vtk import write_vtu
-from peridyn.jobs.build import build
 from peridyn.jobs.modal import case_modes, match_modes
-from peridyn.jobs.run import output_directory
 from peridyn.jobs.summary import finish_summary
+from peridyn.setup.build import build
+from peridyn.setup.estimate import check_memory
+from peridyn.setup.recording import output_directory
 
 logger = logging.getLogger(__name__)
 
@@ -157,21 +161,28 @@ def run_fatigue_case(
     progress=None,
     overwrite: bool = False,
     comm=None,
+    max_memory: float | None = None,
+    case_path=None,
 ) -> dict:
     """Run a fatigue case; returns the summary (JSON keys of ``peridyn fatigue --json``, also in
     ``fatigue.json``; docs/user-guide.md, "Summaries and results files"). A folder holding an
-    earlier ``fatigue.json`` is refused unless ``overwrite``; the job's status goes to
-    ``status.json`` (``peridyn.io.outdir``). ``comm``: ``peridyn.parallel.comm.world()`` under
+    earlier ``fatigue.json`` is refused unless ``overwrite``; the job's status, provenance and
+    summary go to ``status.json``, ``provenance.json`` and ``summary.json``
+    (``peridyn.io.job_files``). ``comm``: ``peridyn.parallel.comm.world()`` under
     ``mpiexec -n N`` (N > 1; see the module docstring), every rank returning the summary; None:
-    one process."""
+    one process. ``max_memory``: bytes the job may hold (default: the machine's); a case whose
+    estimated peak exceeds it is refused before it is built (``setup.estimate.check_memory``).
+    ``case_path``: the case file, recorded in the provenance (None: a case made in Python)."""
     start = time.perf_counter()
     check_fatigue_case(case)
     if comm is not None and comm.size > 1:
         check_parallel_fatigue(case)
+    check_memory(case, max_memory, base_dir, job="fatigue")
     setup = build(case, base_dir, comm)
     d = setup.domain
     out = d.on_root(prepare_output, output_directory(case, output_dir), "fatigue.json", overwrite)
-    with json_job_status(out) if d.is_root else nullcontext(), run_log(out, d.is_root):
+    files = job_files(out, provenance(case_path, case=case)) if d.is_root else nullcontext()
+    with files, run_log(out, d.is_root):
         logger.info(f"fatigue case {case.name!r} ({setup.whole_body.n_points} points) into {out}")
         summary = d.comm.bcast(_run_fatigue(case, setup, out, modal, progress, start))
         logger.info(f"fatigue case {case.name!r} complete in {time.perf_counter() - start:.1f} s")
@@ -258,6 +269,7 @@ def _write_fatigue(case, setup, out, summary, result, before, after, start) -> d
         plots.append(plot_crack_length(result.cycles, result.crack_length, out / "crack_length.png"))
     finish_summary(summary, "fatigue", out, start, plots)
     (out / "fatigue.json").write_text(json.dumps(summary, indent=1))
+    write_summary(out, summary)
     return summary
 
 

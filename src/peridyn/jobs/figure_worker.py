@@ -29,7 +29,7 @@ import numpy as np
 from peridyn.errors import InputError
 from peridyn.io.case import Case
 from peridyn.jobs.children import end_with_parent
-from peridyn.jobs.estimate import grid_shape
+from peridyn.setup.estimate import grid_shape
 
 #: Grids with fewer points draw their figures in the run's own process: the worker's start (about
 #: 1.5 s of imports) would not be hidden by a short run.

@@ -17,6 +17,7 @@ from peridyn.analysis.lamb import dispersion_curves, lamb_modes
 from peridyn.discretization.body import Body
 from peridyn.errors import CaseFileError, InputError
 from peridyn.io.case import Case
+from peridyn.io.results import Results
 
 #: Modes whose wavenumber is picked by default.
 FUNDAMENTAL_MODES = ("S0", "A0")
@@ -52,8 +53,8 @@ def centre_frequency(case: Case) -> float:
     raise CaseFileError(case.name, "analysis.fk.frequency", None, "a frequency (Hz)")
 
 
-def analyse(case: Case, body: Body, directory, plots: bool = True) -> tuple[dict, list]:
-    """Run the case's analyses on ``directory/results.h5``.
+def analyse(case: Case, body: Body, results: Results, plots: bool = True) -> tuple[dict, list]:
+    """Run the case's analyses on a run's ``results``, their figures in the results' folder.
 
     Returns
     -------
@@ -67,7 +68,7 @@ def analyse(case: Case, body: Body, directory, plots: bool = True) -> tuple[dict
     summary, figures = {}, []
     if case.analysis is None:
         return summary, figures
-    results = Path(directory) / "results.h5"
+    directory = Path(results.path).parent
     for name, wanted, step in (("fk", case.analysis.fk, _fk), ("kxky", case.analysis.kxky, _kxky)):
         if wanted is None:
             continue
@@ -83,7 +84,7 @@ def analyse(case: Case, body: Body, directory, plots: bool = True) -> tuple[dict
     return summary, figures
 
 
-def _fk(case: Case, body: Body, results: Path, directory, plots: bool) -> tuple[dict, list]:
+def _fk(case: Case, body: Body, results: Results, directory, plots: bool) -> tuple[dict, list]:
     fk = case.analysis.fk
     f0 = centre_frequency(case)
     E, nu, rho, thickness = plate_theory(case)
@@ -133,7 +134,7 @@ def _fk(case: Case, body: Body, results: Path, directory, plots: bool) -> tuple[
     return out, figures
 
 
-def _kxky(case: Case, body: Body, results: Path, directory, plots: bool) -> tuple[dict, list]:
+def _kxky(case: Case, body: Body, results: Results, directory, plots: bool) -> tuple[dict, list]:
     spec = case.analysis.kxky
     E, nu, rho, thickness = plate_theory(case)
     set_name = case.output.planes[spec.plane]

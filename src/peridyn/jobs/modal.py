@@ -15,18 +15,12 @@ from pathlib import Path
 import numpy as np
 
 from peridyn.analysis.modes import classify_modes, mac_matrix
-from peridyn.errors import CaseFileError, InputError
+from peridyn.errors import InputError
 from peridyn.io.hdf5 import HDF5Writer
 from peridyn.io.provenance import provenance
 from peridyn.io.vtk import write_vtu
-from peridyn.linalg.ordering import estimated_factor_entries
+from peridyn.setup.eigensolver import check_mode_count, choose_eigensolver
 from peridyn.solvers.modal import ModalResult, modal_analysis
-
-#: Share of the machine's memory the factorisation may take.
-MEMORY_SHARE = 0.7
-#: ``auto`` factorises (shift-invert) only below this estimated factor size, bytes; above
-#: it LOBPCG is faster as well as smaller (benchmarks/HISTORY.md, "Modal: LOBPCG without a factor").
-FACTOR_BUDGET = 2**30
 
 
 @dataclass(frozen=True)
@@ -95,29 +89,6 @@ def run_modal(case, setup, out: Path, case_path=None) -> tuple[dict, list[Path]]
     return d.comm.bcast({**summary, **table.stats} if d.is_root else None), plots
 
 
-#: Rigid-body modes of a free body by its dimension: translations and rotations.
-RIGID_MODES = {2: 3, 3: 6}
-
-
-def check_mode_count(case, dim: int, held: bool) -> None:
-    """Refuse a modal run of a free body (not ``held`` by a boundary condition) that asks for
-    no more modes than its rigid-body modes: it would find no vibration mode.
-
-    Raises
-    ------
-    CaseFileError
-        Naming ``solver.modes`` and the rigid modes.
-    """
-    rigid = RIGID_MODES[dim]
-    if not held and case.solver.modes <= rigid:
-        raise CaseFileError(
-            case.name,
-            "solver.modes",
-            case.solver.modes,
-            f"more than the {rigid} rigid-body modes of a free {dim}D body (--modes), e.g. {rigid + 10}",
-        )
-
-
 def _write_modal(case, body, n_bonds, table: ModeTable, out, case_path) -> tuple[dict, list[Path]]:
     """Write the tables, results.h5, the mode-shape VTUs and figure of the modes ``table`` of
     ``body``; the summary's own keys and the figures."""
@@ -153,6 +124,24 @@ def _write_modal(case, body, n_bonds, table: ModeTable, out, case_path) -> tuple
 
         plots.append(plot_mode_shapes(body, result, types, out / "modes.png"))
     return summary, plots
+
+
+def redraw_mode_shapes(body, results) -> Path:
+    """``modes.png`` of a finished modal run of ``body`` again, from its ``results``
+    (``peridyn.io.results.Results``: the frequencies, shapes and rigid modes, and the types and
+    residuals of its summary's rows)."""
+    from peridyn.analysis.modes import ModeType
+    from peridyn.plotting.modes import plot_mode_shapes
+
+    rows = results.summary()["modes"]
+    result = ModalResult(
+        results.array("modes/frequencies"),
+        results.array("modes/shapes"),
+        np.array([row["residual"] for row in rows]),
+        results.array("modes/rigid").astype(bool),
+    )
+    types = [ModeType(row["type"], row["order"]) for row in rows]
+    return plot_mode_shapes(body, result, types, Path(results.path).parent / "modes.png")
 
 
 def modal_table(model, n_modes: int, fixed=None, eigensolver: str = "auto"):
@@ -273,57 +262,6 @@ def mode_label(row: dict) -> str:
     from peridyn.analysis.modes import ModeType
 
     return str(ModeType(row["type"], row["order"]))
-
-
-def choose_eigensolver(model, requested: str = "auto") -> str:
-    """``shift-invert`` or ``lobpcg`` for ``model``.
-
-    ``auto``: shift-invert when the estimated factor (``factor_bytes``) is at most
-    ``FACTOR_BUDGET`` and fits in the machine's memory, LOBPCG otherwise. An explicit
-    ``shift-invert`` is refused when it cannot fit (``check_assembly_fits``).
-    """
-    if requested == "auto":
-        fits = factor_bytes(model) <= min(FACTOR_BUDGET, MEMORY_SHARE * _machine_memory())
-        return "shift-invert" if fits else "lobpcg"
-    if requested == "shift-invert":
-        check_assembly_fits(model)
-    elif requested != "lobpcg":
-        raise InputError(f"eigensolver must be auto, shift-invert or lobpcg, got {requested!r}")
-    return requested
-
-
-def factor_bytes(model) -> float:
-    """Estimated memory of the shift-invert factor, bytes (8-byte values, 4-byte indices)."""
-    unknowns = 4 if model.has_dilatation else 3  # with a dilatation (LPS): three dofs and theta
-    return 12.0 * estimated_factor_entries(model.body.points, model.bonds.horizon, unknowns)
-
-
-def _machine_memory() -> float:
-    """Physical memory, bytes (infinite where the system does not say)."""
-    import os
-
-    try:
-        return float(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
-    except (ValueError, OSError, AttributeError):
-        return float("inf")
-
-
-def check_assembly_fits(model) -> None:
-    """Refuse, with the numbers, a shift-invert factorisation too large for this machine.
-
-    The factor's size is estimated from the nested-dissection separators of the
-    points (``linalg.ordering.estimated_factor_entries``): it grows with the
-    horizon (wider separators) much faster than the number of bonds does.
-    """
-    needed = factor_bytes(model)
-    entries = needed / 12.0
-    available = _machine_memory()
-    if needed > MEMORY_SHARE * available:
-        raise InputError(
-            f"the sparse factorisation of this model would hold about {entries / 1e9:.2f} billion "
-            f"entries (~{needed / 2**30:.0f} GiB; this machine has {available / 2**30:.0f} GiB): "
-            "use solver.eigensolver lobpcg (or auto), a smaller horizon or a coarser spacing"
-        )
 
 
 def _write_tables(out: Path, modes: list[dict]) -> None:

@@ -55,3 +55,12 @@ class CrackLengthObserver:
     def history(self) -> dict:
         """``{"time_s": [...], "length_m": [...]}``."""
         return {"time_s": list(self.times), "length_m": list(self.lengths)}
+
+
+def crack_observer(case, setup, n_steps, damage):
+    """Crack length against time, sampled at the snapshots (or 100 times a run) of a case
+    with damage (``damage``: the whole body's damage index, a callable); None without damage."""
+    if setup.damage is None:
+        return None
+    every = case.output.snapshot_every or max(1, n_steps // 100)
+    return CrackLengthObserver(setup.whole_body, damage, every)

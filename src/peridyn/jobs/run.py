@@ -1,111 +1,50 @@
-"""Run a built case and write its results: explicit, static, Newton and Newmark runs (modal
-runs are ``jobs.modal``), recording, checkpoints, crack history and the stored summary.
-``run_case`` is what ``peridyn run`` calls."""
+"""Run a case and write its results: explicit and Newmark runs (the time loop with recording
+and checkpoints: ``jobs.explicit_run``), static and Newton runs (``jobs.equilibrium``), modal
+runs (``jobs.modal``); then the analyses, figures, crack paths and the stored summary, status
+and provenance. ``run_case`` is what ``peridyn run`` and ``peridyn modal`` call
+(``jobs.dispatch``)."""
 
 from __future__ import annotations
 
 import contextlib
-import functools
-import hashlib
-import json
 import logging
-import shutil
 import time
-import warnings
-from pathlib import Path
-
-import numpy as np
 
 from peridyn import interrupts
-from peridyn.discretization import geometry
 from peridyn.discretization.body import Body
-from peridyn.discretization.state import State
-from peridyn.errors import CaseFileError, InputError, Interrupted
+from peridyn.errors import InputError, Interrupted
 from peridyn.io.case import Case
-from peridyn.io.checkpoint import Checkpointer, load_checkpoint
 from peridyn.io.hdf5 import HDF5Writer
+from peridyn.io.job_files import write_provenance, write_summary
 from peridyn.io.lock import OutputLock
-from peridyn.io.outdir import RUN_OUTPUTS, end_status, prepare_output
-from peridyn.io.provenance import package_version, provenance
-from peridyn.io.recorder import LineProbe, Probes, Recorder, RecorderSpec
-from peridyn.io.reserve import RESERVE_BYTES, RESERVE_FILE
+from peridyn.io.outdir import RUN_OUTPUTS, end_status, prepare_output, write_status
+from peridyn.io.reserve import RESERVE_FILE
+from peridyn.io.results import Results
 from peridyn.io.run_log import run_log
-from peridyn.io.vtu_pieces import VtuPieces
-from peridyn.jobs.build import Setup, build, pad3
-from peridyn.jobs.exodus_variables import GatheredVariables, check_variables, variable_values
+from peridyn.jobs.context import RunContext
+from peridyn.jobs.equilibrium import run_newton, run_static
+from peridyn.jobs.explicit_run import run_explicit
 from peridyn.jobs.figure_worker import figure_worker_for, figures_of, submit
 from peridyn.jobs.figures import draw_crack_figures, draw_run_figures, final_crack_paths
 from peridyn.jobs.lamb_analysis import analyse
-from peridyn.jobs.peridigm_step import peridigm_stable_step
-from peridyn.jobs.run_checks import check_run_plan
-from peridyn.jobs.summary import finish_summary, peak_memory_bytes
-from peridyn.parallel.observers import RootObservers
-from peridyn.physics.absorbing import layer_damping
+from peridyn.jobs.summary import finish_summary
 from peridyn.physics.damage import damage_field
-from peridyn.physics.deformation import strain_field
-from peridyn.physics.transducers import pzt_sensor_weights
-from peridyn.solvers import ExplicitSolver, relax
-from peridyn.solvers.explicit_gpu import GPUExplicitSolver
+from peridyn.setup.build import Setup, build
+from peridyn.setup.estimate import check_memory
+from peridyn.setup.recording import (
+    RESULTS,
+    check_output_fits,
+    output_directory,
+    recorder_spec,
+)
+from peridyn.setup.run_checks import check_run_plan
+from peridyn.setup.solver_choice import (
+    check_parallel,
+    step_count,
+    time_stepper,
+)
 
 logger = logging.getLogger(__name__)
-
-#: The results file in a run's output folder.
-RESULTS = "results.h5"
-
-
-def recorder_spec(case: Case, body: Body, dt: float) -> RecorderSpec:
-    """What the case asks to record, with snapshot times turned into steps."""
-    out = case.output
-    planes = {name: body.node_set(set_name) for name, set_name in out.planes.items()}
-    return RecorderSpec(
-        every=out.every,
-        snapshot_every=out.snapshot_every,
-        snapshot_steps=[int(round(t / dt)) for t in out.snapshot_times],
-        sensors={k: pad3(v) for k, v in out.sensors.items()},
-        lines={k: LineProbe(pad3(v.start), pad3(v.end), v.points) for k, v in out.lines.items()},
-        planes=planes,
-        pzt_sensors={k: _pzt_weights(body, v) for k, v in out.pzt_sensors.items()},
-        series_dtype=out.series_dtype,
-        vtu=out.vtu,
-        vtu_compression=out.vtu_compression,
-        stress=out.stress,
-        strain=out.strain,
-        **exodus_spec(out.exodus),
-        exodus_more=tuple(exodus_spec(more) for more in out.exodus_more),
-    )
-
-
-def exodus_spec(exodus) -> dict:
-    """The recorder's Exodus settings of ``output.exodus`` (a bool or an ``ExodusOutput``)."""
-    if isinstance(exodus, bool):
-        return {"exodus": exodus}
-    return {
-        "exodus": True,
-        "exodus_file": exodus.file,
-        "exodus_every": exodus.every,
-        "exodus_first": exodus.first_step,
-        "exodus_last": exodus.last_step,
-        "exodus_variables": tuple(exodus.variables),
-        "exodus_sums": {k: (v.variable, v.set, v.calculation) for k, v in exodus.sums.items()},
-        "exodus_order": exodus.point_order,
-        "exodus_three_d": exodus.three_d,
-        "exodus_named": True,
-    }
-
-
-def _pzt_weights(body: Body, sensor) -> tuple[np.ndarray, np.ndarray]:
-    """Point indices and (n, 2) weights of a PZT sensor patch on its layer."""
-    idx = np.flatnonzero(geometry.layer(body, sensor.layer))
-    weights = pzt_sensor_weights(body.points[idx], sensor.center, sensor.size, sensor.shape)
-    used = np.any(weights != 0, axis=1)
-    return idx[used], weights[used]
-
-
-def output_directory(case: Case, override=None) -> Path:
-    """The run's output folder: the override, the case's ``output.directory`` or peridyn-out/NAME."""
-    if override is not None:
-        return Path(override)
-    return Path(case.output.directory or Path("peridyn-out") / case.name)
 
 
 @interrupts.deferred()
@@ -121,12 +60,16 @@ def run_case(
     command: str | None = None,
     comm=None,
     figure_worker: bool = False,
+    max_memory: float | None = None,
 ) -> dict:
     """Run a case and write its results; returns the summary (also stored in results.h5; keys
     in docs/user-guide.md, "Summaries and results files").
 
-    The case is built and every argument checked before the output folder is touched; a
-    folder holding an earlier run's results.h5 is refused unless ``overwrite`` or ``restart``.
+    The case and every argument are checked before anything of the case's size is allocated
+    (its memory estimate, ``setup.estimate.check_memory``), the case is built and its time step
+    and records checked (the model's stable step, the records against the free disk) before
+    the output folder is touched; a folder holding an earlier run's results.h5 is refused
+    unless ``overwrite`` or ``restart``.
     results.h5 carries the run's status (``peridyn.io.outdir``).
 
     Parameters
@@ -156,6 +99,9 @@ def run_case(
         ``MIN_POINTS`` or more). What ``peridyn run`` does; a script that asks for it must
         guard its own run with ``if __name__ == "__main__":``, as every program that starts
         processes by ``spawn`` must.
+    max_memory : float or None
+        Bytes the job may hold (default: the machine's, ``discretization.geometry.memory_limit``):
+        a case whose estimated peak exceeds it is refused before it is built.
 
     Raises
     ------
@@ -178,7 +124,8 @@ def run_case(
         raise InputError(f"--restart continues an explicit or newmark run, not a {case.solver.type} run")
     parallel = comm is not None and comm.size > 1
     if parallel:
-        _check_parallel(case)
+        check_parallel(case)
+    check_memory(case, max_memory, base_dir)
     wanted = figure_worker and _draws_run_figures(case) and not parallel
     with figure_worker_for(case, base_dir, wanted) as worker, contextlib.ExitStack() as held:
         setup = build(case, base_dir, comm)
@@ -198,20 +145,22 @@ def run_case(
         domain.on_root(prepare_output, out, RESULTS, overwrite, restart, RUN_OUTPUTS, command != "")
         held.enter_context(run_log(out, domain.is_root))
         logger.info(f"case {case.name!r} ({case.solver.type}, {setup.whole_body.n_points} points) into {out}")
+        ctx = RunContext(case, out, case_path, start, progress, checkpoint_every, restart, command)
         written = not restart  # a restart writes once its checkpoint is accepted (the recorder's part)
+        if written and domain.is_root:
+            write_provenance(out, ctx.provenance())
+            write_status(out, "running")
         try:
-            summary, plots = _solve(
-                case, setup, solver, spec, out, case_path, checkpoint_every, restart, progress, start
-            )
+            summary, plots = _solve(ctx, setup, solver, spec)
             written = True
-            _finish(case, setup, out, summary, plots, start, worker)
+            _finish(ctx, setup, summary, plots, worker)
             logger.info(f"case {case.name!r} complete in {time.perf_counter() - start:.1f} s")
         except Exception as exc:
             logger.warning(f"case {case.name!r}: {end_status(exc)}")
             if written and domain.is_root:
                 (out / RESERVE_FILE).unlink(missing_ok=True)  # room for the status on a full disk
                 try:
-                    _set_status(out / RESULTS, setup.whole_body, end_status(exc))
+                    _record_end(ctx, setup.whole_body, end_status(exc))
                 except Exception:  # noqa: BLE001 - e.g. the full disk that failed the run: its error is the one to report
                     pass
             if isinstance(exc, Interrupted):
@@ -219,96 +168,6 @@ def run_case(
                 raise Interrupted(exc.signal_name, exc.step, hint, exc.where) from None
             raise
         return domain.comm.bcast(summary)
-
-
-def _check_parallel(case: Case) -> None:
-    """Refuse what an MPI run cannot do yet."""
-    if case.solver.type not in ("explicit", "modal", "static"):
-        raise InputError(
-            "an MPI run (mpiexec -n N) is an explicit, static or modal run for now, not a "
-            f"{case.solver.type} run"
-        )
-    if case.solver.type == "modal" and case.solver.eigensolver == "shift-invert":
-        raise CaseFileError(case.name, "solver.eigensolver", "shift-invert", "lobpcg or auto in an MPI run")
-
-
-def point_tensors(setup: Setup, spec: RecorderSpec):
-    """The recorder's ``tensors``: u (n_points, 3) m -> the per-point ``stress`` (Pa) and
-    ``strain`` (with ``strain_valid``) that ``output.stress`` and ``output.strain`` ask for,
-    (n_points, dim, dim); None when neither is asked. Under MPI, of the rank's part (its owned
-    rows are the serial ones: ``RootObservers`` gathers them)."""
-    if not (spec.stress or spec.strain):
-        return None
-    dim = setup.body.dim
-
-    def fields(u: np.ndarray) -> dict:
-        out = {}
-        if spec.stress:
-            out["stress"] = setup.model.partial_stress(u)[:, :dim, :dim]
-        if spec.strain:
-            out["strain"], out["strain_valid"] = strain_field(setup.body, setup.model.bonds, u)
-        return out
-
-    return fields
-
-
-def exodus_values(case: Case, setup: Setup, spec: RecorderSpec, force=None):
-    """The recorder's ``fields``: the values of the named Exodus variables (``output.exodus``
-    as a mapping) at a state, or None without them; under MPI a ``GatheredVariables``, whose
-    ``collect`` every rank calls at the states recorded. ``force``: the internal force density
-    at a state (``variable_values``; one process)."""
-    if not spec.exodus_named:
-        return None
-    variables, sums = spec.all_exodus_variables()
-    check_variables(case.name, setup.model, variables)
-    if setup.domain.size > 1:  # each rank's owned values, gathered on rank 0 (``collect``)
-        return GatheredVariables(setup.domain, setup.model, variables, sums, setup.whole_body, setup.loading)
-    return variable_values(setup.model, variables, sums, setup.loading, force)
-
-
-def step_count(case: Case, solver) -> int:
-    """Time steps of a time-stepping run: ``solver.steps``, or ``solver.time`` in steps of dt
-    (ceil(time / dt), or floor(time / dt) with ``solver.step_rule: peridigm``)."""
-    s = case.solver
-    if s.steps is not None:
-        return s.steps
-    if s.step_rule == "peridigm":  # Peridigm's floor((final - initial) / dt)
-        steps = int(np.floor(s.time / solver.dt))
-        if steps < 1:
-            raise CaseFileError(
-                case.name, "solver.time", s.time, f"at least one step of dt = {solver.dt:.4g} s"
-            )
-        return steps
-    return int(np.ceil(s.time / solver.dt - 1e-9))
-
-
-def check_output_fits(
-    spec: RecorderSpec, body: Body, n_steps: int, dt: float, out: Path, damage: bool = False
-) -> None:
-    """Refuse a run whose records (``spec.output_bytes``, ``spec`` from ``recorder_spec``) would
-    not fit in the free space of the disk of its output folder, before anything is written.
-
-    Raises
-    ------
-    InputError
-        Naming the steps, the bytes and the free space.
-    """
-    need = spec.output_bytes(body.n_points, n_steps, body.dim, damage) + RESERVE_BYTES
-    folder = out.resolve()
-    while not folder.exists():
-        folder = folder.parent
-    free = shutil.disk_usage(folder).free
-    if need > free:
-        raise InputError(
-            f"the run's {n_steps:.3g} steps (dt = {dt:.3g} s) would write "
-            + (
-                f"about {need / 1e9:.3g} GB of results"
-                if np.isfinite(need)
-                else "more results than any disk holds"
-            )
-            + f", more than the {free / 1e9:.3g} GB free on {folder}: "
-            "shorten solver.time or record less (output.every, output.snapshot_every)"
-        )
 
 
 def _resume_hint(command: str | None) -> str:
@@ -320,21 +179,19 @@ def _resume_hint(command: str | None) -> str:
     return command if "--restart" in command.split() else f"{command} --restart"
 
 
-def _solve(case, setup, solver, spec, out, case_path, checkpoint_every, restart, progress, start):
-    """The solver's part of ``run_case``: its summary and the figures it drew (``spec``: the
-    recorder's, for a time-stepping run)."""
-    if case.solver.type == "static":
-        return _run_static(case, setup, out, case_path), []
-    if case.solver.type == "newton":
-        return _run_newton(case, setup, out, case_path), []
-    if case.solver.type == "modal":
+def _solve(ctx: RunContext, setup: Setup, solver, spec) -> tuple[dict, list]:
+    """The solver's part of ``run_case``: its summary and the figures it drew (``solver`` and
+    ``spec``: the time stepper and the recorder's, for a time-stepping run)."""
+    kind = ctx.case.solver.type
+    if kind == "static":
+        return run_static(ctx, setup), []
+    if kind == "newton":
+        return run_newton(ctx, setup), []
+    if kind == "modal":
         from peridyn.jobs.modal import run_modal
 
-        return run_modal(case, setup, out, case_path)
-    summary = _run_explicit(
-        case, setup, solver, spec, out, case_path, checkpoint_every, restart, progress, start
-    )
-    return summary, []
+        return run_modal(ctx.case, setup, ctx.out, ctx.case_path)
+    return run_explicit(ctx, setup, solver, spec), []
 
 
 def _draws_run_figures(case: Case) -> bool:
@@ -342,609 +199,45 @@ def _draws_run_figures(case: Case) -> bool:
     return case.output.plots and case.solver.type != "modal"
 
 
-def _finish(case, setup, out, summary, plots, start, worker=None) -> None:
+def _finish(ctx: RunContext, setup: Setup, summary: dict, plots, worker=None) -> None:
     """Analyses, figures and the stored summary after the solve; the status becomes complete
     (on rank 0, with the damage of the whole body). ``worker``: a figure worker
     (``figure_worker_for``) that draws the run figures while this process analyses."""
     d = setup.domain
     phi = d.gather(damage_field(setup.model)) if setup.damage is not None else None
-    d.on_root(_finish_on_root, case, setup.whole_body, out, summary, plots, start, phi, worker)
+    d.on_root(_finish_on_root, ctx, setup.whole_body, summary, plots, phi, worker)
 
 
-def _finish_on_root(case, body, out, summary, plots, start, phi, worker=None) -> None:
+def _finish_on_root(ctx: RunContext, body, summary: dict, plots, phi, worker=None) -> None:
     """``_finish`` on rank 0: ``body`` the whole body, ``phi`` its damage (None without damage)."""
+    case, out = ctx.case, ctx.out
     draw = _draws_run_figures(case)
-    pending = submit(worker, draw_run_figures, case, body, out) if draw else None
-    analysis, figures = analyse(case, body, out, plots=case.output.plots)
+    results = Results(ctx.results) if draw or case.analysis is not None else None  # read once
+    pending = submit(worker, draw_run_figures, case, body, results) if draw else None
+    analysis, figures = analyse(case, body, results, plots=case.output.plots)
     summary.update(analysis)
     paths = final_crack_paths(case, body, phi) if phi is not None else None
     if paths is not None:
         summary["crack_paths"] = [p.summary() for p in paths]
     if draw:
-        plots = [*figures_of(pending, draw_run_figures, case, body, out), *figures]
+        plots = [*figures_of(pending, draw_run_figures, case, body, results), *figures]
         if paths is not None:
-            plots += draw_crack_figures(body, out, paths, summary)
-    finish_summary(summary, "modal" if case.solver.type == "modal" else "run", out, start, plots)
-    store_summary(out / RESULTS, body, summary, status="complete")
+            plots += draw_crack_figures(body, results, paths, summary)
+    finish_summary(summary, "modal" if case.solver.type == "modal" else "run", out, ctx.start, plots)
+    _record_end(ctx, body, "complete", summary)
 
 
-def case_identity(case: Case, run_length: bool = False) -> tuple[str, str]:
-    """The validated case (after ``--set``) as JSON text without its output folder and, unless
-    ``run_length`` (a sweep's runs differ by it), without its run length (``solver.steps``,
-    ``solver.time``: a restart may extend a run), and the SHA-256 of that text."""
-    data = case.model_dump(mode="json")
-    if not run_length:
-        for key in ("steps", "time"):
-            data["solver"].pop(key, None)
-    data["output"].pop("directory", None)
-    text = json.dumps(data, sort_keys=True)
-    return text, hashlib.sha256(text.encode()).hexdigest()
-
-
-def _set_status(results: Path, body: Body, status: str) -> None:
-    """Set the status of a results file (created if the job failed before writing one)."""
-    with HDF5Writer(results, body.points[:, : body.dim], body.volumes, {}, mode="a") as h5:
+def _record_end(ctx: RunContext, body: Body, status: str, summary: dict | None = None) -> None:
+    """The end of a run in its folder (rank 0): its ``status`` and ``summary`` (None: a job that
+    did not complete) in results.h5 (created if the job failed before writing one) and in the
+    output contract's files (``peridyn.io.job_files``; a restart's provenance too, written once
+    its checkpoint was accepted)."""
+    with HDF5Writer(ctx.results, body.points[:, : body.dim], body.volumes, {}, mode="a") as h5:
+        if summary is not None:
+            h5.write_summary(summary)
         h5.set_status(status)
-
-
-def store_summary(results, body: Body, summary: dict, status: str | None = None) -> None:
-    """(Re)write the run summary in ``/summary/json`` of a results file, and its status when
-    given."""
-    with HDF5Writer(results, body.points[:, : body.dim], body.volumes, {}, mode="a") as h5:
-        h5.write_summary(summary)
-        if status is not None:
-            h5.set_status(status)
-
-
-def _base_summary(setup: Setup) -> dict:
-    """Points, directed bonds, broken bonds and largest damage of the whole body (collective)."""
-    d = setup.domain
-    n = d.n_owned
-    phi = damage_field(setup.model)
-    if setup.storage == "lattice":  # one process
-        bonds, broken = setup.bonds.n_bonds, setup.bonds.n_broken()
-    else:
-        owned_bonds = int(setup.bonds.offsets[n])  # the owned points' families come first
-        bonds, broken = d.count(owned_bonds), d.count((~setup.bonds.intact[:owned_bonds]).sum())
-    return {
-        "points": setup.whole_body.n_points,
-        "bonds": bonds,
-        "broken_bonds": broken,
-        "max_damage": float(d.max(phi[:n].max())),
-        "storage": setup.storage,
-    }
-
-
-def bond_state(setup: Setup) -> tuple[np.ndarray, np.ndarray]:
-    """(array, offsets): the bonds' state that a checkpoint saves and a restart writes back in
-    place, with its CSR family ``offsets``: the intact mask of bond lists, or the broken words
-    of a lattice (flat, ``offsets`` [0, their number]: one process)."""
-    if setup.storage == "lattice":
-        words = setup.bonds.broken.reshape(-1)
-        return words, np.array([0, len(words)])
-    return setup.bonds.intact, setup.bonds.offsets
-
-
-def time_stepper(case, setup):
-    """The solver of an explicit or newmark case (velocity Verlet or implicit Newmark)."""
-    if case.solver.type == "newmark":
-        return _newmark_solver(case, setup)
-    s = case.solver
-    damping = explicit_damping(case, setup.whole_body)
-    if np.ndim(damping):  # per point: the rank's points
-        damping = damping[setup.domain.global_ids]
-    peridigm_dt = s.dt is None and s.step_rule == "peridigm"
-    solver_class = GPUExplicitSolver if s.backend == "gpu" else ExplicitSolver
-    return solver_class(
-        setup.model,
-        setup.loading,
-        dt=s.safety * peridigm_stable_step(case, setup) if peridigm_dt else s.dt,
-        safety=s.safety,
-        damping=damping,
-        damage=setup.damage,
-        contact=setup.contact,
-        domain=setup.domain,
-        prescribed_velocity=s.prescribed_velocity,
-        **({"arithmetic": "peridigm"} if _peridigm_arithmetic(case, setup) else {}),
-        **({"beyond_bound": "warn"} if peridigm_dt and s.backend == "cpu" else {}),  # as Peridigm runs it
-    )
-
-
-def _peridigm_arithmetic(case, setup) -> bool:
-    """True for ``solver.arithmetic: peridigm`` on the CPU in one process, where it runs; on
-    the GPU backend or under MPI the run takes peridyn's order of operations, with a warning
-    (the results then differ from Peridigm's in their last bits, docs/peridigm.md)."""
-    s = case.solver
-    if s.arithmetic != "peridigm":
-        return False
-    if s.backend == "gpu" or setup.domain.halo is not None:
-        warnings.warn(
-            f"{case.name}: solver.arithmetic peridigm runs on the cpu backend in one process: this "
-            "run takes peridyn's order of operations (its last bits differ from Peridigm's)",
-            stacklevel=3,
-        )
-        return False
-    return True
-
-
-#: Seconds of running after which an interrupted run writes a checkpoint even unasked.
-CHECKPOINT_AFTER_S = 60.0
-
-
-def _run_explicit(
-    case, setup, solver, spec, out, case_path, checkpoint_every, restart, progress, start
-) -> dict:
-    """Time integration by ``solver`` with recording by ``spec`` (``recorder_spec``),
-    checkpoints and the status."""
-    d = setup.domain
-    n_steps = step_count(case, solver)
-    ckpt_path = out / "checkpoint.h5"
-    case_json, digest = case_identity(case)
-    meta = {"case_hash": digest, "case": case_json, "dt": float(solver.dt), "version": package_version()}
-    spec = recorder_spec(case, setup.whole_body, solver.dt)
-    tensors = point_tensors(setup, spec)
-    gathered = RootObservers(d, setup.model, tensors)
-    cracks = crack_observer(case, setup, n_steps, gathered.damage)
-    parts = {
-        name: part
-        for name, part in (("damage", setup.damage), ("contact", setup.contact), ("cracks", cracks))
-        if part is not None
-    }
-    whole_bonds = d.bond_offsets(bond_state(setup)[1])
-    if restart:
-        state = _restart(ckpt_path, setup, meta, parts, whole_bonds, n_steps, out / RESULTS)
-        resume = (state.step, state.time)
-        logger.info(f"restarting from the checkpoint at step {state.step} (t = {state.time:.6g} s)")
-    else:
-        state, resume = solver.initial_state(), None
-    info = provenance(case_path, case=case)
-    if d.size > 1:
-        info.update(d.provenance())
-    pieces = None  # under MPI, each rank writes its piece of the VTU snapshots
-    if d.size > 1 and spec.vtu:
-        pieces = VtuPieces(
-            d, setup.body, out, lambda: damage_field(setup.model), tensors, spec.vtu_compression
-        )
-    if d.size > 1 and tensors is not None:
-        tensors = gathered.tensor_fields
-    # the explicit solver's own force (Peridigm's order: from its deformed positions); Newmark's: None
-    fields = exodus_values(case, setup, spec, getattr(solver, "internal_force", None))
-    probes = Probes.of(setup.whole_body, spec)  # every rank: under MPI, gathered at a series record
-    recorder = d.on_root(
-        Recorder,
-        setup.whole_body,
-        out,
-        spec,
-        info,
-        gathered.damage,
-        resume,
-        tensors,
-        fields,
-        d.size > 1,
-        probes,
-    )
-    checkpointer, gather_checkpoint = _checkpointer(
-        ckpt_path,
-        checkpoint_every or n_steps + 1,
-        setup,
-        meta,
-        parts,
-        whole_bonds,
-        [recorder.flush] if recorder is not None else [],
-        recorder.h5.identity if recorder is not None else None,
-    )
-    watched = [recorder, *([cracks] if cracks is not None else [])]
-    due = [spec.whole_due, *([cracks.due] if cracks is not None else [])]  # the series: ``series``
-    if d.size > 1 and checkpoint_every:  # saved on rank 0 from the gathered state
-        watched, due = [*watched, checkpointer], [*due, checkpointer.due]
-    prepare = gather_checkpoint
-    if pieces is not None:
-        prepare = [*prepare, (spec.snapshot_due, pieces.write)]
-    collect = fields.collect if isinstance(fields, GatheredVariables) else lambda state: None
-    if isinstance(fields, GatheredVariables):
-        prepare = [*prepare, (spec.exodus_due, collect)]
-    damage_due = [spec.snapshot_due, spec.exodus_due, *([cracks.due] if cracks is not None else [])]
-    record = recorder.record_series if recorder is not None else None
-    try:
-        if resume is None:
-            if pieces is not None:
-                pieces.write(state)
-            collect(state)
-            gathered.call(state, lambda whole: (recorder.record_series(whole), recorder.snapshot(whole)))
-        observers = [gathered]
-        if checkpoint_every and d.size == 1:
-            observers.append(checkpointer)
-        remaining = n_steps - state.step
-        bar = progress(remaining) if progress is not None else None
-        traffic = d.comm.traffic.copy()
-        loop_start = time.perf_counter()
-        try:
-            series = (spec.series_due, probes.u_points, probes.v_points, record)
-            # the GPU backend's state is on the device: a series-only step reads the probe points only
-            device_probes = solver.probe_values if isinstance(solver, GPUExplicitSolver) else None
-            gathered.attach(watched, due, prepare, damage_due, series, device_probes)
-            solver.run(state, remaining, observers, bar)
-        finally:
-            gathered.detach()
-            if bar is not None:
-                bar.close()
-        loop_seconds = time.perf_counter() - loop_start
-        step_seconds = d.max(loop_seconds)
-    except Interrupted as exc:  # under MPI: on every rank after the same step
-        saved = bool(checkpoint_every) or time.perf_counter() - start > CHECKPOINT_AFTER_S
-        saved = bool(d.max(int(saved)))  # the ranks' clocks differ: all save if one would
-        if saved and d.size == 1:
-            checkpointer.save(state)
-        elif saved:
-            for _, gather in gather_checkpoint:
-                gather(state)
-            gathered.call(state, checkpointer.save)
-        if recorder is not None:
-            recorder.close(f"interrupted at step {exc.step}")
-        raise Interrupted(exc.signal_name, exc.step, "resume" if saved else "") from None
-    except BaseException as exc:
-        if recorder is not None:
-            recorder.close(end_status(exc))
-        raise
-    try:
-        collect(state)  # the end-of-run snapshot's Exodus record
-        if not spec.snapshot_due(state.step):
-            if pieces is not None:
-                pieces.write(state)
-            gathered.call(state, lambda whole: recorder.snapshot(whole))
-    except BaseException as exc:  # e.g. a full disk: the records held are written, the file closed
-        if recorder is not None:
-            recorder.close(end_status(exc))
-        raise
-    n = d.n_owned
-    summary = _base_summary(setup)
-    summary.update(
-        {
-            "steps": state.step,
-            "time_s": state.time,
-            "dt_s": solver.dt,
-            "stable_dt_s": solver.stable_dt,
-            "kinetic_energy_j": solver.kinetic_energy(state),
-            "strain_energy_j": float(d.dot(setup.model.energy_density(state.u)[:n], setup.body.volumes[:n])),
-            "step_seconds": step_seconds,
-        }
-    )
-    if d.size > 1:
-        summary["mpi"] = {
-            **{key: info[key] for key in d.provenance_keys},
-            "per_rank": d.traffic_per_rank(traffic, remaining, loop_seconds),
-        }
-        peaks = d.comm.allgather(peak_memory_bytes())  # so far: the build and the time loop
-        for rank, peak in zip(summary["mpi"]["per_rank"], peaks, strict=True):
-            rank["peak_memory_bytes"] = peak
-    if setup.contact is not None:
-        summary["contact_rebuilds"] = setup.contact.rebuilds
-    if cracks is not None:
-        summary["crack_length_history"] = cracks.history()  # rank 0's is the one returned
-    gathered.call(state, lambda whole: recorder.finish(whole), True)
-    return summary
-
-
-def _restart(
-    path, setup: Setup, meta: dict, parts: dict, whole_bonds: np.ndarray, n_steps: int, results
-) -> State:
-    """The state of the checkpoint at ``path`` (this rank's points), with the bonds' intact mask
-    and the parts' states restored; a checkpoint at or past the run's last step ``n_steps`` is
-    refused (before the recorder reopens, and would rewrite, results.h5). Checkpoints hold the
-    whole body in serial numbering, so a run may restart on another number of ranks. A rank's
-    damage skin covers its part only and is not saved under MPI: it starts again with a full
-    stretch test (the same bonds break, see ``peridyn.physics.damage``). The results file
-    ``results`` must be the one the checkpoint was saved with (``check_results``)."""
-    d = setup.domain
-    state, intact, saved = d.agree(
-        load_checkpoint, path, setup.whole_body.n_points, int(whole_bonds[-1]), meta, results
-    )
-    if state.step >= n_steps:
-        raise InputError(
-            f"--restart: the checkpoint is at step {state.step} and the run ends at step {n_steps}: "
-            "nothing is left to run (a longer solver.time or solver.steps continues it)"
-        )
-    if d.size > 1:
-        ids = d.global_ids
-        state = State(state.u[ids], state.v[ids], state.a[ids], state.time, state.step)
-    bond_state(setup)[0][:] = d.scatter_bonds(intact, setup.bonds, whole_bonds)
-    for name, part in parts.items():
-        part.restore_state(saved.get(name, {}) if d.size == 1 or name != "damage" else {})
-    return state
-
-
-def _checkpointer(
-    path,
-    every: int,
-    setup: Setup,
-    meta: dict,
-    parts: dict,
-    whole_bonds: np.ndarray,
-    before_save=(),
-    results=None,
-):
-    """The run's ``Checkpointer`` and what must be gathered before it saves (``RootObservers``):
-    under MPI it writes, on rank 0, the whole body's state and intact mask in serial numbering
-    and the parts that hold whole-body state (the contact list's build displacement, gathered;
-    not a rank's damage skin). ``before_save``: the calls made before every save (the
-    recorder's ``flush``, on rank 0); ``results``: the identity of the results file
-    (``HDF5Writer.identity``, on rank 0)."""
-    d = setup.domain
-    if d.size == 1:
-        return Checkpointer(path, every, bond_state(setup)[0], meta, parts, before_save, results), []
-    whole_intact = np.ones(int(whole_bonds[-1]), dtype=bool) if d.is_root else None
-    checkpointer = Checkpointer(
-        path,
-        every,
-        whole_intact,
-        meta,
-        {k: v for k, v in parts.items() if k != "damage"},
-        before_save,
-        results,
-    )
-
-    def gather_whole(state):  # the state itself is gathered by RootObservers.call
-        intact = d.gather_bonds(setup.bonds.intact, setup.bonds.offsets, whole_bonds)
-        if d.is_root:
-            whole_intact[:] = intact
-        if setup.contact is not None:
-            setup.contact.gather_built()
-
-    return checkpointer, [(checkpointer.due, gather_whole)]
-
-
-def explicit_damping(case: Case, body: Body):
-    """``solver.damping`` (1/s), plus the absorbing layers' per-point damping when the case
-    has them: a number or an (n_points,) array for ``ExplicitSolver``."""
-    if case.absorbing is None:
-        return case.solver.damping
-    a = case.absorbing
-    try:
-        return case.solver.damping + layer_damping(body.points, a.width, a.damping, a.faces)
-    except InputError as exc:
-        raise CaseFileError(case.name, "absorbing", a.model_dump(), str(exc)) from None
-
-
-def crack_observer(case, setup, n_steps, damage):
-    """Crack length against time, sampled at the snapshots (or 100 times a run) of a case
-    with damage (``damage``: the whole body's damage index, a callable); None without damage."""
-    if setup.damage is None:
-        return None
-    from peridyn.jobs.observers import CrackLengthObserver
-
-    every = case.output.snapshot_every or max(1, n_steps // 100)
-    return CrackLengthObserver(setup.whole_body, damage, every)
-
-
-def _run_static(case, setup, out, case_path) -> dict:
-    s = case.solver
-    u = None
-    iterations = 0
-    solve = _static_solver(setup)
-    for k in range(1, s.load_steps + 1):
-        result = solve(
-            setup.model,
-            setup.loading,
-            time=k / s.load_steps,
-            u0=u,
-            tolerance=s.tolerance,
-            max_iterations=s.max_iterations,
-            damage=setup.damage,
-            contact=setup.contact,
-        )
-        u, iterations = result.u, iterations + result.iterations
-        if not result.converged:
-            raise InputError(
-                f"static load step {k}/{s.load_steps} did not converge in {s.max_iterations} "
-                f"iterations (residual {result.residual:.3g} > {s.tolerance:g}): raise "
-                "solver.max_iterations or solver.load_steps"
-            )
-    results = {"steps": s.load_steps, "iterations": iterations, "residual": result.residual}
-    if setup.contact is not None:
-        results["contact_rebuilds"] = setup.contact.rebuilds
-    return _record_equilibrium(case, setup, out, case_path, u, results)
-
-
-def _static_solver(setup: Setup):
-    """The solve of each load step of a static run, called as ``relax``: ``relax`` itself in one
-    process; under MPI ``relax`` on the rank's part (the serial iterates bit for bit) when bonds
-    break or contact acts, else modified Newton with CG (``_distributed_static``)."""
-    d = setup.domain
-    if d.size == 1:
-        return relax
-    if setup.damage is not None or setup.contact is not None:
-        return functools.partial(relax, domain=d)
-    return _distributed_static(setup)
-
-
-def _distributed_static(setup: Setup):
-    """``relax``'s stand-in under MPI for a linear-elastic body (no damage, no contact): modified
-    Newton with CG (``solvers.distributed_static``) on the rank's dofs, its preconditioner built
-    once for every load step."""
-    from peridyn.linalg.distributed import RankDofs, rank_preconditioner
-    from peridyn.solvers.distributed_static import distributed_equilibrium
-
-    dofs = RankDofs(setup.model, setup.domain, setup.loading.constrained)
-    precond = rank_preconditioner(dofs)
-
-    def solve(model, loading, time, u0, tolerance, max_iterations, damage, contact):
-        return distributed_equilibrium(dofs, precond, loading, time, u0, tolerance, max_iterations)
-
-    return solve
-
-
-def _equilibrium_recorder(case, setup, out, case_path) -> Recorder:
-    """The recorder of a quasi-static run."""
-    spec = recorder_spec(case, setup.body, 1.0)
-    return Recorder(
-        setup.body,
-        out,
-        spec,
-        provenance(case_path, case=case),
-        lambda: damage_field(setup.model),
-        tensors=point_tensors(setup, spec),
-        fields=exodus_values(case, setup, spec),
-    )
-
-
-def _record_equilibrium(case, setup, out, case_path, u, results: dict, recorder=None, time=1.0) -> dict:
-    """Record a quasi-static solution ``u`` as one state at ``time`` (s; ``recorder``: the
-    run's, else a new one); the run's summary."""
-    state = State(u, np.zeros_like(u), np.zeros_like(u), time, results["steps"])
-    if setup.domain.size > 1:
-        return _record_distributed_equilibrium(case, setup, out, case_path, state, results)
-    if recorder is None:
-        recorder = _equilibrium_recorder(case, setup, out, case_path)
-    return _record_last(setup, recorder, state, results)
-
-
-def _record_last(setup, recorder: Recorder, state: State, results: dict) -> dict:
-    """Record ``state`` as the run's last (series, snapshot, final fields) and close
-    ``recorder``; the run's summary, ``results`` added (one process)."""
-    recorder.record_series(state)
-    recorder.snapshot(state)
-    summary = _base_summary(setup)
-    summary.update(results)
-    summary["strain_energy_j"] = setup.model.strain_energy(state.u)
-    recorder.finish(state)
-    return summary
-
-
-def _record_distributed_equilibrium(case, setup, out, case_path, state: State, results: dict) -> dict:
-    """``_record_equilibrium`` under MPI: ``state`` of the rank's part (ghost rows filled), gathered
-    on rank 0, which records it as a serial run would (VTU snapshots in per-rank pieces); the
-    summary (collective)."""
-    d = setup.domain
-    spec = recorder_spec(case, setup.whole_body, 1.0)
-    tensors = point_tensors(setup, spec)
-    gathered = RootObservers(d, setup.model, tensors)
-    info = provenance(case_path, case=case)
-    info.update(d.provenance())
-    if spec.vtu:
-        VtuPieces(d, setup.body, out, lambda: damage_field(setup.model), tensors).write(state)
-    whole_tensors = gathered.tensor_fields if tensors is not None else None
-    recorder = d.on_root(
-        Recorder, setup.whole_body, out, spec, info, gathered.damage, None, whole_tensors, None, True
-    )
-    gathered.call(state, lambda whole: (recorder.record_series(whole), recorder.snapshot(whole)), True)
-    summary = _base_summary(setup)
-    summary.update(results)
-    n = d.n_owned
-    summary["strain_energy_j"] = float(d.dot(setup.model.energy_density(state.u)[:n], setup.body.volumes[:n]))
-    gathered.call(state, lambda whole: recorder.finish(whole), True)
-    return summary
-
-
-def _newmark_solver(case, setup):
-    """The implicit Newmark solver of a ``newmark`` case."""
-    from peridyn.solvers.newmark import NewmarkSolver
-
-    s = case.solver
-    return NewmarkSolver(
-        setup.model,
-        setup.loading,
-        dt=s.dt,
-        tolerance=s.displacement_tolerance,
-        max_iterations=s.newton_iterations,
-        damping=s.damping,
-        damage=setup.damage,
-        linear_solver=s.linear_solver,
-        residual_tolerance=s.absolute_tolerance,
-        initial_acceleration=s.initial_acceleration,
-    )
-
-
-def _run_newton(case, setup, out, case_path) -> dict:
-    """Newton-Raphson equilibrium of a ``newton`` case, recorded as one state at t = 1 s."""
-    from peridyn.solvers.newton import newton
-
-    s = case.solver
-    end = s.time if s.time is not None else 1.0
-    recorder = _equilibrium_recorder(case, setup, out, case_path)
-    last: dict = {}  # the last load step's u and v (``_load_step_records``)
-    on_step = _load_step_records(recorder, setup.loading, end / s.load_steps, last)
-    result = newton(
-        setup.model,
-        setup.loading,
-        load_steps=s.load_steps,
-        time=end,
-        tolerance=s.tolerance,
-        max_iterations=s.newton_iterations,
-        damage=setup.damage,
-        max_breaking_rounds=s.breaking_rounds,
-        linear_solver=s.linear_solver,
-        absolute_tolerance=s.absolute_tolerance,
-        on_step=on_step,
-    )
-    if not result.converged:
-        step = len(result.steps)
-        raise InputError(
-            f"Newton load step {step}/{s.load_steps} did not converge (residual "
-            f"{result.residual:.3g}, tolerance {s.tolerance:g}, {s.newton_iterations} iterations, "
-            f"{s.breaking_rounds} breaking rounds): raise solver.load_steps or "
-            "solver.newton_iterations"
-        )
-    results = {
-        "steps": s.load_steps,
-        "iterations": result.iterations,
-        "residual": result.residual,
-        "residual_history": [step.residuals for step in result.steps],
-    }
-    if s.then is None:
-        return _record_equilibrium(case, setup, out, case_path, result.u, results, recorder, end)
-    state = _explicit_stage(setup, recorder, s.then, result.u, last["v"], end, s.load_steps + 1)
-    return _record_last(setup, recorder, state, results | {"steps": state.step, "time_s": state.time})
-
-
-def _explicit_stage(setup, recorder: Recorder, stage, u, v, time: float, first_step: int) -> State:
-    """Run ``stage`` (``ExplicitStage``) from displacement ``u`` and velocity ``v``
-    (n_points, 3; m, m/s) at ``time`` (s), its first state numbered ``first_step``, writing the
-    Exodus records due at its steps; its last state."""
-    stepper = ExplicitSolver(
-        setup.model,
-        setup.loading,
-        dt=stage.dt,
-        damage=setup.damage,
-        contact=setup.contact,
-        prescribed_velocity=stage.prescribed_velocity,
-    )
-    state = stepper.continued_state(u, v, time, first_step)
-    records = _ExodusRecords(recorder)
-    records.observe(state)
-    return stepper.run(state, stage.steps, [records])
-
-
-class _ExodusRecords:
-    """A time stepper's observer writing the Exodus records due at each step
-    (``RecorderSpec.exodus_due``)."""
-
-    def __init__(self, recorder: Recorder):
-        self.recorder = recorder
-
-    def observe(self, state: State, solver=None) -> None:
-        if self.recorder.spec.exodus_due(state.step):
-            self.recorder.write_exodus(state)
-
-
-def _load_step_records(recorder: Recorder, loading, step_time: float, last: dict):
-    """Newton's ``on_step`` writing the Exodus records that ``output.exodus`` asks at its load
-    steps (with the state at t = 0 first), as Peridigm's quasi-static solver writes them: the
-    load step as the step, velocity the displacement's change over the step's time
-    ``step_time`` (s), acceleration zero; at t = 0 the initial conditions. ``last`` (IN/OUT,
-    ``u`` and ``v``, (n_points, 3)) holds the last load step's displacement and velocity (an
-    Exodus file written at the end only gets no records here)."""
-    spec = recorder.spec
-    u0, v0, zero = (np.zeros((loading.body.n_points, 3)) for _ in range(3))
-    loading.apply_initial(u0, v0)
-    if spec.exodus_every is not None:
-        recorder.write_exodus(State(u0, v0, zero, 0.0, 0))
-    last["u"] = u0
-
-    def on_step(step, u):
-        k = int(round(step.time / step_time))
-        last["v"] = (u - last["u"]) / step_time
-        if spec.exodus_every is not None and spec.exodus_due(k):
-            recorder.write_exodus(State(u, last["v"], zero, step.time, k))
-        last["u"] = u.copy()
-
-    return on_step
+    if ctx.restart:
+        write_provenance(ctx.out, ctx.provenance())
+    if summary is not None:
+        write_summary(ctx.out, summary)
+    write_status(ctx.out, status)

@@ -30,9 +30,10 @@ from peridyn.analysis.convergence import ConvergenceError, richardson
 from peridyn.discretization.bonds import horizon_metres
 from peridyn.errors import CaseFileError, InputError
 from peridyn.io.case import load_case, parse_yaml
+from peridyn.io.job_files import write_summary
 from peridyn.io.results import Results
-from peridyn.jobs.run import RESULTS
 from peridyn.jobs.summary import finish_summary
+from peridyn.setup.recording import RESULTS
 
 #: The kinds of series a study can fit, see the module docstring.
 SERIES = ("delta-m", "delta", "m")
@@ -216,6 +217,7 @@ def run_levels(
         overwrite=overwrite,
         command=command,
         on_record=None if progress is None else report,
+        job_files_of_its_own=False,  # the study's folder: its own status, provenance and summary
     )
     case = load_case(case_path, overrides)
     return runs_from_dataset(load_sweep(summary["dataset"]), out, case), summary
@@ -409,7 +411,8 @@ def write_study(
     out: Path, runs: list[StudyRun], fits: list[dict], meta: dict, start: float, plots=()
 ) -> dict:
     """Write ``runs.csv`` (one row per run and mode), ``study.csv`` (one row per fit) and
-    ``study.json`` (everything); returns the JSON summary (docs/user-guide.md, "Summaries and
+    ``study.json`` (everything, also the output contract's ``summary.json``:
+    ``peridyn.io.job_files``); returns the JSON summary (docs/user-guide.md, "Summaries and
     results files"). ``start``: ``time.perf_counter()`` when the study started; ``plots``: the
     figures drawn."""
     out.mkdir(parents=True, exist_ok=True)
@@ -481,4 +484,5 @@ def write_study(
     }
     finish_summary(summary, "study", out, start, plots)
     (out / "study.json").write_text(json.dumps(summary, indent=1))
+    write_summary(out, summary)
     return summary

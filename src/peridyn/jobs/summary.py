@@ -1,4 +1,4 @@
-"""The keys every job summary shares (run, modal, fatigue and study).
+"""The keys every job summary shares (run, modal, fatigue, study and sweep).
 
 The schema of the summaries, these keys and each kind's own, is the table of docs/user-guide.md,
 "Summaries and results files"; ``peridyn.io.hdf5.SCHEMA_VERSION`` numbers it.
@@ -11,9 +11,10 @@ import time
 from pathlib import Path
 
 from peridyn.io.hdf5 import SCHEMA_VERSION
+from peridyn.physics.damage import damage_field
 
 #: The job kinds: the ``kind`` of their summaries.
-KINDS = ("run", "modal", "fatigue", "study")
+KINDS = ("run", "modal", "fatigue", "study", "sweep")
 
 
 def finish_summary(summary: dict, kind: str, out: Path, start: float, plots=()) -> dict:
@@ -47,3 +48,23 @@ def finish_summary(summary: dict, kind: str, out: Path, start: float, plots=()) 
 def peak_memory_bytes() -> int:
     """Peak resident memory of this process so far, bytes (Linux reports KiB)."""
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+
+
+def base_summary(setup) -> dict:
+    """Points, directed bonds, broken bonds and largest damage of the whole body of a built case
+    ``setup`` (``setup.build.Setup``; collective): the first keys of a run's summary."""
+    d = setup.domain
+    n = d.n_owned
+    phi = damage_field(setup.model)
+    if setup.storage == "lattice":  # one process
+        bonds, broken = setup.bonds.n_bonds, setup.bonds.n_broken()
+    else:
+        owned_bonds = int(setup.bonds.offsets[n])  # the owned points' families come first
+        bonds, broken = d.count(owned_bonds), d.count((~setup.bonds.intact[:owned_bonds]).sum())
+    return {
+        "points": setup.whole_body.n_points,
+        "bonds": bonds,
+        "broken_bonds": broken,
+        "max_damage": float(d.max(phi[:n].max())),
+        "storage": setup.storage,
+    }

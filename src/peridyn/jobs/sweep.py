@@ -15,11 +15,8 @@ is recorded and the sweep goes on; Ctrl-C stops starting runs and keeps every fi
 from __future__ import annotations
 
 import json
-import signal
-import threading
 import time
-from collections.abc import Iterator
-from contextlib import contextmanager
+from contextlib import nullcontext
 from pathlib import Path
 
 import numpy as np
@@ -27,7 +24,11 @@ import numpy as np
 from peridyn.errors import InputError, Interrupted
 from peridyn.io.case_schema import case_unit
 from peridyn.io.dataset import SeriesColumn, build_dataset, require_xarray, write_dataset
+from peridyn.io.job_files import job_files, write_summary
+from peridyn.io.provenance import provenance
 from peridyn.io.results import Results
+from peridyn.jobs.summary import finish_summary
+from peridyn.jobs.sweep_memory import check_sweep_memory
 from peridyn.jobs.sweep_run import (
     EXECUTORS,
     RunTask,
@@ -36,6 +37,7 @@ from peridyn.jobs.sweep_run import (
     run_tasks,
     run_threads,
 )
+from peridyn.jobs.sweep_signals import Signals
 from peridyn.jobs.sweep_spec import Sweep, expand
 
 #: The dataset file in a sweep's output folder.
@@ -72,40 +74,6 @@ class SweepInterrupted(Interrupted):
         )
 
 
-#: The jobs whose memory a sweep estimates before it starts (``jobs.estimate``), by command
-#: (None: the case's solver type); bloch runs build no body of the case's size.
-SWEEP_JOBS = {"run": None, "modal": "modal", "fatigue": "fatigue"}
-
-
-def check_sweep_memory(sweep: Sweep, workers: int) -> None:
-    """Refuse, before any run starts, a sweep whose ``workers`` runs at once would not fit in
-    memory: the largest run's peak (``jobs.estimate.estimate_case``) times the runs held at once,
-    against ``geometry.memory_limit``.
-
-    Raises
-    ------
-    InputError
-        Naming the largest run, its peak, the runs at once and the bytes available.
-    """
-    from peridyn.discretization.geometry import memory_limit
-    from peridyn.jobs.estimate import estimate_case
-
-    if sweep.spec.command not in SWEEP_JOBS or not sweep.runs:
-        return
-    job = SWEEP_JOBS[sweep.spec.command]
-    peaks = [estimate_case(run.case, sweep.base.parent, job).peak_bytes for run in sweep.runs]
-    largest = int(np.argmax(peaks))
-    at_once = min(workers, len(sweep.runs))
-    needed, available = peaks[largest] * at_once, memory_limit()
-    if needed > available:
-        run = sweep.runs[largest]
-        raise InputError(
-            f"{sweep.path}: run {run.index} ({run.parameters}) needs ~{peaks[largest] / 1e9:.3g} GB; "
-            f"{at_once} at once need ~{needed / 1e9:.3g} GB, more than the {available / 1e9:.3g} GB "
-            "available: fewer --workers, or a coarser discretization.spacing"
-        )
-
-
 def run_sweep(
     path,
     output_dir=None,
@@ -119,6 +87,7 @@ def run_sweep(
     first: int | None = None,
     on_record=None,
     threads: int | None = None,
+    job_files_of_its_own: bool = True,
 ) -> dict:
     """Run the sweep file ``path``; returns its summary.
 
@@ -150,6 +119,10 @@ def run_sweep(
         OpenMP). Default: ``cores // workers`` for processes and a local dask cluster, the
         process's own threads for serial, the workers' own setting on a ``scheduler``
         cluster (:func:`peridyn.jobs.sweep_run.run_threads`).
+    job_files_of_its_own : bool
+        Write the output contract's ``status.json``, ``provenance.json`` and ``summary.json``
+        (``peridyn.io.job_files``) in the output folder; False for a sweep that is part of
+        another job writing its own there (a convergence study: ``jobs.study.run_levels``).
 
     Returns
     -------
@@ -179,122 +152,87 @@ def run_sweep(
     if out.exists() and not out.is_dir():
         raise InputError(f"output folder {str(out)!r} is a file, not a folder: choose another --output")
     (out / "runs").mkdir(parents=True, exist_ok=True)
-    _write_manifest(sweep, out)
-    collector = Collector(sweep, out)
-    reference_dir = _reference(sweep, out, overwrite)
-    if reference_dir is not None:
-        collector.add_reference(Path(reference_dir))
-    tasks = []
-    for run in sweep.runs:
-        if not overwrite and collector.is_complete(run):
-            collector.skipped += 1
-            continue
-        tasks.append(
-            RunTask(
-                run.run_id,
-                run.index,
-                run.parameters,
-                run.case,
-                run.case_hash,
-                sweep.spec.command,
-                str(out / "runs" / run.run_id),
-                str(sweep.base.parent),
-                threads,
-                reference_dir,
-                tuple(sweep.spec.outputs.bloch),
+    with job_files(out, provenance(path)) if job_files_of_its_own else nullcontext():
+        _write_manifest(sweep, out)
+        collector = Collector(sweep, out)
+        reference_dir = _reference(sweep, out, overwrite)
+        if reference_dir is not None:
+            collector.add_reference(Path(reference_dir))
+        tasks = []
+        for run in sweep.runs:
+            if not overwrite and collector.is_complete(run):
+                collector.skipped += 1
+                continue
+            tasks.append(
+                RunTask(
+                    run.run_id,
+                    run.index,
+                    run.parameters,
+                    run.case,
+                    run.case_hash,
+                    sweep.spec.command,
+                    str(out / "runs" / run.run_id),
+                    str(sweep.base.parent),
+                    threads,
+                    reference_dir,
+                    tuple(sweep.spec.outputs.bloch),
+                )
             )
-        )
-    collector.write(final=True)  # every run pending or done: the dataset exists from the start
-    bar = progress(len(tasks)) if progress is not None and tasks else None
-    interrupted = None
-    signals = Signals()
+        collector.write(final=True)  # every run pending or done: the dataset exists from the start
+        bar = progress(len(tasks)) if progress is not None and tasks else None
+        interrupted = None
+        signals = Signals()
 
-    def on_done(record: dict) -> bool:
-        nonlocal interrupted
-        with signals.deferred():
-            collector.add(record)
-            if on_record is not None:
-                on_record(record)
-            if bar is not None:
-                bar.update(1)
-            if record["status"].startswith("interrupted"):
-                interrupted = record["status"].partition("(")[2].rstrip(")") or "SIGINT"
-                return False
-            collector.write(final=False)
-        return True
-
-    with signals:
-        try:
-            run_tasks(tasks, on_done, executor, workers, scheduler)
-        except KeyboardInterrupt:
-            interrupted = signals.name or "SIGINT"
-        finally:
+        def on_done(record: dict) -> bool:
+            nonlocal interrupted
             with signals.deferred():
+                collector.add(record)
+                if on_record is not None:
+                    on_record(record)
                 if bar is not None:
-                    bar.close()
-                collector.read_finished()  # runs that workers finished after the interrupt
-                collector.write(final=True)
-    counts = collector.counts()
-    if interrupted is not None:
-        raise SweepInterrupted(
-            interrupted, counts["completed"], len(sweep.runs), command or f"run_sweep({str(path)!r}, ...)"
-        )
-    figures = draw_figures(sweep, collector.dataset(), out)
-    return {
-        "sweep": sweep.name,
-        "runs": len(sweep.runs),
-        **counts,
-        "skipped": collector.skipped,
-        "seconds": time.perf_counter() - start,
-        "dataset": str(out / DATASET),
-        "output_dir": str(out),
-        "figures": [str(p) for p in figures],
-        "executor": executor,
-        "workers": 1 if executor == "serial" else workers,
-        "threads": threads,
-    }
+                    bar.update(1)
+                if record["status"].startswith("interrupted"):
+                    interrupted = record["status"].partition("(")[2].rstrip(")") or "SIGINT"
+                    return False
+                collector.write(final=False)
+            return True
 
-
-class Signals:
-    """SIGINT and SIGTERM while a sweep runs (in the main thread): each raises KeyboardInterrupt
-    where it arrives (``name`` says which), except within ``deferred()`` (the dataset being
-    written), where it is raised when the block ends. A run's time stepping installs its own
-    handlers (``peridyn.solvers.stepping``) and ends the run with ``Interrupted`` instead."""
-
-    def __init__(self):
-        self.name = None
-        self._depth = 0
-        self._pending = False
-        self._previous = {}
-
-    def __enter__(self):
-        if threading.current_thread() is threading.main_thread():
-            self._previous = {sig: signal.signal(sig, self._note) for sig in (signal.SIGINT, signal.SIGTERM)}
-        return self
-
-    def __exit__(self, *exc):
-        for sig, handler in self._previous.items():
-            signal.signal(sig, signal.SIG_DFL if handler is None else handler)
-        return False
-
-    def _note(self, signum, frame):
-        self.name = signal.Signals(signum).name
-        if self._depth:
-            self._pending = True
-        else:
-            raise KeyboardInterrupt
-
-    @contextmanager
-    def deferred(self) -> Iterator[None]:
-        """A block that a signal does not cut short."""
-        self._depth += 1
-        try:
-            yield
-        finally:
-            self._depth -= 1
-        if self._pending and not self._depth:
-            self._pending = False
-            raise KeyboardInterrupt
+        with signals:
+            try:
+                run_tasks(tasks, on_done, executor, workers, scheduler)
+            except KeyboardInterrupt:
+                interrupted = signals.name or "SIGINT"
+            finally:
+                with signals.deferred():
+                    if bar is not None:
+                        bar.close()
+                    collector.read_finished()  # runs that workers finished after the interrupt
+                    collector.write(final=True)
+        counts = collector.counts()
+        if interrupted is not None:
+            raise SweepInterrupted(
+                interrupted,
+                counts["completed"],
+                len(sweep.runs),
+                command or f"run_sweep({str(path)!r}, ...)",
+            )
+        figures = draw_figures(sweep, collector.dataset(), out)
+        summary = {
+            "sweep": sweep.name,
+            "runs": len(sweep.runs),
+            **counts,
+            "skipped": collector.skipped,
+            "dataset": str(out / DATASET),
+            "output_dir": str(out),
+            "figures": [str(p) for p in figures],
+            "executor": executor,
+            "workers": 1 if executor == "serial" else workers,
+            "threads": threads,
+        }
+        finish_summary(summary, "sweep", out, start, summary["figures"])
+        if job_files_of_its_own:
+            write_summary(out, summary)
+    return summary
 
 
 def _reference(sweep: Sweep, out: Path, overwrite: bool) -> str | None:

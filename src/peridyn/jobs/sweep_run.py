@@ -94,19 +94,14 @@ def execute(task: RunTask) -> dict:
 
 
 def _job(task: RunTask) -> dict:
-    """The job's summary (run and modal: ``run_case``; fatigue: ``run_fatigue_case``; bloch:
-    none), with the comparison with the reference and the Bloch prediction when asked."""
+    """The job's summary (run, modal, fatigue: ``jobs.dispatch.run_job``; bloch: none), with
+    the comparison with the reference and the Bloch prediction when asked."""
     Path(task.run_dir).mkdir(parents=True, exist_ok=True)
-    if task.command == "fatigue":
-        from peridyn.jobs.fatigue import run_fatigue_case
+    summary = {}
+    if task.command != "bloch":
+        from peridyn.jobs.dispatch import run_job
 
-        summary = run_fatigue_case(task.case, task.run_dir, base_dir=task.base_dir, overwrite=True)
-    elif task.command == "bloch":
-        summary = {}
-    else:
-        from peridyn.jobs.run import run_case
-
-        summary = run_case(task.case, task.run_dir, base_dir=task.base_dir, overwrite=True)
+        summary = run_job(task.command, task.case, task.run_dir, base_dir=task.base_dir, overwrite=True)
     if task.reference_dir is not None and task.command == "modal":
         from peridyn.jobs.modal import compare_with_run
 

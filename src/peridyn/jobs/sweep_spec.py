@@ -15,7 +15,7 @@ by its ``--set`` path (``material.E``, ``precracks.0.end.1``). docs/sweeps.md de
 format with examples.
 
 :func:`expand` turns a sweep file into its runs, each with its parameters, its validated case
-and its id (the case's hash, :func:`peridyn.jobs.run.case_identity`); every case is validated
+and its id (the case's hash, :func:`peridyn.setup.identity.case_identity`); every case is validated
 before anything runs.
 """
 
@@ -36,8 +36,8 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_valida
 from peridyn.errors import CaseFileError, InputError
 from peridyn.io.case import Case, apply_override, load_case, parse_yaml, validate_case, yaml_problem
 from peridyn.io.text_file import read_input_text
-from peridyn.jobs.run import case_identity
 from peridyn.physics.expressions import evaluate
+from peridyn.setup.identity import case_identity
 
 #: Characters of the case hash that name a run's folder.
 ID_LENGTH = 16

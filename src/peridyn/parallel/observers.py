@@ -37,7 +37,7 @@ class RootObservers:
 
     tensors : callable (u) -> dict of str to array, or None
         The rank's per-point tensor fields at its local displacement ``u`` (n_local, 3), m
-        (``peridyn.jobs.run.point_tensors``); None: none asked.
+        (``peridyn.setup.recording.point_tensors``); None: none asked.
 
     The observers are given by ``attach`` (they may take ``damage`` as their damage index and
     ``tensor_fields`` as their tensors).

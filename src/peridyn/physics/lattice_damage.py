@@ -61,7 +61,7 @@ class LatticeDamage:
     def update(self, u: np.ndarray, t: float | None = None) -> int:
         """Break every over-stretched breakable bond at displacement ``u`` (n_points, 3), m;
         returns the number of directed bonds broken. ``t`` (s) is that of ``BondDamage.update``:
-        the lattice's critical stretch does not change in time (``jobs.storage`` refuses one
+        the lattice's critical stretch does not change in time (``setup.storage`` refuses one
         that does)."""
         u = np.ascontiguousarray(u, dtype=np.float64)
         if self._u_ref is not None:

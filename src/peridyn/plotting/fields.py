@@ -19,10 +19,10 @@ from peridyn.io.results import Results  # noqa: E402
 COMPONENT_NAMES = ("x", "y", "z")
 
 
-def plot_run(directory, body: Body) -> list[Path]:
-    """Draw every figure the results support; returns the PNG paths written."""
-    directory = Path(directory)
-    results = Results(directory / "results.h5")
+def plot_run(results: Results, body: Body) -> list[Path]:
+    """Draw every figure the ``results`` of a run of ``body`` support, in the results' folder;
+    returns the PNG paths written."""
+    directory = Path(results.path).parent
     written = []
     series = results.series_names()
     if "sensor_u" in series:

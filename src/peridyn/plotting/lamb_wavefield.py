@@ -40,7 +40,7 @@ DYNAMIC_RANGE_DB = 40.0
 
 
 def plot_wavefield_snapshots(
-    results: str | os.PathLike,
+    results: Results | str | os.PathLike,
     path: str | os.PathLike,
     times,
     components: str = "xyz",
@@ -54,8 +54,8 @@ def plot_wavefield_snapshots(
 
     Parameters
     ----------
-    results : str or path-like
-        A ``results.h5``.
+    results : Results, str or path-like
+        A ``results.h5`` (``peridyn.io.results.Results`` or its path).
     path : str or path-like
         The PNG to write.
     times : sequence of float, s
@@ -71,7 +71,8 @@ def plot_wavefield_snapshots(
     -------
     Path
     """
-    points = Results(results).array("geometry/points")
+    results = Results.of(results)
+    points = results.array("geometry/points")
     layer, n_layers = _layers(points)
     shown = range(n_layers) if layers is None else [_layer_number(i, n_layers) for i in layers]
     columns = parse_components(components)
@@ -222,7 +223,7 @@ def plot_kxky_maps(
 
 
 def plot_through_thickness(
-    results: str | os.PathLike,
+    results: Results | str | os.PathLike,
     path: str | os.PathLike,
     time: float,
     center,
@@ -237,8 +238,8 @@ def plot_through_thickness(
 
     Parameters
     ----------
-    results : str or path-like
-        A ``results.h5`` of a plate.
+    results : Results, str or path-like
+        A ``results.h5`` of a plate (``peridyn.io.results.Results`` or its path).
     path : str or path-like
         The PNG to write.
     time : float, s
@@ -254,7 +255,8 @@ def plot_through_thickness(
     -------
     Path
     """
-    points = Results(results).array("geometry/points")
+    results = Results.of(results)
+    points = results.array("geometry/points")
     if points.shape[1] != 3:
         raise InputError("a through-thickness cut needs a 3D body")
     found, records = _records_near(results, series, [time])
@@ -397,7 +399,7 @@ def _records_near(results, series: str, times) -> tuple[np.ndarray, np.ndarray]:
     wanted = np.atleast_1d(np.asarray(times, dtype=float))
     best_gap = np.full(len(wanted), np.inf)
     found, records = np.zeros(len(wanted)), [None] * len(wanted)
-    for chunk_times, data in Results(results).iter_series(series, 1):
+    for chunk_times, data in Results.of(results).iter_series(series, 1):
         gap = np.abs(wanted - chunk_times[0])
         for i in np.flatnonzero(gap < best_gap):
             best_gap[i], found[i], records[i] = gap[i], chunk_times[0], data[0]

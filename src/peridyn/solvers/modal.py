@@ -17,7 +17,7 @@ with nu < 1/3, only needs more pivoting). Rigid-body modes
 counted and reported separately.
 
 Where the factor would be too large (wide horizons, large bodies; the choice is
-``jobs.modal.choose_eigensolver``), ``method="lobpcg"`` finds the same modes without
+``setup.eigensolver.choose_eigensolver``), ``method="lobpcg"`` finds the same modes without
 factorising anything (``solvers.eigen_iterative``).
 """
 

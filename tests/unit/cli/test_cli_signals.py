@@ -155,6 +155,7 @@ def test_a_disk_that_fills_during_a_run_ends_it_cleanly(small_disk):
     """A full disk during a run: segfault (exit 139), tracebacks, status stuck at ``running``.
     Now exit 1 with one line, the records held written, the status saying so, the file
     readable (its checksums agree)."""
+    from peridyn.io.outdir import read_status
     from peridyn.io.results import Results
 
     out = small_disk / "out"
@@ -169,7 +170,15 @@ def test_a_disk_that_fills_during_a_run_ends_it_cleanly(small_disk):
     results = Results(out / "results.h5")
     assert results.status().startswith(f"failed: {os.strerror(28)} ({out}/")
     assert results.n_records("sensor_u") == 16  # every 2 steps from 0 to 30: none lost
-    assert sorted(p.name for p in out.iterdir()) == ["results.h5", "run.log", "snapshots", "snapshots.pvd"]
+    assert sorted(p.name for p in out.iterdir()) == [
+        "provenance.json",
+        "results.h5",
+        "run.log",
+        "snapshots",
+        "snapshots.pvd",
+        "status.json",
+    ]
+    assert read_status(out) == results.status()  # the output contract's status says the same
 
 
 def test_a_run_ends_cleanly_on_an_injected_enospc(tmp_path, capsys, monkeypatch):

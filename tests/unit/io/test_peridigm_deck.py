@@ -17,9 +17,9 @@ from peridyn.io.case import load_case, validate_case
 from peridyn.io.exodus import read_exodus
 from peridyn.io.peridigm_case import convert_deck, deck_case, load_deck
 from peridyn.io.peridigm_deck import is_peridigm_deck, read_deck
-from peridyn.jobs.build import build
 from peridyn.physics.materials.elastic import bulk_modulus, shear_modulus
 from peridyn.physics.timefunctions import from_spec
+from peridyn.setup.build import build
 
 DATA = Path(__file__).parents[2] / "data" / "peridigm"
 WAVE = DATA / "WaveInBar.xml"

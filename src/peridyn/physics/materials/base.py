@@ -89,7 +89,7 @@ class Model:
     #: the class; a bound model answers :attr:`has_dilatation` from its linearisation).
     state_based = False
     #: Bytes per directed bond of the model's own arrays in float64 (the memory estimate of a
-    #: case, ``jobs.estimate``): PMB 1/length, stiffness and surface factor; LPS weight,
+    #: case, ``setup.estimate``): PMB 1/length, stiffness and surface factor; LPS weight,
     #: deviatoric coefficient and the shear factor's share.
     bond_bytes = 24.0
     #: The ``surface_correction`` names the material takes (case key ``material.surface_correction``).
@@ -177,7 +177,7 @@ class Model:
     @classmethod
     def family_stiffness_bound(cls, family: PointFamily, E, nu) -> float:
         """Block-Gershgorin bound B (N/m^5 in 3D) of the stiffness row of a point whose bonds
-        are ``family``, the continuum form of :meth:`stiffness_bound` (``jobs.stable_step``:
+        are ``family``, the continuum form of :meth:`stiffness_bound` (``setup.stable_step``:
         dt = 2 / sqrt(B / rho)). ``E`` (Pa) and ``nu`` are sequences, one value per material of
         the body (its blocks); the bound holds for all of them.
 

@@ -3,7 +3,7 @@
 What a material class answers from it (``Model.plane_wave_coefficients``,
 ``Model.family_stiffness_bound``): the plane-wave dispersion of an infinite medium
 (``peridyn.analysis.dispersion``) and the continuum stable step that ``peridyn validate``
-estimates from a case alone (``peridyn.jobs.stable_step``).
+estimates from a case alone (``peridyn.setup.stable_step``).
 """
 
 from __future__ import annotations

@@ -21,9 +21,9 @@ import numpy as np
 
 from peridyn.errors import InputError
 from peridyn.io.case import Case
-from peridyn.jobs.build import Setup, block_index
 from peridyn.physics.materials.elastic import bulk_modulus
 from peridyn.physics.materials.registry import model_class
+from peridyn.setup.build import Setup, block_index
 
 
 def peridigm_stable_step(case: Case, setup: Setup) -> float:

@@ -33,7 +33,6 @@ from peridyn.discretization.pairs import index_bandwidth, row_blocks
 from peridyn.errors import CaseFileError, InputError
 from peridyn.io import exodus, mesh_text
 from peridyn.io.case import Case, Geometry, Region, box_cells
-from peridyn.jobs.storage import choose_storage
 from peridyn.parallel.contact import RankContact
 from peridyn.parallel.domain import Domain, agree
 from peridyn.parallel.halo import Halo, clearance, ghost_layers, plan_halo
@@ -48,6 +47,7 @@ from peridyn.physics.materials.blocks import BlockMaterial, assign_blocks, make_
 from peridyn.physics.materials.lattice import make_lattice_model
 from peridyn.physics.timefunctions import from_spec
 from peridyn.physics.transducers import pin_force_actuator, pzt_radial_actuator
+from peridyn.setup.storage import choose_storage
 
 #: What ``Interrupted`` says a job was doing when it stopped during ``build``.
 BUILDING = "building the model"
@@ -491,7 +491,7 @@ def build(case: Case, base_dir=".", comm=None) -> Setup:
 
 
 def build_on_lattice(case: Case, body: Body, actuation=()) -> Setup:
-    """The Setup of a case on lattice storage (``jobs.storage``): the body's lattice with the
+    """The Setup of a case on lattice storage (``setup.storage``): the body's lattice with the
     pre-cracks cut, the material and damage on it (``setup.bonds`` is the lattice)."""
     lattice = build_lattice(
         body, case_horizon(case, body), case.discretization.influence, case.discretization.partial_volumes

@@ -33,8 +33,8 @@ import numpy as np
 
 from peridyn.discretization.bonds import influence_function
 from peridyn.io.case import Case
-from peridyn.jobs.estimate import grid_shape, neighbour_offsets
 from peridyn.physics.materials.family import PointFamily
+from peridyn.setup.estimate import grid_shape, neighbour_offsets
 
 #: The estimate is at most this much longer than ``critical_time_step`` on the shipped cases.
 STEP_MARGIN = 0.15

@@ -27,7 +27,7 @@ import numpy as np
 from peridyn.discretization import geometry
 from peridyn.errors import CaseFileError, InputError
 from peridyn.io.case import Case
-from peridyn.jobs.storage import lattice_refusals
+from peridyn.setup.storage import lattice_refusals
 
 #: Resident bytes of the interpreter with numpy, scipy, numba (and its loaded kernels), h5py
 #: and peridyn imported, before the first array: measured with ``/usr/bin/time -v`` on a
@@ -208,7 +208,7 @@ def grid_shape(case: Case, base_dir=".") -> tuple[np.ndarray, np.ndarray, int]:
             return np.array([*xy, g.layers]), np.array([h, h, dz]), 3
     except InputError as exc:
         raise CaseFileError(case.name, "discretization.spacing", d.spacing, str(exc)) from None
-    from peridyn.jobs.build import mesh_body
+    from peridyn.setup.build import mesh_body
 
     body = mesh_body(g, base_dir)
     return np.array([body.n_points, 1, 1]), np.array([body.spacing] * 3), g.dimension
@@ -219,7 +219,7 @@ def kept_share(case: Case, counts: np.ndarray, base_dir=".") -> float:
     measured on a copy of the body at a spacing giving about ``REMOVAL_SAMPLE_POINTS``."""
     if not case.removals or case.geometry.is_mesh:
         return 1.0
-    from peridyn.jobs.build import build_points
+    from peridyn.setup.build import build_points
 
     coarsen = max(1.0, (float(np.prod(counts)) / REMOVAL_SAMPLE_POINTS) ** (1 / 3))
     d = case.discretization
@@ -259,17 +259,17 @@ def estimate_case(case: Case, base_dir=".", job: str | None = None) -> Estimate:
 
 
 def runs_on_lattice(case: Case) -> bool:
-    """Whether ``discretization.storage`` puts the case on lattice storage (``jobs.storage``):
+    """Whether ``discretization.storage`` puts the case on lattice storage (``setup.storage``):
     ``lattice``, or ``auto`` where nothing needs bond lists (a box, plate or rectangle is a grid)."""
     return case.discretization.storage != "bonds" and not lattice_refusals(case)
 
 
 def modal_factor_bytes(case: Case, base_dir, points: float, horizon: float) -> float:
-    """Bytes of the shift-invert factor when ``jobs.modal.choose_eigensolver`` would pick it
+    """Bytes of the shift-invert factor when ``setup.eigensolver.choose_eigensolver`` would pick it
     (0 for LOBPCG, which factorises nothing)."""
-    from peridyn.jobs.build import build_points
-    from peridyn.jobs.modal import FACTOR_BUDGET, MEMORY_SHARE
     from peridyn.linalg.ordering import estimated_factor_entries
+    from peridyn.setup.build import build_points
+    from peridyn.setup.eigensolver import FACTOR_BUDGET, MEMORY_SHARE
 
     method = case.solver.eigensolver
     if method == "lobpcg" or (method == "auto" and points * 24 > FACTOR_BUDGET):
