@@ -1,4 +1,4 @@
-"""The keys every job summary shares (run, modal, fatigue and study).
+"""The keys every job summary shares (run, modal, fatigue, study and monitor).
 
 The schema of the summaries, these keys and each kind's own, is the table of docs/user-guide.md,
 "Summaries and results files"; ``peridyn.io.hdf5.SCHEMA_VERSION`` numbers it.
@@ -13,7 +13,7 @@ from pathlib import Path
 from peridyn.io.hdf5 import SCHEMA_VERSION
 
 #: The job kinds: the ``kind`` of their summaries.
-KINDS = ("run", "modal", "fatigue", "study")
+KINDS = ("run", "modal", "fatigue", "study", "monitor")
 
 
 def finish_summary(summary: dict, kind: str, out: Path, start: float, plots=()) -> dict:
