@@ -20,7 +20,7 @@ from peridyn.jobs.monitor_plan import (
     removed_case,
 )
 
-TINY = Path(__file__).parents[1] / "data" / "monitor_tiny"
+TINY = Path(__file__).parents[2] / "cases" / "monitoring"
 
 
 def test_schedule_takes_the_baseline_each_growth_step_each_cycle_mark_and_the_end():
@@ -57,7 +57,9 @@ def test_the_crack_at_a_cycle_is_the_final_path_from_the_start_cut_to_the_crack_
 
 
 def test_a_cut_crack_becomes_through_thickness_rectangles_and_removed_points_boxes():
-    wave = network_case(load_monitor_case(TINY / "monitor.yaml")[0], load_case(TINY / "wave.yaml"), 0)
+    wave = network_case(
+        load_monitor_case(TINY / "monitor_small.yaml")[0], load_case(TINY / "monitor_small_wave.yaml"), 0
+    )
     crack = np.array([[0.020, 0.020], [0.022, 0.020], [0.024, 0.021]])
     cut = cut_case(wave, "cut", crack)
     added = cut.precracks[len(wave.precracks) :]
@@ -86,6 +88,6 @@ def test_a_cut_crack_becomes_through_thickness_rectangles_and_removed_points_box
 )
 def test_a_bad_monitoring_case_gets_one_line_naming_its_key(setting, key):
     with pytest.raises(CaseFileError) as err:
-        load_monitor_case(TINY / "monitor.yaml", [setting])
+        load_monitor_case(TINY / "monitor_small.yaml", [setting])
     message = str(err.value)
     assert "\n" not in message and key in message
