@@ -86,7 +86,7 @@ def run_monitor(
     root = not parallel or comm.rank == 0
     out = Path(output_dir or mon.output.directory or Path("peridyn-out") / mon.name)
     if root:
-        prepare_output(out, SUMMARY, overwrite, restart=not overwrite)
+        prepare_output(out, SUMMARY, overwrite, restartable=False)
     with json_job_status(out) if root else nullcontext(), run_log(out, root):
         history = _fatigue(fatigue, base / mon.fatigue_case, out / "fatigue", overwrite, comm)
         plan = _plan(mon, fatigue, wave, history)

@@ -66,11 +66,11 @@ def assess(mon, wave, plan, data: dict) -> dict:
         "index": mon.processing.index,
         "noise_level": level,
         "crossed_paths": [f"t{i}-t{j}" for i, j in plan.paths[out["crossed"]]],
-        **_trend(chosen, plan.crack_length, out["crossed"]),
+        **trend_figures(chosen, plan.crack_length, out["crossed"]),
         "image_peak_error_max_m": _max_or_none(out["image_peak_error"][plan.crack_length > 0]),
     }
     if level:
-        block["noise_free"] = _trend(
+        block["noise_free"] = trend_figures(
             out[f"{INDEX_NAMES[mon.processing.index]}_noise_free"], plan.crack_length, out["crossed"]
         )
     if data["removed"] is not None:
@@ -80,7 +80,7 @@ def assess(mon, wave, plan, data: dict) -> dict:
     return out
 
 
-def _trend(index: np.ndarray, crack_length: np.ndarray, crossed: np.ndarray) -> dict:
+def trend_figures(index: np.ndarray, crack_length: np.ndarray, crossed: np.ndarray) -> dict:
     """Spearman's rank correlation of each crossed path's index with the crack length (min over
     them), and whether every crossed path's index exceeds every uncrossed one's at each
     interrogation after the crack first grew."""
