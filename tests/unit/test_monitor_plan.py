@@ -30,6 +30,8 @@ def test_schedule_takes_the_baseline_each_growth_step_each_cycle_mark_and_the_en
     assert interrogation_steps(cycles, a, every_growth=1e-3).tolist() == [0, 4, 6, 8, 10]
     # cycle marks every 4000: the last step at or before 4000 and 8000
     assert interrogation_steps(cycles, a, every_cycles=4000).tolist() == [0, 4, 8, 10]
+    # until 2 mm: the history ends at the first step with a >= 2 mm (k 6)
+    assert interrogation_steps(cycles, a, every_growth=1e-3, until=2e-3).tolist() == [0, 4, 6]
     # at most 3: the baseline, the first other one, the last
     assert interrogation_steps(cycles, a, every_growth=1e-3, most=3).tolist() == [0, 4, 10]
 

@@ -55,10 +55,14 @@ class Transducers(Strict):
 
 class Schedule(Strict):
     """When the structure is interrogated: at 0 cycles (the baseline, always), then every
-    ``every_cycles`` cycles and/or every ``every_crack_growth`` of crack growth, and at the end."""
+    ``every_cycles`` cycles and/or every ``every_crack_growth`` of crack growth, and at the end of
+    the fatigue life, or at the first step whose crack reaches ``until_crack_length``."""
 
     every_cycles: Positive | None = described(None, "cycles between interrogations")
     every_crack_growth: Positive | None = described(None, "crack growth between interrogations", "m")
+    until_crack_length: Positive | None = described(
+        None, "the last interrogation: the first step whose crack is at least this long", "m"
+    )
     max_interrogations: Annotated[int, NotBool, Field(ge=2, le=100)] = described(
         20, "most interrogations, the baseline included"
     )

@@ -174,7 +174,12 @@ class Plan:
         self.tip = f.tip
         self.spacing = fatigue.discretization.spacing
         self.steps = interrogation_steps(
-            history.cycles, history.crack_length, s.every_cycles, s.every_crack_growth, s.max_interrogations
+            history.cycles,
+            history.crack_length,
+            s.every_cycles,
+            s.every_crack_growth,
+            s.max_interrogations,
+            s.until_crack_length,
         )
         self.cycles = history.cycles[self.steps]
         self.crack_length = history.crack_length[self.steps]
@@ -262,6 +267,7 @@ def _run(tasks: dict, executor, workers, scheduler, overwrite: bool, comm) -> No
         logger.info(f"interrogation run {record['run_id']}: {record['status']} ({record['seconds']:.1f} s)")
         if record["status"] != "complete":
             failed.append(f"{record['run_id']}: {record['error'] or record['status']}")
+        interrupts.check()  # SIGINT/SIGTERM: no more runs start, the finished ones are kept
         return not failed
 
     if comm is not None and comm.size > 1:

@@ -48,14 +48,18 @@ class FatigueHistory:
 
 
 def interrogation_steps(
-    cycles, crack_length, every_cycles=None, every_growth=None, most: int = 20
+    cycles, crack_length, every_cycles=None, every_growth=None, most: int = 20, until=None
 ) -> np.ndarray:
     """Indices into the fatigue history of the interrogations: 0 (the baseline), the last step at
     or before each multiple of ``every_cycles``, the first step at which the crack grew by
-    ``every_growth`` (m) since the last interrogation, and the last step; at most ``most``
-    (the baseline, the first ``most - 2`` others and the last step)."""
+    ``every_growth`` (m) since the last interrogation, and the last step (the first whose crack
+    reaches ``until``, m, when it is given and reached); at most ``most`` (the baseline, the
+    first ``most - 2`` others and the last step)."""
     cycles = np.asarray(cycles, dtype=float)
     a = np.asarray(crack_length, dtype=float)
+    if until is not None and np.any(a >= until):
+        end = int(np.argmax(a >= until)) + 1
+        cycles, a = cycles[:end], a[:end]
     chosen = {0, len(cycles) - 1}
     if every_cycles is not None:
         marks = np.arange(every_cycles, cycles[-1] + 0.5 * every_cycles, every_cycles)
