@@ -183,7 +183,7 @@ class Plan:
         )
         self.cycles = history.cycles[self.steps]
         self.crack_length = history.crack_length[self.steps]
-        self.whole = grown_crack(history, self.spacing, f.tip)
+        self.whole = grown_crack(history, self.spacing, f.tip, self.cycles[-1])
         self.cracks = [crack_at(self.whole, a) for a in self.crack_length]
         self.transducers = np.asarray(mon.transducers.centers, dtype=float)
         self.paths = network_paths(len(self.transducers))

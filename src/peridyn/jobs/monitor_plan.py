@@ -3,9 +3,10 @@ crack at each of them, and the wave cases of the body so damaged (the damage tra
 
 The fatigue runs on a plane-stress (2D) model of the plate; its history (cycles, crack length)
 and final damage field (with each point's first-break cycle) give the crack at any cycle: the
-final crack path (``peridyn.analysis.crack``) from the crack's start (``fatigue.tip.start``), cut
-to the crack length of that cycle. The wave case is the 3D plate on the same in-plane grid; a
-crack reaches it in one of two ways (docs/monitoring.md, "Damage transfer"):
+crack path (``peridyn.analysis.crack``) of the points broken by the last interrogation, from the
+crack's start (``fatigue.tip.start``), cut to the crack length of that cycle. The wave case is
+the 3D plate on the same in-plane grid; a crack reaches it in one of two ways (docs/monitoring.md,
+"Damage transfer"):
 
 - ``cut`` (the interrogations): the crack polyline becomes through-thickness pre-crack
   rectangles, one per polyline segment, that cut every bond crossing them;
@@ -76,19 +77,23 @@ def interrogation_steps(
     return np.array(steps, dtype=int)
 
 
-def grown_crack(history: FatigueHistory, spacing: float, tip) -> np.ndarray | None:
-    """(m, 2) polyline (m) of the whole crack the fatigue grew, from ``tip.start`` along
-    ``tip.axis`` in ``tip.sense`` (the fatigue case's ``FatigueTip``); None without one."""
+def grown_crack(history: FatigueHistory, spacing: float, tip, cycles: float = np.inf) -> np.ndarray | None:
+    """(m, 2) polyline (m) of the crack the fatigue grew by ``cycles`` (the points that lost a
+    bond by then, at their final damage), from ``tip.start`` along ``tip.axis`` in ``tip.sense``
+    (the fatigue case's ``FatigueTip``): of the crack paths, the one that comes nearest to the
+    start along the axis; None without one."""
     if tip.axis not in AXIS or tip.start is None:
         raise InputError(
             "a monitored fatigue case needs fatigue.tip.axis x or y and tip.start (the notch root)"
         )
-    paths = crack_paths(history.points, history.damage, spacing, threshold=tip.damage)
+    phi = np.where(history.first_break <= cycles, history.damage, 0.0)
+    paths = crack_paths(history.points, phi, spacing, threshold=tip.damage)
     if not paths:
         return None
-    line = paths[0].points
+    axis = AXIS[tip.axis]
+    line = min(paths, key=lambda p: np.abs(p.points[:, axis] - tip.start).min()).points
     sense = 1.0 if tip.sense == "+" else -1.0
-    ahead = (line[:, AXIS[tip.axis]] - tip.start) * sense
+    ahead = (line[:, axis] - tip.start) * sense
     if sense < 0:
         line, ahead = line[::-1], ahead[::-1]
     inside = np.flatnonzero(ahead > 0)
@@ -100,7 +105,7 @@ def grown_crack(history: FatigueHistory, spacing: float, tip) -> np.ndarray | No
         first = line[k - 1] + w * (line[k] - line[k - 1])
     else:
         first = line[0].copy()
-        first[AXIS[tip.axis]] = tip.start
+        first[axis] = tip.start
     return np.vstack([first, line[k:]])
 
 

@@ -26,6 +26,7 @@ def plot_indices(cycles, crack_length, index, labels, crossed, path, name="damag
         left.plot(cycles, index[:, p], style, label=label + (" (crossed)" if crossed[p] else ""))
         right.plot(1e3 * np.asarray(crack_length), index[:, p], style)
     left.set_xlabel("cycles N")
+    left.ticklabel_format(axis="x", style="sci", scilimits=(0, 0))
     right.set_xlabel("crack length a (mm)")
     for ax in (left, right):
         ax.set_ylabel(name)
