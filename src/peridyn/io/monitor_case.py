@@ -84,19 +84,28 @@ class Noise(Strict):
 class Processing(Strict):
     """Windows, images and the crack threshold of the signal processing."""
 
+    modes: Annotated[list[str], Field(min_length=1)] = described(
+        ["S0"], "Lamb modes whose direct packets the windows hold (S0: the first arrival; S0 and A0)"
+    )
     window_padding: NonNegative = described(
-        0.5, "window length after the slowest direct packet, in burst durations"
+        0.0, "window length after the slowest direct packet, in burst durations"
     )
     rapid_beta: Annotated[float, NotBool, Field(gt=1, allow_inf_nan=False)] = described(
         1.05, "RAPID ellipse size (path-length ratio of its rim)"
     )
     image_spacing: Positive = described(0.5e-3, "pixel size of the damage images", "m")
+    peak_exclusion: NonNegative | None = described(
+        None, "no image peak within this distance of a transducer (default: twice the patch size)", "m"
+    )
     index: str = described(
         "correlation", "index the image and the checks use: correlation or residual_energy"
     )
 
     @model_validator(mode="after")
     def _index(self):
+        unknown = sorted(set(self.modes) - {"S0", "A0"})
+        if unknown:
+            raise ValueError(f"modes: S0 and/or A0, got {unknown[0]!r}")
         if self.index not in ("correlation", "residual_energy"):
             raise ValueError(f"index: correlation or residual_energy, got {self.index!r}")
         return self

@@ -33,7 +33,8 @@ def assess(mon, wave, plan, data: dict) -> dict:
     summary block)
     """
     m, t = wave.material, mon.transducers
-    velocities = fundamental_group_velocities(m.E, m.nu, m.density, wave.geometry.size[2], t.frequency)
+    fundamental = fundamental_group_velocities(m.E, m.nu, m.density, wave.geometry.size[2], t.frequency)
+    velocities = {mode: fundamental[mode] for mode in mon.processing.modes}
     distances = path_lengths(plan.transducers, plan.paths)
     windows = arrival_windows(
         distances, velocities.values(), t.cycles / t.frequency, mon.processing.window_padding
@@ -102,6 +103,9 @@ def _images(mon, wave, plan, index: np.ndarray) -> dict:
     """RAPID images of each interrogation on the plate, their peaks and the peaks' distances
     from the crack's centre (NaN before the crack grows)."""
     step = mon.processing.image_spacing
+    exclusion = mon.processing.peak_exclusion
+    if exclusion is None:
+        exclusion = 2 * mon.transducers.size
     lx, ly = wave.geometry.size[:2]
     x = np.arange(0.5 * step, lx, step)
     y = np.arange(0.5 * step, ly, step)
@@ -109,7 +113,7 @@ def _images(mon, wave, plan, index: np.ndarray) -> dict:
     for k, crack in enumerate(plan.cracks):
         image = rapid_image(plan.transducers, plan.paths, index[k], x, y, mon.processing.rapid_beta)
         images.append(image)
-        peaks.append(image_peak(x, y, image) if k > 0 else np.full(2, np.nan))
+        peaks.append(image_peak(x, y, image, plan.transducers, exclusion) if k > 0 else np.full(2, np.nan))
         centres.append(polyline_centre(crack) if crack is not None else np.full(2, np.nan))
     peaks, centres = np.array(peaks), np.array(centres)
     return {

@@ -106,3 +106,16 @@ def test_paths_crossed_by_a_crack_and_the_crack_cut_to_a_length():
     assert polyline_length(bent) == pytest.approx(0.03)
     np.testing.assert_allclose(truncated(bent, 0.02), [[0.0, 0.0], [0.01, 0.0], [0.01, 0.01]], atol=1e-15)
     np.testing.assert_allclose(polyline_centre(bent), [0.01, 0.005], atol=1e-15)
+
+
+def test_the_image_peak_is_sought_away_from_the_transducers():
+    # all three paths of transducer 0 changed: the image is largest on transducer 0 itself
+    # (weight 1 from each path); away from it the peak is on its paths' common ellipses
+    xy = np.array([[0.0, 0.0], [0.1, 0.0], [0.0, 0.1], [0.1, 0.1]])
+    paths = network_paths(4)
+    di = np.where(paths[:, 0] == 0, 1.0, 0.0)
+    x = y = np.linspace(0.0, 0.1, 101)
+    image = rapid_image(xy, paths, di, x, y)
+    np.testing.assert_allclose(image_peak(x, y, image), [0.0, 0.0], atol=1e-12)
+    far = image_peak(x, y, image, xy, 0.01)
+    assert np.min(np.hypot(*(xy - far).T)) > 0.01

@@ -60,10 +60,19 @@ def rapid_image(transducers, paths, indices, x, y, beta: float = 1.05) -> np.nda
     return image
 
 
-def image_peak(x, y, image) -> np.ndarray:
-    """(2,) position (m) of the largest pixel of ``image`` ((ny, nx) on grid lines ``x``, ``y``)."""
+def image_peak(x, y, image, transducers=(), exclusion: float = 0.0) -> np.ndarray:
+    """(2,) position (m) of the largest pixel of ``image`` ((ny, nx) on grid lines ``x``, ``y``)
+    farther than ``exclusion`` (m) from every one of ``transducers`` ((n, 2), m). Every path
+    from a transducer has weight 1 there, so a RAPID image peaks on a transducer whose paths
+    changed together, wherever the damage is."""
     image = np.asarray(image, dtype=float)
     if image.shape != (len(y), len(x)):
         raise InputError(f"image must be (len(y), len(x)) = {(len(y), len(x))}, got {image.shape}")
-    row, col = np.unravel_index(np.argmax(image), image.shape)
+    gx, gy = np.meshgrid(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
+    allowed = np.ones(image.shape, dtype=bool)
+    for tx, ty in np.asarray(transducers, dtype=float).reshape(-1, 2):
+        allowed &= np.hypot(gx - tx, gy - ty) > exclusion
+    if not allowed.any():
+        raise InputError(f"no image pixel lies farther than {exclusion} m from every transducer")
+    row, col = np.unravel_index(np.argmax(np.where(allowed, image, -np.inf)), image.shape)
     return np.array([float(x[col]), float(y[row])])
