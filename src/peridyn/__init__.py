@@ -24,6 +24,7 @@ _PUBLIC = {
     "load_sweep": "peridyn.io.dataset",
     "run_case": "peridyn.jobs.run",
     "run_sweep": "peridyn.jobs.sweep",
+    "run_monitor": "peridyn.jobs.monitor",
     "BondDamage": "peridyn.physics.damage",
     "damage_field": "peridyn.physics.damage",
     "BoundaryCondition": "peridyn.physics.loads",
@@ -80,5 +81,6 @@ __all__ = [
     "make_model",
     "relax",
     "run_case",
+    "run_monitor",
     "run_sweep",
 ]

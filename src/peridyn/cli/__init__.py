@@ -40,6 +40,7 @@ COMMAND_MODULES = (
     "peridyn.cli.fatigue_cmd",
     "peridyn.cli.study_cmd",
     "peridyn.cli.sweep_cmd",
+    "peridyn.cli.monitor_cmd",
 )
 
 

@@ -33,7 +33,13 @@ def run(args) -> dict:
 
     out = Path(args.run_dir)
     h5 = out / "results.h5"
-    redraw = {"fatigue": _fatigue, "study": _study, "sweep": _sweep}.get(job_kind(out))
+    kind = job_kind(out)
+    if kind == "monitor":
+        raise InputError(
+            f"{str(out)!r} is a monitoring job's folder: its figures are drawn by the job "
+            "(peridyn monitor); peridyn plot does not redraw them"
+        )
+    redraw = {"fatigue": _fatigue, "study": _study, "sweep": _sweep}.get(kind)
     if redraw is not None:
         paths = [str(p) for p in redraw(out)]
         if not args.json:

@@ -1,4 +1,4 @@
-"""The keys every job summary shares (run, modal, fatigue, study and sweep).
+"""The keys every job summary shares (run, modal, fatigue, study, sweep and monitor).
 
 The schema of the summaries, these keys and each kind's own, is the table of docs/user-guide.md,
 "Summaries and results files"; ``peridyn.io.hdf5.SCHEMA_VERSION`` numbers it.
@@ -14,7 +14,7 @@ from peridyn.io.hdf5 import SCHEMA_VERSION
 from peridyn.physics.damage import damage_field
 
 #: The job kinds: the ``kind`` of their summaries.
-KINDS = ("run", "modal", "fatigue", "study", "sweep")
+KINDS = ("run", "modal", "fatigue", "study", "sweep", "monitor")
 
 
 def finish_summary(summary: dict, kind: str, out: Path, start: float, plots=()) -> dict:

@@ -1,0 +1,333 @@
+"""The monitoring job (``peridyn monitor CASE.yaml``, docs/monitoring.md): a fatigue life and, at
+the interrogation points of its schedule, a pitch-catch interrogation of the damaged plate by a
+PZT network; damage indices, images and the dataset of the whole life.
+
+1. The fatigue case runs once (``peridyn.jobs.fatigue.run_fatigue_case``, in ``fatigue/``).
+2. Its history gives the interrogation points and the crack at each (``peridyn.jobs.monitor_plan``).
+3. Each interrogation fires every transducer in turn on the wave case with the crack cut into it
+   (``peridyn.run_case``, one run per actuator in ``interrogations/kNN_tI/``), through the sweep
+   executors (serial, processes, dask); a run whose folder holds a complete record of the same
+   case is not run again, so an interrupted job resumes where it stopped. Under ``mpiexec -n N``
+   the runs go one after the other, each on all ranks.
+4. The signals are compared with the baseline's (``peridyn.jobs.monitor_assess``) and written as
+   one dataset with figures and the summary (``peridyn.jobs.monitor_output``).
+"""
+
+from __future__ import annotations
+
+import csv
+import logging
+import time
+from contextlib import nullcontext
+from pathlib import Path
+
+import numpy as np
+
+from peridyn import interrupts
+from peridyn.analysis.shm.paths import network_paths
+from peridyn.errors import CaseFileError, InputError
+from peridyn.io.case import Case, load_case, validate_case
+from peridyn.io.job_files import job_files
+from peridyn.io.monitor_case import MonitorCase, load_monitor_case
+from peridyn.io.outdir import prepare_output
+from peridyn.io.provenance import provenance
+from peridyn.io.results import Results
+from peridyn.io.run_log import run_log
+from peridyn.jobs.monitor_plan import (
+    FatigueHistory,
+    crack_at,
+    cut_case,
+    grown_crack,
+    interrogation_steps,
+    removed_case,
+)
+from peridyn.jobs.sweep_run import RunTask, read_record, run_tasks, run_threads
+from peridyn.setup.identity import case_identity
+
+logger = logging.getLogger(__name__)
+
+#: The job's summary file in its output folder (its presence: a finished job).
+SUMMARY = "monitor.json"
+
+
+@interrupts.deferred()
+def run_monitor(
+    case_path,
+    output_dir=None,
+    overrides=(),
+    executor: str = "serial",
+    workers: int = 1,
+    scheduler: str | None = None,
+    threads: int | None = None,
+    overwrite: bool = False,
+    comm=None,
+) -> dict:
+    """Run a monitoring case file; returns the summary (``monitor.json``; its ``monitoring``
+    block: docs/monitoring.md).
+
+    Parameters
+    ----------
+    case_path : path
+        The monitoring case file (``peridyn.io.monitor_case``).
+    output_dir : path or None
+        Output folder (default: the case's ``output.directory`` or ``peridyn-out/<name>``).
+    overrides : sequence of "key.path=value"
+        Changes to the monitoring case before validation.
+    executor, workers, scheduler, threads
+        How the interrogation runs are run (``peridyn.jobs.sweep_run.run_tasks``).
+    overwrite : bool
+        Redo every run; otherwise a folder's finished fatigue and interrogation runs are kept
+        (the job resumes) and only a finished job's folder is refused.
+    comm : communicator or None
+        ``peridyn.parallel.comm.world()`` under ``mpiexec -n N`` (N > 1).
+    """
+    start = time.perf_counter()
+    mon, base = load_monitor_case(case_path, overrides)
+    fatigue, wave = _cases(mon, base, case_path)
+    parallel = comm is not None and comm.size > 1
+    root = not parallel or comm.rank == 0
+    out = Path(output_dir or mon.output.directory or Path("peridyn-out") / mon.name)
+    if root:
+        prepare_output(out, SUMMARY, overwrite, restartable=False)
+    files = job_files(out, provenance(case_path, case=mon)) if root else nullcontext()
+    with files, run_log(out, root):
+        history = _fatigue(fatigue, base / mon.fatigue_case, out / "fatigue", overwrite, comm)
+        plan = _plan(mon, fatigue, wave, history)
+        tasks = _tasks(mon, wave, plan, out, base / mon.wave_case, executor, workers, scheduler, threads)
+        _run(tasks, executor, workers, scheduler, overwrite, comm)
+        if not root:
+            return comm.bcast(None)
+        from peridyn.jobs.monitor_output import write_outputs
+
+        summary = write_outputs(mon, wave, plan, _signals(mon, plan, tasks), out, start)
+        return comm.bcast(summary) if parallel else summary
+
+
+def _cases(mon: MonitorCase, base: Path, path) -> tuple[Case, Case]:
+    """The fatigue and wave cases, checked against each other and the network."""
+    fatigue = load_case(base / mon.fatigue_case)
+    wave = load_case(base / mon.wave_case)
+    src = str(path)
+    if fatigue.fatigue is None:
+        raise CaseFileError(src, "fatigue_case", mon.fatigue_case, "a case with a fatigue block")
+    if fatigue.geometry.type != "rectangle":
+        raise CaseFileError(src, "fatigue_case", mon.fatigue_case, "a 2D (rectangle) fatigue case")
+    if fatigue.fatigue.tip.start is None or fatigue.fatigue.tip.axis == "z":
+        raise CaseFileError(
+            src, "fatigue_case", mon.fatigue_case, "fatigue.tip.start and an in-plane tip.axis"
+        )
+    if wave.geometry.type != "plate" or wave.solver.type != "explicit":
+        raise CaseFileError(src, "wave_case", mon.wave_case, "an explicit run of a plate")
+    if not np.isclose(wave.discretization.spacing, fatigue.discretization.spacing):
+        raise CaseFileError(
+            src, "wave_case", mon.wave_case, "the fatigue case's spacing (one in-plane grid for both)"
+        )
+    size = np.asarray(wave.geometry.size[:2])
+    xy = np.asarray(mon.transducers.centers)
+    if np.any(xy < 0) or np.any(xy > size):
+        raise CaseFileError(
+            src, "transducers.centers", xy.tolist(), f"centres on the plate (0..{size.tolist()} m)"
+        )
+    return fatigue, wave
+
+
+def _fatigue(fatigue: Case, path: Path, folder: Path, overwrite: bool, comm) -> FatigueHistory:
+    """Run the fatigue case into ``folder`` (or keep its finished run of the same case) and read
+    its history and final damage."""
+    from peridyn.jobs.fatigue import run_fatigue_case
+
+    stamp = folder / "case_hash.txt"
+    digest = case_identity(fatigue, run_length=True)[1]
+    done = (folder / "fatigue.json").exists() and stamp.exists() and stamp.read_text().strip() == digest
+    if overwrite or not done:
+        run_fatigue_case(fatigue, output_dir=folder, base_dir=path.parent, overwrite=True, comm=comm)
+        if comm is None or comm.rank == 0:
+            stamp.write_text(digest + "\n")
+    else:
+        logger.info(f"fatigue run in {folder} kept (finished, same case)")
+    return read_history(folder)
+
+
+def read_history(folder: Path) -> FatigueHistory:
+    """The fatigue run's ``crack_length.csv`` and ``damage.vtu`` in ``folder``."""
+    import meshio
+
+    with open(folder / "crack_length.csv") as fh:
+        rows = list(csv.DictReader(fh))
+    mesh = meshio.read(folder / "damage.vtu")
+    first = np.asarray(mesh.point_data["first_break_cycle"], dtype=float)
+    return FatigueHistory(
+        cycles=np.array([float(r["cycles"]) for r in rows]),
+        crack_length=np.array([float(r["crack_length_m"]) for r in rows]),
+        points=np.asarray(mesh.points[:, :2], dtype=float),
+        damage=np.asarray(mesh.point_data["damage"], dtype=float),
+        first_break=np.where(first < 0, np.inf, first),
+    )
+
+
+class Plan:
+    """The interrogations: fatigue steps, cycles (n_int,), crack lengths (n_int,) m, crack
+    polylines (None or (m, 2) m each), the whole final crack, and the cycle of the transfer
+    check (the last interrogation's) when the case asks for it."""
+
+    def __init__(self, mon: MonitorCase, fatigue: Case, history: FatigueHistory):
+        f = fatigue.fatigue
+        s = mon.schedule
+        self.history = history
+        self.tip = f.tip
+        self.spacing = fatigue.discretization.spacing
+        self.steps = interrogation_steps(
+            history.cycles,
+            history.crack_length,
+            s.every_cycles,
+            s.every_crack_growth,
+            s.max_interrogations,
+            s.until_crack_length,
+        )
+        self.cycles = history.cycles[self.steps]
+        self.crack_length = history.crack_length[self.steps]
+        self.whole = grown_crack(history, self.spacing, f.tip, self.cycles[-1])
+        self.cracks = [crack_at(self.whole, a) for a in self.crack_length]
+        self.transducers = np.asarray(mon.transducers.centers, dtype=float)
+        self.paths = network_paths(len(self.transducers))
+        self.check = mon.check_transfer and self.cracks[-1] is not None
+
+
+def _plan(mon, fatigue, wave, history) -> Plan:
+    plan = Plan(mon, fatigue, history)
+    logger.info(
+        f"{len(plan.steps)} interrogations at {plan.cycles.tolist()} cycles, crack "
+        f"{(plan.crack_length * 1e3).round(2).tolist()} mm"
+    )
+    return plan
+
+
+def network_case(mon: MonitorCase, wave: Case, actuator: int) -> Case:
+    """The wave case with transducer ``actuator`` fired and every transducer recorded."""
+    t = mon.transducers
+    data = wave.model_dump(mode="python")
+    data["actuators"] = {
+        f"t{actuator}": {
+            "type": "pzt_radial",
+            "center": t.centers[actuator],
+            "size": t.size,
+            "shape": t.shape,
+            "amplitude": t.amplitude,
+            "signal": t.signal(),
+        }
+    }
+    data["output"]["pzt_sensors"] = {
+        f"t{j}": {"center": c, "size": t.size, "shape": t.shape} for j, c in enumerate(t.centers)
+    }
+    data["output"]["plots"] = False
+    data["analysis"] = None
+    return validate_case(data, wave.name)
+
+
+def _tasks(mon, wave, plan: Plan, out: Path, wave_path: Path, executor, workers, scheduler, threads):
+    """``{(label, actuator): RunTask}``: label ``k`` for interrogation k, ``"removed"`` for the
+    transfer check on the last crack."""
+    n = len(plan.transducers)
+    fired = [network_case(mon, wave, i) for i in range(n)]
+    per_run = run_threads(threads, executor, workers, scheduler)
+    tasks = {}
+    labels = [(k, crack) for k, crack in enumerate(plan.cracks)] + ([("removed", None)] if plan.check else [])
+    for label, crack in labels:
+        for i in range(n):
+            name = f"{mon.name}_{label if label == 'removed' else f'k{label:02d}'}_t{i}"
+            if label == "removed":
+                case = removed_case(fired[i], name, plan.history, plan.cycles[-1], plan.tip, plan.spacing)
+            else:
+                case = cut_case(fired[i], name, crack)
+            folder = out / "interrogations" / name.removeprefix(f"{mon.name}_")
+            tasks[(label, i)] = RunTask(
+                run_id=folder.name,
+                index=len(tasks),
+                parameters={"interrogation": str(label), "actuator": i},
+                case=case,
+                case_hash=case_identity(case, run_length=True)[1],
+                command="run",
+                run_dir=str(folder),
+                base_dir=str(wave_path.parent),
+                threads=per_run,
+            )
+    return tasks
+
+
+def _run(tasks: dict, executor, workers, scheduler, overwrite: bool, comm) -> None:
+    """Run the tasks whose folders hold no complete record of the same case."""
+    todo = []
+    for task in tasks.values():
+        record = read_record(task.run_dir)
+        if overwrite or not (
+            record and record["status"] == "complete" and record["case_hash"] == task.case_hash
+        ):
+            todo.append(task)
+    logger.info(f"{len(tasks) - len(todo)} of {len(tasks)} interrogation runs kept; {len(todo)} to run")
+    failed = []
+
+    def done(record: dict) -> bool:
+        logger.info(f"interrogation run {record['run_id']}: {record['status']} ({record['seconds']:.1f} s)")
+        if record["status"] != "complete":
+            failed.append(f"{record['run_id']}: {record['error'] or record['status']}")
+        interrupts.check()  # SIGINT/SIGTERM: no more runs start, the finished ones are kept
+        return not failed
+
+    if comm is not None and comm.size > 1:
+        _run_ranks(todo, comm, done)
+    else:
+        run_tasks(todo, done, executor, workers, scheduler)
+    if failed:
+        raise InputError(f"an interrogation run failed ({failed[0]}); its run.json holds the error")
+
+
+def _run_ranks(todo, comm, done) -> None:
+    """The runs one after the other, each on all ranks (``run_case`` with ``comm``); rank 0
+    writes the records."""
+    from peridyn.jobs.run import run_case
+    from peridyn.jobs.sweep_run import write_record
+
+    for task in todo:
+        begin = time.perf_counter()
+        Path(task.run_dir).mkdir(parents=True, exist_ok=True)
+        summary = run_case(task.case, task.run_dir, base_dir=task.base_dir, overwrite=True, comm=comm)
+        if comm.rank == 0:
+            record = {
+                "run_id": task.run_id,
+                "index": task.index,
+                "parameters": task.parameters,
+                "case_hash": task.case_hash,
+                "command": task.command,
+                "status": "complete",
+                "error": "",
+                "summary": summary,
+                "seconds": time.perf_counter() - begin,
+                "finished": time.time(),
+            }
+            write_record(task.run_dir, record)
+            done(record)
+
+
+def _signals(mon: MonitorCase, plan: Plan, tasks: dict) -> dict:
+    """``{"times": (n_t,) s, "signals": (n_int, n_paths, n_t), "removed": (n_paths, n_t) or
+    None}``: each path's signal the mean of its two directions (reciprocity), unit of
+    ``pzt_signal`` (mean in-plane strain under the sensor)."""
+    n = len(plan.transducers)
+
+    def interrogation(label) -> tuple[np.ndarray, np.ndarray]:
+        by_actuator = []
+        times = None
+        for i in range(n):
+            _, t, data = Results(Path(tasks[(label, i)].run_dir) / "results.h5").series("pzt_signal")
+            times = t if times is None else times
+            by_actuator.append(np.asarray(data, dtype=float))
+        signals = np.stack([0.5 * (by_actuator[i][:, j] + by_actuator[j][:, i]) for i, j in plan.paths])
+        return times, signals
+
+    series = [interrogation(k) for k in range(len(plan.steps))]
+    times = series[0][0]
+    return {
+        "times": np.asarray(times, dtype=float),
+        "signals": np.stack([s for _, s in series]),
+        "removed": interrogation("removed")[1] if plan.check else None,
+    }

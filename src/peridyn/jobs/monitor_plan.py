@@ -1,0 +1,161 @@
+"""What a monitoring job interrogates: the fatigue life's interrogation points (the schedule), the
+crack at each of them, and the wave cases of the body so damaged (the damage transfer).
+
+The fatigue runs on a plane-stress (2D) model of the plate; its history (cycles, crack length)
+and final damage field (with each point's first-break cycle) give the crack at any cycle: the
+crack path (``peridyn.analysis.crack``) of the points broken by the last interrogation, from the
+crack's start (``fatigue.tip.start``), cut to the crack length of that cycle. The wave case is
+the 3D plate on the same in-plane grid; a crack reaches it in one of two ways (docs/monitoring.md,
+"Damage transfer"):
+
+- ``cut`` (the interrogations): the crack polyline becomes through-thickness pre-crack
+  rectangles, one per polyline segment, that cut every bond crossing them;
+- ``removed`` (the check of the transfer): the columns of points that the fatigue had cracked
+  by that cycle (first break at or before it, final damage at the crack threshold) are removed
+  through the thickness, a notch of the fatigue's own damaged points.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from peridyn.analysis.crack import crack_paths
+from peridyn.analysis.shm.paths import truncated
+from peridyn.errors import InputError
+from peridyn.io.case import Case, validate_case
+
+AXIS = {"x": 0, "y": 1}
+
+
+@dataclass(frozen=True)
+class FatigueHistory:
+    """What the fatigue run left: history and final damage of the plane-stress model.
+
+    Attributes
+    ----------
+    cycles, crack_length : (n_steps + 1,) float64; cycles and crack length (m) after each step
+    points : (n_points, 2) float64, m, the 2D model's points
+    damage : (n_points,) float64, final damage index
+    first_break : (n_points,) float64, cycle of each point's first broken bond (inf: none)
+    """
+
+    cycles: np.ndarray
+    crack_length: np.ndarray
+    points: np.ndarray
+    damage: np.ndarray
+    first_break: np.ndarray
+
+
+def interrogation_steps(
+    cycles, crack_length, every_cycles=None, every_growth=None, most: int = 20, until=None
+) -> np.ndarray:
+    """Indices into the fatigue history of the interrogations: 0 (the baseline), the last step at
+    or before each multiple of ``every_cycles``, the first step at which the crack grew by
+    ``every_growth`` (m) since the last interrogation, and the last step (the first whose crack
+    reaches ``until``, m, when it is given and reached); at most ``most`` (the baseline, the
+    first ``most - 2`` others and the last step)."""
+    cycles = np.asarray(cycles, dtype=float)
+    a = np.asarray(crack_length, dtype=float)
+    if until is not None and np.any(a >= until):
+        end = int(np.argmax(a >= until)) + 1
+        cycles, a = cycles[:end], a[:end]
+    chosen = {0, len(cycles) - 1}
+    if every_cycles is not None:
+        marks = np.arange(every_cycles, cycles[-1] + 0.5 * every_cycles, every_cycles)
+        chosen |= {int(np.searchsorted(cycles, m, side="right") - 1) for m in marks}
+    if every_growth is not None:
+        last = a[0]
+        for k in range(1, len(a)):
+            if a[k] >= last + every_growth * (1 - 1e-9):
+                chosen.add(k)
+                last = a[k]
+    steps = sorted(chosen)
+    if len(steps) > most:
+        steps = steps[: most - 1] + [steps[-1]]
+    return np.array(steps, dtype=int)
+
+
+def grown_crack(history: FatigueHistory, spacing: float, tip, cycles: float = np.inf) -> np.ndarray | None:
+    """(m, 2) polyline (m) of the crack the fatigue grew by ``cycles`` (the points that lost a
+    bond by then, at their final damage), from ``tip.start`` along ``tip.axis`` in ``tip.sense``
+    (the fatigue case's ``FatigueTip``): of the crack paths, the one that comes nearest to the
+    start along the axis; None without one."""
+    if tip.axis not in AXIS or tip.start is None:
+        raise InputError(
+            "a monitored fatigue case needs fatigue.tip.axis x or y and tip.start (the notch root)"
+        )
+    phi = np.where(history.first_break <= cycles, history.damage, 0.0)
+    paths = crack_paths(history.points, phi, spacing, threshold=tip.damage)
+    if not paths:
+        return None
+    axis = AXIS[tip.axis]
+    line = min(paths, key=lambda p: np.abs(p.points[:, axis] - tip.start).min()).points
+    sense = 1.0 if tip.sense == "+" else -1.0
+    ahead = (line[:, axis] - tip.start) * sense
+    if sense < 0:
+        line, ahead = line[::-1], ahead[::-1]
+    inside = np.flatnonzero(ahead > 0)
+    if inside.size == 0:
+        return None
+    k = inside[0]
+    if k > 0:  # the vertex where the path passes the start
+        w = -ahead[k - 1] / (ahead[k] - ahead[k - 1])
+        first = line[k - 1] + w * (line[k] - line[k - 1])
+    else:
+        first = line[0].copy()
+        first[axis] = tip.start
+    return np.vstack([first, line[k:]])
+
+
+def crack_at(whole: np.ndarray | None, length: float) -> np.ndarray | None:
+    """The crack polyline (m) of crack length ``length`` (m): ``whole`` cut to it; None at 0."""
+    if whole is None or length <= 0:
+        return None
+    return truncated(whole, length)
+
+
+def cut_case(wave: Case, name: str, crack: np.ndarray | None) -> Case:
+    """The wave case with the crack ``crack`` ((m, 2), m, or None) as through-thickness pre-crack
+    rectangles (one per segment), renamed ``name``."""
+    data = wave.model_dump(mode="python")
+    data["name"] = name
+    if crack is not None:
+        z0, depth = _through(wave)
+        for a, b in zip(crack[:-1], crack[1:], strict=True):
+            data["precracks"].append(
+                {
+                    "type": "rectangle",
+                    "origin": [float(a[0]), float(a[1]), z0],
+                    "edge_u": [float(b[0] - a[0]), float(b[1] - a[1]), 0.0],
+                    "edge_v": [0.0, 0.0, depth],
+                }
+            )
+    return validate_case(data, name)
+
+
+def removed_case(wave: Case, name: str, history: FatigueHistory, cycles: float, tip, spacing: float) -> Case:
+    """The wave case with the fatigue's cracked points at ``cycles`` removed as through-thickness
+    columns (boxes of one ``spacing`` square around each), renamed ``name``."""
+    sense = 1.0 if tip.sense == "+" else -1.0
+    cracked = (
+        (history.first_break <= cycles)
+        & (history.damage >= tip.damage)
+        & ((history.points[:, AXIS[tip.axis]] - tip.start) * sense > 0)
+    )
+    data = wave.model_dump(mode="python")
+    data["name"] = name
+    z0, depth = _through(wave)
+    h = 0.5 * spacing
+    for x, y in history.points[cracked]:
+        data["removals"].append({"type": "box", "min": [x - h, y - h, z0], "max": [x + h, y + h, z0 + depth]})
+    return validate_case(data, name)
+
+
+def _through(wave: Case) -> tuple[float, float]:
+    """Bottom (m) and height (m) of a region that spans the plate's thickness with a margin."""
+    if wave.geometry.type != "plate":
+        raise InputError(f"the wave case of a monitoring job is a plate, got geometry {wave.geometry.type!r}")
+    t = wave.geometry.size[2]
+    return -t, 3 * t
