@@ -542,6 +542,8 @@ def exact_moduli_pair(E: float, nu: float, bulk: float, shear: float) -> tuple[f
     steps = sorted(range(-INVERSE_ULPS, INVERSE_ULPS + 1), key=abs)
     for i, j in sorted(((i, j) for i in steps for j in steps), key=lambda ij: abs(ij[0]) + abs(ij[1])):
         e, n = moved(E, i), moved(nu, j)
+        if not -1.0 < n < 0.5:  # no moduli there (a shear modulus far below the bulk's: nu near 0.5)
+            continue
         if bulk_modulus(e, n) == bulk and shear_modulus(e, n) == shear:
             return e, n
     return E, nu

@@ -15,7 +15,7 @@ from peridyn.cli import main
 from peridyn.errors import CaseFileError
 from peridyn.io.case import load_case, validate_case
 from peridyn.io.exodus import read_exodus
-from peridyn.io.peridigm_case import convert_deck, deck_case, load_deck
+from peridyn.io.peridigm_case import convert_deck, deck_case, exact_moduli_pair, load_deck
 from peridyn.io.peridigm_deck import is_peridigm_deck, read_deck
 from peridyn.physics.materials.elastic import bulk_modulus, shear_modulus
 from peridyn.physics.timefunctions import from_spec
@@ -337,6 +337,15 @@ def test_moduli_reach_lps_to_the_bit():
     assert bulk_modulus(material["E"], material["nu"]) == K
     assert shear_modulus(material["E"], material["nu"]) == mu
     assert material["E"] == pytest.approx(E, rel=1e-15) and material["nu"] == pytest.approx(nu, rel=1e-15)
+
+
+def test_moduli_search_keeps_nu_below_one_half():
+    """A shear modulus far below the bulk modulus (5e-324 Pa, the smallest float: a damaged deck
+    the fuzz campaign made) puts nu a few ulps below 1/2; the search for the exact pair must not
+    step onto nu = 1/2, where K = E / (3 (1 - 2 nu)) divides by zero: it returns the given pair."""
+    K, mu = 130.0e9, 5e-324
+    E, nu = 9.0 * K * mu / (3.0 * K + mu), (3.0 * K - 2.0 * mu) / (2.0 * (3.0 * K + mu))
+    assert exact_moduli_pair(E, nu, K, mu) == (E, nu)
 
 
 SEQUENCE = (
