@@ -15,14 +15,16 @@ from __future__ import annotations
 import importlib
 import json
 import os
+import signal
 import sys
+import threading
 import time
 
 from peridyn.cli.errors import ArgumentParser, report, writing
 from peridyn.cli.logs import configure_logging, plain_warnings
 from peridyn.cli.streams import usable_streams
 from peridyn.errors import InputError
-from peridyn.interrupts import raised_outside_jobs
+from peridyn.interrupts import STOP_SIGNALS, raised_outside_jobs
 
 #: Subcommand modules, in the order ``peridyn --help`` lists them.
 COMMAND_MODULES = (
@@ -69,6 +71,7 @@ def main(argv: list[str] | None = None) -> int:
     Never raises (but ``--help``'s SystemExit): every failure is reported by
     :func:`peridyn.cli.errors.report`.
     """
+    the_process = argv is None  # the console script: the process ends with this command
     argv = sys.argv[1:] if argv is None else list(argv)
     _quiet_unless_first_rank()
     configure_logging()
@@ -91,7 +94,18 @@ def main(argv: list[str] | None = None) -> int:
             _drop_unwritable_stdout()
             if getattr(exc, "failed_rank", None) is not None:
                 _abort_every_rank(status)
+    if the_process:
+        _exit_uninterrupted()
     return status
+
+
+def _exit_uninterrupted() -> None:
+    """Ignore stop signals from here on: the command's outcome and exit status are decided, and
+    the interpreter's exit that follows (a second or so of closing libraries) is not cut short
+    into a death by the signal (exit -1 after a complete run)."""
+    if threading.current_thread() is threading.main_thread():
+        for sig in STOP_SIGNALS:
+            signal.signal(sig, signal.SIG_IGN)
 
 
 def _parse(parser: ArgumentParser, argv: list[str]):

@@ -103,10 +103,13 @@ def write_root_view(f: h5py.File, name: str) -> None:
     virtual datasets of the series' own (nothing copied), labelled along ``record`` and the
     series' other axes (copies of their coordinates), with the series' checksums (nothing is
     read).
-    Replaces the view a run continued from a checkpoint left (``drop_root_view``)."""
+    Replaces the view a run continued from a checkpoint left (``drop_root_view``); none when the
+    series' data, time and step hold different numbers of records (a write that failed)."""
     drop_root_view(f)
     group = f["series"][name]
     sources = {name: group["data"], "time": group["time"], "step": group["step"]}
+    if len({len(source) for source in sources.values()}) > 1:
+        return  # a write failed part-way through a record (a full or failing disk): no view of it
     root = f["/"]
     views = {}
     for key, source in sources.items():
