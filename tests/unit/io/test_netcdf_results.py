@@ -17,6 +17,7 @@ from peridyn.cli import main
 from peridyn.errors import InputError
 from peridyn.io.hdf5 import SCHEMA_ATTR, HDF5Writer
 from peridyn.io.integrity import verify_file
+from peridyn.io.netcdf import write_root_view
 from peridyn.io.results import Results
 
 BAR = str(Path(__file__).resolve().parents[3] / "cases" / "bar_pulse.yaml")
@@ -179,3 +180,19 @@ def test_write_array_refuses_dimension_names_that_do_not_fit(tmp_path):
             out.write_array("final/w", np.zeros((5, 3)), dims=("point", "component"))
         with pytest.raises(InputError, match="1 dimension names"):
             out.write_array("final/q", np.zeros((2, 3)), dims=("point",))
+
+
+def test_no_root_view_of_a_series_torn_by_a_failed_write(tmp_path):
+    """A write that failed part-way (a full or failing disk) can leave a series' data one record
+    longer than its time and step; closing the file then wrote a root view whose ``record``
+    lengths disagreed, and the labelling error hid the disk's (the disk-fault fuzz campaign,
+    seed 4). Such a series gets no view; the file closes without a new error."""
+    path = tmp_path / "r.h5"
+    with HDF5Writer(path, np.zeros((2, 3)), np.ones(2), {}) as out:
+        out.create_series("sensor_u", (1, 3), dims=("sensor", "component"), coords={"sensor": ["s"]})
+        for step in range(3):
+            out.append("sensor_u", step, step * 1e-7, np.zeros((1, 3)))
+    with h5py.File(path, "a") as f:
+        f["series/sensor_u/time"].resize((2,))  # the last record's time never written
+        write_root_view(f, "sensor_u")
+        assert [k for k, v in f["/"].items() if isinstance(v, h5py.Dataset)] == []
