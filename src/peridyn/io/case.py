@@ -1116,16 +1116,39 @@ def load_case(path, overrides=()) -> Case:
         Applied before validation; values are parsed as YAML (``1e-3``, ``true``, ``[1, 2]``).
     """
     path = Path(path)
-    text = read_input_text(path, "YAML case file")
+    raw = read_yaml_mapping(path, "YAML case file")
+    for item in overrides:
+        apply_override(raw, item, str(path))
+    return validate_case(raw, str(path))
+
+
+def read_yaml_mapping(path: Path, what: str, root: str = "a mapping of sections") -> dict:
+    """The mapping a YAML input file (a case, sweep or monitoring file: ``what``) holds.
+
+    Raises
+    ------
+    CaseFileError
+        Missing, unreadable or oversized file, bad YAML, or a root that is not a mapping
+        (``root`` says what it should be).
+    """
+    text = read_input_text(path, what)
     try:
         raw = parse_yaml(text)
     except yaml.YAMLError as exc:
         raise CaseFileError(str(path), "<file>", None, f"valid YAML ({yaml_problem(exc)})") from None
     if not isinstance(raw, dict):
-        raise CaseFileError(str(path), "<root>", raw, "a mapping of sections")
-    for item in overrides:
-        apply_override(raw, item, str(path))
-    return validate_case(raw, str(path))
+        raise CaseFileError(str(path), "<root>", raw, root)
+    return raw
+
+
+def first_problem(exc: ValidationError, source: str) -> CaseFileError:
+    """The one-line error of a file validated by a model other than :class:`Case` (a sweep or
+    monitoring file): its first problem, named by its key, and how many more there are."""
+    err = exc.errors()[0]
+    key = ".".join(str(p) for p in err["loc"] if not str(p).startswith("function-")) or "<root>"
+    more = f" (and {len(exc.errors()) - 1} more problems)" if len(exc.errors()) > 1 else ""
+    value = None if err["type"] == "missing" else err.get("input")
+    return CaseFileError(source, key, value, err["msg"].removeprefix("Value error, ") + more)
 
 
 def validate_case(raw: dict, source: str = "<case>") -> Case:

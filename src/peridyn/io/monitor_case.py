@@ -7,10 +7,8 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Annotated
 
-import yaml
 from pydantic import Field, ValidationError, model_validator
 
-from peridyn.errors import CaseFileError
 from peridyn.io.case import (
     Finite,
     NonNegative,
@@ -19,10 +17,9 @@ from peridyn.io.case import (
     Strict,
     apply_override,
     described,
-    parse_yaml,
-    yaml_problem,
+    first_problem,
+    read_yaml_mapping,
 )
-from peridyn.io.text_file import read_input_text
 
 __all__ = ["MonitorCase", "load_monitor_case"]
 
@@ -150,20 +147,10 @@ def load_monitor_case(path, overrides=()) -> tuple[MonitorCase, Path]:
         Missing or unreadable file, bad YAML or a wrong entry (one line naming its key).
     """
     path = Path(path)
-    text = read_input_text(path, "YAML monitoring case file")
-    try:
-        raw = parse_yaml(text)
-    except yaml.YAMLError as exc:
-        raise CaseFileError(str(path), "<file>", None, f"valid YAML ({yaml_problem(exc)})") from None
-    if not isinstance(raw, dict):
-        raise CaseFileError(str(path), "<root>", raw, "a mapping of sections")
+    raw = read_yaml_mapping(path, "YAML monitoring case file")
     for item in overrides:
         apply_override(raw, item, str(path))
     try:
         return MonitorCase.model_validate(raw), path.parent
     except ValidationError as exc:
-        err = exc.errors()[0]
-        key = ".".join(str(p) for p in err["loc"] if not str(p).startswith("function-")) or "<root>"
-        more = f" (and {len(exc.errors()) - 1} more problems)" if len(exc.errors()) > 1 else ""
-        value = None if err["type"] == "missing" else err.get("input")
-        raise CaseFileError(str(path), key, value, err["msg"].removeprefix("Value error, ") + more) from None
+        raise first_problem(exc, str(path)) from None

@@ -30,11 +30,18 @@ from pathlib import Path
 from typing import Annotated, Any, Literal
 
 import numpy as np
-import yaml
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
 from peridyn.errors import CaseFileError, InputError
-from peridyn.io.case import Case, apply_override, load_case, parse_yaml, validate_case, yaml_problem
+from peridyn.io.case import (
+    Case,
+    apply_override,
+    first_problem,
+    load_case,
+    parse_yaml,
+    read_yaml_mapping,
+    validate_case,
+)
 from peridyn.io.text_file import read_input_text
 from peridyn.physics.expressions import evaluate
 from peridyn.setup.identity import case_identity
@@ -271,22 +278,11 @@ def read_spec(path) -> SweepSpec:
         Missing or unreadable file, bad YAML, or an entry that is wrong (named with its path).
     """
     path = Path(path)
-    text = read_input_text(path, "YAML sweep file")
-    try:
-        raw = parse_yaml(text)
-    except yaml.YAMLError as exc:
-        raise CaseFileError(str(path), "<file>", None, f"valid YAML ({yaml_problem(exc)})") from None
-    if not isinstance(raw, dict):
-        raise CaseFileError(str(path), "<root>", raw, "a mapping with base and vary")
+    raw = read_yaml_mapping(path, "YAML sweep file", "a mapping with base and vary")
     try:
         return SweepSpec.model_validate(raw)
     except ValidationError as exc:
-        err = exc.errors()[0]
-        key = ".".join(str(p) for p in err["loc"] if not str(p).startswith("function-")) or "<root>"
-        more = f" (and {len(exc.errors()) - 1} more problems)" if len(exc.errors()) > 1 else ""
-        raise CaseFileError(
-            str(path), key, err.get("input"), err["msg"].removeprefix("Value error, ") + more
-        ) from None
+        raise first_problem(exc, str(path)) from None
 
 
 def expand(path, overrides=(), first: int | None = None) -> Sweep:
