@@ -19,9 +19,8 @@ from peridyn.errors import CaseFileError
 from peridyn.io.case import parse_yaml, yaml_problem
 from peridyn.io.text_file import read_input_text
 
-#: Suffixes of the two deck forms.
+#: Suffixes of the XML deck form (any other deck is read as YAML).
 XML_SUFFIXES = (".xml",)
-YAML_SUFFIXES = (".yaml", ".yml")
 
 
 def _bool(text: str) -> bool:
