@@ -41,7 +41,14 @@ from peridyn.jobs.monitor_plan import (
     interrogation_steps,
     removed_case,
 )
-from peridyn.jobs.sweep_run import RunTask, read_record, run_tasks, run_threads
+from peridyn.jobs.sweep_run import (
+    RunTask,
+    numba_threads_kept,
+    read_record,
+    run_tasks,
+    run_threads,
+    set_threads,
+)
 from peridyn.setup.identity import case_identity
 
 logger = logging.getLogger(__name__)
@@ -74,7 +81,8 @@ def run_monitor(
     overrides : sequence of "key.path=value"
         Changes to the monitoring case before validation.
     executor, workers, scheduler, threads
-        How the interrogation runs are run (``peridyn.jobs.sweep_run.run_tasks``).
+        How the interrogation runs are run (``peridyn.jobs.sweep_run.run_tasks``); ``threads``
+        given, the fatigue run too has that many numba threads.
     overwrite : bool
         Redo every run; otherwise a folder's finished fatigue and interrogation runs are kept
         (the job resumes) and only a finished job's folder is refused.
@@ -91,7 +99,10 @@ def run_monitor(
         prepare_output(out, SUMMARY, overwrite, restartable=False)
     files = job_files(out, provenance(case_path, case=mon)) if root else nullcontext()
     with files, run_log(out, root):
-        history = _fatigue(fatigue, base / mon.fatigue_case, out / "fatigue", overwrite, comm)
+        with numba_threads_kept():
+            if threads is not None:
+                set_threads(run_threads(threads, executor, workers, scheduler))
+            history = _fatigue(fatigue, base / mon.fatigue_case, out / "fatigue", overwrite, comm)
         plan = _plan(mon, fatigue, wave, history)
         tasks = _tasks(mon, wave, plan, out, base / mon.wave_case, executor, workers, scheduler, threads)
         _run(tasks, executor, workers, scheduler, overwrite, comm)
