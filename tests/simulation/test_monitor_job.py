@@ -1,9 +1,17 @@
 """``peridyn monitor`` end to end on the small notched-hole plate of cases/monitoring/monitor_small.yaml: a
 fatigue life, three interrogations by three PZTs, the dataset, the summary, the figures redrawn
-by ``peridyn plot`` and resuming."""
+by ``peridyn plot`` and resuming; the Dask executor gives the serial job's dataset.
 
+Runs have one numba thread (``--threads 1``): on a loaded machine two threads wait on each other
+at every step. Every run is deterministic (the same kernels, the same order of sums; sensor noise
+from a seeded generator), so the datasets of two executors agree bit for bit (the sweeps'
+executors: tests/simulation/test_sweep.py).
+"""
+
+import io
 import json
 import shutil
+from contextlib import redirect_stdout
 from pathlib import Path
 
 import matplotlib.image
@@ -13,19 +21,28 @@ import xarray as xr
 
 from peridyn.cli import main
 from peridyn.errors import InputError
+from peridyn.io.dataset import load_dataset
 from peridyn.io.job_files import read_job
 from peridyn.jobs.monitor import run_monitor
 from peridyn.jobs.sweep_run import RECORD
 
 TINY = Path(__file__).parents[2] / "cases" / "monitoring" / "monitor_small.yaml"
+SETS = ["check_transfer=false"]
 
 
-def test_monitor_job_writes_a_labelled_dataset_and_its_summary_and_resumes(tmp_path, capsys):
-    out = tmp_path / "mon"
-    # one numba thread per run: on a loaded machine two threads wait on each other at every step
-    args = ["monitor", str(TINY), "-o", str(out), "--set", "check_transfer=false", "--threads", "1", "--json"]
-    assert main(args) == 0
-    summary = json.loads(capsys.readouterr().out)
+@pytest.fixture(scope="module")
+def serial(tmp_path_factory):
+    """The job by the serial executor via the CLI: (summary, output folder, its dataset as written)."""
+    out = tmp_path_factory.mktemp("serial") / "mon"
+    args = ["monitor", str(TINY), "-o", str(out), "--set", *SETS, "--threads", "1", "--json"]
+    with redirect_stdout(io.StringIO()) as stdout:
+        assert main(args) == 0
+    summary = json.loads(stdout.getvalue())
+    return summary, out, load_dataset(out / "monitoring.nc", "monitoring dataset")
+
+
+def test_monitor_job_writes_a_labelled_dataset_and_its_summary_and_resumes(serial, tmp_path, capsys):
+    summary, out, dataset = serial
     m = summary["monitoring"]
     assert summary["kind"] == "monitor"
     assert m["interrogations"] >= 3 and m["final_crack_length_m"] >= 2e-3
@@ -52,15 +69,25 @@ def test_monitor_job_writes_a_labelled_dataset_and_its_summary_and_resumes(tmp_p
     # a finished folder is refused; without its summary the job resumes and redoes only the run
     # whose folder was removed
     with pytest.raises(InputError, match="monitor.json"):
-        run_monitor(TINY, out, overrides=["check_transfer=false"])
+        run_monitor(TINY, out, overrides=SETS)
     (out / "monitor.json").unlink()
     runs = sorted((out / "interrogations").iterdir())
     kept = {p.name: json.loads((p / RECORD).read_text())["finished"] for p in runs}
     shutil.rmtree(runs[-1])
-    again = run_monitor(TINY, out, overrides=["check_transfer=false"], threads=1)
+    again = run_monitor(TINY, out, overrides=SETS, threads=1)
     after = {p.name: json.loads((p / RECORD).read_text())["finished"] for p in runs}
     assert [name for name in kept if after[name] != kept[name]] == [runs[-1].name]
     assert again["monitoring"] == m
+    xr.testing.assert_identical(load_dataset(out / "monitoring.nc", "monitoring dataset"), dataset)
+
+
+def test_dask_executor_gives_the_serial_dataset(serial, tmp_path):
+    """A local Dask cluster of 2 workers, one thread each: the serial job's dataset bit for bit."""
+    pytest.importorskip("dask.distributed", reason="the dask executor needs the sweep extra")
+    summary, _, dataset = serial
+    other = run_monitor(TINY, tmp_path / "dask", overrides=SETS, executor="dask", workers=2, threads=1)
+    assert other["monitoring"] == summary["monitoring"]
+    xr.testing.assert_identical(load_dataset(other["dataset"], "monitoring dataset"), dataset)
 
 
 def _figures_redrawn_from_the_dataset(out: Path, plots: list, keep: Path, capsys) -> None:
