@@ -90,6 +90,19 @@ def test_dask_executor_gives_the_serial_dataset(serial, tmp_path):
     xr.testing.assert_identical(load_dataset(other["dataset"], "monitoring dataset"), dataset)
 
 
+@pytest.mark.parametrize(("executor", "scheduler"), [("processes", None), ("serial", "tcp://host:8786")])
+def test_an_executor_under_mpi_is_refused_in_one_line(tmp_path, executor, scheduler):
+    """Under mpiexec each run goes over the ranks: an executor of its own would run every run on
+    every rank. The refusal comes before anything is written."""
+
+    class TwoRanks:  # what run_monitor asks of a communicator before the first collective call
+        size, rank = 2, 0
+
+    with pytest.raises(InputError, match="under mpiexec") as err:
+        run_monitor(TINY, tmp_path / "out", executor=executor, scheduler=scheduler, comm=TwoRanks())
+    assert "\n" not in str(err.value) and not (tmp_path / "out").exists()
+
+
 def _figures_redrawn_from_the_dataset(out: Path, plots: list, keep: Path, capsys) -> None:
     """``peridyn plot`` of the folder with its figures removed draws them again from
     monitoring.nc alone (the interrogation runs moved away): the same pixels, as the job draws

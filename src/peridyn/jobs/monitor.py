@@ -94,6 +94,11 @@ def run_monitor(
     start = time.perf_counter()
     mon, base = load_monitor_case(case_path, overrides)
     fatigue, wave = _cases(mon, base, case_path)
+    if comm is not None and comm.size > 1 and (executor != "serial" or scheduler is not None):
+        raise InputError(
+            f"--executor {executor}{' --scheduler' if scheduler else ''} under mpiexec: each run goes "
+            "over the MPI ranks, one after the other; run without --executor (serial) or without mpiexec"
+        )
     root = comm is None or comm.rank == 0
     out = Path(output_dir or mon.output.directory or Path("peridyn-out") / mon.name)
     _on_root(comm, lambda: prepare_output(out, SUMMARY, overwrite, restartable=False))
