@@ -9,9 +9,11 @@ timed, and its figures of merit against the acceptance numbers:
 - the two damage transfers agree on the crossed paths' indices within 10%;
 - the whole loop under 30 minutes on 2 cores.
 
-    python benchmarks/monitoring_acceptance.py [OUTPUT_DIR]
+    python benchmarks/monitoring_acceptance.py [OUTPUT_DIR [KEY=VALUE ...]]
 
-A second call into the same folder resumes it (finished runs are kept; the time is then that of
+``KEY=VALUE``: changes to the monitoring case (``--set``), for a variant that the case's
+processing settings were not chosen on, e.g. the network moved (benchmarks/RESULTS.md,
+"Monitoring"). A second call into the same folder resumes it (finished runs are kept; the time is then that of
 the rest). Prints the summary's ``monitoring`` block, the wall time and each check.
 """
 
@@ -54,9 +56,10 @@ def checks(m: dict, seconds: float) -> dict:
     }
 
 
-def run(out: Path) -> dict:
+def run(out: Path, sets=()) -> dict:
     start = time.perf_counter()
     args = ["monitor", str(CASE), "-o", str(out), "--executor", "processes", "--workers", "2", "--json"]
+    args += [arg for s in sets for arg in ("--set", s)]
     status = main(args)
     seconds = time.perf_counter() - start
     summary = json.loads((out / "monitor.json").read_text()) if status == 0 else {}
@@ -65,7 +68,7 @@ def run(out: Path) -> dict:
 
 if __name__ == "__main__":
     folder = Path(sys.argv[1] if len(sys.argv) > 1 else "peridyn-out/monitoring-acceptance")
-    result = run(folder)
+    result = run(folder, sys.argv[2:])
     m = result["summary"].get("monitoring", {})
     print(json.dumps(m, indent=1), file=sys.stderr)
     print(f"wall time {result['seconds']:.0f} s", file=sys.stderr)

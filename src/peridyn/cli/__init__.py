@@ -141,7 +141,7 @@ def _dispatch(parser: ArgumentParser, args) -> int:
 ABORT_GRACE_SECONDS = 1.0
 
 #: The commands that run over MPI ranks (``mpiexec -n N peridyn ...``, N > 1).
-MPI_COMMANDS = ("run", "modal", "fatigue")
+MPI_COMMANDS = ("run", "modal", "fatigue", "monitor")
 
 
 def _refuse_under_mpi(command: str) -> None:

@@ -2,7 +2,8 @@
 analyses) from its results.h5, with the crack figures (damage map and crack paths, crack length
 against time) of a run with damage; a modal run's modes.png; a fatigue job's crack length
 against cycles (crack_length.csv); a convergence study's study.png (study.json); a sweep's
-figures (dataset.nc). The job's kind is its summary.json's (docs/user-guide.md)."""
+figures (dataset.nc); a monitoring job's figures (monitoring.nc, docs/monitoring.md). The job's
+kind is its summary.json's (docs/user-guide.md)."""
 
 from __future__ import annotations
 
@@ -15,9 +16,9 @@ from peridyn.errors import InputError
 
 def register(sub) -> None:
     """Add the ``plot`` subcommand."""
-    what = "redraw the figures of a run, fatigue job, study or sweep"
+    what = "redraw the figures of a run, fatigue job, study, sweep or monitoring job"
     p = sub.add_parser("plot", help=what, description=__doc__)
-    p.add_argument("run_dir", help="output folder of a run, fatigue job, study or sweep")
+    p.add_argument("run_dir", help="output folder of a run, fatigue job, study, sweep or monitoring job")
     add_common_flags(p)
     p.set_defaults(func=run)
 
@@ -34,12 +35,7 @@ def run(args) -> dict:
     out = Path(args.run_dir)
     h5 = out / "results.h5"
     kind = job_kind(out)
-    if kind == "monitor":
-        raise InputError(
-            f"{str(out)!r} is a monitoring job's folder: its figures are drawn by the job "
-            "(peridyn monitor); peridyn plot does not redraw them"
-        )
-    redraw = {"fatigue": _fatigue, "study": _study, "sweep": _sweep}.get(kind)
+    redraw = {"fatigue": _fatigue, "study": _study, "sweep": _sweep, "monitor": _monitor}.get(kind)
     if redraw is not None:
         paths = [str(p) for p in redraw(out)]
         if not args.json:
@@ -81,7 +77,7 @@ MARKERS = {"results.h5": "run", "fatigue.json": "fatigue", "study.json": "study"
 
 def job_kind(out: Path) -> str:
     """The kind of the job whose output folder is ``out`` (``run``, ``modal``, ``fatigue``,
-    ``study``, ``sweep``): its ``summary.json``'s ``kind``, else the file that marks it.
+    ``study``, ``sweep``, ``monitor``): its ``summary.json``'s ``kind``, else the file that marks it.
 
     Raises
     ------
@@ -134,3 +130,10 @@ def _sweep(out: Path) -> list[Path]:
 
     ds = load_sweep(out / "dataset.nc")
     return draw_figures(expand(ds.attrs["sweep_file"]), ds, out)
+
+
+def _monitor(out: Path) -> list[Path]:
+    """A monitoring job's figures from ``monitoring.nc``."""
+    from peridyn.jobs.monitor_output import redraw_figures
+
+    return redraw_figures(out)

@@ -146,9 +146,21 @@ def write_dataset(ds, path) -> Path:
 def load_sweep(path):
     """A sweep's dataset, read whole into memory (the file is closed after), e.g.
     ``peridyn.load_sweep("peridyn-out/demo/dataset.nc")["max_damage"].to_series()``."""
+    return load_dataset(path, "sweep dataset")
+
+
+def load_dataset(path, what: str):
+    """The NetCDF-4 dataset at ``path`` read whole into memory (the file is closed after);
+    ``what`` names it in the error.
+
+    Raises
+    ------
+    InputError
+        No file at ``path``.
+    """
     xr = require_xarray()
     if not Path(path).is_file():
-        raise InputError(f"sweep dataset {str(path)!r} does not exist")
+        raise InputError(f"{what} {str(path)!r} does not exist")
     with xr.open_dataset(path, engine="h5netcdf") as ds:
         return ds.load()
 

@@ -8,7 +8,8 @@ PZT network; damage indices, images and the dataset of the whole life.
    (``peridyn.run_case``, one run per actuator in ``interrogations/kNN_tI/``), through the sweep
    executors (serial, processes, dask); a run whose folder holds a complete record of the same
    case is not run again, so an interrupted job resumes where it stopped. Under ``mpiexec -n N``
-   the runs go one after the other, each on all ranks.
+   the fatigue and the runs go one after the other, each on all ranks; rank 0 reads and writes
+   the job's own files (the records kept, the dataset, figures and summary) and tells the others.
 4. The signals are compared with the baseline's (``peridyn.jobs.monitor_assess``) and written as
    one dataset with figures and the summary (``peridyn.jobs.monitor_output``).
 """
@@ -41,7 +42,15 @@ from peridyn.jobs.monitor_plan import (
     interrogation_steps,
     removed_case,
 )
-from peridyn.jobs.sweep_run import RunTask, read_record, run_tasks, run_threads
+from peridyn.jobs.sweep_run import (
+    RunTask,
+    numba_threads_kept,
+    read_record,
+    run_tasks,
+    run_threads,
+    set_threads,
+)
+from peridyn.parallel.domain import agree
 from peridyn.setup.identity import case_identity
 
 logger = logging.getLogger(__name__)
@@ -74,7 +83,8 @@ def run_monitor(
     overrides : sequence of "key.path=value"
         Changes to the monitoring case before validation.
     executor, workers, scheduler, threads
-        How the interrogation runs are run (``peridyn.jobs.sweep_run.run_tasks``).
+        How the interrogation runs are run (``peridyn.jobs.sweep_run.run_tasks``); ``threads``
+        given, the fatigue run too has that many numba threads.
     overwrite : bool
         Redo every run; otherwise a folder's finished fatigue and interrogation runs are kept
         (the job resumes) and only a finished job's folder is refused.
@@ -84,23 +94,30 @@ def run_monitor(
     start = time.perf_counter()
     mon, base = load_monitor_case(case_path, overrides)
     fatigue, wave = _cases(mon, base, case_path)
-    parallel = comm is not None and comm.size > 1
-    root = not parallel or comm.rank == 0
+    if comm is not None and comm.size > 1 and (executor != "serial" or scheduler is not None):
+        raise InputError(
+            f"--executor {executor}{' --scheduler' if scheduler else ''} under mpiexec: each run goes "
+            "over the MPI ranks, one after the other; run without --executor (serial) or without mpiexec"
+        )
+    root = comm is None or comm.rank == 0
     out = Path(output_dir or mon.output.directory or Path("peridyn-out") / mon.name)
-    if root:
-        prepare_output(out, SUMMARY, overwrite, restartable=False)
+    _on_root(comm, lambda: prepare_output(out, SUMMARY, overwrite, restartable=False))
     files = job_files(out, provenance(case_path, case=mon)) if root else nullcontext()
     with files, run_log(out, root):
-        history = _fatigue(fatigue, base / mon.fatigue_case, out / "fatigue", overwrite, comm)
+        with numba_threads_kept():
+            if threads is not None:
+                set_threads(run_threads(threads, executor, workers, scheduler))
+            history = _fatigue(fatigue, base / mon.fatigue_case, out / "fatigue", overwrite, comm)
         plan = _plan(mon, fatigue, wave, history)
         tasks = _tasks(mon, wave, plan, out, base / mon.wave_case, executor, workers, scheduler, threads)
         _run(tasks, executor, workers, scheduler, overwrite, comm)
-        if not root:
-            return comm.bcast(None)
-        from peridyn.jobs.monitor_output import write_outputs
 
-        summary = write_outputs(mon, wave, plan, _signals(mon, plan, tasks), out, start)
-        return comm.bcast(summary) if parallel else summary
+        def outputs() -> dict:
+            from peridyn.jobs.monitor_output import write_outputs
+
+            return write_outputs(mon, wave, plan, _signals(mon, plan, tasks), out, start)
+
+        return _on_root(comm, outputs)  # every rank returns the summary
 
 
 def _cases(mon: MonitorCase, base: Path, path) -> tuple[Case, Case]:
@@ -133,19 +150,29 @@ def _cases(mon: MonitorCase, base: Path, path) -> tuple[Case, Case]:
 
 def _fatigue(fatigue: Case, path: Path, folder: Path, overwrite: bool, comm) -> FatigueHistory:
     """Run the fatigue case into ``folder`` (or keep its finished run of the same case) and read
-    its history and final damage."""
+    its history and final damage (under MPI: rank 0 decides and reads, every rank gets them)."""
     from peridyn.jobs.fatigue import run_fatigue_case
 
     stamp = folder / "case_hash.txt"
     digest = case_identity(fatigue, run_length=True)[1]
-    done = (folder / "fatigue.json").exists() and stamp.exists() and stamp.read_text().strip() == digest
-    if overwrite or not done:
+
+    def finished() -> bool:
+        return (folder / "fatigue.json").exists() and stamp.exists() and stamp.read_text().strip() == digest
+
+    if overwrite or not _on_root(comm, finished):
         run_fatigue_case(fatigue, output_dir=folder, base_dir=path.parent, overwrite=True, comm=comm)
-        if comm is None or comm.rank == 0:
-            stamp.write_text(digest + "\n")
+        _on_root(comm, stamp.write_text, digest + "\n")
     else:
         logger.info(f"fatigue run in {folder} kept (finished, same case)")
-    return read_history(folder)
+    return _on_root(comm, read_history, folder)
+
+
+def _on_root(comm, fn, *args):
+    """``fn(*args)`` on rank 0 (on the one process without MPI), its result on every rank; an
+    error there is raised on every rank."""
+    if comm is None or comm.size == 1:
+        return fn(*args)
+    return comm.bcast(agree(comm, lambda: fn(*args) if comm.rank == 0 else None))
 
 
 def read_history(folder: Path) -> FatigueHistory:
@@ -255,14 +282,21 @@ def _tasks(mon, wave, plan: Plan, out: Path, wave_path: Path, executor, workers,
 
 
 def _run(tasks: dict, executor, workers, scheduler, overwrite: bool, comm) -> None:
-    """Run the tasks whose folders hold no complete record of the same case."""
-    todo = []
-    for task in tasks.values():
-        record = read_record(task.run_dir)
-        if overwrite or not (
-            record and record["status"] == "complete" and record["case_hash"] == task.case_hash
-        ):
-            todo.append(task)
+    """Run the tasks whose folders hold no complete record of the same case (under MPI: as rank
+    0 reads the records)."""
+
+    def unfinished() -> list[str]:
+        todo = []
+        for task in tasks.values():
+            record = read_record(task.run_dir)
+            if overwrite or not (
+                record and record["status"] == "complete" and record["case_hash"] == task.case_hash
+            ):
+                todo.append(task.run_id)
+        return todo
+
+    by_id = {task.run_id: task for task in tasks.values()}
+    todo = [by_id[run_id] for run_id in _on_root(comm, unfinished)]
     logger.info(f"{len(tasks) - len(todo)} of {len(tasks)} interrogation runs kept; {len(todo)} to run")
     failed = []
 

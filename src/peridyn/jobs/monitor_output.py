@@ -1,5 +1,6 @@
 """What a monitoring job writes: ``monitoring.nc`` (one netCDF-4 dataset, units and long_name on
-every variable), the figures and ``monitor.json`` (the summary with its ``monitoring`` block)."""
+every variable), the figures (drawn from the dataset, so that ``peridyn plot`` redraws them from
+the file: ``redraw_figures``) and ``monitor.json`` (the summary with its ``monitoring`` block)."""
 
 from __future__ import annotations
 
@@ -7,10 +8,12 @@ from pathlib import Path
 
 import numpy as np
 
-from peridyn.io.dataset import require_xarray, write_dataset
+from peridyn.errors import InputError
+from peridyn.io.dataset import load_dataset, require_xarray, write_dataset
 from peridyn.io.job_files import write_json_file, write_summary
 from peridyn.jobs.monitor_assess import assess
 from peridyn.jobs.summary import finish_summary
+from peridyn.plotting.monitoring import FIGURE_VARIABLES, draw_monitoring_figures
 
 #: The dataset of a monitoring job in its output folder.
 DATASET = "monitoring.nc"
@@ -19,8 +22,9 @@ DATASET = "monitoring.nc"
 def write_outputs(mon, wave, plan, data: dict, out: Path, start: float) -> dict:
     """Process the signals, write the dataset, figures and summary; returns the summary."""
     result = assess(mon, wave, plan, data)
-    write_dataset(monitoring_dataset(mon, plan, data, result), out / DATASET)
-    plots = _figures(mon, wave, plan, result, out) if mon.output.plots else []
+    ds = monitoring_dataset(mon, wave, plan, data, result)
+    write_dataset(ds, out / DATASET)
+    plots = draw_monitoring_figures(ds, out) if mon.output.plots else []
     summary = {
         "monitoring": result["monitoring"],
         "dataset": str(out / DATASET),
@@ -34,9 +38,29 @@ def write_outputs(mon, wave, plan, data: dict, out: Path, start: float) -> dict:
     return summary
 
 
-def monitoring_dataset(mon, plan, data: dict, result: dict):
+def redraw_figures(out) -> list[Path]:
+    """The figures of the monitoring job in folder ``out`` drawn again from its ``monitoring.nc``
+    (``peridyn plot``); returns their paths.
+
+    Raises
+    ------
+    InputError
+        ``out`` holds no ``monitoring.nc``, or one without a variable that the figures need.
+    """
+    path = Path(out) / DATASET
+    ds = load_dataset(path, "monitoring dataset")
+    missing = [name for name in FIGURE_VARIABLES if name not in ds.variables]
+    if missing:
+        raise InputError(
+            f"{str(path)!r} has no {', '.join(missing)} (written by an older peridyn): remove "
+            "monitor.json and run peridyn monitor again (its runs are kept)"
+        )
+    return draw_monitoring_figures(ds, out)
+
+
+def monitoring_dataset(mon, wave, plan, data: dict, result: dict):
     """The xarray Dataset of the job (dimensions interrogation, path, time, transducer, vertex,
-    image_y, image_x)."""
+    image_y, image_x, cracked_point)."""
     xr = require_xarray()
     labels = [f"t{i}-t{j}" for i, j in plan.paths]
     vertices = max([len(c) for c in plan.cracks if c is not None] or [1])
@@ -45,6 +69,9 @@ def monitoring_dataset(mon, plan, data: dict, result: dict):
         if c is not None:
             crack[k, : len(c)] = c
     tip = np.array([c[-1] if c is not None else [np.nan, np.nan] for c in plan.cracks])
+    h = plan.history
+    cracked = np.isfinite(h.first_break)
+    lx, ly = wave.geometry.size[:2]
     ip, ipath, it = ("interrogation",), ("interrogation", "path"), ("interrogation", "path", "time")
     strain = "1"  # pzt_signal: mean in-plane strain under a patch
     variables = {
@@ -74,6 +101,16 @@ def monitoring_dataset(mon, plan, data: dict, result: dict):
         ),
         "path_actuator": (("path",), plan.paths[:, 0], "1", "index of the path's first transducer"),
         "path_sensor": (("path",), plan.paths[:, 1], "1", "index of the path's second transducer"),
+        "plate_size_x": ((), lx, "m", "plate's extent along x"),
+        "plate_size_y": ((), ly, "m", "plate's extent along y"),
+        "cracked_point_x": (("cracked_point",), h.points[cracked, 0], "m", "x of a point with a broken bond"),
+        "cracked_point_y": (("cracked_point",), h.points[cracked, 1], "m", "y of a point with a broken bond"),
+        "first_break_cycle": (
+            ("cracked_point",),
+            h.first_break[cracked],
+            "1",
+            "fatigue cycle of the point's first broken bond",
+        ),
         "transducer_x": (("transducer",), plan.transducers[:, 0], "m", "x of the transducer centre"),
         "transducer_y": (("transducer",), plan.transducers[:, 1], "m", "y of the transducer centre"),
         "image": (("interrogation", "image_y", "image_x"), result["image"], "1", "RAPID damage image"),
@@ -113,50 +150,3 @@ def monitoring_dataset(mon, plan, data: dict, result: dict):
         Conventions="CF-1.8",
     )
     return ds
-
-
-def _figures(mon, wave, plan, result: dict, out: Path) -> list[Path]:
-    from peridyn.plotting.monitoring import plot_crack_history, plot_image_frames, plot_indices
-
-    labels = [f"t{i}-t{j}" for i, j in plan.paths]
-    plots = [
-        plot_indices(
-            plan.cycles,
-            plan.crack_length,
-            result[name],
-            labels,
-            result["crossed"],
-            out / f"{name}.png",
-            name.replace("_", " "),
-        )
-        for name in ("correlation_index", "residual_energy_index")
-    ]
-    titles = [
-        f"N = {n:.3g}, a = {1e3 * a:.1f} mm" for n, a in zip(plan.cycles, plan.crack_length, strict=True)
-    ]
-    plots.append(
-        plot_image_frames(
-            result["image_x"],
-            result["image_y"],
-            result["image"],
-            plan.transducers,
-            plan.cracks,
-            result["image_peak"],
-            titles,
-            wave.geometry.size[:2],
-            out / "images.png",
-        )
-    )
-    h = plan.history
-    plots.append(
-        plot_crack_history(
-            h.points,
-            h.first_break,
-            plan.cracks,
-            plan.crack_length,
-            plan.cycles,
-            plan.transducers,
-            out / "crack_path.png",
-        )
-    )
-    return plots

@@ -1,5 +1,6 @@
 """Figures of a monitoring job: path indices against cycles and crack length, damage image
-frames with the true crack, and the crack path over the life."""
+frames with the true crack, and the crack path over the life; ``draw_monitoring_figures`` draws
+them all from the job's dataset (the job, and ``peridyn plot`` from ``monitoring.nc``)."""
 
 from __future__ import annotations
 
@@ -14,6 +15,87 @@ def _figure(size):
     fig = Figure(figsize=size)
     FigureCanvasAgg(fig)
     return fig
+
+
+#: The index figures of a monitoring job: ``<variable>.png`` for each of these dataset variables.
+INDEX_FIGURES = ("correlation_index", "residual_energy_index")
+#: The dataset variables that the figures are drawn from (``draw_monitoring_figures``).
+FIGURE_VARIABLES = (
+    *INDEX_FIGURES,
+    "cycles",
+    "crack_length",
+    "crossed",
+    "transducer_x",
+    "transducer_y",
+    "crack_x",
+    "crack_y",
+    "image",
+    "image_peak_x",
+    "image_peak_y",
+    "plate_size_x",
+    "plate_size_y",
+    "cracked_point_x",
+    "cracked_point_y",
+    "first_break_cycle",
+)
+
+
+def draw_monitoring_figures(ds, out) -> list[Path]:
+    """The figures of a monitoring job from its dataset ``ds`` (the ``xarray.Dataset`` of
+    ``monitoring.nc``, docs/monitoring.md "Output") into folder ``out``: ``correlation_index.png``,
+    ``residual_energy_index.png``, ``images.png`` and ``crack_path.png``; returns their paths."""
+    out = Path(out)
+    cycles = ds["cycles"].values
+    crack_length = ds["crack_length"].values
+    labels = [str(p) for p in ds["path"].values]
+    crossed = ds["crossed"].values.astype(bool)
+    transducers = np.column_stack([ds["transducer_x"].values, ds["transducer_y"].values])
+    cracks = [_polyline(x, y) for x, y in zip(ds["crack_x"].values, ds["crack_y"].values, strict=True)]
+    plots = [
+        plot_indices(
+            cycles,
+            crack_length,
+            ds[name].values,
+            labels,
+            crossed,
+            out / f"{name}.png",
+            name.replace("_", " "),
+        )
+        for name in INDEX_FIGURES
+    ]
+    titles = [f"N = {n:.3g}, a = {1e3 * a:.1f} mm" for n, a in zip(cycles, crack_length, strict=True)]
+    plots.append(
+        plot_image_frames(
+            ds["image_x"].values,
+            ds["image_y"].values,
+            ds["image"].values,
+            transducers,
+            cracks,
+            np.column_stack([ds["image_peak_x"].values, ds["image_peak_y"].values]),
+            titles,
+            (float(ds["plate_size_x"]), float(ds["plate_size_y"])),
+            out / "images.png",
+        )
+    )
+    points = np.column_stack([ds["cracked_point_x"].values, ds["cracked_point_y"].values])
+    plots.append(
+        plot_crack_history(
+            points,
+            ds["first_break_cycle"].values,
+            cracks,
+            crack_length,
+            cycles,
+            transducers,
+            out / "crack_path.png",
+        )
+    )
+    return plots
+
+
+def _polyline(x, y) -> np.ndarray | None:
+    """A crack polyline ((m, 2), m) from its vertices' x and y padded with NaN; None if it has none."""
+    keep = np.isfinite(x) & np.isfinite(y)
+    return np.column_stack([x[keep], y[keep]]) if keep.any() else None
 
 
 def plot_indices(cycles, crack_length, index, labels, crossed, path, name="damage index") -> Path:

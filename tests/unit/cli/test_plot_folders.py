@@ -1,5 +1,6 @@
-"""``peridyn plot DIR`` redraws the figures of a fatigue job, a convergence study and a sweep
-from the files they leave (crack_length.csv, study.json, dataset.nc), not only a run's."""
+"""``peridyn plot DIR`` redraws the figures of a fatigue job, a convergence study, a sweep and a
+monitoring job from the files they leave (crack_length.csv, study.json, dataset.nc,
+monitoring.nc), not only a run's."""
 
 from __future__ import annotations
 
@@ -56,6 +57,16 @@ def test_sweep_folder_gets_its_figures_from_the_dataset(tmp_path, capsys):
     )  # fmt: skip
     write_dataset(ds, tmp_path / "dataset.nc")
     assert _plotted([str(tmp_path)], capsys) == [str(tmp_path / "figures" / "time_s.png")]
+
+
+def test_a_monitoring_folder_without_its_dataset_is_named(tmp_path, capsys):
+    """A monitoring job's figures are redrawn from monitoring.nc alone (the end to end test:
+    tests/simulation/test_monitor_job.py); without it the error names the file, in one line."""
+    (tmp_path / "summary.json").write_text(json.dumps({"kind": "monitor"}))
+    assert main(["plot", str(tmp_path)]) != 0
+    err = capsys.readouterr().err.strip().splitlines()
+    missing = f"monitoring dataset {str(tmp_path / 'monitoring.nc')!r} does not exist"
+    assert len(err) == 1 and missing in err[0]
 
 
 def test_a_folder_without_results_is_named(tmp_path, capsys):
