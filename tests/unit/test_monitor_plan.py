@@ -13,11 +13,11 @@ from peridyn.io.monitor_case import load_monitor_case
 from peridyn.jobs.monitor import network_case
 from peridyn.jobs.monitor_plan import (
     FatigueHistory,
+    bonds_case,
     crack_at,
     cut_case,
     grown_crack,
     interrogation_steps,
-    removed_case,
 )
 
 TINY = Path(__file__).parents[2] / "cases" / "monitoring"
@@ -38,13 +38,19 @@ def test_schedule_takes_the_baseline_each_growth_step_each_cycle_mark_and_the_en
 
 def _straight_history() -> FatigueHistory:
     # a 2D grid of 1 mm with a damaged row pair along y = 20 mm from x = 15 to 30 mm; the points
-    # beyond x = 20 mm broke one after another (first break = 1000 cycles per mm past 20 mm)
+    # beyond x = 20 mm broke one after another (first break = 1000 cycles per mm past 20 mm),
+    # each losing its bond across the crack line to the point opposite then
     x, y = np.meshgrid(np.arange(0.5, 40) * 1e-3, np.arange(0.5, 40) * 1e-3)
     points = np.column_stack([x.ravel(), y.ravel()])
     on = (np.abs(points[:, 1] - 0.020) < 0.001) & (points[:, 0] > 0.015) & (points[:, 0] < 0.030)
     damage = np.where(on, 0.4, 0.0)
     first = np.where(on, np.maximum(0.0, points[:, 0] - 0.020) * 1e6, np.inf)
-    return FatigueHistory(np.array([0.0]), np.array([0.0]), points, damage, first)
+    below = np.flatnonzero(on & (points[:, 1] < 0.020) & (points[:, 0] > 0.020))
+    above = np.array([np.argmin(np.hypot(*(points - points[i] - [0, 1e-3]).T)) for i in below])
+    pairs = np.column_stack([below, above])
+    return FatigueHistory(
+        np.array([0.0]), np.array([0.0]), points, damage, first, pairs, first[below].astype(float)
+    )
 
 
 def test_the_crack_at_a_cycle_is_the_final_path_from_the_start_cut_to_the_crack_length():
@@ -58,7 +64,7 @@ def test_the_crack_at_a_cycle_is_the_final_path_from_the_start_cut_to_the_crack_
     assert crack_at(whole, 0.0) is None
 
 
-def test_a_cut_crack_becomes_through_thickness_rectangles_and_removed_points_boxes():
+def test_a_cut_crack_becomes_through_thickness_rectangles_and_broken_bonds_a_bonds_precrack():
     wave = network_case(
         load_monitor_case(TINY / "monitor_small.yaml")[0], load_case(TINY / "monitor_small_wave.yaml"), 0
     )
@@ -70,11 +76,14 @@ def test_a_cut_crack_becomes_through_thickness_rectangles_and_removed_points_box
     assert added[1].origin == pytest.approx([0.022, 0.020, -0.002])
     assert added[1].edge_u == pytest.approx([0.002, 0.001, 0.0])
     assert added[1].edge_v[2] > 3 * 0.002 - 1e-12
-    history = _straight_history()
-    tip = FatigueTip(axis="x", start=0.020, damage=0.3)
-    removed = removed_case(wave, "removed", history, 3000.0, tip, 1e-3)
-    # the two rows of points of x in (20, 23] mm broke by 3000 cycles: 3 columns x 2 rows
-    assert len(removed.removals) - len(wave.removals) == 6
+    bonds = bonds_case(wave, "bonds", _straight_history(), 3000.0, 1e-3)
+    (added,) = bonds.precracks[len(wave.precracks) :]
+    # the bonds across the crack line of x in (20, 23] mm broke by 3000 cycles: 3 of them, each
+    # from (x, 19.5 mm) to (x, 20.5 mm), found within a quarter spacing
+    assert added.type == "bonds" and added.tolerance == pytest.approx(0.25e-3)
+    np.testing.assert_allclose(
+        added.pairs, [[x, 0.0195, x, 0.0205] for x in (0.0205, 0.0215, 0.0225)], atol=1e-12
+    )
     assert cut.actuators.keys() == {"t0"} and len(cut.output.pzt_sensors) == 3
 
 

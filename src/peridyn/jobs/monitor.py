@@ -35,11 +35,11 @@ from peridyn.io.results import Results
 from peridyn.io.run_log import run_log
 from peridyn.jobs.monitor_plan import (
     FatigueHistory,
+    bonds_case,
     crack_at,
     cut_case,
     grown_crack,
     interrogation_steps,
-    removed_case,
 )
 from peridyn.jobs.sweep_run import RunTask, read_record, run_tasks, run_threads
 from peridyn.setup.identity import case_identity
@@ -134,11 +134,16 @@ def _cases(mon: MonitorCase, base: Path, path) -> tuple[Case, Case]:
 def _fatigue(fatigue: Case, path: Path, folder: Path, overwrite: bool, comm) -> FatigueHistory:
     """Run the fatigue case into ``folder`` (or keep its finished run of the same case) and read
     its history and final damage."""
-    from peridyn.jobs.fatigue import run_fatigue_case
+    from peridyn.jobs.fatigue import BROKEN_BONDS, run_fatigue_case
 
     stamp = folder / "case_hash.txt"
     digest = case_identity(fatigue, run_length=True)[1]
-    done = (folder / "fatigue.json").exists() and stamp.exists() and stamp.read_text().strip() == digest
+    done = (
+        (folder / "fatigue.json").exists()
+        and (folder / BROKEN_BONDS).exists()
+        and stamp.exists()
+        and stamp.read_text().strip() == digest
+    )
     if overwrite or not done:
         run_fatigue_case(fatigue, output_dir=folder, base_dir=path.parent, overwrite=True, comm=comm)
         if comm is None or comm.rank == 0:
@@ -149,11 +154,15 @@ def _fatigue(fatigue: Case, path: Path, folder: Path, overwrite: bool, comm) -> 
 
 
 def read_history(folder: Path) -> FatigueHistory:
-    """The fatigue run's ``crack_length.csv`` and ``damage.vtu`` in ``folder``."""
+    """The fatigue run's ``crack_length.csv``, ``damage.vtu`` and ``broken_bonds.csv`` in ``folder``."""
     import meshio
+
+    from peridyn.jobs.fatigue import BROKEN_BONDS
 
     with open(folder / "crack_length.csv") as fh:
         rows = list(csv.DictReader(fh))
+    with open(folder / BROKEN_BONDS) as fh:
+        bonds = list(csv.DictReader(fh))
     mesh = meshio.read(folder / "damage.vtu")
     first = np.asarray(mesh.point_data["first_break_cycle"], dtype=float)
     return FatigueHistory(
@@ -162,13 +171,18 @@ def read_history(folder: Path) -> FatigueHistory:
         points=np.asarray(mesh.points[:, :2], dtype=float),
         damage=np.asarray(mesh.point_data["damage"], dtype=float),
         first_break=np.where(first < 0, np.inf, first),
+        broken_pairs=np.array(
+            [[int(r["point_a"]), int(r["point_b"])] for r in bonds], dtype=np.int64
+        ).reshape(-1, 2),
+        break_cycle=np.array([float(r["cycles"]) for r in bonds]),
     )
 
 
 class Plan:
     """The interrogations: fatigue steps, cycles (n_int,), crack lengths (n_int,) m, crack
-    polylines (None or (m, 2) m each), the whole final crack, and the cycle of the transfer
-    check (the last interrogation's) when the case asks for it."""
+    polylines (None or (m, 2) m each), the whole final crack, and the interrogations that the
+    transfer check repeats by the second route (``checked``: each after the crack first grew,
+    when the case asks for it)."""
 
     def __init__(self, mon: MonitorCase, fatigue: Case, history: FatigueHistory):
         f = fatigue.fatigue
@@ -190,7 +204,8 @@ class Plan:
         self.cracks = [crack_at(self.whole, a) for a in self.crack_length]
         self.transducers = np.asarray(mon.transducers.centers, dtype=float)
         self.paths = network_paths(len(self.transducers))
-        self.check = mon.check_transfer and self.cracks[-1] is not None
+        grown = [k for k, crack in enumerate(self.cracks) if k > 0 and crack is not None]
+        self.checked = grown if mon.check_transfer else []
 
 
 def _plan(mon, fatigue, wave, history) -> Plan:
@@ -225,20 +240,21 @@ def network_case(mon: MonitorCase, wave: Case, actuator: int) -> Case:
 
 
 def _tasks(mon, wave, plan: Plan, out: Path, wave_path: Path, executor, workers, scheduler, threads):
-    """``{(label, actuator): RunTask}``: label ``k`` for interrogation k, ``"removed"`` for the
-    transfer check on the last crack."""
+    """``{(label, actuator): RunTask}``: label ``k`` for interrogation k, ``("bonds", k)`` for its
+    transfer check."""
     n = len(plan.transducers)
     fired = [network_case(mon, wave, i) for i in range(n)]
     per_run = run_threads(threads, executor, workers, scheduler)
     tasks = {}
-    labels = [(k, crack) for k, crack in enumerate(plan.cracks)] + ([("removed", None)] if plan.check else [])
-    for label, crack in labels:
+    labels = list(range(len(plan.cracks))) + [("bonds", k) for k in plan.checked]
+    for label in labels:
         for i in range(n):
-            name = f"{mon.name}_{label if label == 'removed' else f'k{label:02d}'}_t{i}"
-            if label == "removed":
-                case = removed_case(fired[i], name, plan.history, plan.cycles[-1], plan.tip, plan.spacing)
+            if isinstance(label, tuple):
+                name = f"{mon.name}_bonds_k{label[1]:02d}_t{i}"
+                case = bonds_case(fired[i], name, plan.history, plan.cycles[label[1]], plan.spacing)
             else:
-                case = cut_case(fired[i], name, crack)
+                name = f"{mon.name}_k{label:02d}_t{i}"
+                case = cut_case(fired[i], name, plan.cracks[label])
             folder = out / "interrogations" / name.removeprefix(f"{mon.name}_")
             tasks[(label, i)] = RunTask(
                 run_id=folder.name,
@@ -309,9 +325,10 @@ def _run_ranks(todo, comm, done) -> None:
 
 
 def _signals(mon: MonitorCase, plan: Plan, tasks: dict) -> dict:
-    """``{"times": (n_t,) s, "signals": (n_int, n_paths, n_t), "removed": (n_paths, n_t) or
-    None}``: each path's signal the mean of its two directions (reciprocity), unit of
-    ``pzt_signal`` (mean in-plane strain under the sensor)."""
+    """``{"times": (n_t,) s, "signals": (n_int, n_paths, n_t), "bonds": (n_checked, n_paths,
+    n_t), the checked interrogations by the bonds route (``Plan.checked``)}``: each path's
+    signal the mean of its two directions (reciprocity), unit of ``pzt_signal`` (mean in-plane
+    strain under the sensor)."""
     n = len(plan.transducers)
 
     def interrogation(label) -> tuple[np.ndarray, np.ndarray]:
@@ -329,5 +346,5 @@ def _signals(mon: MonitorCase, plan: Plan, tasks: dict) -> dict:
     return {
         "times": np.asarray(times, dtype=float),
         "signals": np.stack([s for _, s in series]),
-        "removed": interrogation("removed")[1] if plan.check else None,
+        "bonds": np.stack([interrogation(("bonds", k))[1] for k in plan.checked]) if plan.checked else None,
     }

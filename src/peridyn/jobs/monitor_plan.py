@@ -1,18 +1,18 @@
 """What a monitoring job interrogates: the fatigue life's interrogation points (the schedule), the
 crack at each of them, and the wave cases of the body so damaged (the damage transfer).
 
-The fatigue runs on a plane-stress (2D) model of the plate; its history (cycles, crack length)
-and final damage field (with each point's first-break cycle) give the crack at any cycle: the
-crack path (``peridyn.analysis.crack``) of the points broken by the last interrogation, from the
-crack's start (``fatigue.tip.start``), cut to the crack length of that cycle. The wave case is
-the 3D plate on the same in-plane grid; a crack reaches it in one of two ways (docs/monitoring.md,
-"Damage transfer"):
+The fatigue runs on a plane-stress (2D) model of the plate; its history (cycles, crack length),
+final damage field (with each point's first-break cycle) and broken bonds (with the cycle of
+each break) give the crack at any cycle. The wave case is the 3D plate on the same in-plane
+grid; a crack reaches it in one of two ways (docs/monitoring.md, "Damage transfer"):
 
-- ``cut`` (the interrogations): the crack polyline becomes through-thickness pre-crack
-  rectangles, one per polyline segment, that cut every bond crossing them;
-- ``removed`` (the check of the transfer): the columns of points that the fatigue had cracked
-  by that cycle (first break at or before it, final damage at the crack threshold) are removed
-  through the thickness, a notch of the fatigue's own damaged points.
+- ``cut`` (the interrogations): the crack path (``peridyn.analysis.crack``) of the points
+  broken by the last interrogation, from the crack's start (``fatigue.tip.start``), cut to the
+  crack length of that cycle, becomes through-thickness pre-crack rectangles, one per polyline
+  segment, that cut every bond crossing them;
+- ``bonds`` (the check of the transfer): every 3D bond whose ends lie in the columns of a 2D
+  bond that the fatigue had broken by that cycle is cut (a ``bonds`` pre-crack), the 2D model's
+  own broken bonds through the thickness.
 """
 
 from __future__ import annotations
@@ -39,6 +39,9 @@ class FatigueHistory:
     points : (n_points, 2) float64, m, the 2D model's points
     damage : (n_points,) float64, final damage index
     first_break : (n_points,) float64, cycle of each point's first broken bond (inf: none)
+    broken_pairs : (n_broken, 2) int64, the points (indices into ``points``) of each bond the
+        cycles broke
+    break_cycle : (n_broken,) float64, the cycle at which each of them broke
     """
 
     cycles: np.ndarray
@@ -46,6 +49,8 @@ class FatigueHistory:
     points: np.ndarray
     damage: np.ndarray
     first_break: np.ndarray
+    broken_pairs: np.ndarray
+    break_cycle: np.ndarray
 
 
 def interrogation_steps(
@@ -135,21 +140,16 @@ def cut_case(wave: Case, name: str, crack: np.ndarray | None) -> Case:
     return validate_case(data, name)
 
 
-def removed_case(wave: Case, name: str, history: FatigueHistory, cycles: float, tip, spacing: float) -> Case:
-    """The wave case with the fatigue's cracked points at ``cycles`` removed as through-thickness
-    columns (boxes of one ``spacing`` square around each), renamed ``name``."""
-    sense = 1.0 if tip.sense == "+" else -1.0
-    cracked = (
-        (history.first_break <= cycles)
-        & (history.damage >= tip.damage)
-        & ((history.points[:, AXIS[tip.axis]] - tip.start) * sense > 0)
-    )
+def bonds_case(wave: Case, name: str, history: FatigueHistory, cycles: float, spacing: float) -> Case:
+    """The wave case with the bonds that the fatigue had broken by ``cycles`` cut through the
+    thickness (a ``bonds`` pre-crack: every bond between the two columns of points at the
+    broken 2D bond's ends; the columns found within a quarter ``spacing``, m), renamed ``name``."""
     data = wave.model_dump(mode="python")
     data["name"] = name
-    z0, depth = _through(wave)
-    h = 0.5 * spacing
-    for x, y in history.points[cracked]:
-        data["removals"].append({"type": "box", "min": [x - h, y - h, z0], "max": [x + h, y + h, z0 + depth]})
+    broken = history.broken_pairs[history.break_cycle <= cycles]
+    if len(broken):
+        pairs = history.points[broken].reshape(-1, 4)
+        data["precracks"].append({"type": "bonds", "pairs": pairs.tolist(), "tolerance": 0.25 * spacing})
     return validate_case(data, name)
 
 
