@@ -7,6 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from peridyn.discretization.bonds import crossing_segment, cut_bonds
 from peridyn.errors import CaseFileError
 from peridyn.io.case import FatigueTip, load_case
 from peridyn.io.monitor_case import load_monitor_case
@@ -14,11 +15,13 @@ from peridyn.jobs.monitor import network_case
 from peridyn.jobs.monitor_plan import (
     FatigueHistory,
     bonds_case,
-    crack_at,
+    crack_lines,
     cut_case,
-    grown_crack,
+    damage_at,
     interrogation_steps,
 )
+from peridyn.physics.damage import damage_field
+from peridyn.setup.build import build
 
 TINY = Path(__file__).parents[2] / "cases" / "monitoring"
 
@@ -53,15 +56,76 @@ def _straight_history() -> FatigueHistory:
     )
 
 
-def test_the_crack_at_a_cycle_is_the_final_path_from_the_start_cut_to_the_crack_length():
-    tip = FatigueTip(axis="x", start=0.020, damage=0.3)
-    whole = grown_crack(_straight_history(), 1e-3, tip)
-    # the path starts at tip.start on the crack line and runs along +x to the last cracked column
-    np.testing.assert_allclose(whole[0], [0.020, 0.020], atol=1e-12)
-    assert whole[-1][0] == pytest.approx(0.0295, abs=1e-3)
-    crack = crack_at(whole, 0.004)
-    np.testing.assert_allclose(crack[-1], [0.024, 0.020], atol=1e-12)
-    assert crack_at(whole, 0.0) is None
+def _small_crack(end_x: float = 0.023):
+    """The small case's fatigue model and a history whose cycles broke the bonds that cross its
+    crack line (y = 20 mm) from the notch root (x = 20 mm) to ``end_x`` (m), each at 1000 cycles
+    per mm of the crossing from the root."""
+    model = build(load_case(TINY / "monitor_small_fatigue.yaml"), TINY).model
+    b, points = model.bonds, model.body.points
+    owners = b.owners()
+    a, c = points[owners], points[b.neighbours]
+    cross = crossing_segment(a, c, [0.020, 0.020], [end_x, 0.020]) & (owners < b.neighbours) & b.intact
+    at = a[cross, 0] + (0.020 - a[cross, 1]) / (c[cross, 1] - a[cross, 1]) * (c[cross, 0] - a[cross, 0])
+    pairs = np.column_stack([owners[cross], b.neighbours[cross]])
+    n = model.body.n_points
+    history = FatigueHistory(
+        np.array([0.0]),
+        np.array([0.0]),
+        points[:, :2],
+        np.zeros(n),
+        np.full(n, np.inf),
+        pairs,
+        (at - 0.020) * 1e6,
+    )
+    return model, history, cross
+
+
+def test_the_fatigue_damage_at_a_cycle_is_its_model_with_the_bonds_broken_by_then():
+    model, history, _ = _small_crack()
+    b = model.bonds
+    intact = b.intact.copy()
+    phi = damage_at(model, history, [0.0, 2400.0, np.inf])
+    np.testing.assert_array_equal(b.intact, intact)  # the model is left as given
+    np.testing.assert_array_equal(phi[0], damage_field(model))  # the notch alone
+    for k, end in ((1, 0.0224), (2, 0.023)):  # 2400 cycles: the bonds crossing up to x = 22.4 mm
+        cut_bonds(model.body, b, lambda x, y, end=end: crossing_segment(x, y, [0.020, 0.020], [end, 0.020]))
+        np.testing.assert_array_equal(phi[k], damage_field(model))
+        b.intact[:] = intact
+    lines = crack_lines(history.points, phi[2], 1e-3, FatigueTip(axis="x", start=0.020, damage=0.3))
+    # one crack, from the notch root along the line to the last cracked point (at the tip's
+    # damage threshold: the points beside the line's last millimetre keep more than 0.7 of
+    # their bonds)
+    cracked = history.points[phi[2] >= 0.3]
+    assert len(lines) == 1
+    np.testing.assert_allclose(lines[0][0], [0.020, 0.020], atol=1e-12)
+    assert lines[0][-1] == pytest.approx([cracked[:, 0].max(), 0.020], abs=0.5e-3)
+    assert cracked[:, 0].max() < 0.023
+
+
+def test_the_two_transfers_of_a_clean_crack_cut_the_same_3d_bonds_but_those_through_its_ends():
+    """A crack line whose every crossing bond the fatigue broke: the cut (a through-thickness
+    rectangle on the line) and the broken bonds (their columns) cut the same bonds of the 3D
+    plate, but for the bonds whose in-plane projection passes through an end of the line, which
+    one transfer or the other may take by round-off (the crossing tests are strict)."""
+    _, history, _ = _small_crack()
+    wave = network_case(
+        load_monitor_case(TINY / "monitor_small.yaml")[0], load_case(TINY / "monitor_small_wave.yaml"), 0
+    )
+    line = np.array([[0.020, 0.020], [0.023, 0.020]])
+    sets = []
+    for case in (cut_case(wave, "cut", [line]), bonds_case(wave, "bonds", history, np.inf, 1e-3)):
+        setup = build(case, TINY)
+        b, points = setup.bonds, setup.body.points
+        owners = b.owners()
+        broken = ~b.intact & (owners < b.neighbours)
+        sets.append({(int(i), int(j)) for i, j in zip(owners[broken], b.neighbours[broken], strict=True)})
+    differ = sets[0] ^ sets[1]
+    assert len(sets[0] & sets[1]) > 100  # both cut the notch and the crack
+    for i, j in differ:  # each through an end of the line, in the plane
+        xy = points[[i, j], :2]
+        u, w = xy[1] - xy[0], line - xy[0]
+        through = np.abs(u[0] * w[:, 1] - u[1] * w[:, 0]) < 1e-12
+        assert any(through), (xy, "passes through neither end")
 
 
 def test_a_cut_crack_becomes_through_thickness_rectangles_and_broken_bonds_a_bonds_precrack():
@@ -69,7 +133,7 @@ def test_a_cut_crack_becomes_through_thickness_rectangles_and_broken_bonds_a_bon
         load_monitor_case(TINY / "monitor_small.yaml")[0], load_case(TINY / "monitor_small_wave.yaml"), 0
     )
     crack = np.array([[0.020, 0.020], [0.022, 0.020], [0.024, 0.021]])
-    cut = cut_case(wave, "cut", crack)
+    cut = cut_case(wave, "cut", [crack])
     added = cut.precracks[len(wave.precracks) :]
     assert [p.type for p in added] == ["rectangle", "rectangle"]
     # each rectangle spans its segment in the plane and the whole 2 mm thickness (with margins)

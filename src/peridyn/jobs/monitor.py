@@ -36,9 +36,9 @@ from peridyn.io.run_log import run_log
 from peridyn.jobs.monitor_plan import (
     FatigueHistory,
     bonds_case,
-    crack_at,
+    crack_lines,
     cut_case,
-    grown_crack,
+    damage_at,
     interrogation_steps,
 )
 from peridyn.jobs.sweep_run import RunTask, read_record, run_tasks, run_threads
@@ -92,7 +92,7 @@ def run_monitor(
     files = job_files(out, provenance(case_path, case=mon)) if root else nullcontext()
     with files, run_log(out, root):
         history = _fatigue(fatigue, base / mon.fatigue_case, out / "fatigue", overwrite, comm)
-        plan = _plan(mon, fatigue, wave, history)
+        plan = _plan(mon, fatigue, history, (base / mon.fatigue_case).parent)
         tasks = _tasks(mon, wave, plan, out, base / mon.wave_case, executor, workers, scheduler, threads)
         _run(tasks, executor, workers, scheduler, overwrite, comm)
         if not root:
@@ -179,12 +179,15 @@ def read_history(folder: Path) -> FatigueHistory:
 
 
 class Plan:
-    """The interrogations: fatigue steps, cycles (n_int,), crack lengths (n_int,) m, crack
-    polylines (None or (m, 2) m each), the whole final crack, and the interrogations that the
-    transfer check repeats by the second route (``checked``: each after the crack first grew,
-    when the case asks for it)."""
+    """The interrogations: fatigue steps, cycles (n_int,), crack lengths (n_int,) m, the crack
+    of each (``lines``: its polylines, (m, 2) m, branches included, from the fatigue model's
+    damage at that cycle; ``cracks``: the main one, None before the crack grew), and the
+    interrogations that the transfer check repeats by the second route (``checked``: each after
+    the crack first grew, when the case asks for it). ``base_dir``: the fatigue case's folder."""
 
-    def __init__(self, mon: MonitorCase, fatigue: Case, history: FatigueHistory):
+    def __init__(self, mon: MonitorCase, fatigue: Case, history: FatigueHistory, base_dir: Path):
+        from peridyn.setup.build import build
+
         f = fatigue.fatigue
         s = mon.schedule
         self.history = history
@@ -200,16 +203,20 @@ class Plan:
         )
         self.cycles = history.cycles[self.steps]
         self.crack_length = history.crack_length[self.steps]
-        self.whole = grown_crack(history, self.spacing, f.tip, self.cycles[-1])
-        self.cracks = [crack_at(self.whole, a) for a in self.crack_length]
+        phi = damage_at(build(fatigue, base_dir).model, history, self.cycles)
+        self.lines = [
+            crack_lines(history.points, p, self.spacing, f.tip) if a > 0 else []
+            for p, a in zip(phi, self.crack_length, strict=True)
+        ]
+        self.cracks = [lines[0] if lines else None for lines in self.lines]
         self.transducers = np.asarray(mon.transducers.centers, dtype=float)
         self.paths = network_paths(len(self.transducers))
         grown = [k for k, crack in enumerate(self.cracks) if k > 0 and crack is not None]
         self.checked = grown if mon.check_transfer else []
 
 
-def _plan(mon, fatigue, wave, history) -> Plan:
-    plan = Plan(mon, fatigue, history)
+def _plan(mon, fatigue, history, base_dir) -> Plan:
+    plan = Plan(mon, fatigue, history, base_dir)
     logger.info(
         f"{len(plan.steps)} interrogations at {plan.cycles.tolist()} cycles, crack "
         f"{(plan.crack_length * 1e3).round(2).tolist()} mm"
@@ -254,7 +261,7 @@ def _tasks(mon, wave, plan: Plan, out: Path, wave_path: Path, executor, workers,
                 case = bonds_case(fired[i], name, plan.history, plan.cycles[label[1]], plan.spacing)
             else:
                 name = f"{mon.name}_k{label:02d}_t{i}"
-                case = cut_case(fired[i], name, plan.cracks[label])
+                case = cut_case(fired[i], name, plan.lines[label])
             folder = out / "interrogations" / name.removeprefix(f"{mon.name}_")
             tasks[(label, i)] = RunTask(
                 run_id=folder.name,

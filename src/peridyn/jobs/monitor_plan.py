@@ -22,9 +22,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from peridyn.analysis.crack import crack_paths
-from peridyn.analysis.shm.paths import truncated
 from peridyn.errors import InputError
 from peridyn.io.case import Case, validate_case
+from peridyn.physics.damage import damage_field
 
 AXIS = {"x": 0, "y": 1}
 
@@ -82,53 +82,82 @@ def interrogation_steps(
     return np.array(steps, dtype=int)
 
 
-def grown_crack(history: FatigueHistory, spacing: float, tip, cycles: float = np.inf) -> np.ndarray | None:
-    """(m, 2) polyline (m) of the crack the fatigue grew by ``cycles`` (the points that lost a
-    bond by then, at their final damage), from ``tip.start`` along ``tip.axis`` in ``tip.sense``
-    (the fatigue case's ``FatigueTip``): of the crack paths, the one that comes nearest to the
-    start along the axis; None without one."""
+def damage_at(model, history: FatigueHistory, cycles) -> np.ndarray:
+    """(n_cycles, n_points) the fatigue model's damage index at each of ``cycles``, exactly:
+    ``model`` (the fatigue case built, its pre-cracks cut) with the bonds that had broken by
+    then (``history.broken_pairs``, ``break_cycle``) broken. ``model.bonds`` is left as given."""
+    b = model.bonds
+    n = model.body.n_points
+    if n != len(history.points) or not np.allclose(model.body.points[:, :2], history.points):
+        raise InputError("the fatigue run's points are not those of its case (damage.vtu of another case?)")
+    owners = b.owners()
+    key = np.minimum(owners, b.neighbours) * n + np.maximum(owners, b.neighbours)
+    listed = history.broken_pairs[:, 0] * n + history.broken_pairs[:, 1]
+    order = np.argsort(listed)
+    at = np.clip(np.searchsorted(listed[order], key), 0, max(len(listed) - 1, 0))
+    found = listed[order][at] == key if len(listed) else np.zeros(b.n_bonds, bool)
+    broke = np.where(found, history.break_cycle[order][at] if len(listed) else 0.0, np.inf)
+    intact = b.intact.copy()
+    phi = []
+    try:
+        for n_cycles in np.atleast_1d(cycles):
+            b.intact[:] = intact & ~(found & (broke <= n_cycles))
+            phi.append(damage_field(model))
+    finally:
+        b.intact[:] = intact
+    return np.array(phi)
+
+
+def crack_lines(points: np.ndarray, phi: np.ndarray, spacing: float, tip) -> list[np.ndarray]:
+    """The crack of the damage ``phi`` ((n_points,)) as (m, 2) polylines (m): every crack path
+    (``peridyn.analysis.crack.crack_paths`` at the tip's damage threshold, branches included)
+    beyond ``tip.start`` along ``tip.axis`` in ``tip.sense`` (the fatigue case's
+    ``FatigueTip``), the path that comes nearest to the start first (the main crack, from the
+    start); [] without one."""
     if tip.axis not in AXIS or tip.start is None:
         raise InputError(
             "a monitored fatigue case needs fatigue.tip.axis x or y and tip.start (the notch root)"
         )
-    phi = np.where(history.first_break <= cycles, history.damage, 0.0)
-    paths = crack_paths(history.points, phi, spacing, threshold=tip.damage)
-    if not paths:
-        return None
     axis = AXIS[tip.axis]
-    line = min(paths, key=lambda p: np.abs(p.points[:, axis] - tip.start).min()).points
     sense = 1.0 if tip.sense == "+" else -1.0
-    ahead = (line[:, axis] - tip.start) * sense
-    if sense < 0:
+    paths = sorted(
+        (p.points for p in crack_paths(points, phi, spacing, threshold=tip.damage)),
+        key=lambda line: np.abs(line[:, axis] - tip.start).min(),
+    )
+    lines = [_beyond(line, axis, sense, tip.start, k == 0) for k, line in enumerate(paths)]
+    return [line for line in lines if line is not None]
+
+
+def _beyond(line: np.ndarray, axis: int, sense: float, start: float, main: bool) -> np.ndarray | None:
+    """The part of the polyline ``line`` beyond ``start`` along ``axis`` in ``sense``, from the
+    point where it passes the start (a ``main`` path that begins beyond it: from its first
+    vertex moved back to the start); None if it never does."""
+    ahead = (line[:, axis] - start) * sense
+    if ahead[-1] < ahead[0]:
         line, ahead = line[::-1], ahead[::-1]
     inside = np.flatnonzero(ahead > 0)
     if inside.size == 0:
         return None
     k = inside[0]
-    if k > 0:  # the vertex where the path passes the start
+    if k > 0:  # the point where the path passes the start
         w = -ahead[k - 1] / (ahead[k] - ahead[k - 1])
         first = line[k - 1] + w * (line[k] - line[k - 1])
-    else:
-        first = line[0].copy()
-        first[axis] = tip.start
-    return np.vstack([first, line[k:]])
+        return np.vstack([first, line[k:]])
+    if not main:
+        return line
+    first = line[0].copy()
+    first[axis] = start
+    return np.vstack([first, line])
 
 
-def crack_at(whole: np.ndarray | None, length: float) -> np.ndarray | None:
-    """The crack polyline (m) of crack length ``length`` (m): ``whole`` cut to it; None at 0."""
-    if whole is None or length <= 0:
-        return None
-    return truncated(whole, length)
-
-
-def cut_case(wave: Case, name: str, crack: np.ndarray | None) -> Case:
-    """The wave case with the crack ``crack`` ((m, 2), m, or None) as through-thickness pre-crack
-    rectangles (one per segment), renamed ``name``."""
+def cut_case(wave: Case, name: str, lines: list) -> Case:
+    """The wave case with the crack ``lines`` ((m, 2) polylines, m, e.g. a crack and its
+    branches) as through-thickness pre-crack rectangles (one per segment), renamed ``name``."""
     data = wave.model_dump(mode="python")
     data["name"] = name
-    if crack is not None:
-        z0, depth = _through(wave)
-        for a, b in zip(crack[:-1], crack[1:], strict=True):
+    z0, depth = _through(wave)
+    for line in lines:
+        for a, b in zip(line[:-1], line[1:], strict=True):
             data["precracks"].append(
                 {
                     "type": "rectangle",
