@@ -40,20 +40,17 @@ def test_schedule_takes_the_baseline_each_growth_step_each_cycle_mark_and_the_en
 
 
 def _straight_history() -> FatigueHistory:
-    # a 2D grid of 1 mm with a damaged row pair along y = 20 mm from x = 15 to 30 mm; the points
+    # a 2D grid of 1 mm with a cracked row pair along y = 20 mm from x = 15 to 30 mm; the points
     # beyond x = 20 mm broke one after another (first break = 1000 cycles per mm past 20 mm),
     # each losing its bond across the crack line to the point opposite then
     x, y = np.meshgrid(np.arange(0.5, 40) * 1e-3, np.arange(0.5, 40) * 1e-3)
     points = np.column_stack([x.ravel(), y.ravel()])
     on = (np.abs(points[:, 1] - 0.020) < 0.001) & (points[:, 0] > 0.015) & (points[:, 0] < 0.030)
-    damage = np.where(on, 0.4, 0.0)
     first = np.where(on, np.maximum(0.0, points[:, 0] - 0.020) * 1e6, np.inf)
     below = np.flatnonzero(on & (points[:, 1] < 0.020) & (points[:, 0] > 0.020))
     above = np.array([np.argmin(np.hypot(*(points - points[i] - [0, 1e-3]).T)) for i in below])
     pairs = np.column_stack([below, above])
-    return FatigueHistory(
-        np.array([0.0]), np.array([0.0]), points, damage, first, pairs, first[below].astype(float)
-    )
+    return FatigueHistory(np.array([0.0]), np.array([0.0]), points, first, pairs, first[below].astype(float))
 
 
 def _small_crack(end_x: float = 0.023):
@@ -72,7 +69,6 @@ def _small_crack(end_x: float = 0.023):
         np.array([0.0]),
         np.array([0.0]),
         points[:, :2],
-        np.zeros(n),
         np.full(n, np.inf),
         pairs,
         (at - 0.020) * 1e6,

@@ -133,7 +133,7 @@ def _cases(mon: MonitorCase, base: Path, path) -> tuple[Case, Case]:
 
 def _fatigue(fatigue: Case, path: Path, folder: Path, overwrite: bool, comm) -> FatigueHistory:
     """Run the fatigue case into ``folder`` (or keep its finished run of the same case) and read
-    its history and final damage."""
+    its history and broken bonds."""
     from peridyn.jobs.fatigue import BROKEN_BONDS, run_fatigue_case
 
     stamp = folder / "case_hash.txt"
@@ -169,7 +169,6 @@ def read_history(folder: Path) -> FatigueHistory:
         cycles=np.array([float(r["cycles"]) for r in rows]),
         crack_length=np.array([float(r["crack_length_m"]) for r in rows]),
         points=np.asarray(mesh.points[:, :2], dtype=float),
-        damage=np.asarray(mesh.point_data["damage"], dtype=float),
         first_break=np.where(first < 0, np.inf, first),
         broken_pairs=np.array(
             [[int(r["point_a"]), int(r["point_b"])] for r in bonds], dtype=np.int64

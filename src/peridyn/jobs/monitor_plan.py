@@ -31,13 +31,12 @@ AXIS = {"x": 0, "y": 1}
 
 @dataclass(frozen=True)
 class FatigueHistory:
-    """What the fatigue run left: history and final damage of the plane-stress model.
+    """What the fatigue run left: history and broken bonds of the plane-stress model.
 
     Attributes
     ----------
     cycles, crack_length : (n_steps + 1,) float64; cycles and crack length (m) after each step
     points : (n_points, 2) float64, m, the 2D model's points
-    damage : (n_points,) float64, final damage index
     first_break : (n_points,) float64, cycle of each point's first broken bond (inf: none)
     broken_pairs : (n_broken, 2) int64, the points (indices into ``points``) of each bond the
         cycles broke
@@ -47,7 +46,6 @@ class FatigueHistory:
     cycles: np.ndarray
     crack_length: np.ndarray
     points: np.ndarray
-    damage: np.ndarray
     first_break: np.ndarray
     broken_pairs: np.ndarray
     break_cycle: np.ndarray
