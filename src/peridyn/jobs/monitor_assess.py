@@ -132,8 +132,8 @@ def transfer_figures(
     """The two damage transfers compared (docs/monitoring.md, "Damage transfer"): each index of
     the crossed paths (all paths without one) at each checked interrogation, by the cut
     (``signals[k]``) and by the broken bonds (``bonds``), on the signals without noise (the
-    noise is no part of a transfer), and the relative differences ``|cut - bonds| / cut``: the
-    largest per interrogation and over them all.
+    noise is no part of a transfer), and the relative differences ``|cut - bonds| / cut`` (0
+    where both are 0): the largest per interrogation and over them all.
 
     Parameters
     ----------
@@ -151,7 +151,8 @@ def transfer_figures(
     ):
         cut = np.stack([index(signals[0], signals[k], masks)[paths] for k in checked])
         other = np.stack([index(signals[0], s, masks)[paths] for s in bonds])
-        relative = np.abs(cut - other) / cut
+        diff = np.abs(cut - other)
+        relative = np.divide(diff, cut, out=np.where(diff > 0, np.inf, 0.0), where=cut > 0)
         block[name] = {
             "cut": cut.tolist(),
             "bonds": other.tolist(),
