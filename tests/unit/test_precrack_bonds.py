@@ -48,6 +48,14 @@ def test_listed_bonds_are_cut_between_their_columns_at_every_layer_pair():
     assert int((~setup.bonds.intact).sum()) == 2 * 18
 
 
+def test_lattice_storage_cuts_the_same_listed_bonds():
+    pairs = [[0.0045, 0.0035, 0.0055, 0.0035], [0.00651, 0.00449, 0.0045, 0.0035]]
+    case = _plate([{"type": "bonds", "pairs": pairs, "tolerance": 0.25 * H}])
+    case["discretization"]["storage"] = "lattice"
+    setup = build(validate_case(case, "plate"))
+    assert setup.storage == "lattice" and setup.bonds.n_broken() == 2 * 18
+
+
 def test_a_bonds_precrack_needs_its_tolerance_and_ends_on_the_body():
     with pytest.raises(CaseFileError, match="tolerance"):
         validate_case(_plate([{"type": "bonds", "pairs": [[0.0045, 0.0035, 0.0055, 0.0035]]}]), "plate")
