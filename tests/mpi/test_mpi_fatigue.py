@@ -57,6 +57,7 @@ CYCLES_RTOL = 4e-6
 CSV_RTOL = CYCLES_RTOL + 5e-6
 #: the files a serial fatigue run writes (output.plots off, no modal analyses)
 FILES = {
+    "broken_bonds.csv",
     "crack_length.csv",
     "damage.vtu",
     "fatigue.json",
@@ -161,7 +162,12 @@ def test_mpi_fatigue_gives_the_serial_crack_history(serial, case, ranks, tmp_pat
     np.testing.assert_allclose(phi, phi_serial, rtol=0, atol=1e-14 if symmetric else 0)
     np.testing.assert_array_equal(first < 0, first_serial < 0)  # -1: never broke
     np.testing.assert_allclose(first, first_serial, rtol=CYCLES_RTOL)
-    if not symmetric:
+    if not symmetric:  # the same bonds broken, at the same cycles (printed to 6 digits)
+        pairs, pairs_serial = (
+            np.loadtxt(f / "broken_bonds.csv", delimiter=",", skiprows=1) for f in (out, folder)
+        )
+        np.testing.assert_array_equal(pairs[:, :2], pairs_serial[:, :2])
+        np.testing.assert_allclose(pairs[:, 2], pairs_serial[:, 2], rtol=CSV_RTOL)
         u, u_serial = (_without_rigid_motion(x, m.point_data["u_max"]) for m in (mine, theirs))
         np.testing.assert_allclose(u, u_serial, rtol=0, atol=1e-6 * np.abs(u_serial).max())
     assert json.loads((out / "status.json").read_text())["status"] == "complete"

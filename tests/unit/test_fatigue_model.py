@@ -43,6 +43,32 @@ def test_bar_loses_all_bonds_at_the_closed_form_life(strain):
     assert result.broken[done[0] - 1] == 0  # none before: uniform strain, one life for all
 
 
+def test_each_broken_bond_is_recorded_once_with_the_cycle_it_broke():
+    """A strain rising along the bar breaks its bonds at different cycles: the run's list of
+    broken bonds is the model's broken bonds, each once; the directed bonds broken by each step
+    of the history are twice those listed by then; each point's first break is the earliest of
+    its bonds' (the monitoring job's bond transfer reads this list: docs/monitoring.md)."""
+    model, loading = _bar(0.0)
+    x = model.body.points[:, 0]
+    profile = np.column_stack([0.006 * x * x / x.max(), np.zeros((len(x), 2))])  # strain 0 to 0.012
+    loading = Loading(model.body, [BoundaryCondition("all", "displacement", "xyz", Constant(1.0), profile)])
+    n_life = V5.phase_one_life(0.012)
+    result = run_fatigue(model, loading, V5, CycleMapping(((40, 0.25 / n_life),)), load_ratio=0.0)
+    b = model.bonds
+    owners = b.owners()
+    broken = ~b.intact
+    want = {(int(i), int(j)) for i, j in zip(owners[broken], b.neighbours[broken], strict=True) if i < j}
+    pairs = [tuple(p) for p in result.broken_pairs.tolist()]
+    assert len(pairs) == len(set(pairs)) == len(want) > 0 and set(pairs) == want
+    assert 1 < len(np.unique(result.break_cycle))  # not all at once
+    listed_by = [2 * int(np.sum(result.break_cycle <= n)) for n in result.cycles]
+    np.testing.assert_array_equal(listed_by, result.broken)
+    earliest = np.full(model.body.n_points, np.inf)
+    for end in (0, 1):
+        np.minimum.at(earliest, result.broken_pairs[:, end], result.break_cycle)
+    np.testing.assert_array_equal(earliest, result.first_break)
+
+
 def test_no_bond_breaks_at_or_below_the_fatigue_limit():
     """Eq. 7.4: d lambda / dN = 0 for eps <= eps_inf, however many cycles."""
     model, loading = _bar(V5.eps_inf)

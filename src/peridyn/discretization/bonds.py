@@ -472,6 +472,41 @@ def crossing_segment(x_from: np.ndarray, x_to: np.ndarray, start, end) -> np.nda
     return (s1 * s2 < 0) & (s3 * s4 < 0)
 
 
+def listed_pairs(pairs, tolerance: float):
+    """``crossing(x_from, x_to)`` of the bonds listed in ``pairs``: True where ``x_from`` and
+    ``x_to`` lie, in the x-y plane, within ``tolerance`` (m) of the two ends of a listed pair,
+    in either order (in a plate: the bonds between two columns of points, at every pair of
+    layers).
+
+    Parameters
+    ----------
+    pairs : (k, 4) float64, m, each bond's ends (x_a, y_a, x_b, y_b)
+    tolerance : float, m, less than half the distance between two listed ends
+    """
+    pairs = np.asarray(pairs, dtype=float).reshape(-1, 4)
+    ends = np.concatenate([pairs[:, :2], pairs[:, 2:]])
+    tree = cKDTree(ends)
+    # each listed end is known by the first listed end within the tolerance
+    first = np.array([min(group) for group in tree.query_ball_point(ends, tolerance)], dtype=np.int64)
+    k = len(pairs)
+    a, b = first[:k], first[k:]
+    keys = np.unique(np.minimum(a, b) * len(ends) + np.maximum(a, b))
+
+    def crossing(x_from: np.ndarray, x_to: np.ndarray) -> np.ndarray:
+        ia, ib = (_listed_end(tree, first, x[:, :2], tolerance) for x in (x_from, x_to))
+        key = np.minimum(ia, ib) * len(ends) + np.maximum(ia, ib)
+        return (ia >= 0) & (ib >= 0) & np.isin(key, keys)
+
+    return crossing
+
+
+def _listed_end(tree: cKDTree, first: np.ndarray, xy: np.ndarray, tolerance: float) -> np.ndarray:
+    """(n,) int64: the listed end (its first index) within ``tolerance`` of each of ``xy``, -1 for none."""
+    d, i = tree.query(xy, distance_upper_bound=tolerance)
+    found = np.isfinite(d)
+    return np.where(found, first[np.where(found, i, 0)], -1)
+
+
 def _dot3(rows: np.ndarray, vector: np.ndarray) -> np.ndarray:
     """(n,) ``rows . vector`` of (n, 3) rows, summed x + y then + z, each product and sum rounded
     once (as Peridigm's bond filters write them; a matrix product may fuse or reorder them)."""

@@ -46,9 +46,13 @@ class FatigueResult:
     u_max : (n_points, 3) float64, m, displacement at the maximum load after the last step
     damage : (n_points,) float64, final damage index
     first_break : (n_points,) float64, cycle at which each point first lost a bond (inf if none)
+    broken_pairs : (n_broken, 2) int64, the bonds the cycles broke, each once: its two points
+        (the smaller index first), sorted
+    break_cycle : (n_broken,) float64, cycle at which each of ``broken_pairs`` broke
 
     Under MPI every rank holds the history (``cycles``, ``crack_length``, ``broken``); the
-    per-point arrays are the whole body's in global point order on rank 0, None on the others.
+    per-point and per-bond arrays are the whole body's in global point order on rank 0, None on
+    the others.
     """
 
     cycles: np.ndarray
@@ -57,6 +61,8 @@ class FatigueResult:
     u_max: np.ndarray | None
     damage: np.ndarray | None
     first_break: np.ndarray | None = field(repr=False)
+    broken_pairs: np.ndarray | None = field(default=None, repr=False)
+    break_cycle: np.ndarray | None = field(default=None, repr=False)
 
 
 def breakable_bonds(model: Model, no_damage_sets=(), domain: Domain | None = None) -> np.ndarray:
@@ -130,6 +136,7 @@ def run_fatigue(
 
     n_broken0 = n_broken()
     first_break = np.full(model.body.n_points, np.inf)
+    breaks = []  # per step that broke bonds: (global point pairs of the owned bonds, cycle)
     life.update_phase(damage_field(model))  # pre-cracks may start families in phase II
     cycles, lengths, broken = [0.0], [], [0]
 
@@ -159,6 +166,10 @@ def run_fatigue(
         hit = np.zeros(model.body.n_points, dtype=bool)
         hit[owners[lost]] = True
         first_break[hit & np.isinf(first_break)] = n_cycles
+        mine = np.flatnonzero(lost[owned_bonds])
+        if mine.size:
+            pair = domain.global_ids[np.column_stack([owners[mine], model.bonds.neighbours[mine]])]
+            breaks.append((np.sort(pair, axis=1), n_cycles))
         phi = damage_field(model)
         life.update_phase(phi)
         cycles.append(n_cycles)
@@ -169,9 +180,25 @@ def run_fatigue(
         if lengths[-1] >= stop_length:
             break
     u_max = (statics.solve() if changed else u) if u is not None else np.zeros_like(model.body.points)
+    pairs = domain.comm.gather(breaks) if domain.size > 1 else [breaks]
     return FatigueResult(
         np.array(cycles),
         np.array(lengths),
         np.array(broken, dtype=np.int64),
         *domain.gather_many(u_max, damage_field(model), first_break) or (None, None, None),
+        *(_first_breaks([b for rank in pairs for b in rank]) if pairs is not None else (None, None)),
     )
+
+
+def _first_breaks(breaks: list) -> tuple[np.ndarray, np.ndarray]:
+    """(n, 2) int64 point pairs, each bond once (sorted), and (n,) the cycle of its first break,
+    from ``breaks``: (pairs (k, 2) with the smaller index first, cycle) of every step and rank."""
+    if not breaks:
+        return np.zeros((0, 2), dtype=np.int64), np.zeros(0)
+    pairs = np.concatenate([p for p, _ in breaks])
+    cycle = np.concatenate([np.full(len(p), c) for p, c in breaks])
+    order = np.lexsort((cycle, pairs[:, 1], pairs[:, 0]))
+    pairs, cycle = pairs[order], cycle[order]
+    first = np.ones(len(pairs), dtype=bool)
+    first[1:] = np.any(pairs[1:] != pairs[:-1], axis=1)
+    return pairs[first], cycle[first]

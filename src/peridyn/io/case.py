@@ -498,13 +498,19 @@ class Block(Strict):
         return self
 
 
+#: A bond's two ends in the x-y plane, [x_a, y_a, x_b, y_b] (m).
+BondEnds = Annotated[list[Finite], Field(min_length=4, max_length=4)]
+
+
 class Precrack(Strict):
     """Bonds crossing a planar rectangle (origin, edge_u, edge_v; 3D), a segment (start, end;
     2D) or a surface (``file``: an Exodus mesh of triangles, e.g. shells, relative to the case
-    file; Peridigm's "Exodus Mesh" bond filter of an initial damage model) are cut."""
+    file; Peridigm's "Exodus Mesh" bond filter of an initial damage model) are cut; or the
+    bonds listed by their ends' in-plane positions (``pairs``, ``tolerance``: in a plate, the
+    bonds between two columns of points, e.g. a plane-stress model's broken bonds)."""
 
-    type: Literal["rectangle", "segment", "surface"] = described(
-        ..., "rectangle (3D), segment (2D) or surface (the triangles of a mesh file)"
+    type: Literal["rectangle", "segment", "surface", "bonds"] = described(
+        ..., "rectangle (3D), segment (2D), surface (the triangles of a mesh file) or bonds (listed)"
     )
     file: str | None = described(None, "surface: the mesh file of the crack's triangles")
     in_weighted_volume: bool = described(
@@ -517,6 +523,12 @@ class Precrack(Strict):
     edge_v: Vector3 | None = described(None, "rectangle: second edge from the origin", "m")
     start: Vector3 | None = described(None, "segment: first end", "m")
     end: Vector3 | None = described(None, "segment: second end", "m")
+    pairs: Annotated[list[BondEnds], Field(min_length=1)] | None = described(
+        None, "bonds: each bond's ends in the x-y plane, [x_a, y_a, x_b, y_b]", "m"
+    )
+    tolerance: Positive | None = described(
+        None, "bonds: how near, in the x-y plane, a point lies to a listed end (under half the spacing)", "m"
+    )
 
     @model_validator(mode="after")
     def _complete(self):
@@ -524,6 +536,7 @@ class Precrack(Strict):
             "rectangle": ("origin", "edge_u", "edge_v"),
             "segment": ("start", "end"),
             "surface": ("file",),
+            "bonds": ("pairs", "tolerance"),
         }[self.type]
         missing = [k for k in keys if getattr(self, k) is None]
         if missing:

@@ -127,7 +127,9 @@ class MonitorCase(Strict):
     noise: Noise = described(Noise(), "sensor noise")
     processing: Processing = described(Processing(), "signal processing settings")
     check_transfer: bool = described(
-        True, "interrogate the final crack also through the second damage transfer (damaged points removed)"
+        True,
+        "repeat each interrogation after the crack first grew through the second damage transfer (the "
+        "fatigue model's broken bonds)",
     )
     output: MonitorOutput = described(MonitorOutput(), "output folder and figures")
 

@@ -2,7 +2,9 @@
 
 Outputs in the run folder: ``crack_length.csv`` (cycles, crack length, directed bonds broken by
 the cycles),
-``crack_length.png``, ``damage.vtu`` (final damage and first-break cycle), ``modal.json``
+``crack_length.png``, ``damage.vtu`` (final damage and first-break cycle), ``broken_bonds.csv``
+(each bond the cycles broke, once: its two points, indices into ``damage.vtu``'s, and the cycle
+at which it broke), ``modal.json``
 (frequency tables before/after, MAC matrix, matched types) when ``modal_after`` is set,
 and ``fatigue.json`` (the summary), with the files of every job's folder (``status.json``,
 ``provenance.json``, ``summary.json``: ``peridyn.io.job_files``).
@@ -251,6 +253,7 @@ def _write_fatigue(case, setup, out, summary, result, before, after, start) -> d
         summary["modal"] = {"before": before.rows, "after": after.rows, "mac": mac.tolist(), "matches": pairs}
         (out / "modal.json").write_text(json.dumps(summary["modal"], indent=1))
     _write_history(out / "crack_length.csv", result)
+    _write_broken_bonds(out / BROKEN_BONDS, result)
     body = setup.whole_body
     write_vtu(
         out / "damage.vtu",
@@ -271,6 +274,21 @@ def _write_fatigue(case, setup, out, summary, result, before, after, start) -> d
     (out / "fatigue.json").write_text(json.dumps(summary, indent=1))
     write_summary(out, summary)
     return summary
+
+
+#: The file of the bonds a fatigue run broke (``_write_broken_bonds``).
+BROKEN_BONDS = "broken_bonds.csv"
+
+
+def _write_broken_bonds(path: Path, result: FatigueResult) -> None:
+    """``point_a, point_b, cycles``: each bond the cycles broke (its points, indices into
+    ``damage.vtu``'s) and the cycle at which it broke, written as ``crack_length.csv``'s cycles
+    (a bond broken at a step has that step's cycles there)."""
+    with open(path, "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(["point_a", "point_b", "cycles"])
+        for (a, b), n in zip(result.broken_pairs, result.break_cycle, strict=True):
+            w.writerow([int(a), int(b), f"{n:.6g}"])
 
 
 def _write_history(path: Path, result: FatigueResult) -> None:

@@ -36,11 +36,11 @@ from peridyn.io.results import Results
 from peridyn.io.run_log import run_log
 from peridyn.jobs.monitor_plan import (
     FatigueHistory,
-    crack_at,
+    bonds_case,
+    crack_lines,
     cut_case,
-    grown_crack,
+    damage_at,
     interrogation_steps,
-    removed_case,
 )
 from peridyn.jobs.sweep_run import (
     RunTask,
@@ -108,7 +108,7 @@ def run_monitor(
             if threads is not None:
                 set_threads(run_threads(threads, executor, workers, scheduler))
             history = _fatigue(fatigue, base / mon.fatigue_case, out / "fatigue", overwrite, comm)
-        plan = _plan(mon, fatigue, wave, history)
+        plan = _plan(mon, fatigue, history, (base / mon.fatigue_case).parent)
         tasks = _tasks(mon, wave, plan, out, base / mon.wave_case, executor, workers, scheduler, threads)
         _run(tasks, executor, workers, scheduler, overwrite, comm)
 
@@ -150,14 +150,19 @@ def _cases(mon: MonitorCase, base: Path, path) -> tuple[Case, Case]:
 
 def _fatigue(fatigue: Case, path: Path, folder: Path, overwrite: bool, comm) -> FatigueHistory:
     """Run the fatigue case into ``folder`` (or keep its finished run of the same case) and read
-    its history and final damage (under MPI: rank 0 decides and reads, every rank gets them)."""
-    from peridyn.jobs.fatigue import run_fatigue_case
+    its history and broken bonds (under MPI: rank 0 decides and reads, every rank gets them)."""
+    from peridyn.jobs.fatigue import BROKEN_BONDS, run_fatigue_case
 
     stamp = folder / "case_hash.txt"
     digest = case_identity(fatigue, run_length=True)[1]
 
     def finished() -> bool:
-        return (folder / "fatigue.json").exists() and stamp.exists() and stamp.read_text().strip() == digest
+        return (
+            (folder / "fatigue.json").exists()
+            and (folder / BROKEN_BONDS).exists()
+            and stamp.exists()
+            and stamp.read_text().strip() == digest
+        )
 
     if overwrite or not _on_root(comm, finished):
         run_fatigue_case(fatigue, output_dir=folder, base_dir=path.parent, overwrite=True, comm=comm)
@@ -176,28 +181,39 @@ def _on_root(comm, fn, *args):
 
 
 def read_history(folder: Path) -> FatigueHistory:
-    """The fatigue run's ``crack_length.csv`` and ``damage.vtu`` in ``folder``."""
+    """The fatigue run's ``crack_length.csv``, ``damage.vtu`` and ``broken_bonds.csv`` in ``folder``."""
     import meshio
+
+    from peridyn.jobs.fatigue import BROKEN_BONDS
 
     with open(folder / "crack_length.csv") as fh:
         rows = list(csv.DictReader(fh))
+    with open(folder / BROKEN_BONDS) as fh:
+        bonds = list(csv.DictReader(fh))
     mesh = meshio.read(folder / "damage.vtu")
     first = np.asarray(mesh.point_data["first_break_cycle"], dtype=float)
     return FatigueHistory(
         cycles=np.array([float(r["cycles"]) for r in rows]),
         crack_length=np.array([float(r["crack_length_m"]) for r in rows]),
         points=np.asarray(mesh.points[:, :2], dtype=float),
-        damage=np.asarray(mesh.point_data["damage"], dtype=float),
         first_break=np.where(first < 0, np.inf, first),
+        broken_pairs=np.array(
+            [[int(r["point_a"]), int(r["point_b"])] for r in bonds], dtype=np.int64
+        ).reshape(-1, 2),
+        break_cycle=np.array([float(r["cycles"]) for r in bonds]),
     )
 
 
 class Plan:
-    """The interrogations: fatigue steps, cycles (n_int,), crack lengths (n_int,) m, crack
-    polylines (None or (m, 2) m each), the whole final crack, and the cycle of the transfer
-    check (the last interrogation's) when the case asks for it."""
+    """The interrogations: fatigue steps, cycles (n_int,), crack lengths (n_int,) m, the crack
+    of each (``lines``: its polylines, (m, 2) m, branches included, from the fatigue model's
+    damage at that cycle; ``cracks``: the main one, None before the crack grew), and the
+    interrogations that the transfer check repeats by the second route (``checked``: each after
+    the crack first grew, when the case asks for it). ``base_dir``: the fatigue case's folder."""
 
-    def __init__(self, mon: MonitorCase, fatigue: Case, history: FatigueHistory):
+    def __init__(self, mon: MonitorCase, fatigue: Case, history: FatigueHistory, base_dir: Path):
+        from peridyn.setup.build import build
+
         f = fatigue.fatigue
         s = mon.schedule
         self.history = history
@@ -213,15 +229,20 @@ class Plan:
         )
         self.cycles = history.cycles[self.steps]
         self.crack_length = history.crack_length[self.steps]
-        self.whole = grown_crack(history, self.spacing, f.tip, self.cycles[-1])
-        self.cracks = [crack_at(self.whole, a) for a in self.crack_length]
+        phi = damage_at(build(fatigue, base_dir).model, history, self.cycles)
+        self.lines = [
+            crack_lines(history.points, p, self.spacing, f.tip) if a > 0 else []
+            for p, a in zip(phi, self.crack_length, strict=True)
+        ]
+        self.cracks = [lines[0] if lines else None for lines in self.lines]
         self.transducers = np.asarray(mon.transducers.centers, dtype=float)
         self.paths = network_paths(len(self.transducers))
-        self.check = mon.check_transfer and self.cracks[-1] is not None
+        grown = [k for k, crack in enumerate(self.cracks) if k > 0 and crack is not None]
+        self.checked = grown if mon.check_transfer else []
 
 
-def _plan(mon, fatigue, wave, history) -> Plan:
-    plan = Plan(mon, fatigue, history)
+def _plan(mon, fatigue, history, base_dir) -> Plan:
+    plan = Plan(mon, fatigue, history, base_dir)
     logger.info(
         f"{len(plan.steps)} interrogations at {plan.cycles.tolist()} cycles, crack "
         f"{(plan.crack_length * 1e3).round(2).tolist()} mm"
@@ -252,20 +273,21 @@ def network_case(mon: MonitorCase, wave: Case, actuator: int) -> Case:
 
 
 def _tasks(mon, wave, plan: Plan, out: Path, wave_path: Path, executor, workers, scheduler, threads):
-    """``{(label, actuator): RunTask}``: label ``k`` for interrogation k, ``"removed"`` for the
-    transfer check on the last crack."""
+    """``{(label, actuator): RunTask}``: label ``k`` for interrogation k, ``("bonds", k)`` for its
+    transfer check."""
     n = len(plan.transducers)
     fired = [network_case(mon, wave, i) for i in range(n)]
     per_run = run_threads(threads, executor, workers, scheduler)
     tasks = {}
-    labels = [(k, crack) for k, crack in enumerate(plan.cracks)] + ([("removed", None)] if plan.check else [])
-    for label, crack in labels:
+    labels = list(range(len(plan.cracks))) + [("bonds", k) for k in plan.checked]
+    for label in labels:
         for i in range(n):
-            name = f"{mon.name}_{label if label == 'removed' else f'k{label:02d}'}_t{i}"
-            if label == "removed":
-                case = removed_case(fired[i], name, plan.history, plan.cycles[-1], plan.tip, plan.spacing)
+            if isinstance(label, tuple):
+                name = f"{mon.name}_bonds_k{label[1]:02d}_t{i}"
+                case = bonds_case(fired[i], name, plan.history, plan.cycles[label[1]], plan.spacing)
             else:
-                case = cut_case(fired[i], name, crack)
+                name = f"{mon.name}_k{label:02d}_t{i}"
+                case = cut_case(fired[i], name, plan.lines[label])
             folder = out / "interrogations" / name.removeprefix(f"{mon.name}_")
             tasks[(label, i)] = RunTask(
                 run_id=folder.name,
@@ -343,9 +365,10 @@ def _run_ranks(todo, comm, done) -> None:
 
 
 def _signals(mon: MonitorCase, plan: Plan, tasks: dict) -> dict:
-    """``{"times": (n_t,) s, "signals": (n_int, n_paths, n_t), "removed": (n_paths, n_t) or
-    None}``: each path's signal the mean of its two directions (reciprocity), unit of
-    ``pzt_signal`` (mean in-plane strain under the sensor)."""
+    """``{"times": (n_t,) s, "signals": (n_int, n_paths, n_t), "bonds": (n_checked, n_paths,
+    n_t), the checked interrogations by the bonds route (``Plan.checked``)}``: each path's
+    signal the mean of its two directions (reciprocity), unit of ``pzt_signal`` (mean in-plane
+    strain under the sensor)."""
     n = len(plan.transducers)
 
     def interrogation(label) -> tuple[np.ndarray, np.ndarray]:
@@ -363,5 +386,5 @@ def _signals(mon: MonitorCase, plan: Plan, tasks: dict) -> dict:
     return {
         "times": np.asarray(times, dtype=float),
         "signals": np.stack([s for _, s in series]),
-        "removed": interrogation("removed")[1] if plan.check else None,
+        "bonds": np.stack([interrogation(("bonds", k))[1] for k in plan.checked]) if plan.checked else None,
     }

@@ -25,7 +25,8 @@ def assess(mon, wave, plan, data: dict) -> dict:
         The wave case (its material and plate).
     plan : peridyn.jobs.monitor.Plan
     data : dict
-        ``times`` (n_t,) s, ``signals`` (n_int, n_paths, n_t), ``removed`` (n_paths, n_t) or None.
+        ``times`` (n_t,) s, ``signals`` (n_int, n_paths, n_t), ``bonds`` (n_checked, n_paths,
+        n_t): the interrogations ``plan.checked`` by the second damage transfer, or None.
 
     Returns
     -------
@@ -74,9 +75,8 @@ def assess(mon, wave, plan, data: dict) -> dict:
         block["noise_free"] = trend_figures(
             out[f"{INDEX_NAMES[mon.processing.index]}_noise_free"], plan.crack_length, out["crossed"]
         )
-    if data["removed"] is not None:
-        removed = with_noise(data["removed"], level, peaks, seed + len(signals)) if level else data["removed"]
-        block["transfer"] = _transfer(recorded, removed, masks, out["crossed"])
+    if data["bonds"] is not None:
+        block["transfer"] = transfer_figures(signals, data["bonds"], plan.checked, masks, out["crossed"])
     out["monitoring"] = block
     return out
 
@@ -126,22 +126,38 @@ def _images(mon, wave, plan, index: np.ndarray) -> dict:
     }
 
 
-def _transfer(recorded: np.ndarray, removed: np.ndarray, masks: np.ndarray, crossed: np.ndarray) -> dict:
-    """The two damage transfers of the last crack compared: each index of the crossed paths
-    (all paths without one) by the cut (``recorded[-1]``) and by the removed points, and the
-    largest relative difference ``|cut - removed| / cut``."""
+def transfer_figures(
+    signals: np.ndarray, bonds: np.ndarray, checked: list, masks: np.ndarray, crossed: np.ndarray
+) -> dict:
+    """The two damage transfers compared (docs/monitoring.md, "Damage transfer"): each index of
+    the crossed paths (all paths without one) at each checked interrogation, by the cut
+    (``signals[k]``) and by the broken bonds (``bonds``), on the signals without noise (the
+    noise is no part of a transfer), and the relative differences ``|cut - bonds| / cut`` (0
+    where both are 0): the largest per interrogation and over them all.
+
+    Parameters
+    ----------
+    signals : (n_int, n_paths, n_t), the interrogations by the cut, the baseline first
+    bonds : (n_checked, n_paths, n_t), the interrogations ``checked`` by the broken bonds
+    checked : the interrogations (indices into ``signals``) of ``bonds``
+    masks : (n_paths, n_t) bool, the paths' windows
+    crossed : (n_paths,) bool, the paths that the final crack crosses
+    """
     paths = crossed if crossed.any() else np.ones(len(crossed), bool)
-    block = {}
+    block = {"interrogations": [int(k) for k in checked]}
     for name, index in (
         ("residual_energy_index", residual_energy_index),
         ("correlation_index", correlation_index),
     ):
-        cut = index(recorded[0], recorded[-1], masks)[paths]
-        other = index(recorded[0], removed, masks)[paths]
+        cut = np.stack([index(signals[0], signals[k], masks)[paths] for k in checked])
+        other = np.stack([index(signals[0], s, masks)[paths] for s in bonds])
+        diff = np.abs(cut - other)
+        relative = np.divide(diff, cut, out=np.where(diff > 0, np.inf, 0.0), where=cut > 0)
         block[name] = {
             "cut": cut.tolist(),
-            "removed": other.tolist(),
-            "relative_difference_max": float(np.max(np.abs(cut - other) / cut)),
+            "bonds": other.tolist(),
+            "relative_difference": relative.max(axis=1).tolist(),
+            "relative_difference_max": float(relative.max()),
         }
     return block
 

@@ -1,18 +1,18 @@
 """What a monitoring job interrogates: the fatigue life's interrogation points (the schedule), the
 crack at each of them, and the wave cases of the body so damaged (the damage transfer).
 
-The fatigue runs on a plane-stress (2D) model of the plate; its history (cycles, crack length)
-and final damage field (with each point's first-break cycle) give the crack at any cycle: the
-crack path (``peridyn.analysis.crack``) of the points broken by the last interrogation, from the
-crack's start (``fatigue.tip.start``), cut to the crack length of that cycle. The wave case is
-the 3D plate on the same in-plane grid; a crack reaches it in one of two ways (docs/monitoring.md,
-"Damage transfer"):
+The fatigue runs on a plane-stress (2D) model of the plate; its history (cycles, crack length),
+final damage field (with each point's first-break cycle) and broken bonds (with the cycle of
+each break) give the crack at any cycle. The wave case is the 3D plate on the same in-plane
+grid; a crack reaches it in one of two ways (docs/monitoring.md, "Damage transfer"):
 
-- ``cut`` (the interrogations): the crack polyline becomes through-thickness pre-crack
-  rectangles, one per polyline segment, that cut every bond crossing them;
-- ``removed`` (the check of the transfer): the columns of points that the fatigue had cracked
-  by that cycle (first break at or before it, final damage at the crack threshold) are removed
-  through the thickness, a notch of the fatigue's own damaged points.
+- ``cut`` (the interrogations): the crack path (``peridyn.analysis.crack``) of the points
+  broken by the last interrogation, from the crack's start (``fatigue.tip.start``), cut to the
+  crack length of that cycle, becomes through-thickness pre-crack rectangles, one per polyline
+  segment, that cut every bond crossing them;
+- ``bonds`` (the check of the transfer): every 3D bond whose ends lie in the columns of a 2D
+  bond that the fatigue had broken by that cycle is cut (a ``bonds`` pre-crack), the 2D model's
+  own broken bonds through the thickness.
 """
 
 from __future__ import annotations
@@ -22,30 +22,33 @@ from dataclasses import dataclass
 import numpy as np
 
 from peridyn.analysis.crack import crack_paths
-from peridyn.analysis.shm.paths import truncated
 from peridyn.errors import InputError
 from peridyn.io.case import Case, validate_case
+from peridyn.physics.damage import damage_field
 
 AXIS = {"x": 0, "y": 1}
 
 
 @dataclass(frozen=True)
 class FatigueHistory:
-    """What the fatigue run left: history and final damage of the plane-stress model.
+    """What the fatigue run left: history and broken bonds of the plane-stress model.
 
     Attributes
     ----------
     cycles, crack_length : (n_steps + 1,) float64; cycles and crack length (m) after each step
     points : (n_points, 2) float64, m, the 2D model's points
-    damage : (n_points,) float64, final damage index
     first_break : (n_points,) float64, cycle of each point's first broken bond (inf: none)
+    broken_pairs : (n_broken, 2) int64, the points (indices into ``points``) of each bond the
+        cycles broke
+    break_cycle : (n_broken,) float64, the cycle at which each of them broke
     """
 
     cycles: np.ndarray
     crack_length: np.ndarray
     points: np.ndarray
-    damage: np.ndarray
     first_break: np.ndarray
+    broken_pairs: np.ndarray
+    break_cycle: np.ndarray
 
 
 def interrogation_steps(
@@ -77,53 +80,82 @@ def interrogation_steps(
     return np.array(steps, dtype=int)
 
 
-def grown_crack(history: FatigueHistory, spacing: float, tip, cycles: float = np.inf) -> np.ndarray | None:
-    """(m, 2) polyline (m) of the crack the fatigue grew by ``cycles`` (the points that lost a
-    bond by then, at their final damage), from ``tip.start`` along ``tip.axis`` in ``tip.sense``
-    (the fatigue case's ``FatigueTip``): of the crack paths, the one that comes nearest to the
-    start along the axis; None without one."""
+def damage_at(model, history: FatigueHistory, cycles) -> np.ndarray:
+    """(n_cycles, n_points) the fatigue model's damage index at each of ``cycles``, exactly:
+    ``model`` (the fatigue case built, its pre-cracks cut) with the bonds that had broken by
+    then (``history.broken_pairs``, ``break_cycle``) broken. ``model.bonds`` is left as given."""
+    b = model.bonds
+    n = model.body.n_points
+    if n != len(history.points) or not np.allclose(model.body.points[:, :2], history.points):
+        raise InputError("the fatigue run's points are not those of its case (damage.vtu of another case?)")
+    owners = b.owners()
+    key = np.minimum(owners, b.neighbours) * n + np.maximum(owners, b.neighbours)
+    listed = history.broken_pairs[:, 0] * n + history.broken_pairs[:, 1]
+    order = np.argsort(listed)
+    at = np.clip(np.searchsorted(listed[order], key), 0, max(len(listed) - 1, 0))
+    found = listed[order][at] == key if len(listed) else np.zeros(b.n_bonds, bool)
+    broke = np.where(found, history.break_cycle[order][at] if len(listed) else 0.0, np.inf)
+    intact = b.intact.copy()
+    phi = []
+    try:
+        for n_cycles in np.atleast_1d(cycles):
+            b.intact[:] = intact & ~(found & (broke <= n_cycles))
+            phi.append(damage_field(model))
+    finally:
+        b.intact[:] = intact
+    return np.array(phi)
+
+
+def crack_lines(points: np.ndarray, phi: np.ndarray, spacing: float, tip) -> list[np.ndarray]:
+    """The crack of the damage ``phi`` ((n_points,)) as (m, 2) polylines (m): every crack path
+    (``peridyn.analysis.crack.crack_paths`` at the tip's damage threshold, branches included)
+    beyond ``tip.start`` along ``tip.axis`` in ``tip.sense`` (the fatigue case's
+    ``FatigueTip``), the path that comes nearest to the start first (the main crack, from the
+    start); [] without one."""
     if tip.axis not in AXIS or tip.start is None:
         raise InputError(
             "a monitored fatigue case needs fatigue.tip.axis x or y and tip.start (the notch root)"
         )
-    phi = np.where(history.first_break <= cycles, history.damage, 0.0)
-    paths = crack_paths(history.points, phi, spacing, threshold=tip.damage)
-    if not paths:
-        return None
     axis = AXIS[tip.axis]
-    line = min(paths, key=lambda p: np.abs(p.points[:, axis] - tip.start).min()).points
     sense = 1.0 if tip.sense == "+" else -1.0
-    ahead = (line[:, axis] - tip.start) * sense
-    if sense < 0:
+    paths = sorted(
+        (p.points for p in crack_paths(points, phi, spacing, threshold=tip.damage)),
+        key=lambda line: np.abs(line[:, axis] - tip.start).min(),
+    )
+    lines = [_beyond(line, axis, sense, tip.start, k == 0) for k, line in enumerate(paths)]
+    return [line for line in lines if line is not None]
+
+
+def _beyond(line: np.ndarray, axis: int, sense: float, start: float, main: bool) -> np.ndarray | None:
+    """The part of the polyline ``line`` beyond ``start`` along ``axis`` in ``sense``, from the
+    point where it passes the start (a ``main`` path that begins beyond it: from its first
+    vertex moved back to the start); None if it never does."""
+    ahead = (line[:, axis] - start) * sense
+    if ahead[-1] < ahead[0]:
         line, ahead = line[::-1], ahead[::-1]
     inside = np.flatnonzero(ahead > 0)
     if inside.size == 0:
         return None
     k = inside[0]
-    if k > 0:  # the vertex where the path passes the start
+    if k > 0:  # the point where the path passes the start
         w = -ahead[k - 1] / (ahead[k] - ahead[k - 1])
         first = line[k - 1] + w * (line[k] - line[k - 1])
-    else:
-        first = line[0].copy()
-        first[axis] = tip.start
-    return np.vstack([first, line[k:]])
+        return np.vstack([first, line[k:]])
+    if not main:
+        return line
+    first = line[0].copy()
+    first[axis] = start
+    return np.vstack([first, line])
 
 
-def crack_at(whole: np.ndarray | None, length: float) -> np.ndarray | None:
-    """The crack polyline (m) of crack length ``length`` (m): ``whole`` cut to it; None at 0."""
-    if whole is None or length <= 0:
-        return None
-    return truncated(whole, length)
-
-
-def cut_case(wave: Case, name: str, crack: np.ndarray | None) -> Case:
-    """The wave case with the crack ``crack`` ((m, 2), m, or None) as through-thickness pre-crack
-    rectangles (one per segment), renamed ``name``."""
+def cut_case(wave: Case, name: str, lines: list) -> Case:
+    """The wave case with the crack ``lines`` ((m, 2) polylines, m, e.g. a crack and its
+    branches) as through-thickness pre-crack rectangles (one per segment), renamed ``name``."""
     data = wave.model_dump(mode="python")
     data["name"] = name
-    if crack is not None:
-        z0, depth = _through(wave)
-        for a, b in zip(crack[:-1], crack[1:], strict=True):
+    z0, depth = _through(wave)
+    for line in lines:
+        for a, b in zip(line[:-1], line[1:], strict=True):
             data["precracks"].append(
                 {
                     "type": "rectangle",
@@ -135,21 +167,16 @@ def cut_case(wave: Case, name: str, crack: np.ndarray | None) -> Case:
     return validate_case(data, name)
 
 
-def removed_case(wave: Case, name: str, history: FatigueHistory, cycles: float, tip, spacing: float) -> Case:
-    """The wave case with the fatigue's cracked points at ``cycles`` removed as through-thickness
-    columns (boxes of one ``spacing`` square around each), renamed ``name``."""
-    sense = 1.0 if tip.sense == "+" else -1.0
-    cracked = (
-        (history.first_break <= cycles)
-        & (history.damage >= tip.damage)
-        & ((history.points[:, AXIS[tip.axis]] - tip.start) * sense > 0)
-    )
+def bonds_case(wave: Case, name: str, history: FatigueHistory, cycles: float, spacing: float) -> Case:
+    """The wave case with the bonds that the fatigue had broken by ``cycles`` cut through the
+    thickness (a ``bonds`` pre-crack: every bond between the two columns of points at the
+    broken 2D bond's ends; the columns found within a quarter ``spacing``, m), renamed ``name``."""
     data = wave.model_dump(mode="python")
     data["name"] = name
-    z0, depth = _through(wave)
-    h = 0.5 * spacing
-    for x, y in history.points[cracked]:
-        data["removals"].append({"type": "box", "min": [x - h, y - h, z0], "max": [x + h, y + h, z0 + depth]})
+    broken = history.broken_pairs[history.break_cycle <= cycles]
+    if len(broken):
+        pairs = history.points[broken].reshape(-1, 4)
+        data["precracks"].append({"type": "bonds", "pairs": pairs.tolist(), "tolerance": 0.25 * spacing})
     return validate_case(data, name)
 
 

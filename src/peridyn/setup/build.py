@@ -24,6 +24,7 @@ from peridyn.discretization.bonds import (
     crossing_triangles,
     cut_bonds,
     find_bonds,
+    listed_pairs,
     reorder_bonds,
     search_reach,
     without_bonds,
@@ -422,11 +423,14 @@ def check_precracks(case: Case, body: Body) -> None:
         elif crack.type == "surface":  # the triangles' corners and centroids
             triangles = surface_triangles(crack.file)
             samples = np.concatenate([triangles.reshape(-1, 3), triangles.mean(axis=1)])
+        elif crack.type == "bonds":  # the bonds' ends, in the plane
+            samples = np.reshape(crack.pairs, (-1, 2))
         else:
             start, end = np.asarray(pad3(crack.start)), np.asarray(pad3(crack.end))
             samples = start + _samples(end - start, body.spacing)[:, None] * (end - start)
-        samples = samples.reshape(-1, 3)[:, :axes]
-        gap = float(distance_outside(body, samples, axes).min())
+        within = 2 if crack.type == "bonds" else axes
+        samples = samples.reshape(-1, samples.shape[-1])[:, :within]
+        gap = float(distance_outside(body, samples, within).min())
         low, high = body.points.min(axis=0).tolist(), body.points.max(axis=0).tolist()
         if gap > 0.5 * body.spacing:
             raise CaseFileError(
@@ -529,6 +533,8 @@ def precrack_crossing(crack):
     if crack.type == "surface":
         triangles = surface_triangles(crack.file)
         return lambda a, b: crossing_triangles(a, b, triangles)
+    if crack.type == "bonds":
+        return listed_pairs(crack.pairs, crack.tolerance)
     return lambda a, b: crossing_segment(a, b, crack.start, crack.end)
 
 
