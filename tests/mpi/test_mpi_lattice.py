@@ -3,7 +3,7 @@ results.h5 bit for bit (every dataset under ``final/`` and ``series/``, dtypes a
 included) and its summary: each rank holds a slab of grid planes across x with the ghost planes
 either side (``peridyn.parallel.lattice_domain``). Shipped grid cases, shortened: PMB in 2D with
 a pre-crack and bonds breaking (plate2d_stretch with a lower bond strength: the crack
-grows from 6 us), the Kalthoff-Winkler
+grows from 6 us) and VTU snapshots (per-rank pieces), the Kalthoff-Winkler
 plate at 1 mm (removed notches, pre-cracks, fracture energy, a no-damage set, velocity
 loading), LPS in 3D (bar_pulse) and the seed Lamb plate cut short (LPS with the shear-factor
 surface correction, a PZT actuator, every kind of probe); a restart on 3 ranks from a 2-rank
@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from conftest import peridyn_process, results_datasets
+from test_mpi_runs import _assert_same_snapshots
 
 pytestmark = pytest.mark.mpi
 
@@ -28,7 +29,7 @@ LATTICE = "discretization.storage=lattice"
 CASES = {
     "plate2d_stretch": (
         "plate2d_stretch.yaml",
-        ["solver.time=10e-6", "material.damage.critical_bond_stress=4e6"],
+        ["solver.time=10e-6", "material.damage.critical_bond_stress=4e6", "output.vtu=true"],
     ),
     "kalthoff_winkler": ("kalthoff_winkler.yaml", ["discretization.spacing=1e-3", "solver.time=30e-6"]),
     "bar_pulse": ("bar_pulse.yaml", ["solver.time=3e-6"]),
@@ -54,7 +55,7 @@ BREAKING = ("plate2d_stretch", "kalthoff_winkler")
 
 #: Summary keys that a run on ranks must share with the serial run (floats compared exactly).
 SAME = ("points", "bonds", "broken_bonds", "max_damage", "steps", "time_s", "dt_s", "stable_dt_s")
-SAME += ("kinetic_energy_j", "strain_energy_j", "storage")
+SAME += ("kinetic_energy_j", "strain_energy_j", "storage", "crack_length_history", "crack_paths")
 
 
 def _have_mpi() -> bool:
@@ -86,7 +87,7 @@ def serial(tmp_path_factory):
     for case in CASES:
         done = _run(case, base / case, 1)
         assert done.returncode == 0, done.stderr
-        refs[case] = results_datasets(base / case / "results.h5"), json.loads(done.stdout)
+        refs[case] = results_datasets(base / case / "results.h5"), json.loads(done.stdout), base / case
     for case in BREAKING:
         done = _run(case, base / f"{case}-precracks", 1, "solver.time=1e-9")
         assert done.returncode == 0, done.stderr
@@ -113,11 +114,13 @@ def test_mpi_lattice_run_equals_the_serial_lattice_run_bit_for_bit(case, ranks, 
     compiled without value-changing fast-math flags (``peridyn.kernels.FASTMATH``)."""
     done = _run(case, tmp_path / case, ranks)
     assert done.returncode == 0, done.stderr
-    want, reference = serial[case]
+    want, reference, folder = serial[case]
     _assert_same(results_datasets(tmp_path / case / "results.h5"), want)
     summary = json.loads(done.stdout)
     for key in SAME:
-        assert summary[key] == reference[key], key
+        assert summary.get(key) == reference.get(key), key
+    if "output.vtu=true" in CASES[case][1]:  # the ranks' VTU pieces hold the serial snapshots
+        _assert_same_snapshots(tmp_path / case, folder)
     assert summary["storage"] == "lattice"
     if case in BREAKING:  # breaking is covered: bonds broke beyond the pre-cracks
         assert summary["broken_bonds"] > serial[case, "precracks"] > 0
@@ -144,7 +147,7 @@ def test_lattice_restart_on_three_ranks_from_a_two_rank_checkpoint_equals_the_se
     assert json.loads(first.stdout)["broken_bonds"] > serial["plate2d_stretch", "precracks"]
     done = _run("plate2d_stretch", out, 3, flags=["--restart"])
     assert done.returncode == 0, done.stderr
-    want, reference = serial["plate2d_stretch"]
+    want, reference, _ = serial["plate2d_stretch"]
     _assert_same(results_datasets(out / "results.h5"), want)
     resumed = json.loads(done.stdout)
     for key in ("steps", "broken_bonds", "max_damage", "strain_energy_j", "kinetic_energy_j"):

@@ -104,3 +104,14 @@ def test_broken_words_go_to_the_whole_grid_and_back():
         )
         if back is not None:
             assert np.array_equal(back, words)
+
+
+def test_a_rank_whose_planes_hold_no_point_is_refused_on_every_rank():
+    """A removal across the whole width of the plate (planes 27 to 53 of 81) leaves the middle
+    rank of 3 no point: every rank raises the error naming it (``agree``), none waits for the
+    others."""
+    path = ROOT / "cases" / "plate2d_stretch.yaml"
+    gap = "removals=[{type: box, min: [3.4e-3, -1, -1], max: [6.7e-3, 1, 1]}]"
+    case = load_case(path, [*CASES["plate2d_stretch"], gap, "precracks=[]"])
+    with pytest.raises(InputError, match="rank 1's planes across x .* hold no point"):
+        on_ranks(3, lambda comm: build(case, path.parent, comm))

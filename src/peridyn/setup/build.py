@@ -567,6 +567,11 @@ def _build_lattice_part(case: Case, comm, base_dir):
     bounds = slab_bounds(int(shape[0]), comm.size)
     slab = Slab.of_rank(shape, bounds, comm.rank, ghost_planes(stencil.offsets))
     owned, ghosts = slab.points(grid_index)  # planes ascending: the ghosts by owner rank
+    if not len(owned):
+        raise InputError(
+            f"lattice storage: rank {comm.rank}'s planes across x ({slab.lo} to {slab.hi - 1}) "
+            "hold no point: use fewer ranks, or discretization.storage: bonds"
+        )
     local_ids = np.concatenate([owned, ghosts])
     part = body.subset(local_ids)
     layout = slab.layout(spacing, origin, grid_index[local_ids])
