@@ -2,12 +2,11 @@
 results.h5 bit for bit (every dataset under ``final/`` and ``series/``, dtypes and shapes
 included) and its summary: each rank holds a slab of grid planes across x with the ghost planes
 either side (``peridyn.parallel.lattice_domain``). Shipped grid cases, shortened: PMB in 2D with
-a pre-crack and bonds breaking (plate2d_stretch with a lower bond strength: the crack
-grows from 6 us) and VTU snapshots (per-rank pieces), the Kalthoff-Winkler
-plate at 1 mm (removed notches, pre-cracks, fracture energy, a no-damage set, velocity
-loading), LPS in 3D (bar_pulse) and the seed Lamb plate cut short (LPS with the shear-factor
-surface correction, a PZT actuator, every kind of probe); a restart on 3 ranks from a 2-rank
-checkpoint.
+a pre-crack, bonds breaking (plate2d_stretch with a lower bond strength: the crack grows from
+6 us) and VTU snapshots (per-rank pieces); the Kalthoff-Winkler plate at 1 mm (removed notches,
+pre-cracks, fracture energy, a no-damage set, velocity loading); LPS in 3D (bar_pulse, float64
+and float32); the seed Lamb plate cut short (LPS with the shear-factor surface correction, a
+PZT actuator, every kind of probe); and a restart on 3 ranks from a 2-rank checkpoint.
 
 Run with ``PYTHONPATH=src python -m pytest -m mpi -q -p no:cacheprovider tests/mpi/test_mpi_lattice.py``.
 """
@@ -33,6 +32,7 @@ CASES = {
     ),
     "kalthoff_winkler": ("kalthoff_winkler.yaml", ["discretization.spacing=1e-3", "solver.time=30e-6"]),
     "bar_pulse": ("bar_pulse.yaml", ["solver.time=3e-6"]),
+    "bar_pulse_float32": ("bar_pulse.yaml", ["solver.time=3e-6", "solver.dtype=float32"]),
     "lamb_probes": (
         "lamb_plate.yaml",
         [
