@@ -73,12 +73,11 @@ class Domain:
         owned_ids = self.global_ids[: self.n_owned]
         #: on rank 0: every rank's owned global indices (None elsewhere)
         self._rank_ids = comm.gather(owned_ids) if comm.size > 1 else [owned_ids]
-        #: on rank 0: the global indices of the owned points of rank 0, then rank 1, ...
-        self._rank_order = np.concatenate(self._rank_ids) if self._rank_ids is not None else None
-        #: on rank 0: whether that order is the global one (``gather_many`` then places nothing)
-        self._in_rank_order = self._rank_ids is not None and bool(
-            np.array_equal(self._rank_order, np.arange(self.n_global))
-        )
+        gathering = comm.size > 1 and self._rank_ids is not None  # rank 0 of several
+        #: on rank 0 of several: the global indices of the owned points of rank 0, then rank 1, ...
+        self._rank_order = np.concatenate(self._rank_ids) if gathering else None
+        #: on rank 0 of several: whether that order is the global one (``gather_many`` then places nothing)
+        self._in_rank_order = gathering and bool(np.array_equal(self._rank_order, np.arange(self.n_global)))
 
     @classmethod
     def serial(cls, n_points: int) -> Domain:

@@ -109,8 +109,7 @@ class Slab:
         nx = int(self.shape[0])
         rows, ix = np.divmod(grid_index, nx)
         local = rows * (self.stop - self.first) + (ix - self.first)
-        shape = np.array([self.stop - self.first, self.shape[1], self.shape[2]], dtype=np.int64)
-        return shape, spacing, origin + np.array([self.first * spacing[0], 0.0, 0.0]), local
+        return self.local_shape, spacing, origin + np.array([self.first * spacing[0], 0.0, 0.0]), local
 
 
 class LatticeDomain(Domain):

@@ -26,7 +26,8 @@ class LatticeDamage:
     """Critical-stretch bond failure of a lattice model (``materials.lattice``).
 
     Parameters as ``physics.damage.BondDamage`` (one material: the critical stretch is a number;
-    ``protected``, the points of the no-damage sets given directly, as a rank's part gives them).
+    ``protected``: (n_points,) bool, more points whose bonds never break, as a rank's part gives
+    the whole body's no-damage sets).
     """
 
     def __init__(
@@ -47,8 +48,7 @@ class LatticeDamage:
         self.limit = lattice.stencil.length * (1.0 + self.value)
         #: (n_grid,) bool: grid points whose bonds may break
         self.breakable = np.ones(lattice.n_grid, dtype=bool)
-        if protected is None:
-            protected = protected_points(model.body, no_damage_sets)
+        protected = protected_points(model.body, no_damage_sets) | (False if protected is None else protected)
         self.breakable[lattice.grid_index[protected]] = False
         self._ug = np.zeros((3, lattice.n_grid))
         rows = int(lattice.shape[1] * lattice.shape[2])

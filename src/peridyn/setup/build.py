@@ -532,8 +532,9 @@ def lattice_model(case: Case, body: Body, lattice, protected=None) -> tuple:
     d = mat.damage
     damage = None
     if d is not None:
+        no_damage = d.no_damage_sets if protected is None else ()
         damage = LatticeDamage(
-            model, d.critical_stretch, d.fracture_energy, d.no_damage_sets, d.critical_bond_stress, protected
+            model, d.critical_stretch, d.fracture_energy, no_damage, d.critical_bond_stress, protected
         )
     interrupts.check(where=BUILDING)
     return model, damage
