@@ -90,6 +90,11 @@ class ThreadComm:
     def allgather(self, obj) -> list:
         return self._everyone(obj)
 
+    def gatherv(self, send: np.ndarray, recv, counts, root: int = 0) -> None:
+        parts = self._everyone(np.ascontiguousarray(send))
+        if self.rank == root:
+            recv.reshape(-1)[...] = np.concatenate([part.reshape(-1) for part in parts])
+
     def alltoall(self, objs: list) -> list:
         return [sent[self.rank] for sent in self._everyone(objs)]
 

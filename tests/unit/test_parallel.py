@@ -15,6 +15,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 from scipy.spatial.distance import cdist
+from test_distributed_relax import on_ranks
 
 from peridyn.discretization import geometry
 from peridyn.discretization.bonds import search_reach
@@ -172,6 +173,29 @@ def test_serial_gatherv_fills_recv_whatever_its_layout():
     recv = np.zeros((2, 3)).T  # (3, 2), Fortran order
     SerialComm().gatherv(send, recv, [6])
     np.testing.assert_array_equal(recv, send)
+
+
+@pytest.mark.parametrize(
+    "owned", [[[4, 0, 2], [5, 1, 3]], [[0, 1, 2], [3, 4, 5]]], ids=["interleaved", "consecutive"]
+)
+def test_gather_many_puts_every_rank_s_rows_at_their_global_points(owned):
+    """``Domain.gather_many`` on 2 simulated ranks: each rank's owned rows (ghost rows after them
+    ignored) land at their global indices on rank 0, for (n, 3) float64 and (n,) bool arrays,
+    whether the ranks own interleaved points or consecutive ranges (gathered straight into the
+    result); copies, so compared exactly."""
+    values = np.arange(18.0).reshape(6, 3) * 1.5
+    flags = np.array([True, False, False, True, True, False])
+
+    def gather(comm):
+        ids = np.array(owned[comm.rank] + [9])  # one ghost row, global index 9: never gathered
+        local = np.vstack([values, [[-1.0, -1.0, -1.0]] * 4])[ids]
+        domain = Domain(comm, ids, 3, 6, None, "test")
+        return domain.gather_many(local, np.append(flags, [False] * 4)[ids])
+
+    whole, elsewhere = on_ranks(2, gather)
+    assert elsewhere is None
+    np.testing.assert_array_equal(whole[0], values)
+    np.testing.assert_array_equal(whole[1], flags)
 
 
 PARTS = [

@@ -136,9 +136,12 @@ class Lattice:
         """Directed bonds between points with material (each bond counted from both ends)."""
         return int(self.family_sizes().sum())
 
-    def n_broken(self) -> int:
-        """Directed bonds broken (pre-cracks and damage; a broken bond has both bits set)."""
-        return int(np.bitwise_count(self.broken).sum())
+    def n_broken(self, points=None) -> int:
+        """Directed bonds broken (pre-cracks and damage; a broken bond has both bits set), of
+        the body points ``points`` (indices or a slice, default all)."""
+        if points is None:
+            return int(np.bitwise_count(self.broken).sum())
+        return int(np.bitwise_count(self.broken[:, self.grid_index[points]]).sum())
 
     def __repr__(self) -> str:
         return (
@@ -234,27 +237,69 @@ def build_lattice(
     InputError
         When the body is not a grid, or a point has no neighbour within the horizon.
     """
-    shape, spacing, origin, grid_index = grid_layout(body)
+    layout = grid_layout(body)
+    stencil = grid_stencil(body, layout[0], layout[1], horizon, influence, partial_volumes, quadrature_points)
+    lattice = lattice_on_grid(body, layout, stencil, horizon, influence)
+    check_families(lattice, body)
+    return lattice
+
+
+def grid_stencil(
+    body: Body,
+    shape: np.ndarray,
+    spacing: np.ndarray,
+    horizon: float,
+    influence: str = "constant",
+    partial_volumes: bool = True,
+    quadrature_points: int = 8,
+) -> Stencil:
+    """The stencil (``make_stencil``) of a grid body of ``shape`` (3,) and ``spacing`` (3,) m
+    (``grid_layout``: the whole body's, also for a part of it).
+
+    Raises
+    ------
+    InputError
+        When the horizon is smaller than half the spacing.
+    """
     if horizon < 0.5 * float(np.min(search_cells(body)[0, : body.dim])):
         raise InputError(
             f"horizon {horizon:g} m is smaller than half the spacing: points would have no neighbours"
         )
-    stencil = make_stencil(spacing, horizon, body.dim, influence, partial_volumes, quadrature_points, shape)
+    return make_stencil(spacing, horizon, body.dim, influence, partial_volumes, quadrature_points, shape)
+
+
+def lattice_on_grid(body: Body, layout, stencil: Stencil, horizon: float, influence: str) -> Lattice:
+    """The :class:`Lattice` of ``body`` on the grid ``layout`` = (shape, spacing, origin,
+    grid_index) (``grid_layout``, or a rank's slab of it) with ``stencil``, none broken."""
+    shape, spacing, origin, grid_index = layout
     volume = np.zeros(int(np.prod(shape)))
     volume[grid_index] = body.volumes
     n_words = -(-stencil.size // WORD_BITS)
     broken = np.zeros((n_words, len(volume)), dtype=np.uint64)
-    lattice = Lattice(
+    shape = np.asarray(shape, dtype=np.int64)
+    return Lattice(
         shape, spacing, origin, volume, grid_index, stencil, broken, float(horizon), influence, body.dim
     )
-    lonely = np.flatnonzero(lattice.family_sizes() == 0)
+
+
+def check_families(lattice: Lattice, body: Body, points=None, names=None) -> None:
+    """Refuse a lattice where one of ``points`` (indices of ``body``'s points, default all) has no
+    neighbour within the horizon, naming it by ``names[i]`` (default its index ``i``).
+
+    Raises
+    ------
+    InputError
+    """
+    sizes = lattice.family_sizes()
+    rows = np.arange(body.n_points) if points is None else np.asarray(points, dtype=np.int64)
+    lonely = rows[sizes[rows] == 0]
     if len(lonely):
         i = int(lonely[0])
+        name = i if names is None else int(names[i])
         raise InputError(
-            f"point {i} at {body.points[i].tolist()} has no neighbour within the horizon "
-            f"{horizon:g} m (spacing {body.spacing:g} m): increase the horizon"
+            f"point {name} at {body.points[i].tolist()} has no neighbour within the horizon "
+            f"{lattice.horizon:g} m (spacing {body.spacing:g} m): increase the horizon"
         )
-    return lattice
 
 
 #: Grid points tested at a time by :func:`cut_lattice` (bounds its (chunk, 3) temporaries).

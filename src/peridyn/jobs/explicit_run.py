@@ -33,7 +33,8 @@ logger = logging.getLogger(__name__)
 def bond_state(setup: Setup) -> tuple[np.ndarray, np.ndarray]:
     """(array, offsets): the bonds' state that a checkpoint saves and a restart writes back in
     place, with its CSR family ``offsets``: the intact mask of bond lists, or the broken words
-    of a lattice (flat, ``offsets`` [0, their number]: one process)."""
+    of a lattice (flat, ``offsets`` [0, their number]; under MPI the rank's
+    ``parallel.lattice_domain.LatticeDomain`` places them in the whole grid)."""
     if setup.storage == "lattice":
         words = setup.bonds.broken.reshape(-1)
         return words, np.array([0, len(words)])
@@ -243,7 +244,9 @@ def _checkpointer(
     d = setup.domain
     if d.size == 1:
         return Checkpointer(path, every, bond_state(setup)[0], meta, parts, before_save, results), []
-    whole_intact = np.ones(int(whole_bonds[-1]), dtype=bool) if d.is_root else None
+    values, offsets = bond_state(setup)
+    none_broken = values.dtype == bool  # all True in an intact mask, all zero in broken words
+    whole_intact = np.full(int(whole_bonds[-1]), none_broken, dtype=values.dtype) if d.is_root else None
     checkpointer = Checkpointer(
         path,
         every,
@@ -255,7 +258,7 @@ def _checkpointer(
     )
 
     def gather_whole(state):  # the state itself is gathered by RootObservers.call
-        intact = d.gather_bonds(setup.bonds.intact, setup.bonds.offsets, whole_bonds)
+        intact = d.gather_bonds(values, offsets, whole_bonds)
         if d.is_root:
             whole_intact[:] = intact
         if setup.contact is not None:

@@ -56,8 +56,9 @@ def base_summary(setup) -> dict:
     d = setup.domain
     n = d.n_owned
     phi = damage_field(setup.model)
-    if setup.storage == "lattice":  # one process
-        bonds, broken = setup.bonds.n_bonds, setup.bonds.n_broken()
+    if setup.storage == "lattice":  # the owned points' families (a broken bond has both bits)
+        bonds = d.count(setup.bonds.family_sizes()[:n].sum())
+        broken = d.count(setup.bonds.n_broken(d.owned))
     else:
         owned_bonds = int(setup.bonds.offsets[n])  # the owned points' families come first
         bonds, broken = d.count(owned_bonds), d.count((~setup.bonds.intact[:owned_bonds]).sum())

@@ -25,7 +25,9 @@ ROUNDING_SLACK = 1e-9
 class LatticeDamage:
     """Critical-stretch bond failure of a lattice model (``materials.lattice``).
 
-    Parameters as ``physics.damage.BondDamage`` (one material: the critical stretch is a number).
+    Parameters as ``physics.damage.BondDamage`` (one material: the critical stretch is a number;
+    ``protected``: (n_points,) bool, more points whose bonds never break, as a rank's part gives
+    the whole body's no-damage sets).
     """
 
     def __init__(
@@ -35,6 +37,7 @@ class LatticeDamage:
         fracture_energy: float | None = None,
         no_damage_sets=(),
         critical_bond_stress: float | None = None,
+        protected: np.ndarray | None = None,
     ):
         criteria = (critical_stretch, fracture_energy, critical_bond_stress)
         critical_stretch = resolve_critical_stretch(model, *criteria)
@@ -45,7 +48,8 @@ class LatticeDamage:
         self.limit = lattice.stencil.length * (1.0 + self.value)
         #: (n_grid,) bool: grid points whose bonds may break
         self.breakable = np.ones(lattice.n_grid, dtype=bool)
-        self.breakable[lattice.grid_index[protected_points(model.body, no_damage_sets)]] = False
+        protected = protected_points(model.body, no_damage_sets) | (False if protected is None else protected)
+        self.breakable[lattice.grid_index[protected]] = False
         self._ug = np.zeros((3, lattice.n_grid))
         rows = int(lattice.shape[1] * lattice.shape[2])
         self._count = np.zeros(rows, dtype=np.int64)

@@ -29,7 +29,14 @@ from peridyn.discretization.bonds import (
     search_reach,
     without_bonds,
 )
-from peridyn.discretization.lattice import build_lattice, cut_lattice
+from peridyn.discretization.lattice import (
+    build_lattice,
+    check_families,
+    cut_lattice,
+    grid_layout,
+    grid_stencil,
+    lattice_on_grid,
+)
 from peridyn.discretization.pairs import index_bandwidth, row_blocks
 from peridyn.errors import CaseFileError, InputError
 from peridyn.io import exodus, mesh_text
@@ -37,6 +44,7 @@ from peridyn.io.case import Case, Geometry, Region, box_cells
 from peridyn.parallel.contact import RankContact
 from peridyn.parallel.domain import Domain, agree
 from peridyn.parallel.halo import Halo, clearance, ghost_layers, plan_halo
+from peridyn.parallel.lattice_domain import LatticeDomain, Slab, ghost_planes, slab_bounds
 from peridyn.parallel.partition import rcb
 from peridyn.physics.contact import Contact
 from peridyn.physics.damage import BondDamage, protected_points
@@ -475,13 +483,14 @@ def build(case: Case, base_dir=".", comm=None) -> Setup:
     Within ``peridyn.interrupts.deferred``, a SIGINT or SIGTERM stops a serial build after the
     phase under way (points, bonds, model) with ``Interrupted``."""
     if comm is not None and comm.size > 1:
-        choose_storage(case, None, comm)  # refuses an explicit lattice: MPI runs on bond lists
+        if choose_storage(case, None) == "lattice":
+            return build_lattice_part(case, comm, base_dir)
         return build_part(case, comm, base_dir)
     body = build_body(case, base_dir)
     interrupts.check(where=BUILDING)
     check_placements(case, body)
     body, actuation = add_actuators(case, body)
-    if choose_storage(case, body, comm) == "lattice":
+    if choose_storage(case, body) == "lattice":
         return build_on_lattice(case, body, actuation)
     bonds = build_bonds(case, body)
     interrupts.check(where=BUILDING)
@@ -497,9 +506,19 @@ def build(case: Case, base_dir=".", comm=None) -> Setup:
 def build_on_lattice(case: Case, body: Body, actuation=()) -> Setup:
     """The Setup of a case on lattice storage (``setup.storage``): the body's lattice with the
     pre-cracks cut, the material and damage on it (``setup.bonds`` is the lattice)."""
-    lattice = build_lattice(
-        body, case_horizon(case, body), case.discretization.influence, case.discretization.partial_volumes
-    )
+    d = case.discretization
+    lattice = build_lattice(body, case_horizon(case, body), d.influence, d.partial_volumes)
+    interrupts.check(where=BUILDING)
+    model, damage = lattice_model(case, body, lattice)
+    loading = build_loading(case, body, actuation)
+    check_loading(case, loading)
+    return Setup(body, lattice, model, loading, damage, storage="lattice")
+
+
+def lattice_model(case: Case, body: Body, lattice, protected=None) -> tuple:
+    """The case's pre-cracks cut into ``lattice`` (in place), then its material and bond breaking
+    (None without ``material.damage``) on ``body`` and ``lattice`` (``protected``: the points of
+    its no-damage sets, (n_points,) bool, given by a rank's part)."""
     for crack in case.precracks:
         cut_lattice(body, lattice, precrack_crossing(crack))
     interrupts.check(where=BUILDING)
@@ -517,13 +536,58 @@ def build_on_lattice(case: Case, body: Body, actuation=()) -> Setup:
     d = mat.damage
     damage = None
     if d is not None:
+        no_damage = d.no_damage_sets if protected is None else ()
         damage = LatticeDamage(
-            model, d.critical_stretch, d.fracture_energy, d.no_damage_sets, d.critical_bond_stress
+            model, d.critical_stretch, d.fracture_energy, no_damage, d.critical_bond_stress, protected
         )
     interrupts.check(where=BUILDING)
+    return model, damage
+
+
+def build_lattice_part(case: Case, comm, base_dir=".") -> Setup:
+    """This rank's part of a case on lattice storage (``peridyn.parallel.lattice_domain``): a
+    slab of grid planes across x and the ghost planes either side, its lattice with the whole
+    grid's stencil, the pre-cracks, model, damage and loading on it. Collective: every rank
+    calls it, and an error on one rank is raised on all."""
+    setup, owned, ghosts, ghost_owner, slab = agree(comm, _build_lattice_part, case, comm, base_dir)
+    halo = Halo(comm, plan_halo(comm, owned, ghosts, ghost_owner))
+    local_ids = np.concatenate([owned, ghosts])
+    n_words = setup.bonds.broken.shape[0]
+    setup.domain = LatticeDomain(comm, local_ids, len(owned), setup.whole_body.n_points, halo, slab, n_words)
+    return setup
+
+
+def _build_lattice_part(case: Case, comm, base_dir):
+    """``build_lattice_part`` up to the halo plan: the part's Setup, the owned and ghost global
+    indices (local order), the ghosts' ranks and the rank's ``Slab``."""
+    body = build_body(case, base_dir)
+    check_placements(case, body)
+    body, actuation = add_actuators(case, body)
     loading = build_loading(case, body, actuation)
     check_loading(case, loading)
-    return Setup(body, lattice, model, loading, damage, storage="lattice")
+    d = case.discretization
+    horizon = case_horizon(case, body)
+    shape, spacing, origin, grid_index = grid_layout(body)
+    stencil = grid_stencil(body, shape, spacing, horizon, d.influence, d.partial_volumes)
+    bounds = slab_bounds(int(shape[0]), comm.size)
+    slab = Slab.of_rank(shape, bounds, comm.rank, ghost_planes(stencil.offsets))
+    owned, ghosts = slab.points(grid_index)  # planes ascending: the ghosts by owner rank
+    if not len(owned):
+        raise InputError(
+            f"lattice storage: rank {comm.rank}'s planes across x ({slab.lo} to {slab.hi - 1}) "
+            "hold no point: use fewer ranks, or discretization.storage: bonds"
+        )
+    local_ids = np.concatenate([owned, ghosts])
+    part = body.subset(local_ids)
+    layout = slab.layout(spacing, origin, grid_index[local_ids])
+    lattice = lattice_on_grid(part, layout, stencil, horizon, d.influence)
+    check_families(lattice, part, np.arange(len(owned)), local_ids)
+    no_damage = case.material.damage.no_damage_sets if case.material.damage is not None else []
+    model, damage = lattice_model(case, part, lattice, protected_points(body, no_damage)[local_ids])
+    ghost_owner = slab.owners(bounds, grid_index[ghosts])
+    loading = loading.restricted(part, local_ids)
+    setup = Setup(part, lattice, model, loading, damage, None, None, body, "lattice")
+    return setup, owned, ghosts, ghost_owner, slab
 
 
 def precrack_crossing(crack):

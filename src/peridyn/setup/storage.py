@@ -10,7 +10,7 @@ from peridyn.io.case import Case
 from peridyn.physics.materials.lattice import lattice_support
 
 
-def lattice_refusals(case: Case, comm=None) -> list[str]:
+def lattice_refusals(case: Case) -> list[str]:
     """What in ``case`` lattice storage cannot run (empty: nothing), before any point is made."""
     why = []
     g, d, s, out = case.geometry, case.discretization, case.solver, case.output
@@ -34,8 +34,6 @@ def lattice_refusals(case: Case, comm=None) -> list[str]:
         why.append("the stress and strain outputs")
     if out.exodus:
         why.append("Exodus output")
-    if comm is not None and comm.size > 1:
-        why.append("an MPI run (for now)")
     if s.backend != "cpu":
         why.append(f"solver.backend {s.backend} (the GPU backend runs on bond lists)")
     if d.bond_filters or not d.bonds_between_blocks:
@@ -52,10 +50,11 @@ def lattice_refusals(case: Case, comm=None) -> list[str]:
     return why
 
 
-def choose_storage(case: Case, body: Body | None, comm=None) -> str:
+def choose_storage(case: Case, body: Body | None) -> str:
     """``bonds`` or ``lattice`` for ``case`` on its ``body``: ``discretization.storage``, with
     ``auto`` taking the lattice where the case allows it and the body is a grid (``body`` None:
-    where ``lattice_refusals`` already refuses, under MPI).
+    the case's generated grid, before its points are made, as under MPI; a box, plate or
+    rectangle is a grid by construction, a mesh is refused by ``lattice_refusals``).
 
     Raises
     ------
@@ -65,8 +64,8 @@ def choose_storage(case: Case, body: Body | None, comm=None) -> str:
     asked = case.discretization.storage
     if asked == "bonds":
         return "bonds"
-    why = lattice_refusals(case, comm)
-    if not why:
+    why = lattice_refusals(case)
+    if not why and body is not None:
         try:
             grid_layout(body)
         except InputError as exc:

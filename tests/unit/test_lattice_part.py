@@ -1,0 +1,117 @@
+"""A rank's part of a grid body on lattice storage (``peridyn.parallel.lattice_domain``), built on
+simulated ranks in one process (``ThreadComm``: MPI's semantics, threads taking turns): each
+rank holds the points of its slab of grid planes across x and of 2 r ghost planes either side
+(r the stencil's reach across x), its owned forces are the serial lattice forces bit for bit,
+and the broken words go to the whole grid's layout and back unchanged (checkpoints). The runs
+under ``mpiexec`` are ``tests/mpi/test_mpi_lattice.py``.
+"""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from test_distributed_relax import on_ranks
+
+from peridyn.errors import InputError
+from peridyn.io.case import load_case
+from peridyn.parallel.lattice_domain import slab_bounds
+from peridyn.setup.build import build
+
+ROOT = Path(__file__).resolve().parents[2]
+
+#: PMB in 2D with a pre-crack and a no-damage set; LPS in 3D (the bar cut to 30 x 6 x 6 mm)
+CASES = {
+    "plate2d_stretch": ["discretization.storage=lattice"],
+    "bar_pulse": [
+        "discretization.storage=lattice",
+        "geometry.size=[0.03, 0.006, 0.006]",
+        "output.sensors={}",
+        "output.lines={}",
+    ],
+}
+
+
+def test_slabs_split_the_planes_evenly_and_need_a_plane_per_rank():
+    """Rank r owns planes bounds[r] .. bounds[r + 1] - 1: every plane once, counts within one."""
+    bounds = slab_bounds(81, 3)
+    assert bounds.tolist() == [0, 27, 54, 81]
+    counts = np.diff(slab_bounds(10, 4))
+    assert counts.sum() == 10 and counts.max() - counts.min() <= 1
+    with pytest.raises(InputError, match="at most 2 ranks"):
+        slab_bounds(2, 3)
+
+
+@pytest.mark.bitwise
+@pytest.mark.parametrize("ranks", [2, 3])
+@pytest.mark.parametrize("name", sorted(CASES))
+def test_a_rank_holds_its_slab_and_ghost_planes_and_computes_the_serial_forces(name, ranks):
+    """Each rank's points are those of its planes (owned) and of the 2 r planes either side within
+    the grid (ghosts); the ranks own every point once; the force of its owned points at a random
+    displacement (ghost rows the owners' values) equals the serial lattice force bit for bit
+    (the pre-crack's bits are the serial ones and every owned point's family is whole)."""
+    path = ROOT / "cases" / f"{name}.yaml"
+    case = load_case(path, CASES[name])
+    whole = build(case, path.parent)
+    lattice = whole.bonds
+    nx = int(lattice.shape[0])
+    plane = lattice.grid_index % nx  # of each body point
+    u = 1e-6 * np.random.default_rng(5).standard_normal((whole.body.n_points, 3))
+    want = whole.model.force(u).copy()
+    reach = int(np.abs(lattice.stencil.offsets[:, 0]).max())
+
+    def part(comm):
+        setup = build(case, path.parent, comm)
+        d = setup.domain
+        f = setup.model.force(u[d.global_ids])
+        return d.global_ids, d.n_owned, f[: d.n_owned], setup.bonds.n_broken(d.owned)
+
+    bounds = slab_bounds(nx, ranks)
+    parts = on_ranks(ranks, part)
+    owned_every = np.concatenate([ids[:n] for ids, n, _, _ in parts])
+    assert np.array_equal(np.sort(owned_every), np.arange(whole.body.n_points))
+    for r, (ids, n, f, _) in enumerate(parts):
+        lo, hi = bounds[r], bounds[r + 1]
+        first, stop = max(0, lo - 2 * reach), min(nx, hi + 2 * reach)
+        assert np.array_equal(ids[:n], np.flatnonzero((plane >= lo) & (plane < hi)))
+        ghost = (plane >= first) & (plane < stop) & ~((plane >= lo) & (plane < hi))
+        assert np.array_equal(np.sort(ids[n:]), np.flatnonzero(ghost))
+        assert np.array_equal(f, want[ids[:n]])
+    assert sum(b for *_, b in parts) == lattice.n_broken()  # the pre-crack's bits, once each
+
+
+def test_broken_words_go_to_the_whole_grid_and_back():
+    """Each rank's broken words (local planes) are the whole grid's at those planes after
+    ``scatter_bonds``, and ``gather_bonds`` of the owned planes gives the whole grid's words back
+    on rank 0 (the checkpoint's layout is the serial one)."""
+    path = ROOT / "cases" / "plate2d_stretch.yaml"
+    case = load_case(path, CASES["plate2d_stretch"])
+    whole = build(case, path.parent).bonds
+    words = np.random.default_rng(7).integers(0, 2**63, size=whole.broken.size, dtype=np.uint64)
+    nx = int(whole.shape[0])
+
+    def part(comm):
+        setup = build(case, path.parent, comm)
+        d = setup.domain
+        flat = setup.bonds.broken.reshape(-1)
+        every = d.bond_offsets(None)
+        flat[:] = d.scatter_bonds(words, setup.bonds, every)
+        return d.slab, setup.bonds.broken.copy(), d.gather_bonds(flat, None, every)
+
+    for slab, local, back in on_ranks(3, part):
+        grid = words.reshape(whole.broken.shape[0], -1, nx)
+        assert np.array_equal(
+            local.reshape(grid.shape[0], -1, slab.stop - slab.first), grid[..., slab.first : slab.stop]
+        )
+        if back is not None:
+            assert np.array_equal(back, words)
+
+
+def test_a_rank_whose_planes_hold_no_point_is_refused_on_every_rank():
+    """A removal across the whole width of the plate (planes 27 to 53 of 81) leaves the middle
+    rank of 3 no point: every rank raises the error naming it (``agree``), none waits for the
+    others."""
+    path = ROOT / "cases" / "plate2d_stretch.yaml"
+    gap = "removals=[{type: box, min: [3.4e-3, -1, -1], max: [6.7e-3, 1, 1]}]"
+    case = load_case(path, [*CASES["plate2d_stretch"], gap, "precracks=[]"])
+    with pytest.raises(InputError, match="rank 1's planes across x .* hold no point"):
+        on_ranks(3, lambda comm: build(case, path.parent, comm))
