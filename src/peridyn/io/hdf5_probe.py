@@ -1,0 +1,120 @@
+"""The probe of an HDF5 file without a seal (``peridyn.io.seal``): read whole in a child process
+with a time limit, before the process that wants the file lets HDF5 open it.
+
+A damaged HDF5 file can make HDF5 loop forever inside the library, where Python cannot
+interrupt it. The probe (``python -c`` running :func:`main`) opens the file and reads what a
+reader of it may touch: every attribute of every group and dataset, the dimension scales of
+each dataset, and every dataset's values, checked against their checksums when the file
+declares them (``peridyn.io.integrity.verify_file``). A probe that fails is refused with its
+one-line error; one that does not finish in :func:`time_limit` is killed and the file refused
+as damaged. HDF5 is deterministic, so what the probe read without trouble the parent reads the
+same way.
+
+The probe also ends itself at its time limit (the default action of SIGALRM, which a loop in
+HDF5 cannot block), so it never outlives a parent killed while waiting for it by more than that.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import signal
+import subprocess
+import sys
+from pathlib import Path
+
+import h5py
+
+from peridyn.errors import InputError
+from peridyn.io import integrity
+
+#: Seconds a probe may take, beyond :data:`BYTES_PER_S`; the environment variable
+#: ``PERIDYN_PROBE_SECONDS`` sets another (a slow file system, a loaded machine).
+TIME_LIMIT_S = 20.0
+#: Bytes per second of the file allowed on top of :data:`TIME_LIMIT_S`.
+BYTES_PER_S = 50e6
+#: The folder holding the ``peridyn`` package the probe runs (this one).
+_PACKAGE_ROOT = str(Path(__file__).resolve().parents[2])
+
+
+def time_limit(size: int) -> float:
+    """Seconds allowed to probe a file of ``size`` bytes."""
+    base = os.environ.get("PERIDYN_PROBE_SECONDS")
+    try:
+        base = float(base) if base is not None else TIME_LIMIT_S
+    except ValueError:
+        raise InputError(f"PERIDYN_PROBE_SECONDS must be a number of seconds, got {base!r}") from None
+    if not base > 0:
+        raise InputError(f"PERIDYN_PROBE_SECONDS must be positive, got {base!r}")
+    return base + size / BYTES_PER_S
+
+
+def probe(path) -> None:
+    """Read ``path`` whole in a child process, killed after :func:`time_limit`.
+
+    Raises
+    ------
+    InputError
+        Naming the file: HDF5 did not finish reading it in time, crashed on it, or it is not
+        an HDF5 file or does not match its checksums (the probe's own message).
+    """
+    path = os.fspath(path)
+    limit = time_limit(os.path.getsize(path))
+    code = f"import sys; sys.path.insert(0, {_PACKAGE_ROOT!r}); from {__name__} import main; main()"
+    try:
+        done = subprocess.run(
+            [sys.executable, "-c", code, path, repr(limit)],
+            stdin=subprocess.DEVNULL,
+            capture_output=True,
+            text=True,
+            errors="replace",
+            timeout=limit,
+        )
+    except subprocess.TimeoutExpired:  # the child is killed
+        raise InputError(
+            f"{path}: HDF5 did not finish reading it in {limit:.0f} s: the file is damaged; it is not used"
+        ) from None
+    if done.returncode == 0:
+        return
+    lines = done.stderr.strip().splitlines()
+    if done.returncode > 0 and lines:
+        raise InputError(lines[-1])
+    ended = signal.Signals(-done.returncode).name if done.returncode < 0 else f"exit {done.returncode}"
+    raise InputError(f"{path}: HDF5 ended reading it ({ended}): the file is damaged; it is not used")
+
+
+def read_whole(path: str) -> None:
+    """Read every attribute, dimension scale and dataset of the HDF5 file ``path`` (datasets in
+    pieces, against their checksums when the file declares them)."""
+    with h5py.File(path, "r") as f:
+        found = [f]
+        f.visititems(lambda _, obj: found.append(obj))
+        for obj in found:
+            for key in obj.attrs:
+                obj.attrs[key]
+            if isinstance(obj, h5py.Dataset):
+                for dim in obj.dims:
+                    [scale.name for scale in dim.values()]
+        if integrity.is_marked(f):
+            integrity.verify_file(f, path)
+            return
+        for obj in found:
+            if isinstance(obj, h5py.Dataset):
+                integrity.prefix_crcs(obj, [integrity.rows_of(obj)])
+
+
+def main() -> None:
+    """The child: ``<path> <time limit in s>``; exit 0 when the file reads, else 1 with the
+    reason on stderr."""
+    path, limit = sys.argv[1], float(sys.argv[2])
+    signal.signal(signal.SIGALRM, signal.SIG_DFL)
+    signal.alarm(math.ceil(limit) + 1)
+    try:
+        read_whole(path)
+    except InputError as exc:
+        print(" ".join(str(exc).split()), file=sys.stderr)
+        sys.exit(1)
+    except Exception as exc:  # HDF5 finds a damaged structure: any error means the same
+        reason = " ".join(str(exc).split())
+        print(f"{path}: not a readable HDF5 file ({reason}): it is damaged; it is not used", file=sys.stderr)
+        sys.exit(1)
