@@ -92,7 +92,10 @@ def load_checkpoint(
     path = Path(path)
     if not path.is_file():
         raise InputError(f"checkpoint file {str(path)!r} does not exist: nothing to restart from")
-    seal.check(path)
+    try:
+        seal.check(path)
+    except InputError as exc:
+        raise InputError(f"{exc} (start again with --overwrite)") from None
     try:
         with h5py.File(path, "r") as f:
             _verify(f, str(path))
