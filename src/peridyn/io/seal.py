@@ -36,6 +36,7 @@ from __future__ import annotations
 
 import os
 import re
+import stat
 import zlib
 
 from peridyn.errors import InputError
@@ -108,6 +109,10 @@ def check(path) -> None:
     version = _version(path)
     if version in _checked:
         return
+    if not stat.S_ISREG(os.stat(path).st_mode):
+        raise InputError(
+            f"{os.fspath(path)}: not a regular file (a pipe, a device or a folder): not an HDF5 file"
+        )
     found = read_seal(path)
     if found is None:
         hdf5_probe.probe(path)

@@ -230,3 +230,10 @@ def test_a_bad_probe_time_limit_is_refused(tmp_path, monkeypatch):
     without_seal(path)
     with pytest.raises(InputError, match="PERIDYN_PROBE_SECONDS must be a number of seconds, got 'soon'"):
         Results(path)
+
+
+def test_a_pipe_is_refused_without_waiting_for_a_writer(tmp_path):
+    path = tmp_path / "results.h5"
+    os.mkfifo(path)  # opening it to read would wait for a writer forever
+    with pytest.raises(InputError, match=f"^{path}: not a regular file"):
+        Results(path)
