@@ -33,6 +33,8 @@ from peridyn.io import integrity
 TIME_LIMIT_S = 20.0
 #: Bytes per second of the file allowed on top of :data:`TIME_LIMIT_S`.
 BYTES_PER_S = 50e6
+#: HDF5's signature, at the start of its superblock.
+HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 #: The folder holding the ``peridyn`` package the probe runs (this one).
 _PACKAGE_ROOT = str(Path(__file__).resolve().parents[2])
 
@@ -59,7 +61,14 @@ def probe(path) -> None:
         an HDF5 file or does not match its checksums (the probe's own message).
     """
     path = os.fspath(path)
-    limit = time_limit(os.path.getsize(path))
+    size = os.path.getsize(path)
+    stored = stored_end(path)
+    if stored is not None and size < stored:
+        raise InputError(
+            f"{path}: holds {size} bytes, its HDF5 superblock says {stored}: the file is truncated; "
+            "it is not used"
+        )
+    limit = time_limit(size)
     code = f"import sys; sys.path.insert(0, {_PACKAGE_ROOT!r}); from {__name__} import main; main()"
     try:
         done = subprocess.run(
@@ -81,6 +90,32 @@ def probe(path) -> None:
         raise InputError(lines[-1])
     ended = signal.Signals(-done.returncode).name if done.returncode < 0 else f"exit {done.returncode}"
     raise InputError(f"{path}: HDF5 ended reading it ({ended}): the file is damaged; it is not used")
+
+
+def stored_end(path) -> int | None:
+    """The end-of-file address in the superblock at the start of the HDF5 file ``path`` (HDF5
+    File Format Specification, "Superblock": versions 0 and 1 after 24 or 28 bytes and the base
+    and free-space addresses, versions 2 and 3 after 12 bytes and the base and extension
+    addresses); None when the file does not start with a superblock of base address 0 that
+    these bytes can be read from (a user block, a damaged superblock: left to the probe).
+    HDF5 refuses a file shorter than that ("truncated file"): checked here, no probe needed."""
+    with open(path, "rb") as f:
+        head = f.read(64)
+    if not head.startswith(HDF5_SIGNATURE) or len(head) < 16:
+        return None
+    version = head[8]
+    if version in (0, 1):
+        width, base_at = head[13], 24 + 4 * version
+    elif version in (2, 3):
+        width, base_at = head[9], 12
+    else:
+        return None
+    end_at = base_at + 2 * width
+    if width not in (2, 4, 8) or len(head) < end_at + width:
+        return None
+    if int.from_bytes(head[base_at : base_at + width], "little") != 0:
+        return None
+    return int.from_bytes(head[end_at : end_at + width], "little")
 
 
 def read_whole(path: str) -> None:
