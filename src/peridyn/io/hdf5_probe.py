@@ -8,8 +8,9 @@ each dataset, and every dataset's values, checked against their checksums when t
 declares them (``peridyn.io.integrity.verify_file``). A probe that fails is refused with its
 one-line error; one that does not finish in :func:`time_limit` is killed and the file refused
 as damaged. HDF5 is deterministic, so what the probe read without trouble the parent reads the
-same way. A file shorter than its superblock's end-of-file address (a copy cut short), which
-HDF5 refuses as truncated, is refused without a probe (:func:`stored_end`).
+same way. A file without HDF5's signature, or shorter than its superblock's end-of-file address
+(a copy cut short), which HDF5 refuses, is refused without a probe (:func:`has_signature`,
+:func:`stored_end`).
 
 The probe also ends itself at its time limit (the default action of SIGALRM, which a loop in
 HDF5 cannot block), so it never outlives a parent killed while waiting for it by more than that.
@@ -63,6 +64,10 @@ def probe(path) -> None:
     """
     path = os.fspath(path)
     size = os.path.getsize(path)
+    if not has_signature(path, size):
+        raise InputError(
+            f"{path}: not a readable HDF5 file (no HDF5 signature): damaged or not HDF5; it is not used"
+        )
     stored = stored_end(path)
     if stored is not None and size < stored:
         raise InputError(
@@ -91,6 +96,19 @@ def probe(path) -> None:
         raise InputError(lines[-1])
     ended = signal.Signals(-done.returncode).name if done.returncode < 0 else f"exit {done.returncode}"
     raise InputError(f"{path}: HDF5 ended reading it ({ended}): the file is damaged; it is not used")
+
+
+def has_signature(path, size: int) -> bool:
+    """Whether HDF5's signature is where HDF5 looks for its superblock: at byte 0, 512, 1024,
+    2048 ... of the file (after a user block of that size)."""
+    with open(path, "rb") as f:
+        at = 0
+        while at + len(HDF5_SIGNATURE) <= size:
+            f.seek(at)
+            if f.read(len(HDF5_SIGNATURE)) == HDF5_SIGNATURE:
+                return True
+            at = max(512, 2 * at)
+    return False
 
 
 def stored_end(path) -> int | None:
@@ -153,5 +171,8 @@ def main() -> None:
         sys.exit(1)
     except Exception as exc:  # HDF5 finds a damaged structure: any error means the same
         reason = " ".join(str(exc).split())
-        print(f"{path}: not a readable HDF5 file ({reason}): it is damaged; it is not used", file=sys.stderr)
+        print(
+            f"{path}: not a readable HDF5 file ({reason}): damaged or not HDF5; it is not used",
+            file=sys.stderr,
+        )
         sys.exit(1)

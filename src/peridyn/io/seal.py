@@ -55,17 +55,15 @@ _checked: set = set()
 
 
 def read_seal(path) -> tuple[int, int] | None:
-    """The seal of ``path``: the CRC-32 and number of the bytes before it; None when the file
-    ends without one (or with one that does not cover exactly the bytes before it)."""
+    """The seal at the end of ``path``: the CRC-32 and number of the bytes it covers (those
+    before it, unless bytes were added or removed); None when the file ends without one."""
     with open(path, "rb") as f:
         size = f.seek(0, os.SEEK_END)
         if size < LENGTH:
             return None
         f.seek(size - LENGTH)
         match = _PATTERN.fullmatch(f.read(LENGTH))
-    if match is None or int(match[2]) != size - LENGTH:
-        return None
-    return int(match[1], 16), int(match[2])
+    return None if match is None else (int(match[1], 16), int(match[2]))
 
 
 def seal(path) -> None:
@@ -81,7 +79,7 @@ def unseal(path) -> None:
     """Cut the seal off ``path`` (if it has one) before a writer opens it: until the writer
     has closed it, the file is not sealed."""
     found = read_seal(path)
-    if found is not None:
+    if found is not None and found[1] == os.path.getsize(path) - LENGTH:
         os.truncate(path, found[1])
 
 
@@ -116,6 +114,11 @@ def check(path) -> None:
     found = read_seal(path)
     if found is None:
         hdf5_probe.probe(path)
+    elif found[1] != version[2] - LENGTH:
+        raise InputError(
+            f"{os.fspath(path)}: holds {version[2] - LENGTH} bytes before its seal, which covers "
+            f"{found[1]}: bytes were added or removed; the file is damaged; it is not used"
+        )
     elif crc_of(path, found[1])[0] != found[0]:
         raise InputError(
             f"{os.fspath(path)}: its bytes do not match its seal (CRC-32): the file is corrupted; "

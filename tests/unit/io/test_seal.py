@@ -113,6 +113,25 @@ def test_a_sealed_file_with_a_flipped_byte_anywhere_is_refused_before_hdf5_opens
         Results(path)
 
 
+@pytest.mark.parametrize("change", ["added", "removed"])
+def test_a_sealed_file_with_bytes_added_or_removed_is_refused_before_hdf5_opens_it(
+    tmp_path, change, monkeypatch
+):
+    path = tmp_path / "results.h5"
+    write_run(path)
+    data = path.read_bytes()
+    whole = len(data) - seal.LENGTH
+    data = data[:1000] + b"\xff" * 8 + data[1000:] if change == "added" else data[:1000] + data[1008:]
+    path.write_bytes(data)
+    monkeypatch.setattr(h5py, "File", None)  # any open by HDF5 would raise a TypeError
+    monkeypatch.setattr(subprocess, "run", None)  # and so would a probe
+    held = whole + (8 if change == "added" else -8)
+    with pytest.raises(
+        InputError, match=f"^{path}: holds {held} bytes before its seal, which covers {whole}: "
+    ):
+        Results(path)
+
+
 def test_a_cut_file_is_refused_naming_it(tmp_path, monkeypatch):
     """Cut short, a file has lost its seal; shorter than its HDF5 superblock's end-of-file
     address, it is refused as HDF5 would refuse it, without a probe."""
@@ -210,7 +229,7 @@ def test_a_checkpoint_left_without_a_seal_and_damaged_is_refused(tmp_path):
     path.write_bytes(bytes(damage))
     with pytest.raises(
         InputError,
-        match=f"^{path}: not a readable HDF5 file .*: it is damaged; it is not used \\(start again with",
+        match=f"^{path}: not a readable HDF5 file \\(no HDF5 signature\\): damaged or not HDF5; it is not",
     ):
         load_checkpoint(path, N, 4, meta)
 
