@@ -18,9 +18,10 @@ reading a damaged variable-length attribute from its global heap). The CRC-32 of
   killed, one written before seals were recorded or changed by another program. A checkpoint
   is written whole, so it is always sealed.
 - Before HDF5 opens a file to read or continue it (:func:`check`), a sealed file whose bytes
-  differ is refused naming the file, without HDF5 reading any of it. A file without a seal is
-  read first by a probe in a child process with a time limit (``peridyn.io.hdf5_probe``), and
-  refused when the probe fails or does not finish.
+  differ (another number of them before the seal, or another CRC-32) is refused naming the
+  file, without HDF5 reading any of it. A file without a seal is read first by a probe in a
+  child process with a time limit (``peridyn.io.hdf5_probe``), and refused when the probe
+  fails or does not finish.
 - Each version of a file (its path, inode, size and modification time) is checked once per
   process; sealing a file counts as checking it.
 
