@@ -26,6 +26,7 @@ import pytest
 
 import peridyn
 from peridyn.io.results import Results
+from peridyn.io.seal import read_seal
 
 ROOT = Path(__file__).resolve().parents[2]
 SRC = str(Path(peridyn.__file__).parents[1])
@@ -137,6 +138,7 @@ def _kill_and_restart(case, references, tmp_path, at, phase):
     every = CASES[case][2]
     killed = _peridyn(_argv(case, out, "--checkpoint-every", str(every)), "SIGKILL", at, phase)
     assert killed.returncode == -signal.SIGKILL
+    assert read_seal(out / "results.h5") is None  # not sealed: read through the probe
     with h5py.File(out / "results.h5", "r") as f:  # the killed run left its status
         assert f.attrs["status"] == "running"
     resumed = _peridyn(_argv(case, out, "--checkpoint-every", str(every), "--restart"))

@@ -273,10 +273,10 @@ def interrupted(tmp_path):
 
 def test_a_restart_from_a_corrupted_checkpoint_is_refused(interrupted):
     """A checkpoint with flipped bytes was restarted from (exit 0, displacements 47x the true
-    ones): now refused, naming the dataset, and nothing of the earlier run changes."""
+    ones): now refused by its seal, naming the file, and nothing of the earlier run changes."""
     _flip(interrupted / "checkpoint.h5", "u", 11)
     before = _digests(interrupted)
-    with pytest.raises(InputError, match="dataset /u does not match its checksum"):
+    with pytest.raises(InputError, match="checkpoint.h5: its bytes do not match its seal .* --overwrite"):
         run_case(_case(solver={"steps": 60}), interrupted, restart=True)
     assert _digests(interrupted) == before
 

@@ -5,8 +5,9 @@ A checkpoint holds u, v, a (n_points, 3), the time, the step, the intact mask of
 version, checked on restart) and the state of the run's stateful parts (``parts``: the
 damage model's stretch-test skin, the contact neighbour list, the crack-length samples),
 each a dict of arrays and numbers given by the part's ``checkpoint_state()`` and given back
-to its ``restore_state(saved)``. It is written to a temporary file and renamed, so a run
-killed while writing leaves the previous checkpoint intact.
+to its ``restore_state(saved)``. It is written to a temporary file, sealed (``peridyn.io.seal``:
+the CRC-32 of the whole file, checked before HDF5 opens it again) and renamed, so a run killed
+while writing leaves the previous checkpoint intact.
 
 Every dataset carries its CRC-32 and the attributes their own (``peridyn.io.integrity``); a
 checkpoint that does not match them is refused, naming what differs. A checkpoint also names
@@ -27,7 +28,7 @@ import numpy as np
 
 from peridyn.discretization.state import State
 from peridyn.errors import InputError
-from peridyn.io import integrity
+from peridyn.io import integrity, seal
 from peridyn.io.results import Results
 
 #: What ``meta`` holds, with its name in the refusal message (``case``, the case as JSON
@@ -64,6 +65,7 @@ def save_checkpoint(
                 _write(group, key, value)
         f.attrs[ATTRS_CRC] = np.uint32(integrity.attrs_crc(f.attrs, SAVED_ATTRS))
         integrity.mark_file(f)
+    seal.seal(tmp)
     os.replace(tmp, path)
 
 
@@ -90,6 +92,10 @@ def load_checkpoint(
     path = Path(path)
     if not path.is_file():
         raise InputError(f"checkpoint file {str(path)!r} does not exist: nothing to restart from")
+    try:
+        seal.check(path)
+    except InputError as exc:
+        raise InputError(f"{exc} (start again with --overwrite)") from None
     try:
         with h5py.File(path, "r") as f:
             _verify(f, str(path))

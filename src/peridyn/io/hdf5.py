@@ -20,7 +20,9 @@ dimension scales, coordinates, ``units`` and ``long_name``): each group opens wi
 ``xarray.open_dataset(path, engine="h5netcdf", group=...)`` (``Results.to_xarray``).
 
 Every dataset carries the CRC-32 of its bytes (``peridyn.io.integrity``), kept up to date as
-records are appended and checked when a file is read or continued.
+records are appended. Once the writer has closed it, the file ends with its seal
+(``peridyn.io.seal``: the CRC-32 of the whole file), checked before the file is read or
+continued.
 
 The writer flushes after every ``flush_every`` appends, so a process that
 crashes loses at most the records appended since the last flush (with ``flush_every=None``
@@ -40,7 +42,7 @@ import h5py
 import numpy as np
 
 from peridyn.errors import InputError, did_you_mean
-from peridyn.io import integrity
+from peridyn.io import integrity, seal
 from peridyn.io.netcdf import COMPONENTS, describe, drop_root_view, label, root_series, write_root_view
 from peridyn.io.reserve import as_disk_error, ensure_room
 
@@ -142,7 +144,7 @@ class HDF5Writer:
         self._pending = 0
         self._series: dict[str, _Series] = {}
         try:
-            self._file = h5py.File(self.path, mode, rdcc_nbytes=_CHUNK_CACHE_BYTES)
+            self._file = self._open(mode)
         except OSError as exc:
             raise InputError(f"cannot open results file {self.path!r} for writing: {exc}") from None
         try:
@@ -167,6 +169,14 @@ class HDF5Writer:
             self._file.close()
             raise
 
+    def _open(self, mode: str) -> h5py.File:
+        """The file opened for writing; an existing one continued is checked whole first
+        (``peridyn.io.seal.check``) and its seal cut off until :meth:`close` seals it again."""
+        if mode == "a" and os.path.exists(self.path):
+            seal.check(self.path)
+            seal.unseal(self.path)
+        return h5py.File(self.path, mode, rdcc_nbytes=_CHUNK_CACHE_BYTES)
+
     def __enter__(self) -> HDF5Writer:
         return self
 
@@ -184,6 +194,10 @@ class HDF5Writer:
                 self.flush()
             finally:
                 self._file.close()
+            try:
+                seal.seal(self.path)
+            except OSError:  # no room left for it: unsealed, the file is read through the probe
+                pass
 
     def flush(self) -> None:
         """Flush everything written so far to the operating system.

@@ -5,9 +5,11 @@ the CRC-32 (``zlib.crc32``) of its stored bytes in C order, in the attribute ``c
 number of rows along its first axis that the checksum covers in ``crc32_rows`` (a series grows
 by rows: appending rows appends bytes, so the checksum is carried along, ``zlib.crc32(new,
 old)``, without reading the file again). A file whose root attribute ``checksums`` is
-``"crc32"`` has one on every dataset; each read checks them, and a dataset whose bytes differ
-(a flipped bit on disk, a truncated copy) is refused with an error naming it. Files written
-before checksums were recorded have no ``checksums`` attribute and are read unchecked.
+``"crc32"`` has one on every dataset, and a dataset whose bytes differ (a flipped bit on disk,
+a truncated copy) is refused with an error naming it: when a file without a seal is read
+(``peridyn.io.hdf5_probe``; a sealed file's seal covers every byte, ``peridyn.io.seal``), when a
+checkpoint is loaded and when a series is truncated or continued. Files written before
+checksums were recorded have no ``checksums`` attribute and are read unchecked.
 
 CRC-32 finds every burst error of up to 32 bits and any other change with probability
 1 - 2^-32; it guards against corruption, not against deliberate tampering.

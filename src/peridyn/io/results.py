@@ -1,12 +1,13 @@
 """The reader of results files (layout in ``peridyn.io.hdf5``, written by its ``HDF5Writer``).
 
 Every reader of a ``results.h5`` (figures, the command line, the jobs, the analyses) goes
-through :class:`Results`, so that each read checks the same things: the file exists and is
-HDF5, its schema is one this peridyn knows, every dataset matches its checksum
-(``peridyn.io.integrity``: a corrupted file is refused, naming the dataset), and a series is
-read up to its last complete record (a crash may leave ``data`` or ``time`` one record longer
-than ``step``). The checksums are checked when a file is opened, once per process for each
-version of the file (its size and modification time).
+through :class:`Results`, so that each read checks the same things: the file exists, its
+bytes are whole before HDF5 opens it (``peridyn.io.seal``: a sealed file matches its seal's
+CRC-32, which covers every dataset's bytes; a file without a seal is read whole by a probe in a
+child process with a time limit, every dataset against its checksum, ``peridyn.io.integrity``),
+its schema is one this peridyn knows, and a series is read up to its last complete record (a
+crash may leave ``data`` or ``time`` one record longer than ``step``). The whole file is
+checked once per process for each version of the file (its size and modification time).
 """
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ import h5py
 import numpy as np
 
 from peridyn.errors import InputError, did_you_mean
-from peridyn.io import integrity
+from peridyn.io import integrity, seal
 from peridyn.io.hdf5 import (
     RUN_ID_ATTR,
     SCHEMA_ATTR,
@@ -66,7 +67,6 @@ class Results:
         self.path = os.fspath(path)
         with self._open() as f:
             self.schema_version = check_schema(f.attrs, self.path)
-            _verify_once(f, self.path)
 
     @classmethod
     def of(cls, source: Results | str | os.PathLike) -> Results:
@@ -194,6 +194,7 @@ class Results:
     def _open(self) -> Iterator[h5py.File]:
         if not os.path.exists(self.path):
             raise InputError(f"results file {self.path!r} does not exist")
+        seal.check(self.path)
         try:
             f = h5py.File(self.path, "r")
         except OSError as exc:
@@ -245,17 +246,3 @@ def _record_dims(data: h5py.Dataset) -> tuple[list[str], dict]:
             name = f"axis_{axis}"
         dims.append(name)
     return dims, coords
-
-
-#: The files whose checksums this process has checked: (real path, inode, size, mtime in ns).
-_verified: set = set()
-
-
-def _verify_once(f: h5py.File, path: str) -> None:
-    """``integrity.verify_file`` unless this version of the file was checked already."""
-    st = os.stat(path)
-    key = (os.path.realpath(path), st.st_ino, st.st_size, st.st_mtime_ns)
-    if key in _verified:
-        return
-    integrity.verify_file(f, path)
-    _verified.add(key)

@@ -33,15 +33,14 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
-import h5py
 import numba
 import numpy as np
 
 from peridyn.errors import InputError
 from peridyn.io.case import Case
-from peridyn.io.hdf5 import n_records
 from peridyn.io.provenance import provenance
 from peridyn.io.recorder import Recorder
+from peridyn.io.results import Results
 from peridyn.jobs.bench import best_seconds
 from peridyn.jobs.bench_gpu import force_seconds
 from peridyn.jobs.observers import crack_observer
@@ -236,8 +235,8 @@ def _best_force(model, u: np.ndarray, repeat: int) -> float:
 
 def _record_counts(path: Path) -> dict[str, int]:
     """Records of every series of a results file."""
-    with h5py.File(path, "r") as f:
-        return {name: int(n_records(group)) for name, group in f["series"].items()}
+    results = Results(path)
+    return {name: results.n_records(name) for name in results.series_names()}
 
 
 def format_case_result(result: dict) -> str:

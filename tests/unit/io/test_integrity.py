@@ -1,5 +1,6 @@
 """Checksums of results files and checkpoints, and the lock of an output folder: a corrupted
-file is refused naming the dataset, never used (peridyn.io.integrity, peridyn.io.lock)."""
+file is refused, naming the file (its seal, peridyn.io.seal) or the dataset (a file without a
+seal, read by the probe), never used (peridyn.io.integrity, peridyn.io.lock)."""
 
 import json
 import os
@@ -14,7 +15,7 @@ import pytest
 
 from peridyn.discretization.state import State
 from peridyn.errors import InputError
-from peridyn.io import integrity
+from peridyn.io import integrity, seal
 from peridyn.io.checkpoint import load_checkpoint, save_checkpoint
 from peridyn.io.hdf5 import HDF5Writer
 from peridyn.io.lock import LOCK_FILE, OutputLock, read_holder
@@ -34,6 +35,11 @@ def flip_byte(path, dataset: str, index: int = 0) -> None:
         byte = f.read(1)[0]
         f.seek(offset + index)
         f.write(bytes([byte ^ 0xFF]))
+
+
+def without_seal(path) -> None:
+    """The file as written before seals were recorded, or left by a killed writer."""
+    seal.unseal(path)
 
 
 def write_run(path, steps=range(6)):
@@ -56,20 +62,38 @@ def test_every_dataset_carries_the_crc32_of_its_bytes(tmp_path):
 
 
 @pytest.mark.parametrize("dataset", ["series/u/data", "series/u/time", "geometry/points", "final/u"])
-def test_a_results_file_with_a_flipped_byte_is_refused_naming_the_dataset(tmp_path, dataset):
+def test_a_results_file_with_a_flipped_byte_is_refused_naming_the_file(tmp_path, dataset, monkeypatch):
+    """A sealed file: refused by its seal, HDF5 never opening it."""
     path = tmp_path / "results.h5"
     write_run(path)
+    flip_byte(path, dataset, 5)
+    monkeypatch.setattr(h5py, "File", None)  # any open by HDF5 would raise a TypeError
+    with pytest.raises(InputError, match=f"{path}: its bytes do not match its seal"):
+        Results(path).series("u")
+
+
+@pytest.mark.parametrize("dataset", ["series/u/data", "series/u/time", "geometry/points", "final/u"])
+def test_a_results_file_without_a_seal_with_a_flipped_byte_is_refused_naming_the_dataset(tmp_path, dataset):
+    """A file without a seal (written before seals were recorded) is read by the probe, which
+    checks every dataset against its checksum."""
+    path = tmp_path / "results.h5"
+    write_run(path)
+    without_seal(path)
     flip_byte(path, dataset, 5)
     with pytest.raises(InputError, match=f"dataset /{dataset} does not match its checksum"):
         Results(path).series("u")
 
 
 def test_a_restart_refuses_a_corrupted_series(tmp_path):
-    """Continuing a results file (a restart truncates it at the checkpoint) checks it first."""
+    """Continuing a results file (a restart truncates it at the checkpoint) checks it first:
+    sealed, by its seal; left by a killed run, by the probe naming the dataset."""
     path = tmp_path / "results.h5"
     write_run(path)
     flip_byte(path, "series/u/data", 17)
     rng = np.random.default_rng(3)
+    with pytest.raises(InputError, match="its bytes do not match its seal"):
+        HDF5Writer(path, rng.random((N, 3)), np.full(N, 1e-9), {}, mode="a")
+    seal.unseal(path)  # as a run killed while writing leaves it
     with pytest.raises(InputError, match="dataset /series/u/data does not match its checksum"):
         with HDF5Writer(path, rng.random((N, 3)), np.full(N, 1e-9), {}, mode="a") as h5:
             h5.truncate(3)
@@ -91,9 +115,10 @@ def test_appending_and_truncating_keep_the_checksums(tmp_path):
 def test_a_results_file_from_before_checksums_is_read(tmp_path):
     path = tmp_path / "results.h5"
     write_run(path)
-    with h5py.File(path, "a") as f:  # as written before checksums were recorded
+    with h5py.File(path, "a") as f:  # as written before checksums (and seals) were recorded
         del f.attrs[integrity.FILE_ATTR]
         f.visititems(lambda _, obj: obj.attrs.pop("crc32", None) if isinstance(obj, h5py.Dataset) else None)
+    without_seal(path)
     assert Results(path).series("u")[0].tolist() == list(range(6))
 
 
@@ -105,11 +130,15 @@ def _checkpoint(path, results=None):
 
 
 @pytest.mark.parametrize("dataset", ["u", "v", "intact"])
-def test_a_checkpoint_with_a_flipped_byte_is_refused_naming_the_dataset(tmp_path, dataset):
+def test_a_checkpoint_with_a_flipped_byte_is_refused_naming_the_file(tmp_path, dataset):
     path = tmp_path / "checkpoint.h5"
     state = _checkpoint(path)
+    assert seal.read_seal(path) is not None  # written whole: always sealed
     np.testing.assert_array_equal(load_checkpoint(path, N, 40, META)[0].u, state.u)  # intact: read back
     flip_byte(path, dataset, 3)
+    with pytest.raises(InputError, match=f"{path}: its bytes do not match its seal"):
+        load_checkpoint(path, N, 40, META)
+    without_seal(path)  # an older peridyn's checkpoint: the probe names the dataset
     with pytest.raises(InputError, match=f"dataset /{dataset} does not match its checksum"):
         load_checkpoint(path, N, 40, META)
 
@@ -119,6 +148,7 @@ def test_a_checkpoint_with_an_altered_step_is_refused(tmp_path):
     _checkpoint(path)
     with h5py.File(path, "a") as f:
         f.attrs["step"] = 31
+    assert seal.read_seal(path) is None  # HDF5 cut the file back to its data: the seal is gone
     with pytest.raises(InputError, match=r"attributes \(time, step, case\) do not match their checksum"):
         load_checkpoint(path, N, 40, META)
 
