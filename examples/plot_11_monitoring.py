@@ -5,11 +5,12 @@ Monitoring a growing fatigue crack with guided waves
 A 40 x 40 x 2 mm aluminium plate with a notched hole is cycled in tension-tension until a crack
 grows from the notch (a plane-stress fatigue model); at 0 cycles and after each millimetre of
 growth until the crack is 2.5 mm long, three PZTs fire 250 kHz tone bursts in turn on the 3D
-plate with the crack cut through its thickness. The path that the crack crosses (t0-t1) shows a
-damage index that rises with the crack length; the RAPID image concentrates on it. The small
-copy of ``cases/monitoring/monitor_notched_hole.yaml`` (docs/monitoring.md). Each run has one
-numba thread (``threads=1``): runs of 4 704 points gain little from two, and on a machine busy
-with other work two threads wait on each other at every step.
+plate with the fatigue model's broken bonds broken through its thickness. The path that the
+crack crosses (t0-t1) shows a damage index that rises with the crack length; the RAPID image
+concentrates on it. The small copy of ``cases/monitoring/monitor_notched_hole.yaml``
+(docs/monitoring.md). Each run has one numba thread (``threads=1``): runs of 4 704 points gain
+little from two, and on a machine busy with other work two threads wait on each other at every
+step.
 """
 
 import matplotlib.image as mpimg

@@ -2,6 +2,7 @@
 
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from peridyn.errors import CaseFileError
@@ -24,6 +25,8 @@ CASE = Path(__file__).resolve().parents[2] / "cases" / "dogbone_fatigue.yaml"
         ("fatigue.mapping.0.tau=-1e-5", "fatigue.mapping[0].tau"),
         ("fatigue.tip.depth_axis=y", "tip.axis and tip.depth_axis must differ"),
         ("fatigue.tip.sense=down", "fatigue.tip.sense"),
+        ("fatigue.crack_plane={axis: w, at: 0.02}", "fatigue.crack_plane.axis"),
+        ("fatigue.crack_plane={axis: y}", "fatigue.crack_plane.at"),
     ],
 )
 def test_bad_fatigue_values_name_their_key(override, message):
@@ -57,3 +60,23 @@ def test_paris_fit_refuses_a_crack_measured_from_inside_the_body():
     sen = CASE.parent / "sen_fatigue_2d.yaml"
     with pytest.raises(CaseFileError, match="leave tip.start and tip.sense at their defaults"):
         load_case(sen, ["fatigue.tip.start=0.01"])
+
+
+def test_a_crack_plane_leaves_only_the_bonds_across_it_breakable():
+    """``fatigue.crack_plane`` (docs/fatigue.md): a bond may break iff its ends lie strictly on
+    opposite sides of the plane, and a no-damage set still protects its points' bonds. On the
+    small monitoring plate's 1 mm grid (rows at y = 19.5 and 20.5 mm about the plane y = 20 mm)
+    the count of breakable bonds is the count of bonds across the plane less the protected ones."""
+    from peridyn.fatigue.loop import breakable_bonds
+    from peridyn.setup.build import build
+
+    small = CASE.parent / "monitoring" / "monitor_small_fatigue.yaml"
+    case = load_case(small, ["fatigue.crack_plane={axis: y, at: 0.020}"])
+    model = build(case, small.parent).model
+    b, y = model.bonds, model.body.points[:, 1]
+    owners = b.owners()
+    across = (y[owners] - 0.020) * (y[b.neighbours] - 0.020) < 0
+    free = breakable_bonds(model, case.fatigue.no_damage_sets)
+    confined = breakable_bonds(model, case.fatigue.no_damage_sets, plane=case.fatigue.crack_plane)
+    np.testing.assert_array_equal(confined, free & across)
+    assert 0 < confined.sum() < across.sum() < free.sum()

@@ -40,8 +40,8 @@ def test_the_transfer_figures_compare_each_checked_interrogation_on_the_crossed_
 
     signals = np.stack([base, scaled(cut_gain[1], 0.9), scaled(cut_gain[2], 0.9)])
     bonds = np.stack([scaled(bonds_gain[1]), scaled(bonds_gain[2])])
-    block = transfer_figures(signals, bonds, [1, 2], masks, CROSSED)
-    assert block["interrogations"] == [1, 2]
+    block = transfer_figures(signals, bonds, [1, 2], masks, CROSSED, "cut", "bonds")
+    assert block["interrogations"] == [1, 2] and (block["route"], block["check"]) == ("cut", "bonds")
     energy = block["residual_energy_index"]
     np.testing.assert_allclose(energy["cut"], [[0.01, 0.01], [0.04, 0.04]], rtol=1e-12)
     np.testing.assert_allclose(energy["relative_difference"], [abs(0.01 - 0.0121) / 0.01, 0.0], atol=1e-12)

@@ -155,6 +155,7 @@ def test_a_cut_crack_becomes_through_thickness_rectangles_and_broken_bonds_a_bon
         ("noise.level=-0.01", "noise.level"),
         ("processing.index=energy", "processing"),
         ("transducers.colour=red", "transducers.colour"),
+        ("transfer=pieces", "transfer"),
     ],
 )
 def test_a_bad_monitoring_case_gets_one_line_naming_its_key(setting, key):

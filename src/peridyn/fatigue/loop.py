@@ -26,7 +26,7 @@ from peridyn.fatigue.mapping import CycleMapping
 from peridyn.fatigue.model import FatigueParameters, RemainingLife, cyclic_bond_strain
 from peridyn.fatigue.statics import LinearStatics
 from peridyn.fatigue.tip import crack_tip
-from peridyn.io.case import FatigueTip
+from peridyn.io.case import CrackPlane, FatigueTip
 from peridyn.parallel.domain import Domain
 from peridyn.physics.damage import damage_field, protected_points
 from peridyn.physics.loads import Loading
@@ -65,8 +65,11 @@ class FatigueResult:
     break_cycle: np.ndarray | None = field(default=None, repr=False)
 
 
-def breakable_bonds(model: Model, no_damage_sets=(), domain: Domain | None = None) -> np.ndarray:
-    """(n_bonds,) bool: bonds with neither end in a no-damage node set.
+def breakable_bonds(
+    model: Model, no_damage_sets=(), domain: Domain | None = None, plane: CrackPlane | None = None
+) -> np.ndarray:
+    """(n_bonds,) bool: bonds with neither end in a no-damage node set (and, with a ``plane``,
+    the case's ``fatigue.crack_plane``, whose ends lie strictly on opposite sides of it).
 
     Under MPI (``domain`` of several ranks) ``model`` is a rank's part, which may hold none of a
     set's points: each set must be known and hold points somewhere in the body (collective)."""
@@ -78,7 +81,12 @@ def breakable_bonds(model: Model, no_damage_sets=(), domain: Domain | None = Non
         no_damage_sets = [name for name in no_damage_sets if len(body.node_sets[name])]
     protected = protected_points(body, no_damage_sets)
     b = model.bonds
-    return ~(protected[b.owners()] | protected[b.neighbours])
+    owners = b.owners()
+    breakable = ~(protected[owners] | protected[b.neighbours])
+    if plane is not None:
+        side = body.points[:, "xyz".index(plane.axis)] - plane.at
+        breakable &= side[owners] * side[b.neighbours] < 0
+    return breakable
 
 
 def run_fatigue(
@@ -90,6 +98,7 @@ def run_fatigue(
     load_ratio: float = 0.0,
     max_load_time: float = 1.0,
     no_damage_sets=(),
+    crack_plane: CrackPlane | None = None,
     tip: FatigueTip | None = None,
     solver: str = "auto",
     stop_length: float = np.inf,
@@ -106,6 +115,7 @@ def run_fatigue(
     mapping : cycles per step
     load_ratio : R = min load / max load, in [-1, 1)
     no_damage_sets : node sets whose bonds never break
+    crack_plane : only the bonds across this plane may break (None: any bond)
     tip : the crack-tip rule (``fatigue.tip.crack_tip``: growth axis, depth axis, damage
         threshold, start, sense), the case's ``fatigue.tip``; default ``FatigueTip()`` (along x,
         depth z, damage 0.385, from the low edge)
@@ -126,7 +136,7 @@ def run_fatigue(
         statics = RankStatics(model, loading, domain, max_load_time)
     else:
         raise InputError(f"an MPI fatigue run solves by CG with AMG (solver auto or amg), not {solver!r}")
-    life = RemainingLife(model, params, breakable_bonds(model, no_damage_sets, domain), domain)
+    life = RemainingLife(model, params, breakable_bonds(model, no_damage_sets, domain, crack_plane), domain)
     points, spacing = domain.gather(model.body.points), model.body.spacing
     owners = model.bonds.owners()
     owned_bonds = slice(0, model.bonds.offsets[domain.n_owned])  # the owned points' families

@@ -1311,6 +1311,15 @@ class FatigueTip(Strict):
     sense: Literal["+", "-"] = described("+", "direction in which the crack grows along axis")
 
 
+class CrackPlane(Strict):
+    """A plane that confines the fatigue crack: only bonds whose ends lie strictly on opposite
+    sides of the plane normal to ``axis`` at ``at`` (m) may break, so the crack is a clean cut
+    along it (e.g. a mode-I crack from a notch on the plane)."""
+
+    axis: Literal["x", "y", "z"] = described(..., "normal of the plane")
+    at: Finite = described(..., "coordinate of the plane along axis", "m")
+
+
 class FatigueModal(Strict):
     """Free-free modal analyses before and after the fatigue run: ``modes`` modes, rigid included."""
 
@@ -1349,7 +1358,8 @@ class Fatigue(Strict):
     (A_II, m_II; A_II given at ``A_II_horizon`` m and scaled to the case's horizon by eq. 7.15),
     phi_c, load ratio R in [-1, 1), the boundary conditions' value at ``max_load_time`` (s) as the
     maximum load, cycle ``mapping`` blocks (``adaptive``: cut a step where the next bond breaks),
-    no-damage node sets, crack ``tip``, linear ``solver`` and optional ``modal_after``."""
+    no-damage node sets, an optional ``crack_plane`` that confines the breaking, crack ``tip``,
+    linear ``solver`` and optional ``modal_after``."""
 
     A_I: Positive = described(..., "phase I (crack nucleation) life constant")
     m_I: Positive = described(..., "phase I exponent")
@@ -1373,6 +1383,9 @@ class Fatigue(Strict):
     )
     adaptive: bool = described(False, "cut a step where the next bond breaks")
     no_damage_sets: list[str] = described([], "node sets whose bonds never break")
+    crack_plane: CrackPlane | None = described(
+        None, "only the bonds that cross this plane may break (default: any bond)"
+    )
     tip: FatigueTip = described(FatigueTip(), "how the crack tip and length are found")
     solver: Literal["auto", "amg", "direct", "cg"] = described("auto", "linear solver of the static steps")
     modal_after: FatigueModal | None = described(None, "free-free modal analyses before and after the cycles")

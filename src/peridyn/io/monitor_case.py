@@ -7,7 +7,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Annotated
 
-from pydantic import Field, ValidationError, model_validator
+from pydantic import Field, ValidationError, field_validator, model_validator
 
 from peridyn.io.case import (
     Finite,
@@ -21,7 +21,10 @@ from peridyn.io.case import (
     read_yaml_mapping,
 )
 
-__all__ = ["MonitorCase", "load_monitor_case"]
+__all__ = ["TRANSFERS", "MonitorCase", "load_monitor_case"]
+
+#: The damage transfers (docs/monitoring.md, "Damage transfer"), each against the other.
+TRANSFERS = {"bonds": "cut", "cut": "bonds"}
 
 XY = Annotated[list[Finite], Field(min_length=2, max_length=2)]
 
@@ -126,12 +129,23 @@ class MonitorCase(Strict):
     schedule: Schedule = described(..., "interrogation schedule")
     noise: Noise = described(Noise(), "sensor noise")
     processing: Processing = described(Processing(), "signal processing settings")
+    transfer: str = described(
+        "bonds",
+        "how the fatigue damage reaches the wave case: bonds (the fatigue model's broken bonds "
+        "through the thickness) or cut (its crack paths as through-thickness cuts)",
+    )
     check_transfer: bool = described(
         True,
-        "repeat each interrogation after the crack first grew through the second damage transfer (the "
-        "fatigue model's broken bonds)",
+        "repeat each interrogation after the crack first grew through the other damage transfer",
     )
     output: MonitorOutput = described(MonitorOutput(), "output folder and figures")
+
+    @field_validator("transfer")
+    @classmethod
+    def _transfer(cls, value: str) -> str:
+        if value not in TRANSFERS:
+            raise ValueError(f"bonds or cut, got {value!r}")
+        return value
 
     @model_validator(mode="after")
     def _name(self):

@@ -211,6 +211,7 @@ def _run_fatigue(case, setup, out, modal, progress, start) -> dict:
         load_ratio=f.load_ratio,
         max_load_time=f.max_load_time,
         no_damage_sets=f.no_damage_sets,
+        crack_plane=f.crack_plane,
         tip=f.tip,
         solver=f.solver,
         stop_length=_stop_length(f),

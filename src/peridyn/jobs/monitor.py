@@ -4,10 +4,12 @@ PZT network; damage indices, images and the dataset of the whole life.
 
 1. The fatigue case runs once (``peridyn.jobs.fatigue.run_fatigue_case``, in ``fatigue/``).
 2. Its history gives the interrogation points and the crack at each (``peridyn.jobs.monitor_plan``).
-3. Each interrogation fires every transducer in turn on the wave case with the crack cut into it
-   (``peridyn.run_case``, one run per actuator in ``interrogations/kNN_tI/``), through the sweep
-   executors (serial, processes, dask); a run whose folder holds a complete record of the same
-   case is not run again, so an interrupted job resumes where it stopped. Under ``mpiexec -n N``
+3. Each interrogation fires every transducer in turn on the wave case with the fatigue damage of
+   its cycle transferred into it (the case's ``transfer``: ``bonds`` or ``cut``; the transfer
+   check repeats it by the other) (``peridyn.run_case``, one run per actuator in
+   ``interrogations/kNN_tI/``), through the sweep executors (serial, processes, dask); a run
+   whose folder holds a complete record of the same case is not run again, so an interrupted
+   job resumes where it stopped. Under ``mpiexec -n N``
    the fatigue and the runs go one after the other, each on all ranks; rank 0 reads and writes
    the job's own files (the records kept, the dataset, figures and summary) and tells the others.
 4. The signals are compared with the baseline's (``peridyn.jobs.monitor_assess``) and written as
@@ -29,7 +31,7 @@ from peridyn.analysis.shm.paths import network_paths
 from peridyn.errors import CaseFileError, InputError
 from peridyn.io.case import Case, load_case, validate_case
 from peridyn.io.job_files import job_files
-from peridyn.io.monitor_case import MonitorCase, load_monitor_case
+from peridyn.io.monitor_case import TRANSFERS, MonitorCase, load_monitor_case
 from peridyn.io.outdir import prepare_output
 from peridyn.io.provenance import provenance
 from peridyn.io.results import Results
@@ -207,9 +209,10 @@ def read_history(folder: Path) -> FatigueHistory:
 class Plan:
     """The interrogations: fatigue steps, cycles (n_int,), crack lengths (n_int,) m, the crack
     of each (``lines``: its polylines, (m, 2) m, branches included, from the fatigue model's
-    damage at that cycle; ``cracks``: the main one, None before the crack grew), and the
-    interrogations that the transfer check repeats by the second route (``checked``: each after
-    the crack first grew, when the case asks for it). ``base_dir``: the fatigue case's folder."""
+    damage at that cycle; ``cracks``: the main one, None before the crack grew), the damage
+    transfer of the interrogations (``route``: bonds or cut) and of their check (``check``: the
+    other), and the interrogations that the check repeats (``checked``: each after the crack
+    first grew, when the case asks for it). ``base_dir``: the fatigue case's folder."""
 
     def __init__(self, mon: MonitorCase, fatigue: Case, history: FatigueHistory, base_dir: Path):
         from peridyn.setup.build import build
@@ -239,6 +242,14 @@ class Plan:
         self.paths = network_paths(len(self.transducers))
         grown = [k for k, crack in enumerate(self.cracks) if k > 0 and crack is not None]
         self.checked = grown if mon.check_transfer else []
+        self.route, self.check = mon.transfer, TRANSFERS[mon.transfer]
+
+    def wave_case(self, fired: Case, name: str, k: int, route: str) -> Case:
+        """The wave case ``fired`` with the damage of interrogation ``k`` transferred by ``route``
+        (bonds or cut), renamed ``name``."""
+        if route == "bonds":
+            return bonds_case(fired, name, self.history, self.cycles[k], self.spacing)
+        return cut_case(fired, name, self.lines[k])
 
 
 def _plan(mon, fatigue, history, base_dir) -> Plan:
@@ -273,21 +284,21 @@ def network_case(mon: MonitorCase, wave: Case, actuator: int) -> Case:
 
 
 def _tasks(mon, wave, plan: Plan, out: Path, wave_path: Path, executor, workers, scheduler, threads):
-    """``{(label, actuator): RunTask}``: label ``k`` for interrogation k, ``("bonds", k)`` for its
-    transfer check."""
+    """``{(label, actuator): RunTask}``: label ``k`` for interrogation k (folders ``kNN_tI``),
+    ``("check", k)`` for its transfer check (folders ``<check route>_kNN_tI``)."""
     n = len(plan.transducers)
     fired = [network_case(mon, wave, i) for i in range(n)]
     per_run = run_threads(threads, executor, workers, scheduler)
     tasks = {}
-    labels = list(range(len(plan.cracks))) + [("bonds", k) for k in plan.checked]
+    labels = list(range(len(plan.cracks))) + [("check", k) for k in plan.checked]
     for label in labels:
         for i in range(n):
             if isinstance(label, tuple):
-                name = f"{mon.name}_bonds_k{label[1]:02d}_t{i}"
-                case = bonds_case(fired[i], name, plan.history, plan.cycles[label[1]], plan.spacing)
+                name = f"{mon.name}_{plan.check}_k{label[1]:02d}_t{i}"
+                case = plan.wave_case(fired[i], name, label[1], plan.check)
             else:
                 name = f"{mon.name}_k{label:02d}_t{i}"
-                case = cut_case(fired[i], name, plan.lines[label])
+                case = plan.wave_case(fired[i], name, label, plan.route)
             folder = out / "interrogations" / name.removeprefix(f"{mon.name}_")
             tasks[(label, i)] = RunTask(
                 run_id=folder.name,
@@ -365,8 +376,8 @@ def _run_ranks(todo, comm, done) -> None:
 
 
 def _signals(mon: MonitorCase, plan: Plan, tasks: dict) -> dict:
-    """``{"times": (n_t,) s, "signals": (n_int, n_paths, n_t), "bonds": (n_checked, n_paths,
-    n_t), the checked interrogations by the bonds route (``Plan.checked``)}``: each path's
+    """``{"times": (n_t,) s, "signals": (n_int, n_paths, n_t), "check": (n_checked, n_paths,
+    n_t), the checked interrogations by the check's route (``Plan.checked``, ``Plan.check``)}``: each path's
     signal the mean of its two directions (reciprocity), unit of ``pzt_signal`` (mean in-plane
     strain under the sensor)."""
     n = len(plan.transducers)
@@ -386,5 +397,5 @@ def _signals(mon: MonitorCase, plan: Plan, tasks: dict) -> dict:
     return {
         "times": np.asarray(times, dtype=float),
         "signals": np.stack([s for _, s in series]),
-        "bonds": np.stack([interrogation(("bonds", k))[1] for k in plan.checked]) if plan.checked else None,
+        "check": np.stack([interrogation(("check", k))[1] for k in plan.checked]) if plan.checked else None,
     }

@@ -25,8 +25,9 @@ def assess(mon, wave, plan, data: dict) -> dict:
         The wave case (its material and plate).
     plan : peridyn.jobs.monitor.Plan
     data : dict
-        ``times`` (n_t,) s, ``signals`` (n_int, n_paths, n_t), ``bonds`` (n_checked, n_paths,
-        n_t): the interrogations ``plan.checked`` by the second damage transfer, or None.
+        ``times`` (n_t,) s, ``signals`` (n_int, n_paths, n_t), ``check`` (n_checked, n_paths,
+        n_t): the interrogations ``plan.checked`` by the other damage transfer (``plan.check``),
+        or None.
 
     Returns
     -------
@@ -75,8 +76,10 @@ def assess(mon, wave, plan, data: dict) -> dict:
         block["noise_free"] = trend_figures(
             out[f"{INDEX_NAMES[mon.processing.index]}_noise_free"], plan.crack_length, out["crossed"]
         )
-    if data["bonds"] is not None:
-        block["transfer"] = transfer_figures(signals, data["bonds"], plan.checked, masks, out["crossed"])
+    if data["check"] is not None:
+        block["transfer"] = transfer_figures(
+            signals, data["check"], plan.checked, masks, out["crossed"], plan.route, plan.check
+        )
     out["monitoring"] = block
     return out
 
@@ -127,35 +130,44 @@ def _images(mon, wave, plan, index: np.ndarray) -> dict:
 
 
 def transfer_figures(
-    signals: np.ndarray, bonds: np.ndarray, checked: list, masks: np.ndarray, crossed: np.ndarray
+    signals: np.ndarray,
+    checks: np.ndarray,
+    checked: list,
+    masks: np.ndarray,
+    crossed: np.ndarray,
+    route: str,
+    check: str,
 ) -> dict:
     """The two damage transfers compared (docs/monitoring.md, "Damage transfer"): each index of
-    the crossed paths (all paths without one) at each checked interrogation, by the cut
-    (``signals[k]``) and by the broken bonds (``bonds``), on the signals without noise (the
-    noise is no part of a transfer), and the relative differences ``|cut - bonds| / cut`` (0
-    where both are 0): the largest per interrogation and over them all.
+    the crossed paths (all paths without one) at each checked interrogation, by the
+    interrogations' transfer ``route`` (``signals[k]``) and by the other, ``check``
+    (``checks``), on the signals without noise (the noise is no part of a transfer), and the
+    relative differences ``|route - check| / route`` (0 where both are 0): the largest per
+    interrogation and over them all. The block names the two (``route``, ``check``) and holds
+    each one's indices under its name.
 
     Parameters
     ----------
-    signals : (n_int, n_paths, n_t), the interrogations by the cut, the baseline first
-    bonds : (n_checked, n_paths, n_t), the interrogations ``checked`` by the broken bonds
-    checked : the interrogations (indices into ``signals``) of ``bonds``
+    signals : (n_int, n_paths, n_t), the interrogations by ``route``, the baseline first
+    checks : (n_checked, n_paths, n_t), the interrogations ``checked`` by ``check``
+    checked : the interrogations (indices into ``signals``) of ``checks``
     masks : (n_paths, n_t) bool, the paths' windows
     crossed : (n_paths,) bool, the paths that the final crack crosses
+    route, check : the transfers' names (bonds, cut)
     """
     paths = crossed if crossed.any() else np.ones(len(crossed), bool)
-    block = {"interrogations": [int(k) for k in checked]}
+    block = {"route": route, "check": check, "interrogations": [int(k) for k in checked]}
     for name, index in (
         ("residual_energy_index", residual_energy_index),
         ("correlation_index", correlation_index),
     ):
-        cut = np.stack([index(signals[0], signals[k], masks)[paths] for k in checked])
-        other = np.stack([index(signals[0], s, masks)[paths] for s in bonds])
-        diff = np.abs(cut - other)
-        relative = np.divide(diff, cut, out=np.where(diff > 0, np.inf, 0.0), where=cut > 0)
+        used = np.stack([index(signals[0], signals[k], masks)[paths] for k in checked])
+        other = np.stack([index(signals[0], s, masks)[paths] for s in checks])
+        diff = np.abs(used - other)
+        relative = np.divide(diff, used, out=np.where(diff > 0, np.inf, 0.0), where=used > 0)
         block[name] = {
-            "cut": cut.tolist(),
-            "bonds": other.tolist(),
+            route: used.tolist(),
+            check: other.tolist(),
             "relative_difference": relative.max(axis=1).tolist(),
             "relative_difference_max": float(relative.max()),
         }

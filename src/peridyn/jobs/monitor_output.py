@@ -58,16 +58,29 @@ def redraw_figures(out) -> list[Path]:
     return draw_monitoring_figures(ds, out)
 
 
+#: long_name of the crack polylines' vertices in the dataset.
+CRACK_VERTICES = "{} of the crack polylines' vertices (main crack first, NaN between branches)"
+
+
+def branches(lines: list) -> np.ndarray:
+    """(m, 2) the crack ``lines`` ((m_i, 2) polylines, m: the main crack and its branches) one
+    after the other, a NaN row between two (a drawn line breaks there); (0, 2) without one."""
+    rows = []
+    for line in lines:
+        rows += [np.full((1, 2), np.nan)] if rows else []
+        rows.append(np.asarray(line, dtype=float))
+    return np.vstack(rows) if rows else np.empty((0, 2))
+
+
 def monitoring_dataset(mon, wave, plan, data: dict, result: dict):
     """The xarray Dataset of the job (dimensions interrogation, path, time, transducer, vertex,
     image_y, image_x, cracked_point)."""
     xr = require_xarray()
     labels = [f"t{i}-t{j}" for i, j in plan.paths]
-    vertices = max([len(c) for c in plan.cracks if c is not None] or [1])
-    crack = np.full((len(plan.cracks), vertices, 2), np.nan)
-    for k, c in enumerate(plan.cracks):
-        if c is not None:
-            crack[k, : len(c)] = c
+    drawn = [branches(lines) for lines in plan.lines]
+    crack = np.full((len(drawn), max([len(c) for c in drawn] + [1]), 2), np.nan)
+    for k, c in enumerate(drawn):
+        crack[k, : len(c)] = c
     tip = np.array([c[-1] if c is not None else [np.nan, np.nan] for c in plan.cracks])
     h = plan.history
     cracked = np.isfinite(h.first_break)
@@ -79,8 +92,8 @@ def monitoring_dataset(mon, wave, plan, data: dict, result: dict):
         "crack_length": (ip, plan.crack_length, "m", "crack length from the notch root"),
         "crack_tip_x": (ip, tip[:, 0], "m", "x of the crack tip"),
         "crack_tip_y": (ip, tip[:, 1], "m", "y of the crack tip"),
-        "crack_x": (("interrogation", "vertex"), crack[:, :, 0], "m", "x of the crack polyline's vertices"),
-        "crack_y": (("interrogation", "vertex"), crack[:, :, 1], "m", "y of the crack polyline's vertices"),
+        "crack_x": (("interrogation", "vertex"), crack[:, :, 0], "m", CRACK_VERTICES.format("x")),
+        "crack_y": (("interrogation", "vertex"), crack[:, :, 1], "m", CRACK_VERTICES.format("y")),
         "signal": (it, result["recorded"], strain, "path signal (mean of both directions), noise included"),
         "signal_noise_free": (it, data["signals"], strain, "path signal (mean of both directions), no noise"),
         "residual_energy_index": (ipath, result["residual_energy_index"], "1", "residual energy index"),

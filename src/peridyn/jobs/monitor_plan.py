@@ -4,15 +4,16 @@ crack at each of them, and the wave cases of the body so damaged (the damage tra
 The fatigue runs on a plane-stress (2D) model of the plate; its history (cycles, crack length),
 final damage field (with each point's first-break cycle) and broken bonds (with the cycle of
 each break) give the crack at any cycle. The wave case is the 3D plate on the same in-plane
-grid; a crack reaches it in one of two ways (docs/monitoring.md, "Damage transfer"):
+grid; a crack reaches it in one of two ways (docs/monitoring.md, "Damage transfer"; the
+monitoring case's ``transfer`` chooses the interrogations', the other checks it):
 
-- ``cut`` (the interrogations): the crack path (``peridyn.analysis.crack``) of the points
-  broken by the last interrogation, from the crack's start (``fatigue.tip.start``), cut to the
-  crack length of that cycle, becomes through-thickness pre-crack rectangles, one per polyline
-  segment, that cut every bond crossing them;
-- ``bonds`` (the check of the transfer): every 3D bond whose ends lie in the columns of a 2D
-  bond that the fatigue had broken by that cycle is cut (a ``bonds`` pre-crack), the 2D model's
-  own broken bonds through the thickness.
+- ``bonds`` (the default): every 3D bond whose ends lie in the columns of a 2D bond that the
+  fatigue had broken by that cycle is cut (a ``bonds`` pre-crack), the 2D model's own broken
+  bonds through the thickness;
+- ``cut``: every crack path (``peridyn.analysis.crack``, branches included) of the fatigue
+  model's damage at that cycle, from the crack's start (``fatigue.tip.start``), becomes
+  through-thickness pre-crack rectangles, one per polyline segment, that cut every bond
+  crossing them.
 """
 
 from __future__ import annotations

@@ -93,9 +93,12 @@ def draw_monitoring_figures(ds, out) -> list[Path]:
 
 
 def _polyline(x, y) -> np.ndarray | None:
-    """A crack polyline ((m, 2), m) from its vertices' x and y padded with NaN; None if it has none."""
-    keep = np.isfinite(x) & np.isfinite(y)
-    return np.column_stack([x[keep], y[keep]]) if keep.any() else None
+    """The crack polylines ((m, 2), m, a NaN row between two branches: a drawn line breaks
+    there) from their vertices' x and y padded with NaN at the end; None if it has none."""
+    keep = np.flatnonzero(np.isfinite(x) & np.isfinite(y))
+    if keep.size == 0:
+        return None
+    return np.column_stack([x, y])[: keep[-1] + 1]
 
 
 def plot_indices(cycles, crack_length, index, labels, crossed, path, name="damage index") -> Path:
@@ -121,7 +124,8 @@ def plot_indices(cycles, crack_length, index, labels, crossed, path, name="damag
 
 def plot_image_frames(x, y, images, transducers, cracks, peaks, titles, size, path) -> Path:
     """RAPID image frames ((n, ny, nx) on grid lines ``x``, ``y`` m) with the transducers, the
-    true crack (polylines, m, or None) and each image's peak; writes PNG ``path``."""
+    true crack (its polylines, m, NaN rows between branches, or None) and each image's peak;
+    writes PNG ``path``."""
     n = len(images)
     cols = min(n, 4)
     rows = -(-n // cols)
@@ -147,7 +151,8 @@ def plot_image_frames(x, y, images, transducers, cracks, peaks, titles, size, pa
 
 def plot_crack_history(points, first_break, cracks, crack_length, cycles, transducers, path) -> Path:
     """The crack over the life: the fatigue model's cracked points coloured by the cycle of
-    their first broken bond, the crack polyline at each interrogation and the transducers
+    their first broken bond, the crack at each interrogation (its polylines, NaN rows between
+    branches) and the transducers
     (all m, drawn in mm); writes PNG ``path``."""
     fig = _figure((6, 5))
     ax = fig.add_subplot()
