@@ -9,6 +9,11 @@ single changed bit anywhere in the results shows.
     python benchmarks/case_summaries.py record benchmarks/case_summaries.json
     python benchmarks/case_summaries.py compare benchmarks/case_summaries.json
 
+``--lattice`` runs the explicit cases only, on ``discretization.storage: auto`` (lattice storage
+wherever a case allows it; the summary's ``storage`` says which ran), against its own table:
+
+    python benchmarks/case_summaries.py compare --lattice benchmarks/case_summaries_lattice.json
+
 ``compare`` prints one line per case (``same`` or the values that differ) and exits 1 when
 anything differs. It uses only the command line and h5py, so it runs unchanged across a
 reorganisation of the package.
@@ -120,18 +125,25 @@ def _run(args: list[str], folder: Path) -> dict:
     return {"summary": summary, "datasets": _digests(results) if results.is_file() else {}}
 
 
-def record() -> dict:
+#: ``--lattice``: what each explicit run adds
+LATTICE = ["--set", "discretization.storage=auto"]
+
+
+def record(lattice: bool = False) -> dict:
     import yaml
 
     table = {}
     for path in CASES:
         spec = yaml.safe_load(path.read_text())
         kind = spec["solver"]["type"]
+        if lattice and kind != "explicit":
+            continue
         with tempfile.TemporaryDirectory() as tmp:
+            extra = LATTICE if lattice else []
             table[f"run {path.stem}"] = _run(
-                ["run", str(path), "--set", "output.plots=false", *SHORTEN[kind]], Path(tmp)
+                ["run", str(path), "--set", "output.plots=false", *SHORTEN[kind], *extra], Path(tmp)
             )
-        if "fatigue" in spec:
+        if "fatigue" in spec and not lattice:
             with tempfile.TemporaryDirectory() as tmp:
                 table[f"fatigue {path.stem}"] = _run(["fatigue", str(path), *FATIGUE_SHORT], Path(tmp))
         print(f"{path.stem}: done", file=sys.stderr)
@@ -211,8 +223,9 @@ def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("action", choices=["record", "compare"])
     p.add_argument("table", type=Path, help="JSON table of summaries")
+    p.add_argument("--lattice", action="store_true", help="explicit cases on discretization.storage auto")
     ns = p.parse_args(argv)
-    table = record()
+    table = record(ns.lattice)
     if ns.action == "record":
         ns.table.write_text(json.dumps(table, indent=1, sort_keys=True) + "\n")
         return 0

@@ -44,6 +44,25 @@ def _grid(rng, dtype, shape=(6, 5, 4), horizon=2.015):
     return np.array(shape, dtype=np.int64), stencil, vol, broken, u
 
 
+def _written_rows(rng, vol):
+    """(n_grid,) int32 rows of the force kernels' output: the grid points with material in a
+    random order, -1 (not written) for holes; and an output of NaN, (n_grid, 3)."""
+    point_of = rng.permutation(vol.size).astype(np.int32)
+    point_of[vol == 0] = -1
+    return point_of, np.full((vol.size, 3), np.nan, dtype=vol.dtype)
+
+
+def _grid_order(point_of, f):
+    """The kernels' output ``f`` (n_out, 3) back in grid order, (3, n_grid): NaN for holes,
+    which must be left unwritten."""
+    at_grid = np.full((3, len(point_of)), np.nan, dtype=f.dtype)
+    at_grid[:, point_of >= 0] = f[point_of[point_of >= 0]].T
+    written = np.zeros(len(f), dtype=bool)
+    written[point_of[point_of >= 0]] = True
+    assert np.isnan(f[~written]).all(), "a row no grid point maps to was written"
+    return at_grid
+
+
 def _tables(stencil, dtype):
     return stencil.xi.astype(dtype), stencil.length.astype(dtype)
 
@@ -60,18 +79,20 @@ def test_lattice_pmb_force_matches_reference(rng, dtype):
     shape, s, vol, broken, u = _grid(rng, dtype)
     xi, length = _tables(s, dtype)
     coef = (1e20 * s.influence * s.volume_factor).astype(dtype)
-    f = np.full((3, vol.size), np.nan, dtype=dtype)
+    point_of, out = _written_rows(rng, vol)
     cf = dtype == np.float32
     kern.lattice_pmb_force(
-        u, vol, broken, shape, s.offsets, xi, length, (1 / length).astype(dtype), coef, cf, f
+        u, vol, broken, shape, s.offsets, xi, length, (1 / length).astype(dtype), coef, cf, point_of, out
     )
+    f = _grid_order(point_of, out)
     expected = ref.lattice_pmb_force(u, vol, broken, shape, s.offsets, xi, length, coef, cf)
     p, q, k, _ = ref.lattice_bonds(vol, broken, shape, s.offsets)
     scale = _magnitude(
         vol, broken, shape, s.offsets, coef[k] * vol[q] * np.linalg.norm(xi[k], axis=1) / length[k]
     )
     assert f.dtype == dtype
-    assert_close(f.T, expected.T, TOL[dtype], scale)
+    held = vol > 0
+    assert_close(f.T[held], expected.T[held], TOL[dtype], scale[held])
 
 
 @pytest.mark.parametrize("dtype", DTYPES)
@@ -97,15 +118,20 @@ def test_lattice_lps_dilatation_and_force_match_reference(rng, dtype):
     assert_close(theta, expected, TOL[dtype], scale)
     alpha = (rng.random(n) * 1e25).astype(dtype)
     pressure = (rng.normal(size=n) * 1e22).astype(dtype)
-    f = np.full((3, n), np.nan, dtype=dtype)
-    kern.lattice_lps_force(u, vol, broken, shape, s.offsets, xi, length, weight, cf, alpha, pressure, f)
+    point_of, out = _written_rows(rng, vol)
+    kern.lattice_lps_force(
+        u, vol, broken, shape, s.offsets, xi, length, weight, cf, alpha, pressure, point_of, out
+    )
+    f = _grid_order(point_of, out)
     expected = ref.lattice_lps_force(
         u, vol, broken, shape, s.offsets, xi, length, weight, alpha, pressure, cf
     )
     size = w * (
         length[k] * (np.abs(pressure[p]) + np.abs(pressure[q])) + (alpha[p] + alpha[q]) * np.abs(extension)
     )
-    assert_close(f.T, expected.T, TOL[dtype], _magnitude(vol, broken, shape, s.offsets, size))
+    held = vol > 0
+    scale = _magnitude(vol, broken, shape, s.offsets, size)
+    assert_close(f.T[held], expected.T[held], TOL[dtype], scale[held])
 
 
 def test_lattice_sums_and_energy_match_reference(rng):

@@ -160,7 +160,7 @@ def test_lattice_storage_estimate_counts_its_broken_words(changes):
     )
     assert est.storage == "lattice" and est.bonds == lattice.n_bonds
     assert est.parts["bonds"] == lattice.broken.nbytes
-    assert est.parts["points"] == estimate.LATTICE_PER_POINT * body.n_points
+    assert est.parts["points"] == estimate.lattice_point_bytes(case) * body.n_points
     bonded = estimate.estimate_case(_case(**changes))
     assert bonded.storage == "bonds" and bonded.peak_bytes > est.peak_bytes
     assert estimate.estimate_case(case, job="static").storage == "bonds"

@@ -41,8 +41,9 @@ class Body:
         Out-of-plane thickness of a 2D body.
     plane : {"stress", "strain"} or None
         Plane assumption of a 2D body.
-    layer_index : (n_points,) int64 or None
-        Through-thickness layer of each point for layered plates (0 = bottom).
+    layer_index : (n_points,) int or None
+        Through-thickness layer of each point for layered plates (0 = bottom; int8 up to 127
+        layers).
     """
 
     points: np.ndarray
@@ -74,9 +75,11 @@ class Body:
         cells = np.asarray(self.cells, dtype=np.float64)
         # one cell for every point (a grid) stays one row seen n times: a read-only view that
         # spares 24 bytes a point; cells of their own are an (n, 3) array
+        # (a body made from another, ``dataclasses.replace``, keeps that view: rows of stride 0)
+        one_cell = cells.ndim == 1 or (cells.shape == (n, 3) and cells.strides[0] == 0)
         cells = (
-            np.broadcast_to(cells, (n, 3))
-            if cells.ndim == 1
+            np.broadcast_to(cells if cells.ndim == 1 else cells[0], (n, 3))
+            if one_cell
             else np.ascontiguousarray(np.broadcast_to(cells, (n, 3)))
         )
         if self.dim not in (2, 3):
@@ -146,7 +149,7 @@ class Body:
             self,
             points=self.points[idx],
             volumes=self.volumes[idx],
-            cells=self.cells[idx],
+            cells=self.cells[0] if self.cells.strides[0] == 0 else self.cells[idx],
             node_sets=sets,
             layer_index=layers,
         )

@@ -162,7 +162,7 @@ def plate(
     points = np.empty((n_xy * layers, 3))
     points[:, :2] = np.repeat(xy, layers, axis=0)
     points[:, 2] = origin[2] + np.tile(z, n_xy)
-    layer_index = np.tile(np.arange(layers, dtype=np.int64), n_xy)
+    layer_index = np.tile(np.arange(layers, dtype=np.int8 if layers <= 127 else np.int64), n_xy)
     cell = np.array([h, h, dz])
     return Body(
         points=points,

@@ -5,7 +5,9 @@ Layout (``peridyn.discretization.lattice``):
 - the grid has ``shape = (nx, ny, nz)`` (int64 array); grid point (ix, iy, iz) is row
   ``r = iz ny + iy`` and column ``ix``, flat index ``g = r nx + ix``: rows run along x and
   are contiguous;
-- ``u, f``: (3, n_grid) structure of arrays, m and N/m^3, float64 or float32;
+- ``u``: (3, n_grid) structure of arrays, m, float64 or float32; the force kernels sum each
+  row's forces in a (3, nx) array of their own and write them to ``f`` (n_out, 3), N/m^3, at the
+  rows ``point_of`` (n_grid,) int gives (-1: not written), e.g. the body's point order;
 - ``vol``: (n_grid,) m^3 of the kernel dtype, 0 for a grid point without material (a hole);
 - the stencil: ``offs`` (n_off, 3) int64 integer offsets (ox, oy, oz) and per-offset tables
   of the kernel dtype: ``xi`` (n_off, 3) m, ``length`` |xi| m, ``inv_len`` 1/|xi|, and the
@@ -83,29 +85,38 @@ def _bond_terms(cf, u, p0, q0, m, x0, x1, x2, L, bits, bit, vq, buf):
         buf[5 * CHUNK + q] = e
 
 
+@numba.njit(fastmath=FASTMATH, cache=True, inline="always")
+def _write_row(row, point_of, base, f):
+    """The (3, nx) forces ``row`` of the grid points ``base ..`` into ``f`` at their rows
+    ``point_of`` (those with one, >= 0)."""
+    for ix in range(row.shape[1]):
+        i = point_of[base + ix]
+        if i >= 0:
+            f[i, 0] = row[0, ix]
+            f[i, 1] = row[1, ix]
+            f[i, 2] = row[2, ix]
+
+
 #: Values per bond of a chunk in the lattice kernels' stack buffer (see ``_bond_terms``).
 LATTICE_BUFFER = 6 * CHUNK
 
 
 @numba.njit(parallel=True, fastmath=FASTMATH, cache=True)
-def lattice_pmb_force(u, vol, broken, shape, offs, xi, length, inv_len, coef, cf, f):
-    """PMB force density ``f`` (OUT, (3, n_grid), N/m^3) on every grid point:
+def lattice_pmb_force(u, vol, broken, shape, offs, xi, length, inv_len, coef, cf, point_of, f):
+    """PMB force density ``f`` (OUT, (n_out, 3), N/m^3, rows ``point_of``) of the grid points:
     f_i = sum_k coef_k V_j (1/|xi| - 1/|Y|) Y over the counted bonds (``coef`` = c0 omega beta,
     N/m^6; ``cf``: the cancellation-free form ``e / (|xi| |Y|)`` instead). Each row's offsets in
     chunks of ``CHUNK`` columns, two loops a chunk (``peridyn.kernels``)."""
     nx, ny, nz = shape[0], shape[1], shape[2]
-    zero = f.dtype.type(0.0)
-    one = f.dtype.type(1.0)
+    zero = u.dtype.type(0.0)
+    one = u.dtype.type(1.0)
     for r in numba.prange(ny * nz):
         base = r * nx
-        buf = stack_array(LATTICE_BUFFER, f.dtype)
-        f0 = f[0, base : base + nx]
-        f1 = f[1, base : base + nx]
-        f2 = f[2, base : base + nx]
-        for ix in range(nx):
-            f0[ix] = zero
-            f1[ix] = zero
-            f2[ix] = zero
+        buf = stack_array(LATTICE_BUFFER, u.dtype)
+        row = np.zeros((3, nx), dtype=u.dtype)
+        f0 = row[0]
+        f1 = row[1]
+        f2 = row[2]
         for k in range(offs.shape[0]):
             lo, hi, shift = _neighbour_row(r, ny, nz, nx, offs[k, 0], offs[k, 1], offs[k, 2])
             bit = np.uint64(1) << np.uint64(k & 63)
@@ -128,6 +139,7 @@ def lattice_pmb_force(u, vol, broken, shape, offs, xi, length, inv_len, coef, cf
                     g0[q] += s * buf[CHUNK + q]
                     g1[q] += s * buf[2 * CHUNK + q]
                     g2[q] += s * buf[3 * CHUNK + q]
+        _write_row(row, point_of, base, f)
     return f
 
 
@@ -163,22 +175,19 @@ def lattice_lps_dilatation(u, vol, broken, shape, offs, xi, length, weight, cf, 
 
 
 @numba.njit(parallel=True, fastmath=FASTMATH, cache=True)
-def lattice_lps_force(u, vol, broken, shape, offs, xi, length, weight, cf, alpha, p, f):
-    """LPS force density ``f`` (OUT, (3, n_grid), N/m^3) from the per-point ``p`` = P_i and
+def lattice_lps_force(u, vol, broken, shape, offs, xi, length, weight, cf, alpha, p, point_of, f):
+    """LPS force density ``f`` (OUT, (n_out, 3), N/m^3, rows ``point_of``) from the per-point ``p`` = P_i and
     deviatoric coefficients ``alpha`` (n_grid,):
     f_i = sum_k [w |xi| (P_i + P_j) + w (alpha_i + alpha_j) e] Y / |Y|, w = omega beta V_j."""
     nx, ny, nz = shape[0], shape[1], shape[2]
-    zero = f.dtype.type(0.0)
+    zero = u.dtype.type(0.0)
     for r in numba.prange(ny * nz):
         base = r * nx
-        buf = stack_array(LATTICE_BUFFER, f.dtype)
-        f0 = f[0, base : base + nx]
-        f1 = f[1, base : base + nx]
-        f2 = f[2, base : base + nx]
-        for ix in range(nx):
-            f0[ix] = zero
-            f1[ix] = zero
-            f2[ix] = zero
+        buf = stack_array(LATTICE_BUFFER, u.dtype)
+        row = np.zeros((3, nx), dtype=u.dtype)
+        f0 = row[0]
+        f1 = row[1]
+        f2 = row[2]
         for k in range(offs.shape[0]):
             lo, hi, shift = _neighbour_row(r, ny, nz, nx, offs[k, 0], offs[k, 1], offs[k, 2])
             bit = np.uint64(1) << np.uint64(k & 63)
@@ -207,6 +216,7 @@ def lattice_lps_force(u, vol, broken, shape, offs, xi, length, weight, cf, alpha
                     g0[q] += s * buf[CHUNK + q]
                     g1[q] += s * buf[2 * CHUNK + q]
                     g2[q] += s * buf[3 * CHUNK + q]
+        _write_row(row, point_of, base, f)
     return f
 
 
@@ -231,6 +241,49 @@ def lattice_bond_sum(vol, broken, shape, offs, coef, every, out):
                 ok = (every or (broken[word, p] & bit) == 0) and vol[q] > 0.0
                 out[p] += c * vol[q] if ok else 0.0
     return out
+
+
+@numba.njit(parallel=True, cache=True)
+def lattice_damage_index(vol, broken, shape, offs, coef, point_of, phi):
+    """Damage index ``phi`` (OUT, (n_out,) float64, at the rows ``point_of``): 1 - the intact
+    share of sum_k coef_k V_j over each point's bonds to material (0 without one), the two sums
+    as ``lattice_bond_sum`` adds them."""
+    nx, ny, nz = shape[0], shape[1], shape[2]
+    for r in numba.prange(ny * nz):
+        base = r * nx
+        sums = np.zeros((2, nx))  # every bond, the intact ones
+        for k in range(offs.shape[0]):
+            lo, hi, shift = _neighbour_row(r, ny, nz, nx, offs[k, 0], offs[k, 1], offs[k, 2])
+            word = k >> 6
+            bit = np.uint64(1) << np.uint64(k & 63)
+            c = coef[k]
+            for ix in range(lo, hi):
+                p = base + ix
+                q = p + shift
+                held = vol[q] > 0.0
+                sums[0, ix] += c * vol[q] if held else 0.0
+                sums[1, ix] += c * vol[q] if held and (broken[word, p] & bit) == 0 else 0.0
+        for ix in range(nx):
+            i = point_of[base + ix]
+            if i >= 0:
+                phi[i] = 1.0 - sums[1, ix] / sums[0, ix] if sums[0, ix] > 0 else 0.0
+    return phi
+
+
+@numba.njit(parallel=True, cache=True)
+def lattice_bond_count(vol, shape, offs, count):
+    """Directed bonds between grid points that hold material (``vol > 0``), broken or not;
+    ``count`` (scratch, (n_rows,) int64) holds each row's."""
+    nx, ny, nz = shape[0], shape[1], shape[2]
+    for r in numba.prange(ny * nz):
+        base = r * nx
+        count[r] = 0
+        for k in range(offs.shape[0]):
+            lo, hi, shift = _neighbour_row(r, ny, nz, nx, offs[k, 0], offs[k, 1], offs[k, 2])
+            for ix in range(lo, hi):
+                p = base + ix
+                count[r] += 1 if vol[p] > 0.0 and vol[p + shift] > 0.0 else 0
+    return count.sum()
 
 
 @numba.njit(parallel=True, cache=True)
@@ -342,3 +395,15 @@ def lattice_gather(fg, grid_index, f):
         f[i, 1] = fg[1, g]
         f[i, 2] = fg[2, g]
     return f
+
+
+@numba.njit(cache=True)
+def largest_move_squared(u, ref):
+    """max_i |u_i - ref_i|^2 (m^2) of two (n_points, 3) displacements, with no temporary."""
+    largest = 0.0
+    for i in range(u.shape[0]):
+        d0 = u[i, 0] - ref[i, 0]
+        d1 = u[i, 1] - ref[i, 1]
+        d2 = u[i, 2] - ref[i, 2]
+        largest = max(largest, d0 * d0 + d1 * d1 + d2 * d2)
+    return largest

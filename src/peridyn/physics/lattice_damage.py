@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from peridyn.kernels.lattice import lattice_scatter, lattice_stretch_test
+from peridyn.kernels.lattice import largest_move_squared, lattice_stretch_test
 from peridyn.physics.damage import protected_points, resolve_critical_stretch
 
 #: Relative slack on the room (of the largest critical length) for the roundings of |Y|.
@@ -50,7 +50,6 @@ class LatticeDamage:
         self.breakable = np.ones(lattice.n_grid, dtype=bool)
         protected = protected_points(model.body, no_damage_sets) | (False if protected is None else protected)
         self.breakable[lattice.grid_index[protected]] = False
-        self._ug = np.zeros((3, lattice.n_grid))
         rows = int(lattice.shape[1] * lattice.shape[2])
         self._count = np.zeros(rows, dtype=np.int64)
         self._room = np.zeros(rows)
@@ -69,15 +68,17 @@ class LatticeDamage:
         that does)."""
         u = np.ascontiguousarray(u, dtype=np.float64)
         if self._u_ref is not None:
-            moved = u - self._u_ref
-            if 2.0 * np.sqrt(np.max(np.einsum("ij,ij->i", moved, moved))) < self._least - self._slack:
+            if 2.0 * np.sqrt(largest_move_squared(u, self._u_ref)) < self._least - self._slack:
                 return 0
         lat = self.model.lattice
-        ug = lattice_scatter(u, lat.grid_index, self._ug)
+        ug = self.model.grid_displacement(u)
         s = lat.stencil
         args = (lat.volume, lat.broken, lat.shape, s.offsets, s.xi, self.limit, self.breakable)
         broken = int(lattice_stretch_test(ug, *args, self._count, self._room))
-        self._u_ref = u.copy()
+        if self._u_ref is None:
+            self._u_ref = u.copy()
+        else:
+            self._u_ref[...] = u
         self._least = float(self._room.min(initial=np.inf))
         self.full_tests += 1
         return broken

@@ -74,16 +74,28 @@ COSTS = {
 COSTS_MODEL_BYTES = 24.0
 
 #: An explicit run on lattice storage (``discretization.storage``, docs/user-guide.md) holds no
-#: per-bond array: per point the body (points, volumes; one cell size seen by every point), the
-#: state and force (96 B), the grid index, the grid's volume, displacement and force (float64:
-#: 56 B), the per-point LPS coefficients and dilatation (about 70 B) and, with damage, the
-#: damage's grid displacement and reference (48 B); per point and offset of the stencil one
-#: broken bit (``LATTICE_BIT_BYTES``). Measured beyond the bits: 346-360 B a point, with or
-#: without a VTU snapshot (written a few MiB at a time), no damage (``python
-#: benchmarks/lattice_memory.py``, benchmarks/RESULTS.md); with the damage's 48 B and a margin for
-#: the recorders, 450 B (the 1.03 M-point cube with partial volumes: 797 MB estimated, 776 MB
-#: measured).
-LATTICE_PER_POINT = 450.0
+#: per-bond array. Bytes a body point holds at such a run's peak (its end), by part (float64,
+#: counted from the arrays of ``physics.materials.lattice``, ``solvers.explicit`` and the build):
+#: ``body``: positions 24, volume 8, the ``all`` set 8, grid index 8, the domain's point ids 8 and
+#: a plate's layer 1 (one cell size is seen by every point); ``state``: u, v, a (the lattice
+#: force is written into a); ``grid``: the grid's displacement 24, volume 8 and each grid point's
+#: body row 4; ``loads``: the constrained-DOF mask; ``end``: the last snapshot's float32
+#: displacement (12) and the sums of the final energy or damage (16). The material and damage
+#: add ``LATTICE_LPS_BYTES``, ``LATTICE_SHEAR_FACTOR_BYTES``, ``LATTICE_DAMAGE_BYTES``, float32
+#: kernels ``LATTICE_FLOAT32_BYTES``; per point and stencil offset, one broken bit
+#: (``LATTICE_BIT_BYTES``, in 64-bit words). Measured: 249 B a point on the Lamb plate (LPS with
+#: the shear factor, 240 k-480 k points; this model: 236 B), benchmarks/RESULTS.md "Lattice
+#: storage".
+LATTICE_POINT_BYTES = {"body": 57.0, "state": 72.0, "grid": 36.0, "loads": 3.0, "end": 28.0}
+#: LPS: alpha, the dilatation and pressure coefficients (float64) and the dilatation itself.
+LATTICE_LPS_BYTES = 32.0
+#: LPS with ``surface_correction: shear-factor``: the factor of each point.
+LATTICE_SHEAR_FACTOR_BYTES = 8.0
+#: Bond breaking: the displacement of the last bond test (24) and which points may break (1).
+LATTICE_DAMAGE_BYTES = 25.0
+#: float32 kernels: the solver's own force (12), the float32 grid displacement beside the float64
+#: one of the energy and bond tests (12) and LPS's float32 coefficients (12).
+LATTICE_FLOAT32_BYTES = 36.0
 LATTICE_BIT_BYTES = 1.0 / 8.0
 
 #: Bytes per directed bond an explicit run saves with float32 kernels: half of the model's 32 B,
@@ -251,11 +263,26 @@ def estimate_case(case: Case, base_dir=".", job: str | None = None) -> Estimate:
         offsets = len(neighbour_offsets(counts, cell, horizon, d.partial_volumes, dim)[0])
         words = 8.0 * math.ceil(offsets / 64)  # the broken bits, in 64-bit words per grid point
         grid = float(np.prod(counts.astype(float)))  # removed points keep their grid place
-        parts.update(points=points * LATTICE_PER_POINT, bonds=grid * max(words, offsets * LATTICE_BIT_BYTES))
+        parts.update(
+            points=points * lattice_point_bytes(case), bonds=grid * max(words, offsets * LATTICE_BIT_BYTES)
+        )
     if job == "modal":
         parts["factor"] = modal_factor_bytes(case, base_dir, points, horizon)
         parts["modes"] = MODE_BYTES * points * case.solver.modes
     return Estimate(job, int(round(points)), int(round(bonds)), float(sum(parts.values())), parts, storage)
+
+
+def lattice_point_bytes(case: Case) -> float:
+    """Bytes a body point of ``case`` holds in an explicit run on lattice storage
+    (``LATTICE_POINT_BYTES`` and what its material, damage and kernel dtype add)."""
+    total = sum(LATTICE_POINT_BYTES.values())
+    material = case.material
+    if material is not None and material.model == "lps":
+        total += LATTICE_LPS_BYTES
+        total += LATTICE_SHEAR_FACTOR_BYTES if material.surface_correction == "shear-factor" else 0.0
+    if material is not None and material.damage is not None:
+        total += LATTICE_DAMAGE_BYTES
+    return total + (LATTICE_FLOAT32_BYTES if case.solver.dtype == "float32" else 0.0)
 
 
 def runs_on_lattice(case: Case) -> bool:

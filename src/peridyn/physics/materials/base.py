@@ -92,6 +92,9 @@ class Model:
     #: case, ``setup.estimate``): PMB 1/length, stiffness and surface factor; LPS weight,
     #: deviatoric coefficient and the shear factor's share.
     bond_bytes = 24.0
+    #: True when ``force(u, out)`` writes every row of ``out`` whatever it held (the explicit
+    #: solver may then hand it the state's acceleration: ``solvers.explicit``).
+    force_overwrites_out = False
     #: The ``surface_correction`` names the material takes (case key ``material.surface_correction``).
     surface_corrections: tuple[str, ...] = ("none",)
 

@@ -2,10 +2,10 @@
 ``materials.pmb`` and ``materials.lps``, their coefficients per stencil offset and per grid
 point instead of per bond.
 
-A lattice model keeps the displacement and force of the grid as (3, n_grid) arrays: each
-force scatters ``u`` (n_points, 3) to the grid, runs the lattice kernels
-(``peridyn.kernels.lattice``) and gathers the force back to the body's points, so that
-solvers, loads and recorders see the body as with bond lists. It has no bond linearisation
+A lattice model keeps the displacement of the grid as a (3, n_grid) array: each force
+scatters ``u`` (n_points, 3) to the grid and runs the lattice kernels
+(``peridyn.kernels.lattice``), which write each grid row's force straight to the body's
+points, so that solvers, loads and recorders see the body as with bond lists. It has no bond linearisation
 (static, Newton, Newmark, modal runs and the stress output keep bond lists).
 
 What lattice storage takes: one material, the surface corrections of
@@ -21,8 +21,8 @@ from peridyn.discretization.body import Body
 from peridyn.discretization.lattice import Lattice
 from peridyn.errors import InputError
 from peridyn.kernels.lattice import (
+    lattice_damage_index,
     lattice_energy_sum,
-    lattice_gather,
     lattice_lps_dilatation,
     lattice_lps_force,
     lattice_pair_sum,
@@ -33,6 +33,9 @@ from peridyn.physics.materials.base import Model
 from peridyn.physics.materials.elastic import dilatational_modulus, shear_modulus
 from peridyn.physics.materials.lps import LPSModel, shear_correction_factor
 from peridyn.physics.materials.pmb import PMBModel, pmb_micromodulus
+
+#: Grid points a time of the LPS energy's last sum (bounds its temporary).
+ENERGY_CHUNK = 1 << 20
 
 #: Surface corrections lattice storage computes, per material (the others keep bond lists).
 LATTICE_SURFACE_CORRECTIONS = {"pmb": ("none",), "lps": ("none", "shear-factor")}
@@ -46,6 +49,7 @@ class LatticeModel(Model):
     """
 
     storage = "lattice"
+    force_overwrites_out = True  # every body point has a grid point, whose row is written
 
     def __init__(self, body: Body, lattice: Lattice, E, density, dtype=np.float64):
         if np.ndim(E) or np.ndim(density):
@@ -62,7 +66,11 @@ class LatticeModel(Model):
         self._xi = s.xi.astype(self.dtype)
         self._length = s.length.astype(self.dtype)
         self._ug = np.zeros((3, lattice.n_grid), dtype=self.dtype)  # holes stay 0
-        self._fg = np.empty((3, lattice.n_grid), dtype=self.dtype)
+        #: (n_grid,) the body point of each grid point, -1 for none: where the force kernels write
+        self._point_of = np.full(lattice.n_grid, -1, dtype=np.int32 if body.n_points < 2**31 else np.int64)
+        self._point_of[lattice.grid_index] = np.arange(body.n_points, dtype=self._point_of.dtype)
+        #: the float64 grid displacement of ``grid_displacement``: ``_ug`` itself in float64, else made once
+        self._ug64 = self._ug if self.dtype == np.float64 else None
         self._linearisation = None
         self._bond_vectors = None
 
@@ -70,17 +78,16 @@ class LatticeModel(Model):
         """``u`` (n_points, 3) into the grid's (3, n_grid) displacement (kernel dtype)."""
         return lattice_scatter(np.ascontiguousarray(u), self.lattice.grid_index, self._ug)
 
-    def _gather(self, out: np.ndarray | None) -> np.ndarray:
-        out = np.empty_like(self.x) if out is None else out
-        return lattice_gather(self._fg, self.lattice.grid_index, out)
+    def _force_out(self, out: np.ndarray | None) -> np.ndarray:
+        """Where a force goes: ``out`` (n_points, 3), or a new array of the kernel dtype."""
+        return np.empty_like(self.x) if out is None else out
 
-    def _grid64(self, u: np.ndarray) -> np.ndarray:
-        """(3, n_grid) float64 displacement of the grid (energies and set-up sums)."""
-        return lattice_scatter(
-            np.ascontiguousarray(u, dtype=np.float64),
-            self.lattice.grid_index,
-            np.zeros((3, self.lattice.n_grid)),
-        )
+    def grid_displacement(self, u: np.ndarray) -> np.ndarray:
+        """(3, n_grid) float64 displacement of the grid (energies, set-up sums, bond breaking):
+        the model's own grid displacement in float64 (overwritten by the next call or force)."""
+        if self._ug64 is None:
+            self._ug64 = np.zeros((3, self.lattice.n_grid))  # holes stay 0
+        return lattice_scatter(np.ascontiguousarray(u, dtype=np.float64), self.lattice.grid_index, self._ug64)
 
     def _at_points(self, grid_values: np.ndarray) -> np.ndarray:
         return grid_values[self.lattice.grid_index]
@@ -96,11 +103,10 @@ class LatticeModel(Model):
 
     def damage_index(self) -> np.ndarray:
         """(n_points,) 1 - intact / total partial-volume-weighted neighbour volume of each family."""
-        lat = self.lattice
-        factor = lat.stencil.volume_factor
-        total = self._at_points(lat.bond_sum(factor, every=True))
-        alive = self._at_points(lat.bond_sum(factor))
-        return np.where(total > 0, 1.0 - alive / np.where(total > 0, total, 1.0), 0.0)
+        lat, s = self.lattice, self.lattice.stencil
+        phi = np.empty(lat.n_points)
+        args = (lat.volume, lat.broken, lat.shape, s.offsets, s.volume_factor)
+        return lattice_damage_index(*args, self._point_of, phi)
 
     def _offset_table(self, values) -> np.ndarray:
         return np.ascontiguousarray(values, dtype=self.dtype)
@@ -130,7 +136,7 @@ class LatticePMB(LatticeModel):
         lat = self.lattice
         ug = self._scatter(self._as_state(u))
         s = lat.stencil
-        lattice_pmb_force(
+        return lattice_pmb_force(
             ug,
             self._vol,
             lat.broken,
@@ -141,14 +147,14 @@ class LatticePMB(LatticeModel):
             self._inv_len,
             self._coef,
             self._cf,
-            self._fg,
+            self._point_of,
+            self._force_out(out),
         )
-        return self._gather(out)
 
     def energy_density(self, u):
         lat, s = self.lattice, self.lattice.stencil
         w = lattice_energy_sum(
-            self._grid64(u), lat.volume, lat.broken, lat.shape, s.offsets, s.xi, s.length,
+            self.grid_displacement(u), lat.volume, lat.broken, lat.shape, s.offsets, s.xi, s.length,
             0.25 * self._coef64, np.zeros(lat.n_grid), 1.0, np.empty(lat.n_grid),
         )  # fmt: skip
         return self._at_points(w)
@@ -159,7 +165,7 @@ class LatticePMB(LatticeModel):
 
 class LatticeLPS(LatticeModel):
     """LPS (``materials.lps``, no surface correction) on a lattice: w = omega beta V_j per
-    offset, m, alpha, theta and P per grid point."""
+    offset, alpha, theta and P per grid point (the weighted volume m only while set up)."""
 
     name = "lps"
     critical_stretch = LPSModel.critical_stretch
@@ -180,29 +186,30 @@ class LatticeLPS(LatticeModel):
             lonely = int(np.flatnonzero(m[lattice.grid_index] <= 0)[0])
             raise InputError(f"point {lonely} has no intact bond: its weighted volume is zero")
         safe = np.where(occupied, m, 1.0)
-        self.weighted_volume = np.where(occupied, m, 0.0)
         self.alpha = np.where(occupied, (15.0 if dim == 3 else 8.0) * self.shear / safe, 0.0)
         self.theta_coef = np.where(occupied, dim / safe, 0.0)
-        self.shear_factor = np.ones(body.n_points)
+        self.shear_factor = np.broadcast_to(1.0, (body.n_points,))  # read-only: one value
         if surface_correction == "shear-factor":
-            self.shear_factor = self._shear_correction_factor()
+            self.shear_factor = self._shear_correction_factor(m)
             self.alpha[lattice.grid_index] *= self.shear_factor
         self.p_coef = np.where(occupied, dim * self.bulk / safe - self.alpha / dim, 0.0)
         self._weight = self._offset_table(self._weight64)
         self._alpha = self.alpha.astype(self.dtype, copy=False)
         self._theta_coef = self.theta_coef.astype(self.dtype, copy=False)
         self._p_coef = self.p_coef.astype(self.dtype, copy=False)
+        #: the grid's dilatation, then in place P = p_coef theta (``force``)
         self._theta = np.zeros(lattice.n_grid, dtype=self.dtype)
-        self._p = np.zeros(lattice.n_grid, dtype=self.dtype)
 
-    def _shear_correction_factor(self) -> np.ndarray:
-        """``materials.lps.shear_correction_factor`` over the lattice's bonds (float64)."""
+    def _shear_correction_factor(self, m: np.ndarray) -> np.ndarray:
+        """``materials.lps.shear_correction_factor`` over the lattice's bonds (float64); ``m``
+        (n_grid,) the weighted volume."""
         lat, s = self.lattice, self.lattice.stencil
         table = (lat.volume, lat.broken, lat.shape, s.offsets, s.xi, s.length)
 
         def dilatation(u):
+            ug = self.grid_displacement(u)
             theta = lattice_lps_dilatation(
-                self._grid64(u), *table, self._weight64, False, self.theta_coef, np.empty(lat.n_grid)
+                ug, *table, self._weight64, False, self.theta_coef, np.empty(lat.n_grid)
             )
             return self._at_points(theta)
 
@@ -211,11 +218,11 @@ class LatticeLPS(LatticeModel):
             grid_theta[lat.grid_index] = theta
             coef = self._weight64 * s.length
             norm = lattice_energy_sum(
-                self._grid64(u), *table, coef, grid_theta, float(self.dim), np.empty(lat.n_grid)
+                self.grid_displacement(u), *table, coef, grid_theta, float(self.dim), np.empty(lat.n_grid)
             )
             return self._at_points(norm)
 
-        m = self._at_points(self.weighted_volume)
+        m = self._at_points(m)
         return shear_correction_factor(self.body.points, self.dim, m, dilatation, deviatoric_norm)
 
     def _grid_dilatation(self, ug, vol, theta_coef, out):
@@ -233,24 +240,34 @@ class LatticeLPS(LatticeModel):
     def force(self, u, out=None):
         lat, s = self.lattice, self.lattice.stencil
         ug = self._scatter(self._as_state(u))
-        self._grid_dilatation(ug, self._vol, self._theta_coef, self._theta)
-        np.multiply(self._theta, self._p_coef, out=self._p)
-        args = (s.offsets, self._xi, self._length, self._weight, self._cf, self._alpha, self._p)
-        lattice_lps_force(ug, self._vol, lat.broken, lat.shape, *args, self._fg)
-        return self._gather(out)
+        p = self._grid_dilatation(ug, self._vol, self._theta_coef, self._theta)
+        np.multiply(p, self._p_coef, out=p)
+        args = (s.offsets, self._xi, self._length, self._weight, self._cf, self._alpha, p)
+        f = self._force_out(out)
+        return lattice_lps_force(ug, self._vol, lat.broken, lat.shape, *args, self._point_of, f)
 
     def energy_density(self, u):
+        """0.5 K theta^2 + 0.5 alpha sum w (e - theta |xi| / d)^2 (n_points,), J/m^3, at ``u``
+        (float64), with no temporary of the grid's size beyond the deviatoric sums (which hold the
+        result: a view of them)."""
         lat, s = self.lattice, self.lattice.stencil
-        ug = self._grid64(u)
+        ug = self.grid_displacement(u)
+        scratch = self._theta if self.dtype == np.float64 else np.empty(lat.n_grid)
         theta = lattice_lps_dilatation(
             ug, lat.volume, lat.broken, lat.shape, s.offsets, s.xi, s.length, self._weight64, False,
-            self.theta_coef, np.empty(lat.n_grid),
+            self.theta_coef, scratch,
         )  # fmt: skip
         squares = lattice_energy_sum(
             ug, lat.volume, lat.broken, lat.shape, s.offsets, s.xi, s.length, self._weight64 * s.length,
             theta, float(self.dim), np.empty(lat.n_grid),
         )  # fmt: skip
-        return self._at_points(0.5 * self.bulk * theta**2 + 0.5 * self.alpha * squares)
+        np.multiply(theta, theta, out=theta)
+        theta *= 0.5 * self.bulk
+        for start in range(0, lat.n_grid, ENERGY_CHUNK):  # theta += (0.5 alpha) squares
+            part = slice(start, start + ENERGY_CHUNK)
+            half_alpha = 0.5 * self.alpha[part]
+            theta[part] += np.multiply(half_alpha, squares[part], out=half_alpha)
+        return np.take(theta, lat.grid_index, out=squares[: lat.n_points])  # the sums' room reused
 
     def stiffness_bound(self):
         """The block-Gershgorin bound of ``LPSModel.stiffness_bound`` over the lattice's bonds."""
