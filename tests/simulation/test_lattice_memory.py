@@ -22,6 +22,7 @@ TOLERANCE = 0.3
 
 def test_lattice_run_peak_within_30_percent_of_its_estimate(monkeypatch):
     monkeypatch.chdir(ROOT)
+    lattice_memory.warm_kernels(SIDES[0])  # else the first run's peak holds the compiler's memory
     (n0, p0), (n1, p1) = (lattice_memory.peak_bytes(side, vtu=False) for side in SIDES)
     e0, e1 = (lattice_memory.estimated_bytes(side, vtu=False) for side in SIDES)
     measured, estimated = (p1 - p0) / (n1 - n0), (e1 - e0) / (n1 - n0)

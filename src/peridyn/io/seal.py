@@ -49,8 +49,9 @@ FORMAT = "peridyn seal 1 crc32 {crc:08x} bytes {size:020d}\n"
 #: Bytes of a seal.
 LENGTH = len(FORMAT.format(crc=0, size=0))
 _PATTERN = re.compile(rb"peridyn seal 1 crc32 ([0-9a-f]{8}) bytes ([0-9]{20})\n")
-#: Bytes read at a time while computing a file's CRC-32.
-READ_BYTES = 64 << 20
+#: Bytes read at a time while computing a file's CRC-32 (small: a run seals its results file
+#: while its own arrays are still held, so the piece adds to its peak memory).
+READ_BYTES = 4 << 20
 
 #: The versions of files checked in this process: (real path, inode, size, mtime in ns).
 _checked: set = set()

@@ -56,7 +56,9 @@ def base_summary(setup) -> dict:
     d = setup.domain
     n = d.n_owned
     phi = damage_field(setup.model)
-    if setup.storage == "lattice":  # the owned points' families (a broken bond has both bits)
+    if setup.storage == "lattice" and d.size == 1:  # no array the body's size: a run's end is its peak
+        bonds, broken = setup.bonds.n_bonds, setup.bonds.n_broken()
+    elif setup.storage == "lattice":  # the owned points' families (a broken bond has both bits)
         bonds = d.count(setup.bonds.family_sizes()[:n].sum())
         broken = d.count(setup.bonds.n_broken(d.owned))
     else:

@@ -387,17 +387,6 @@ def lattice_scatter(u, grid_index, ug):
 
 
 @numba.njit(cache=True)
-def lattice_gather(fg, grid_index, f):
-    """``f[i]`` (OUT, (n_points, 3)) = ``fg[:, grid_index[i]]`` ((3, n_grid)) for every body point."""
-    for i in range(grid_index.shape[0]):
-        g = grid_index[i]
-        f[i, 0] = fg[0, g]
-        f[i, 1] = fg[1, g]
-        f[i, 2] = fg[2, g]
-    return f
-
-
-@numba.njit(cache=True)
 def largest_move_squared(u, ref):
     """max_i |u_i - ref_i|^2 (m^2) of two (n_points, 3) displacements, with no temporary."""
     largest = 0.0

@@ -127,8 +127,3 @@ def lattice_scatter(u, grid_index, n_grid):
     out = np.zeros((3, n_grid), dtype=np.asarray(u).dtype)
     out[:, grid_index] = np.asarray(u).T
     return out
-
-
-def lattice_gather(fg, grid_index):
-    """(n_points, 3): the values of ``fg`` (3, n_grid) at the body points' grid points."""
-    return np.asarray(fg)[:, grid_index].T.copy()
