@@ -277,7 +277,7 @@ def lattice_point_bytes(case: Case) -> float:
     (``LATTICE_POINT_BYTES`` and what its material, damage and kernel dtype add)."""
     total = sum(LATTICE_POINT_BYTES.values())
     material = case.material
-    if material is not None and material.model == "lps":
+    if material is not None and case.material_class().state_based:  # LPS: dilatation, alpha ...
         total += LATTICE_LPS_BYTES
         total += LATTICE_SHEAR_FACTOR_BYTES if material.surface_correction == "shear-factor" else 0.0
     if material is not None and material.damage is not None:
