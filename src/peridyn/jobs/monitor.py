@@ -337,20 +337,26 @@ def _run(tasks: dict, executor, workers, scheduler, overwrite: bool, comm) -> No
         logger.info(f"interrogation run {record['run_id']}: {record['status']} ({record['seconds']:.1f} s)")
         if record["status"] != "complete":
             failed.append(f"{record['run_id']}: {record['error'] or record['status']}")
-        interrupts.check()  # SIGINT/SIGTERM: no more runs start, the finished ones are kept
         return not failed
+
+    def done_then_check(record: dict) -> bool:
+        keep_going = done(record)
+        interrupts.check()  # SIGINT/SIGTERM: no more runs start, the finished ones are kept
+        return keep_going
 
     if comm is not None and comm.size > 1:
         _run_ranks(todo, comm, done)
     else:
-        run_tasks(todo, done, executor, workers, scheduler)
+        run_tasks(todo, done_then_check, executor, workers, scheduler)
     if failed:
         raise InputError(f"an interrogation run failed ({failed[0]}); its run.json holds the error")
 
 
 def _run_ranks(todo, comm, done) -> None:
     """The runs one after the other, each on all ranks (``run_case`` with ``comm``); rank 0
-    writes the records."""
+    writes the records. After each run every rank checks for a stop signal and the ranks agree
+    (the largest signal number noted on any rank), so all stop together, none left waiting in
+    the next run's first collective."""
     from peridyn.jobs.run import run_case
     from peridyn.jobs.sweep_run import write_record
 
@@ -373,6 +379,9 @@ def _run_ranks(todo, comm, done) -> None:
             }
             write_record(task.run_dir, record)
             done(record)
+        interrupts.check(
+            where="between interrogation runs", agree=lambda signum: comm.allreduce(signum, "max")
+        )
 
 
 def _signals(mon: MonitorCase, plan: Plan, tasks: dict) -> dict:
