@@ -221,6 +221,20 @@ def _both(make, name, partial_volumes, dtype=np.float64):
     return body, make_model(name, body, bonds, **kw), make_lattice_model(name, body, lattice, **kw), cut
 
 
+@pytest.mark.parametrize("which", sorted(BODIES))
+def test_owned_bond_counts_match_bond_lists(which):
+    """What a run's summary counts of a rank's owned points (the first n body points): their
+    directed bonds and the broken ones (the pre-crack's), the same on both storages for any n."""
+    body, bonded, latticed, _ = _both(BODIES[which], "pmb", False)
+    for n in (0, body.n_points // 3, body.n_points):
+        assert latticed.lattice.owned_bond_counts(n) == bonded.bonds.owned_bond_counts(n)
+    assert latticed.lattice.owned_bond_counts(body.n_points) == (
+        bonded.bonds.n_bonds,
+        latticed.lattice.n_broken(),
+    )
+    assert latticed.lattice.n_broken() > 0
+
+
 @pytest.mark.parametrize("partial_volumes", [False, True])
 @pytest.mark.parametrize("material", ["pmb", "lps", "lps/shear-factor"])
 @pytest.mark.parametrize("which", sorted(BODIES))

@@ -271,19 +271,31 @@ def lattice_damage_index(vol, broken, shape, offs, coef, point_of, phi):
 
 
 @numba.njit(parallel=True, cache=True)
-def lattice_bond_count(vol, shape, offs, count):
-    """Directed bonds between grid points that hold material (``vol > 0``), broken or not;
-    ``count`` (scratch, (n_rows,) int64) holds each row's."""
-    nx, ny, nz = shape[0], shape[1], shape[2]
-    for r in numba.prange(ny * nz):
-        base = r * nx
-        count[r] = 0
+def lattice_owned_bonds(vol, broken, shape, offs, grid_index, n_owned):
+    """(bonds, broken bits) of the body points ``0 .. n_owned - 1`` (grid points ``grid_index``,
+    (n_points,) int64): their directed bonds to grid points that hold material (``vol > 0``),
+    broken or not, and the bits set in their broken words. No array of the body's size."""
+    nx, ny = shape[0], shape[1]
+    bonds = 0
+    cut = 0
+    for i in numba.prange(n_owned):
+        g = grid_index[i]
+        r = g // nx
+        ix = g - r * nx
+        iz = r // ny
+        iy = r - iz * ny
         for k in range(offs.shape[0]):
-            lo, hi, shift = _neighbour_row(r, ny, nz, nx, offs[k, 0], offs[k, 1], offs[k, 2])
-            for ix in range(lo, hi):
-                p = base + ix
-                count[r] += 1 if vol[p] > 0.0 and vol[p + shift] > 0.0 else 0
-    return count.sum()
+            jx = ix + offs[k, 0]
+            jy = iy + offs[k, 1]
+            jz = iz + offs[k, 2]
+            inside = 0 <= jx < nx and 0 <= jy < ny and 0 <= jz < shape[2]
+            bonds += 1 if inside and vol[(jz * ny + jy) * nx + jx] > 0.0 else 0
+        for w in range(broken.shape[0]):
+            word = broken[w, g]
+            while word != 0:  # one set bit a turn
+                word &= word - np.uint64(1)
+                cut += 1
+    return bonds, cut
 
 
 @numba.njit(parallel=True, cache=True)
