@@ -21,6 +21,7 @@ from peridyn.physics.damage import BondDamage
 from peridyn.physics.lattice_damage import LatticeDamage
 from peridyn.physics.materials import make_model
 from peridyn.physics.materials.lattice import make_lattice_model
+from peridyn.solvers.explicit import ExplicitSolver
 
 pytestmark = pytest.mark.kernels
 
@@ -219,6 +220,22 @@ def _both(make, name, partial_volumes, dtype=np.float64):
     kw = {"E": 70e9, "density": 2700.0, "nu": None if name == "pmb" else 0.3, "dtype": dtype}
     kw["surface_correction"] = correction or "none"
     return body, make_model(name, body, bonds, **kw), make_lattice_model(name, body, lattice, **kw), cut
+
+
+@pytest.mark.parametrize("dtype", DTYPES)
+def test_explicit_solver_forces_into_the_acceleration_when_the_model_can(rng, dtype):
+    """A float64 lattice force writes every body point's row of its output (no NaN left), so the
+    explicit solver hands it the state's acceleration and keeps no force array (24 B a point);
+    not in float32 (the state is float64) nor on bond lists (``force_overwrites_out`` False)."""
+    body, bonded, latticed, _ = _both(BODIES["box_hole_crack"], "pmb", False, dtype)
+    f = latticed.force(
+        rng.normal(size=(body.n_points, 3)) * 1e-3 * body.spacing, np.full_like(latticed.x, np.nan)
+    )
+    assert np.isfinite(f).all()
+    assert latticed.force_fills_acceleration == (dtype == np.float64)
+    assert not bonded.force_fills_acceleration
+    for model in (bonded, latticed):
+        assert (ExplicitSolver(model)._force is None) == model.force_fills_acceleration
 
 
 @pytest.mark.parametrize("which", sorted(BODIES))
