@@ -5,9 +5,9 @@ Layout (``peridyn.discretization.lattice``):
 - the grid has ``shape = (nx, ny, nz)`` (int64 array); grid point (ix, iy, iz) is row
   ``r = iz ny + iy`` and column ``ix``, flat index ``g = r nx + ix``: rows run along x and
   are contiguous;
-- ``u``: (3, n_grid) structure of arrays, m, float64 or float32; the force kernels sum each
-  row's forces in a (3, nx) array of their own and write them to ``f`` (n_out, 3), N/m^3, at the
-  rows ``point_of`` (n_grid,) int gives (-1: not written), e.g. the body's point order;
+- ``u``: (3, n_grid) structure of arrays, m, float64 or float32; the force kernels sum the
+  forces in ``grid_f`` (3, n_grid) and write each finished plane's to ``f`` (n_out, 3), N/m^3,
+  at the rows ``point_of`` (n_grid,) int gives (-1: not written), e.g. the body's point order;
 - ``vol``: (n_grid,) m^3 of the kernel dtype, 0 for a grid point without material (a hole);
 - the stencil: ``offs`` (n_off, 3) int64 integer offsets (ox, oy, oz) and per-offset tables
   of the kernel dtype: ``xi`` (n_off, 3) m, ``length`` |xi| m, ``inv_len`` 1/|xi|, and the
@@ -16,21 +16,22 @@ Layout (``peridyn.discretization.lattice``):
   grid point g along offset k is broken (pre-crack or damage).
 
 A bond (g, k) counts when its far end lies in the grid, holds material (``vol > 0``) and its
-bit is clear. Every kernel runs rows of the grid in parallel; in a row, the offsets one after
-the other and, for each, the row's points in a unit-stride loop over x (the neighbour row is the
-row shifted by a constant: no index array is read).
+bit is clear. Every kernel runs rows of the grid (or slabs of rows) in parallel; in a row, the
+offsets one after the other and, for each, the row's points in a unit-stride loop over x (the
+neighbour row is the row shifted by a constant: no index array is read).
 
 The force and dilatation kernels compute each pair of points once (``pair_offsets``: the
 offsets whose (oy, oz, ox) is lexicographically positive, one of each two opposite ones): the
-pair's term is added to its point, with the neighbour's volume, and to its neighbour, with the
-point's volume, in a grid-sized sum; its broken bit is the point's (a broken bond has both bits
-set). The grid is cut into slabs of ``width`` y planes (every z), ``width`` the largest |oy|, so
-that the pairs of slab s end in slab s or s + 1: the even slabs run in parallel, then the odd
-ones, each slab by one thread, its rows, offsets and columns in one order. Every point therefore
-adds its pairs in an order set by the grid's y and z planes and the stencil alone, whatever the
-number of threads and whatever the grid's extent across x (an MPI rank's slab of x planes with
-its ghosts adds its owned points' pairs as a serial run does). The other kernels run each
-point's bonds from its own end, in stencil order.
+pair's term goes to its point, with the neighbour's volume, and to its neighbour, with the
+point's volume (a force with the opposite sign), in a grid-sized sum; its broken bit is the
+point's (a broken bond has both bits set). The grid is cut into slabs of ``width`` y planes
+(every z), ``width`` the largest |oy|, so that the pairs of slab s end in slab s or s + 1: the
+even slabs run in parallel, then the odd ones, each slab by one thread, its rows, offsets and
+columns in one order (in a chunk, the neighbours' terms before the points': ``_add_pair_forces``).
+Every point therefore adds its pairs in an order set by the grid's y and z planes and the stencil
+alone, whatever the number of threads and whatever the grid's extent across x (an MPI rank's
+slab of x planes with its ghosts adds its owned points' pairs as a serial run does). The other
+kernels run each point's bonds from its own end, in stencil order.
 
 Two forms of the extension (as in ``peridyn.kernels``): float64 ``|Y| - |xi|`` with the
 per-offset ``length`` (``cf`` False), float32 the cancellation-free
@@ -226,8 +227,8 @@ def lattice_pmb_force(
     n_slabs = (ny + width - 1) // width
     for colour in range(2):
         for h in numba.prange(_phase_tasks(colour, n_slabs)):
-            c0_, c1_ = _to_clear(colour, h, width, ny)
-            _clear_planes(grid_f, c0_, c1_, shape)
+            z0, z1 = _to_clear(colour, h, width, ny)
+            _clear_planes(grid_f, z0, z1, shape)
             buf = stack_array(LATTICE_BUFFER, u.dtype)
             y0, y1 = _slab(colour, h, width, ny)
             for iy in range(y0, y1):
@@ -269,8 +270,8 @@ def lattice_lps_dilatation(
     sums = theta.reshape((1, theta.shape[0]))
     for colour in range(2):
         for h in numba.prange(_phase_tasks(colour, n_slabs)):
-            c0_, c1_ = _to_clear(colour, h, width, ny)
-            _clear_planes(sums, c0_, c1_, shape)
+            z0, z1 = _to_clear(colour, h, width, ny)
+            _clear_planes(sums, z0, z1, shape)
             buf = stack_array(LATTICE_BUFFER, theta.dtype)
             y0, y1 = _slab(colour, h, width, ny)
             for iy in range(y0, y1):
@@ -315,8 +316,8 @@ def lattice_lps_force(
     n_slabs = (ny + width - 1) // width
     for colour in range(2):
         for h in numba.prange(_phase_tasks(colour, n_slabs)):
-            c0_, c1_ = _to_clear(colour, h, width, ny)
-            _clear_planes(grid_f, c0_, c1_, shape)
+            z0, z1 = _to_clear(colour, h, width, ny)
+            _clear_planes(grid_f, z0, z1, shape)
             buf = stack_array(LATTICE_BUFFER, u.dtype)
             y0, y1 = _slab(colour, h, width, ny)
             for iy in range(y0, y1):
