@@ -8,6 +8,7 @@ differently (per offset ``o h``, per bond ``x_j - x_i`` of rounded coordinates, 
 force at bond strains ~1e-3 (the acceptance of lattice storage).
 """
 
+import numba
 import numpy as np
 import pytest
 from kernel_inputs import TOL, assert_close
@@ -21,6 +22,7 @@ from peridyn.physics.damage import BondDamage
 from peridyn.physics.lattice_damage import LatticeDamage
 from peridyn.physics.materials import make_model
 from peridyn.physics.materials.lattice import make_lattice_model
+from peridyn.solvers.explicit import ExplicitSolver
 
 pytestmark = pytest.mark.kernels
 
@@ -31,15 +33,22 @@ STORAGE_RTOL = 1e-12
 
 
 def _grid(rng, dtype, shape=(6, 5, 4), horizon=2.015):
-    """A small lattice: random holes, random broken bits, displacement of strain ~1e-3."""
+    """A small lattice: random holes, random broken bonds (both bits of each, as the lattice
+    keeps them: the pair kernels read one end's), displacement of strain ~1e-3."""
     spacing = np.array([H, 1.1 * H, 0.9 * H])
     stencil = make_stencil(spacing, horizon * H, 3)
     n = int(np.prod(shape))
     vol = np.where(rng.random(n) < 0.15, 0.0, spacing.prod()).astype(dtype)
     broken = np.zeros((-(-stencil.size // 64), n), dtype=np.uint64)
-    for k in range(stencil.size):
-        cut = np.flatnonzero(rng.random(n) < 0.1)
-        broken[k // 64, cut] |= np.uint64(1) << np.uint64(k % 64)
+    g = np.arange(n)
+    at = np.stack([g % shape[0], (g // shape[0]) % shape[1], g // (shape[0] * shape[1])], axis=1)
+    for k, o in enumerate(stencil.offsets):
+        far = at + o
+        cut = np.all((far >= 0) & (far < shape), axis=1) & (rng.random(n) < 0.05)
+        j = (far[cut, 2] * shape[1] + far[cut, 1]) * shape[0] + far[cut, 0]
+        r = stencil.reverse[k]
+        broken[k // 64, g[cut]] |= np.uint64(1) << np.uint64(k % 64)
+        broken[r // 64, j] |= np.uint64(1) << np.uint64(r % 64)
     u = (rng.normal(size=(3, n)) * 1e-3 * H).astype(dtype)
     return np.array(shape, dtype=np.int64), stencil, vol, broken, u
 
@@ -82,8 +91,9 @@ def test_lattice_pmb_force_matches_reference(rng, dtype):
     point_of, out = _written_rows(rng, vol)
     cf = dtype == np.float32
     kern.lattice_pmb_force(
-        u, vol, broken, shape, s.offsets, xi, length, (1 / length).astype(dtype), coef, cf, point_of, out
-    )
+        u, vol, broken, shape, s.offsets, *kern.pair_offsets(s.offsets), xi, length,
+        (1 / length).astype(dtype), coef, cf, np.empty((3, vol.size), dtype), point_of, out,
+    )  # fmt: skip
     f = _grid_order(point_of, out)
     expected = ref.lattice_pmb_force(u, vol, broken, shape, s.offsets, xi, length, coef, cf)
     p, q, k, _ = ref.lattice_bonds(vol, broken, shape, s.offsets)
@@ -104,8 +114,9 @@ def test_lattice_lps_dilatation_and_force_match_reference(rng, dtype):
     n = vol.size
     cf = dtype == np.float32
     theta_coef = (rng.random(n) * 3e14).astype(dtype)
+    pairs = kern.pair_offsets(s.offsets)
     theta = kern.lattice_lps_dilatation(
-        u, vol, broken, shape, s.offsets, xi, length, weight, cf, theta_coef, np.empty(n, dtype)
+        u, vol, broken, shape, s.offsets, *pairs, xi, length, weight, cf, theta_coef, np.empty(n, dtype)
     )
     expected = ref.lattice_lps_dilatation(
         u, vol, broken, shape, s.offsets, xi, length, weight, theta_coef, cf
@@ -115,13 +126,16 @@ def test_lattice_lps_dilatation_and_force_match_reference(rng, dtype):
     y = xi[k].astype(np.float64) + (u[:, q] - u[:, p]).T.astype(np.float64)
     extension = np.linalg.norm(y, axis=1) - length[k]
     scale = theta_coef * _magnitude(vol, broken, shape, s.offsets, w * length[k] * extension)
-    assert_close(theta, expected, TOL[dtype], scale)
+    held = vol > 0  # a hole's sums count no pair (the model's coefficients are 0 there)
+    assert_close(theta[held], expected[held], TOL[dtype], scale[held])
+    assert not theta[~held].any()
     alpha = (rng.random(n) * 1e25).astype(dtype)
     pressure = (rng.normal(size=n) * 1e22).astype(dtype)
     point_of, out = _written_rows(rng, vol)
     kern.lattice_lps_force(
-        u, vol, broken, shape, s.offsets, xi, length, weight, cf, alpha, pressure, point_of, out
-    )
+        u, vol, broken, shape, s.offsets, *pairs, xi, length, weight, cf, alpha, pressure,
+        np.empty((3, n), dtype), point_of, out,
+    )  # fmt: skip
     f = _grid_order(point_of, out)
     expected = ref.lattice_lps_force(
         u, vol, broken, shape, s.offsets, xi, length, weight, alpha, pressure, cf
@@ -129,9 +143,47 @@ def test_lattice_lps_dilatation_and_force_match_reference(rng, dtype):
     size = w * (
         length[k] * (np.abs(pressure[p]) + np.abs(pressure[q])) + (alpha[p] + alpha[q]) * np.abs(extension)
     )
-    held = vol > 0
     scale = _magnitude(vol, broken, shape, s.offsets, size)
     assert_close(f.T[held], expected.T[held], TOL[dtype], scale[held])
+
+
+def test_pair_kernels_give_the_same_bits_on_any_number_of_threads(rng):
+    """Each point adds its pairs in an order set by the grid and the stencil alone (slabs of y
+    planes, the even ones then the odd ones: ``kernels.lattice``), so the PMB force, the LPS
+    dilatation and the LPS force are the same bits on 1, 2 and 3 numba threads (7 slabs)."""
+    if numba.config.NUMBA_NUM_THREADS < 2:
+        pytest.skip("one numba thread available: nothing to compare")
+    shape, s, vol, broken, u = _grid(rng, np.float64, shape=(8, 13, 6))
+    xi, length = _tables(s, np.float64)
+    pairs = kern.pair_offsets(s.offsets)
+    assert pairs[1] == 2 and -(-13 // pairs[1]) == 7
+    n = vol.size
+    weight = s.influence * s.volume_factor
+    alpha, theta_coef = rng.random(n) * 1e25, rng.random(n) * 3e14
+    point_of, _ = _written_rows(rng, vol)
+    head = (u, vol, broken, shape, s.offsets, *pairs, xi, length)
+
+    def evaluate():
+        pmb = kern.lattice_pmb_force(
+            *head, 1 / length, 1e20 * weight, False, np.empty((3, n)), point_of, np.full((n, 3), np.nan)
+        )
+        theta = kern.lattice_lps_dilatation(*head, weight, False, theta_coef, np.empty(n))
+        lps = kern.lattice_lps_force(
+            *head, weight, False, alpha, 1e8 * theta, np.empty((3, n)), point_of, np.full((n, 3), np.nan)
+        )
+        return pmb, theta, lps
+
+    before = numba.get_num_threads()
+    try:
+        results = []
+        for threads in range(1, min(3, numba.config.NUMBA_NUM_THREADS) + 1):
+            numba.set_num_threads(threads)
+            results.append(evaluate())
+    finally:
+        numba.set_num_threads(before)
+    for other in results[1:]:
+        for a, b in zip(results[0], other, strict=True):
+            np.testing.assert_array_equal(a, b)
 
 
 def test_lattice_sums_and_energy_match_reference(rng):
@@ -219,6 +271,36 @@ def _both(make, name, partial_volumes, dtype=np.float64):
     kw = {"E": 70e9, "density": 2700.0, "nu": None if name == "pmb" else 0.3, "dtype": dtype}
     kw["surface_correction"] = correction or "none"
     return body, make_model(name, body, bonds, **kw), make_lattice_model(name, body, lattice, **kw), cut
+
+
+@pytest.mark.parametrize("dtype", DTYPES)
+def test_explicit_solver_forces_into_the_acceleration_when_the_model_can(rng, dtype):
+    """A float64 lattice force writes every body point's row of its output (no NaN left), so the
+    explicit solver hands it the state's acceleration and keeps no force array (24 B a point);
+    not in float32 (the state is float64) nor on bond lists (``force_overwrites_out`` False)."""
+    body, bonded, latticed, _ = _both(BODIES["box_hole_crack"], "pmb", False, dtype)
+    f = latticed.force(
+        rng.normal(size=(body.n_points, 3)) * 1e-3 * body.spacing, np.full_like(latticed.x, np.nan)
+    )
+    assert np.isfinite(f).all()
+    assert latticed.force_fills_acceleration == (dtype == np.float64)
+    assert not bonded.force_fills_acceleration
+    for model in (bonded, latticed):
+        assert (ExplicitSolver(model)._force is None) == model.force_fills_acceleration
+
+
+@pytest.mark.parametrize("which", sorted(BODIES))
+def test_owned_bond_counts_match_bond_lists(which):
+    """What a run's summary counts of a rank's owned points (the first n body points): their
+    directed bonds and the broken ones (the pre-crack's), the same on both storages for any n."""
+    body, bonded, latticed, _ = _both(BODIES[which], "pmb", False)
+    for n in (0, body.n_points // 3, body.n_points):
+        assert latticed.lattice.owned_bond_counts(n) == bonded.bonds.owned_bond_counts(n)
+    assert latticed.lattice.owned_bond_counts(body.n_points) == (
+        bonded.bonds.n_bonds,
+        latticed.lattice.n_broken(),
+    )
+    assert latticed.lattice.n_broken() > 0
 
 
 @pytest.mark.parametrize("partial_volumes", [False, True])

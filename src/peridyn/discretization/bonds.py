@@ -110,6 +110,12 @@ class Bonds:
         """Number of directed bonds (twice the number of bonds)."""
         return len(self.neighbours)
 
+    def owned_bond_counts(self, n_owned: int) -> tuple[int, int]:
+        """(directed bonds, broken ones) of the points ``0 .. n_owned - 1`` (a rank's owned
+        points come first, their families first in the bond arrays)."""
+        owned = int(self.offsets[n_owned])
+        return owned, int(np.count_nonzero(~self.intact[:owned]))
+
     def owners(self) -> np.ndarray:
         """(n_bonds,) int64: the point whose family holds each directed bond."""
         return np.repeat(np.arange(len(self.offsets) - 1), np.diff(self.offsets))

@@ -23,7 +23,7 @@ from peridyn.discretization.body import Body
 from peridyn.discretization.bonds import HORIZON_RTOL, influence_function, search_cells
 from peridyn.errors import InputError
 from peridyn.kernels.bond_search import box_fraction_in_ball
-from peridyn.kernels.lattice import lattice_bond_count, lattice_bond_sum
+from peridyn.kernels.lattice import lattice_bond_sum, lattice_owned_bonds
 
 #: Largest distance of a point from its grid position, as a share of the spacing, for a body
 #: to count as a grid.
@@ -134,8 +134,17 @@ class Lattice:
     @property
     def n_bonds(self) -> int:
         """Directed bonds between points with material (each bond counted from both ends)."""
-        rows = np.empty(int(self.shape[1] * self.shape[2]), dtype=np.int64)
-        return int(lattice_bond_count(self.volume, self.shape, self.stencil.offsets, rows))
+        return self.owned_bond_counts(self.n_points)[0]
+
+    def owned_bond_counts(self, n_owned: int) -> tuple[int, int]:
+        """(directed bonds, broken ones) of the body points ``0 .. n_owned - 1`` (a rank's owned
+        points come first; a broken bond has both bits set), counted without an array of the
+        body's size."""
+        s = self.stencil
+        counts = lattice_owned_bonds(
+            self.volume, self.broken, self.shape, s.offsets, self.grid_index, n_owned
+        )
+        return int(counts[0]), int(counts[1])
 
     def n_broken(self, points=None) -> int:
         """Directed bonds broken (pre-cracks and damage; a broken bond has both bits set), of

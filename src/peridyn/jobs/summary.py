@@ -56,18 +56,11 @@ def base_summary(setup) -> dict:
     d = setup.domain
     n = d.n_owned
     phi = damage_field(setup.model)
-    if setup.storage == "lattice" and d.size == 1:  # no array the body's size: a run's end is its peak
-        bonds, broken = setup.bonds.n_bonds, setup.bonds.n_broken()
-    elif setup.storage == "lattice":  # the owned points' families (a broken bond has both bits)
-        bonds = d.count(setup.bonds.family_sizes()[:n].sum())
-        broken = d.count(setup.bonds.n_broken(d.owned))
-    else:
-        owned_bonds = int(setup.bonds.offsets[n])  # the owned points' families come first
-        bonds, broken = d.count(owned_bonds), d.count((~setup.bonds.intact[:owned_bonds]).sum())
+    bonds, broken = setup.bonds.owned_bond_counts(n)  # bond lists or lattice
     return {
         "points": setup.whole_body.n_points,
-        "bonds": bonds,
-        "broken_bonds": broken,
+        "bonds": d.count(bonds),
+        "broken_bonds": d.count(broken),
         "max_damage": float(d.max(phi[:n].max())),
         "storage": setup.storage,
     }

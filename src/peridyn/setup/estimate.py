@@ -78,15 +78,16 @@ COSTS_MODEL_BYTES = 24.0
 #: counted from the arrays of ``physics.materials.lattice``, ``solvers.explicit`` and the build):
 #: ``body``: positions 24, volume 8, the ``all`` set 8, grid index 8, the domain's point ids 8 and
 #: a plate's layer 1 (one cell size is seen by every point); ``state``: u, v, a (the lattice
-#: force is written into a); ``grid``: the grid's displacement 24, volume 8 and each grid point's
-#: body row 4; ``loads``: the constrained-DOF mask; ``end``: the last snapshot's float32
-#: displacement (12) and the sums of the final energy or damage (16). The material and damage
+#: force is written into a); ``grid``: the grid's displacement 24, volume 8, each grid point's
+#: body row 4 and the force kernels' sum of each grid point's pair forces 24; ``loads``: the
+#: constrained-DOF mask; ``end``: the last snapshot's float32 displacement (12) and the sums of
+#: the final energy or damage (16). The material and damage
 #: add ``LATTICE_LPS_BYTES``, ``LATTICE_SHEAR_FACTOR_BYTES``, ``LATTICE_DAMAGE_BYTES``, float32
 #: kernels ``LATTICE_FLOAT32_BYTES``; per point and stencil offset, one broken bit
 #: (``LATTICE_BIT_BYTES``, in 64-bit words). Measured: 249 B a point on the Lamb plate (LPS with
-#: the shear factor, 240 k-480 k points; this model: 236 B), benchmarks/RESULTS.md "Lattice
-#: storage".
-LATTICE_POINT_BYTES = {"body": 57.0, "state": 72.0, "grid": 36.0, "loads": 3.0, "end": 28.0}
+#: the shear factor, 240 k-480 k points; this model then: 236 B) before the pair forces' sum,
+#: benchmarks/RESULTS.md "Lattice storage".
+LATTICE_POINT_BYTES = {"body": 57.0, "state": 72.0, "grid": 60.0, "loads": 3.0, "end": 28.0}
 #: LPS: alpha, the dilatation and pressure coefficients (float64) and the dilatation itself.
 LATTICE_LPS_BYTES = 32.0
 #: LPS with ``surface_correction: shear-factor``: the factor of each point.
@@ -94,8 +95,9 @@ LATTICE_SHEAR_FACTOR_BYTES = 8.0
 #: Bond breaking: the displacement of the last bond test (24) and which points may break (1).
 LATTICE_DAMAGE_BYTES = 25.0
 #: float32 kernels: the solver's own force (12), the float32 grid displacement beside the float64
-#: one of the energy and bond tests (12) and LPS's float32 coefficients (12).
-LATTICE_FLOAT32_BYTES = 36.0
+#: one of the energy and bond tests (12) and LPS's float32 coefficients (12), less the half of the
+#: pair forces' sum that float32 saves (12).
+LATTICE_FLOAT32_BYTES = 24.0
 LATTICE_BIT_BYTES = 1.0 / 8.0
 
 #: Bytes per directed bond an explicit run saves with float32 kernels: half of the model's 32 B,

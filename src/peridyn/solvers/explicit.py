@@ -126,14 +126,14 @@ class ExplicitSolver:
         n = model.body.n_points
         #: the force's own array (n_points, 3), N/m^3, or None: the force is written into the
         #: state's acceleration, which ``kernels.verlet.acceleration`` turns into a in place
-        #: (24 bytes a point less: one process, a float64 model whose force overwrites its
-        #: output, no contact, Peridigm order or differenced velocity reading the force after)
+        #: (a model that can, ``Model.force_fills_acceleration``, called as ``model.force`` (one
+        #: process, peridyn's order) with nothing reading the force after: no contact, no
+        #: differenced velocity)
         into_acceleration = (
-            model.force_overwrites_out
-            and np.dtype(model.dtype) == np.float64
+            model.force_fills_acceleration
             and self.domain.halo is None
-            and contact is None
             and arithmetic == "peridyn"
+            and contact is None
             and prescribed_velocity == "rate"
         )
         self._force = None if into_acceleration else np.zeros((n, 3), dtype=model.dtype)

@@ -92,8 +92,7 @@ class Model:
     #: case, ``setup.estimate``): PMB 1/length, stiffness and surface factor; LPS weight,
     #: deviatoric coefficient and the shear factor's share.
     bond_bytes = 24.0
-    #: True when ``force(u, out)`` writes every row of ``out`` whatever it held (the explicit
-    #: solver may then hand it the state's acceleration: ``solvers.explicit``).
+    #: True when ``force(u, out)`` writes every row of ``out`` whatever it held.
     force_overwrites_out = False
     #: The ``surface_correction`` names the material takes (case key ``material.surface_correction``).
     surface_corrections: tuple[str, ...] = ("none",)
@@ -244,6 +243,13 @@ class Model:
 
     def _as_state(self, u: np.ndarray) -> np.ndarray:
         return np.ascontiguousarray(u, dtype=self.dtype)
+
+    @property
+    def force_fills_acceleration(self) -> bool:
+        """True when ``force(u, a)`` may write a state's float64 acceleration ``a`` (n_points, 3)
+        in place (the explicit solver then keeps no force array of its own, 24 B a point): the
+        force overwrites every row of its output (``force_overwrites_out``) in float64."""
+        return self.force_overwrites_out and self.dtype == np.float64
 
     def force(self, u: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
         """Internal force density (n_points, 3), N/m^3, at displacement ``u`` (n_points, 3), m."""

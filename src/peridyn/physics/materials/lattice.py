@@ -28,6 +28,7 @@ from peridyn.kernels.lattice import (
     lattice_pair_sum,
     lattice_pmb_force,
     lattice_scatter,
+    pair_offsets,
 )
 from peridyn.physics.materials.base import Model
 from peridyn.physics.materials.elastic import dilatational_modulus, shear_modulus
@@ -66,6 +67,10 @@ class LatticeModel(Model):
         self._xi = s.xi.astype(self.dtype)
         self._length = s.length.astype(self.dtype)
         self._ug = np.zeros((3, lattice.n_grid), dtype=self.dtype)  # holes stay 0
+        #: the stencil rows the pair kernels run (one of each two opposite offsets) and their slab width
+        self._pairs = pair_offsets(s.offsets)
+        #: the force kernels' sum of each grid point's pair forces (3, n_grid), N/m^3
+        self._grid_f = np.empty((3, lattice.n_grid), dtype=self.dtype)
         #: (n_grid,) the body point of each grid point, -1 for none: where the force kernels write
         self._point_of = np.full(lattice.n_grid, -1, dtype=np.int32 if body.n_points < 2**31 else np.int64)
         self._point_of[lattice.grid_index] = np.arange(body.n_points, dtype=self._point_of.dtype)
@@ -142,11 +147,13 @@ class LatticePMB(LatticeModel):
             lat.broken,
             lat.shape,
             s.offsets,
+            *self._pairs,
             self._xi,
             self._length,
             self._inv_len,
             self._coef,
             self._cf,
+            self._grid_f,
             self._point_of,
             self._force_out(out),
         )
@@ -208,8 +215,9 @@ class LatticeLPS(LatticeModel):
 
         def dilatation(u):
             ug = self.grid_displacement(u)
+            head, tail = table[:4], table[4:]
             theta = lattice_lps_dilatation(
-                ug, *table, self._weight64, False, self.theta_coef, np.empty(lat.n_grid)
+                ug, *head, *self._pairs, *tail, self._weight64, False, self.theta_coef, np.empty(lat.n_grid)
             )
             return self._at_points(theta)
 
@@ -230,7 +238,9 @@ class LatticeLPS(LatticeModel):
         args = (s.offsets, self._xi, self._length, self._weight, self._cf)
         if ug.dtype == np.float64 and self.dtype != np.float64:
             args = (s.offsets, s.xi, s.length, self._weight64, False)
-        return lattice_lps_dilatation(ug, vol, lat.broken, lat.shape, *args, theta_coef, out)
+        return lattice_lps_dilatation(
+            ug, vol, lat.broken, lat.shape, s.offsets, *self._pairs, *args[1:], theta_coef, out
+        )
 
     def dilatation(self, u) -> np.ndarray:
         """Dilatation theta (n_points,), dimensionless."""
@@ -242,9 +252,9 @@ class LatticeLPS(LatticeModel):
         ug = self._scatter(self._as_state(u))
         p = self._grid_dilatation(ug, self._vol, self._theta_coef, self._theta)
         np.multiply(p, self._p_coef, out=p)
-        args = (s.offsets, self._xi, self._length, self._weight, self._cf, self._alpha, p)
+        args = (s.offsets, *self._pairs, self._xi, self._length, self._weight, self._cf, self._alpha, p)
         f = self._force_out(out)
-        return lattice_lps_force(ug, self._vol, lat.broken, lat.shape, *args, self._point_of, f)
+        return lattice_lps_force(ug, self._vol, lat.broken, lat.shape, *args, self._grid_f, self._point_of, f)
 
     def energy_density(self, u):
         """0.5 K theta^2 + 0.5 alpha sum w (e - theta |xi| / d)^2 (n_points,), J/m^3, at ``u``
@@ -254,8 +264,8 @@ class LatticeLPS(LatticeModel):
         ug = self.grid_displacement(u)
         scratch = self._theta if self.dtype == np.float64 else np.empty(lat.n_grid)
         theta = lattice_lps_dilatation(
-            ug, lat.volume, lat.broken, lat.shape, s.offsets, s.xi, s.length, self._weight64, False,
-            self.theta_coef, scratch,
+            ug, lat.volume, lat.broken, lat.shape, s.offsets, *self._pairs, s.xi, s.length, self._weight64,
+            False, self.theta_coef, scratch,
         )  # fmt: skip
         squares = lattice_energy_sum(
             ug, lat.volume, lat.broken, lat.shape, s.offsets, s.xi, s.length, self._weight64 * s.length,
