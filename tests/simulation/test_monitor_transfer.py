@@ -25,7 +25,8 @@ convergence check: the process zone is a few spacings long (the broken bonds rea
 tip rule's point on the 1 mm grid, 0.5 mm on the 0.5 mm grid), and the two routes' difference
 falls with it, at each interrogation (at 5.75 and 6.75 mm there, the crack lengths of that grid):
 residual energy 13 and 13% -> 11 and 5%, correlation 14 and 15% -> 6 and 3%. The residual energy
-index's 11% at 5.75 mm keeps the 10% line an open one.
+index's 11% at 5.75 mm (and 10.3-10.7% at 4.25 and 6.25 mm, docs/monitoring.md) keeps the
+10% line an open one.
 
 The job at 1 mm (fatigue of 80 steps on 1 568 points, 15 wave runs of 4 704 points, two
 processes of one thread) takes 34 s on 2 cores at load 4-6, 49 s at load 9; at 0.5 mm (fatigue of
