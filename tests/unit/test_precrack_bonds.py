@@ -1,6 +1,7 @@
 """A ``bonds`` pre-crack (listed bonds, by their ends' in-plane positions): in a plate it cuts
-the bonds between the two columns of points of each pair, at every pair of layers, and no other
-(docs/user-guide.md, the case file; the monitoring job's bond transfer: docs/monitoring.md)."""
+the bonds between the two columns of points of each pair, at every pair of layers, and no other;
+listed by their ends' 3D positions, it cuts those bonds alone (docs/user-guide.md, the case file;
+the monitoring job's bond transfer and its direct check: docs/monitoring.md)."""
 
 import numpy as np
 import pytest
@@ -54,6 +55,33 @@ def test_lattice_storage_cuts_the_same_listed_bonds():
     case["discretization"]["storage"] = "lattice"
     setup = build(validate_case(case, "plate"))
     assert setup.storage == "lattice" and setup.bonds.n_broken() == 2 * 18
+
+
+def test_bonds_listed_in_space_are_cut_alone_with_either_storage():
+    # the horizontal bond of the first test between the bottom and the middle layer, and the
+    # diagonal one within the top layer (one end 1e-5 m off the grid): 2 directed bonds each,
+    # no other bond between their columns
+    z = np.unique(build(validate_case(_plate([]), "plate")).body.points[:, 2])
+    pairs = [
+        [0.0045, 0.0035, z[0], 0.0055, 0.0035, z[1]],
+        [0.00651, 0.00449, z[2], 0.0045, 0.0035, z[2] + 1e-5],
+    ]
+    case = _plate([{"type": "bonds", "pairs": pairs, "tolerance": 0.25 * H}])
+    setup = build(validate_case(case, "plate"))
+    b = setup.bonds
+    p = setup.body.points
+    ends = np.sort(np.stack([p[b.owners()[~b.intact], 2], p[b.neighbours[~b.intact], 2]], axis=1), axis=1)
+    assert _cut_columns(setup) == {((45, 35), (55, 35)), ((45, 35), (65, 45))}
+    assert len(ends) == 2 * 2
+    assert {tuple(e) for e in ends} == {(z[0], z[1]), (z[2], z[2])}
+    case["discretization"]["storage"] = "lattice"
+    assert build(validate_case(case, "plate")).bonds.n_broken() == 2 * 2
+
+
+def test_a_bonds_precrack_lists_pairs_of_one_kind():
+    mixed = [[0.0045, 0.0035, 0.0055, 0.0035], [0.0045, 0.0035, 0.0, 0.0055, 0.0035, 0.0]]
+    with pytest.raises(CaseFileError, match="all"):
+        validate_case(_plate([{"type": "bonds", "pairs": mixed, "tolerance": 0.25 * H}]), "plate")
 
 
 def test_a_bonds_precrack_needs_its_tolerance_and_ends_on_the_body():

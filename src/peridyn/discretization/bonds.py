@@ -480,17 +480,20 @@ def crossing_segment(x_from: np.ndarray, x_to: np.ndarray, start, end) -> np.nda
 
 def listed_pairs(pairs, tolerance: float):
     """``crossing(x_from, x_to)`` of the bonds listed in ``pairs``: True where ``x_from`` and
-    ``x_to`` lie, in the x-y plane, within ``tolerance`` (m) of the two ends of a listed pair,
-    in either order (in a plate: the bonds between two columns of points, at every pair of
-    layers).
+    ``x_to`` lie within ``tolerance`` (m) of the two ends of a listed pair, in either order: in
+    the x-y plane for pairs of in-plane ends (in a plate: the bonds between two columns of
+    points, at every pair of layers), in space for pairs of 3D ends (the bonds between two
+    points).
 
     Parameters
     ----------
-    pairs : (k, 4) float64, m, each bond's ends (x_a, y_a, x_b, y_b)
+    pairs : (k, 4) or (k, 6) float64, m, each bond's ends (x_a, y_a, x_b, y_b) or (x_a, y_a,
+        z_a, x_b, y_b, z_b)
     tolerance : float, m, less than half the distance between two listed ends
     """
-    pairs = np.asarray(pairs, dtype=float).reshape(-1, 4)
-    ends = np.concatenate([pairs[:, :2], pairs[:, 2:]])
+    pairs = np.asarray(pairs, dtype=float)
+    dim = pairs.shape[1] // 2
+    ends = np.concatenate([pairs[:, :dim], pairs[:, dim:]])
     tree = cKDTree(ends)
     # each listed end is known by the first listed end within the tolerance
     first = np.array([min(group) for group in tree.query_ball_point(ends, tolerance)], dtype=np.int64)
@@ -499,7 +502,7 @@ def listed_pairs(pairs, tolerance: float):
     keys = np.unique(np.minimum(a, b) * len(ends) + np.maximum(a, b))
 
     def crossing(x_from: np.ndarray, x_to: np.ndarray) -> np.ndarray:
-        ia, ib = (_listed_end(tree, first, x[:, :2], tolerance) for x in (x_from, x_to))
+        ia, ib = (_listed_end(tree, first, x[:, :dim], tolerance) for x in (x_from, x_to))
         key = np.minimum(ia, ib) * len(ends) + np.maximum(ia, ib)
         return (ia >= 0) & (ib >= 0) & np.isin(key, keys)
 
@@ -507,7 +510,8 @@ def listed_pairs(pairs, tolerance: float):
 
 
 def _listed_end(tree: cKDTree, first: np.ndarray, xy: np.ndarray, tolerance: float) -> np.ndarray:
-    """(n,) int64: the listed end (its first index) within ``tolerance`` of each of ``xy``, -1 for none."""
+    """(n,) int64: the listed end (its first index) within ``tolerance`` of each of ``xy`` ((n, 2)
+    or (n, 3), m, as the ends), -1 for none."""
     d, i = tree.query(xy, distance_upper_bound=tolerance)
     found = np.isfinite(d)
     return np.where(found, first[np.where(found, i, 0)], -1)

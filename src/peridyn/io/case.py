@@ -498,16 +498,17 @@ class Block(Strict):
         return self
 
 
-#: A bond's two ends in the x-y plane, [x_a, y_a, x_b, y_b] (m).
-BondEnds = Annotated[list[Finite], Field(min_length=4, max_length=4)]
+#: A bond's two ends in the x-y plane, [x_a, y_a, x_b, y_b], or in space, [x_a, y_a, z_a, x_b, y_b, z_b] (m).
+BondEnds = Annotated[list[Finite], Field(min_length=4, max_length=6)]
 
 
 class Precrack(Strict):
     """Bonds crossing a planar rectangle (origin, edge_u, edge_v; 3D), a segment (start, end;
     2D) or a surface (``file``: an Exodus mesh of triangles, e.g. shells, relative to the case
     file; Peridigm's "Exodus Mesh" bond filter of an initial damage model) are cut; or the
-    bonds listed by their ends' in-plane positions (``pairs``, ``tolerance``: in a plate, the
-    bonds between two columns of points, e.g. a plane-stress model's broken bonds)."""
+    bonds listed by their ends' positions (``pairs``, ``tolerance``: in the x-y plane, in a plate
+    the bonds between two columns of points, e.g. a plane-stress model's broken bonds; or in
+    space, the bonds between two points, e.g. a 3D model's broken bonds)."""
 
     type: Literal["rectangle", "segment", "surface", "bonds"] = described(
         ..., "rectangle (3D), segment (2D), surface (the triangles of a mesh file) or bonds (listed)"
@@ -524,10 +525,15 @@ class Precrack(Strict):
     start: Vector3 | None = described(None, "segment: first end", "m")
     end: Vector3 | None = described(None, "segment: second end", "m")
     pairs: Annotated[list[BondEnds], Field(min_length=1)] | None = described(
-        None, "bonds: each bond's ends in the x-y plane, [x_a, y_a, x_b, y_b]", "m"
+        None,
+        "bonds: each bond's ends in the x-y plane, [x_a, y_a, x_b, y_b] (every pair of layers of a plate), "
+        "or in space, [x_a, y_a, z_a, x_b, y_b, z_b]",
+        "m",
     )
     tolerance: Positive | None = described(
-        None, "bonds: how near, in the x-y plane, a point lies to a listed end (under half the spacing)", "m"
+        None,
+        "bonds: how near, in the pairs' plane or space, a point lies to a listed end (under half a spacing)",
+        "m",
     )
 
     @model_validator(mode="after")
@@ -541,6 +547,8 @@ class Precrack(Strict):
         missing = [k for k in keys if getattr(self, k) is None]
         if missing:
             raise ValueError(f"a {self.type} pre-crack needs {', '.join(missing)}")
+        if self.pairs is not None and {len(p) for p in self.pairs} not in ({4}, {6}):
+            raise ValueError("bonds pairs are all [x_a, y_a, x_b, y_b] or all [x_a, y_a, z_a, x_b, y_b, z_b]")
         return self
 
 

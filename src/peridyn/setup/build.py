@@ -431,12 +431,12 @@ def check_precracks(case: Case, body: Body) -> None:
         elif crack.type == "surface":  # the triangles' corners and centroids
             triangles = surface_triangles(crack.file)
             samples = np.concatenate([triangles.reshape(-1, 3), triangles.mean(axis=1)])
-        elif crack.type == "bonds":  # the bonds' ends, in the plane
-            samples = np.reshape(crack.pairs, (-1, 2))
+        elif crack.type == "bonds":  # the bonds' ends, in the plane or in space
+            samples = np.reshape(crack.pairs, (-1, len(crack.pairs[0]) // 2))
         else:
             start, end = np.asarray(pad3(crack.start)), np.asarray(pad3(crack.end))
             samples = start + _samples(end - start, body.spacing)[:, None] * (end - start)
-        within = 2 if crack.type == "bonds" else axes
+        within = samples.shape[-1] if crack.type == "bonds" else axes
         samples = samples.reshape(-1, samples.shape[-1])[:, :within]
         gap = float(distance_outside(body, samples, within).min())
         low, high = body.points.min(axis=0).tolist(), body.points.max(axis=0).tolist()
