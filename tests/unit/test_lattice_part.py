@@ -6,6 +6,7 @@ and the broken words go to the whole grid's layout and back unchanged (checkpoin
 under ``mpiexec`` are ``tests/mpi/test_mpi_lattice.py``.
 """
 
+import threading
 from pathlib import Path
 
 import numpy as np
@@ -15,7 +16,10 @@ from test_distributed_relax import on_ranks
 from peridyn.errors import InputError
 from peridyn.io.case import load_case
 from peridyn.parallel.lattice_domain import slab_bounds
+from peridyn.setup import build as build_module
+from peridyn.setup import slab_body
 from peridyn.setup.build import build
+from peridyn.setup.grid_points import grid_points
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -115,3 +119,42 @@ def test_a_rank_whose_planes_hold_no_point_is_refused_on_every_rank():
     case = load_case(path, [*CASES["plate2d_stretch"], gap, "precracks=[]"])
     with pytest.raises(InputError, match="rank 1's planes across x .* hold no point"):
         on_ranks(3, lambda comm: build(case, path.parent, comm))
+
+
+@pytest.mark.parametrize("ranks", [2, 3])
+@pytest.mark.parametrize("name", sorted(CASES))
+def test_a_rank_other_than_the_first_never_makes_the_whole_grid(name, ranks, monkeypatch):
+    """The points a rank holds come from its planes alone (``setup.slab_body``): every grid it
+    makes is a range of planes across x (its share of the counting pass, its slab with its
+    ghost planes, one plane for the stencil), the largest its slab and ghost planes, fewer
+    points than the whole body; only rank 0 makes the whole body (the recorder's). What the
+    ranks hold is checked above: their slabs and ghosts, the serial forces."""
+    path = ROOT / "cases" / f"{name}.yaml"
+    case = load_case(path, CASES[name])
+    whole = build(case, path.parent)
+    nx = int(whole.bonds.shape[0])
+    per_plane = whole.body.n_points // nx  # no removal in these cases
+    reach = int(np.abs(whole.bonds.stencil.offsets[:, 0]).max())
+    made = {}  # thread -> [(planes, points made)]
+
+    def recording(case, planes=None):
+        body = grid_points(case, planes)
+        made.setdefault(threading.get_ident(), []).append((planes, body.n_points))
+        return body
+
+    monkeypatch.setattr(slab_body, "grid_points", recording)
+    monkeypatch.setattr(build_module, "grid_points", recording)
+    ranks_of = dict(
+        on_ranks(ranks, lambda comm: (threading.get_ident(), build(case, path.parent, comm).domain))
+    )
+    bounds = slab_bounds(nx, ranks)
+    for thread, domain in ranks_of.items():
+        r = domain.comm.rank
+        first, stop = max(0, bounds[r] - 2 * reach), min(nx, bounds[r + 1] + 2 * reach)
+        calls = made[thread]
+        if r == 0:
+            assert (None, whole.body.n_points) in calls
+            continue
+        assert all(planes is not None for planes, _ in calls)
+        assert max(n for _, n in calls) == (stop - first) * per_plane == len(domain.global_ids)
+        assert (stop - first) * per_plane < whole.body.n_points

@@ -81,7 +81,7 @@ def run_explicit(ctx: RunContext, setup: Setup, solver, spec) -> dict:
         tensors = gathered.tensor_fields
     # the explicit solver's own force (Peridigm's order: from its deformed positions); Newmark's: None
     fields = exodus_values(case, setup, spec, getattr(solver, "internal_force", None))
-    probes = Probes.of(setup.whole_body, spec)  # every rank: under MPI, gathered at a series record
+    probes = d.from_root(Probes.of, setup.whole_body, spec)  # every rank's: gathered at a series record
     recorder = d.on_root(
         Recorder,
         setup.whole_body,
@@ -163,7 +163,10 @@ def run_explicit(ctx: RunContext, setup: Setup, solver, spec) -> dict:
         if not spec.snapshot_due(state.step):
             if pieces is not None:
                 pieces.write(state)
-            gathered.call(state, lambda whole: recorder.snapshot(whole))
+            lean = not (spec.exodus or spec.exodus_more)  # an Exodus record reads a and the damage
+            gathered.call(
+                state, lambda whole: recorder.snapshot(whole), damage=not lean, accelerations=not lean
+            )
     except BaseException as exc:  # e.g. a full disk: the records held are written, the file closed
         if recorder is not None:
             recorder.close(end_status(exc))
@@ -193,7 +196,7 @@ def run_explicit(ctx: RunContext, setup: Setup, solver, spec) -> dict:
         summary["contact_rebuilds"] = setup.contact.rebuilds
     if cracks is not None:
         summary["crack_length_history"] = cracks.history()  # rank 0's is the one returned
-    gathered.call(state, lambda whole: recorder.finish(whole), True)
+    gathered.finish(state, recorder)
     return summary
 
 

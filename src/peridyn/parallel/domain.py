@@ -218,6 +218,12 @@ class Domain:
         _raise_any([self.comm.bcast(None if error is None else _portable(error))], error)
         return result
 
+    def from_root(self, fn, *args):
+        """``fn(*args)`` on rank 0, its result on every rank (``on_root``, then broadcast): what
+        needs the whole body, which only rank 0 may hold (lattice storage's slabs)."""
+        result = self.on_root(fn, *args)
+        return result if self.size == 1 else self.comm.bcast(result)
+
     def check_state(self, state: State, max_displacement: float) -> None:
         """``check_state`` of the whole body, each rank checking its owned points, then one
         allgather: every rank raises the error of the serial check (the first field out of
@@ -235,11 +241,14 @@ class Domain:
             error.every_rank = True
             raise error
 
-    def gather_state(self, state: State) -> State | None:
-        """The state of the whole body in global order on rank 0 (None elsewhere); in one
-        process ``state`` itself."""
+    def gather_state(self, state: State, accelerations: bool = True) -> State | None:
+        """The state of the whole body in global order on rank 0 (None elsewhere), its ``a``
+        None unless ``accelerations``; in one process ``state`` itself."""
         if self.size == 1:
             return state
+        if not accelerations:
+            whole = self.gather_many(state.u, state.v)
+            return State(*whole, None, state.time, state.step) if self.is_root else None
         whole = self.gather_many(state.u, state.v, state.a)
         return State(*whole, state.time, state.step) if self.is_root else None
 

@@ -143,12 +143,30 @@ class RootObservers:
         probe = None if values is None else ProbeState(*values, state.time, state.step)
         self.domain.on_root(record, probe)
 
-    def call(self, state: State, fn, tensors: bool = False, damage: bool = True):
+    def finish(self, state: State, recorder) -> None:
+        """``recorder.finish`` (rank 0's ``Recorder``, None elsewhere) at the final ``state``,
+        without the whole state on rank 0: under MPI each field (``Recorder.final_keys``) is
+        gathered, written and dropped before the next, so that rank 0 holds one field of the
+        whole body at a time, not u, v, a and the damage index together (collective). With
+        tensor fields asked for, or in one process, ``recorder.finish`` with the whole state."""
+        if self.domain.size == 1 or self.tensors is not None:
+            self.call(state, lambda whole: recorder.finish(whole), True)
+            return
+        keys = self.domain.from_root(lambda: recorder.final_keys())
+        local = {"u": lambda: state.u, "v": lambda: state.v, "damage": lambda: damage_field(self.model)}
+        for key in keys:
+            self.domain.on_root(
+                lambda key, whole: recorder.write_final(key, whole), key, self.domain.gather(local[key]())
+            )
+        self.domain.on_root(lambda: recorder.finished())
+
+    def call(self, state: State, fn, tensors: bool = False, damage: bool = True, accelerations: bool = True):
         """``fn(state of the whole body)`` on rank 0 after gathering (collective); its result on
         rank 0, None elsewhere. ``tensors``: gather the tensor fields too (for ``fn`` to read
         through ``tensor_fields``); ``damage``: gather the damage index (else ``damage()`` gives
-        None until the next call that gathers it)."""
-        whole = self.domain.gather_state(state)
+        None until the next call that gathers it); ``accelerations``: gather ``a`` (else the
+        whole state's ``a`` is None: for an ``fn`` that reads u and v only)."""
+        whole = self.domain.gather_state(state, accelerations)
         if self.domain.size > 1:
             self._damage = self.domain.gather(damage_field(self.model)) if damage else None
             if tensors and self.tensors is not None:
