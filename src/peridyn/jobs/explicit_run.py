@@ -117,12 +117,20 @@ def run_explicit(ctx: RunContext, setup: Setup, solver, spec) -> dict:
         prepare = [*prepare, (spec.exodus_due, collect)]
     damage_due = [spec.snapshot_due, spec.exodus_due, *([cracks.due] if cracks is not None else [])]
     record = recorder.record_series if recorder is not None else None
+    # the series and a snapshot read u and v: under MPI, rank 0 gathers a and the damage index
+    # for an Exodus record only
+    lean = not (spec.exodus or spec.exodus_more)
     try:
         if resume is None:
             if pieces is not None:
                 pieces.write(state)
             collect(state)
-            gathered.call(state, lambda whole: (recorder.record_series(whole), recorder.snapshot(whole)))
+            gathered.call(
+                state,
+                lambda whole: (recorder.record_series(whole), recorder.snapshot(whole)),
+                damage=not lean,
+                accelerations=not lean,
+            )
         observers = [gathered]
         if checkpoint_every and d.size == 1:
             observers.append(checkpointer)
@@ -163,7 +171,6 @@ def run_explicit(ctx: RunContext, setup: Setup, solver, spec) -> dict:
         if not spec.snapshot_due(state.step):
             if pieces is not None:
                 pieces.write(state)
-            lean = not (spec.exodus or spec.exodus_more)  # an Exodus record reads a and the damage
             gathered.call(
                 state, lambda whole: recorder.snapshot(whole), damage=not lean, accelerations=not lean
             )
