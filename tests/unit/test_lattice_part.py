@@ -158,3 +158,44 @@ def test_a_rank_other_than_the_first_never_makes_the_whole_grid(name, ranks, mon
         assert all(planes is not None for planes, _ in calls)
         assert max(n for _, n in calls) == (stop - first) * per_plane == len(domain.global_ids)
         assert (stop - first) * per_plane < whole.body.n_points
+
+
+#: removals (the notches), a box set and a face set (placed by the whole body's bounds)
+NOTCHED = [
+    "discretization.spacing=1e-3",
+    "discretization.storage=lattice",
+    "node_sets.back={type: face, face: x+}",
+    "removals=[{type: box, min: [-0.001, 0.07425, -1], max: [0.050, 0.07575, 1]}, "
+    "{type: face, face: y+, depth: 0.006}]",
+]
+
+
+@pytest.mark.parametrize("ranks", [2, 3])
+def test_planes_made_apart_are_the_whole_bodys_points_and_sets(ranks):
+    """A slab made from its planes alone (``setup.slab_body``) has the whole body's points,
+    volumes and numbers, and the node sets' points, bit for bit, with removals and faces (a
+    face removal placed by the grid before removals, a face set by the body after them, as
+    ``build_body`` places them on the whole body)."""
+    path = ROOT / "cases" / "kalthoff_winkler.yaml"
+    case = load_case(path, NOTCHED)
+    whole = build_module.build_body(case, path.parent)
+
+    def planes(comm):
+        plan = slab_body.grid_plan(case, comm)
+        bounds = slab_bounds(int(plan.shape[0]), comm.size)
+        lo, hi = int(bounds[comm.rank]), int(bounds[comm.rank + 1])
+        part, ids = slab_body.slab_points(case, plan, lo, hi)
+        part = build_module._slab_node_sets(case, part, plan, comm, part.n_points)
+        return plan, part, ids
+
+    parts = on_ranks(ranks, planes)
+    assert np.array_equal(np.concatenate([ids for _, _, ids in parts]), np.arange(whole.n_points))
+    plan = parts[0][0]
+    assert plan.n_points == whole.n_points
+    assert np.array_equal(plan.origin, whole.points.min(axis=0))
+    for _, part, ids in parts:
+        assert np.array_equal(part.points, whole.points[ids])
+        assert np.array_equal(part.volumes, whole.volumes[ids])
+        for name in ("back", "impact", "all"):
+            assert np.array_equal(ids[part.node_sets[name]], np.intersect1d(whole.node_sets[name], ids))
+    assert sum(len(p.node_sets["back"]) for _, p, _ in parts) == len(whole.node_sets["back"]) > 0
