@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 from test_distributed_relax import on_ranks
 
-from peridyn.errors import InputError
+from peridyn.errors import CaseFileError, InputError
 from peridyn.io.case import load_case
 from peridyn.parallel.lattice_domain import slab_bounds
 from peridyn.setup import build as build_module
@@ -199,3 +199,31 @@ def test_planes_made_apart_are_the_whole_bodys_points_and_sets(ranks):
         for name in ("back", "impact", "all"):
             assert np.array_equal(ids[part.node_sets[name]], np.intersect1d(whole.node_sets[name], ids))
     assert sum(len(p.node_sets["back"]) for _, p, _ in parts) == len(whole.node_sets["back"]) > 0
+
+
+def test_a_set_that_no_rank_holds_a_point_of_is_refused_as_in_one_process():
+    """The emptiness of a node set is decided over the ranks, with the serial error."""
+    path = ROOT / "cases" / "plate2d_stretch.yaml"
+    case = load_case(
+        path, [*CASES["plate2d_stretch"], "node_sets.away={type: box, min: [9, 9, -1], max: [10, 10, 1]}"]
+    )
+    with pytest.raises(CaseFileError) as serial:
+        build(case, path.parent)
+    with pytest.raises(CaseFileError) as ranked:
+        on_ranks(2, lambda comm: build(case, path.parent, comm))
+    assert str(ranked.value) == str(serial.value)
+
+
+def test_a_region_of_listed_points_makes_the_whole_body_first():
+    """Point numbers name the whole body's points (``slab_refusals``): such a case is made whole
+    on every rank, then cut; each rank holds the set's points of its slab and ghosts."""
+    path = ROOT / "cases" / "plate2d_stretch.yaml"
+    case = load_case(
+        path, [*CASES["plate2d_stretch"], "node_sets.listed={type: points, indices: [0, 7, 100]}"]
+    )
+    assert slab_body.slab_refusals(case) == ["a region of listed point numbers"]
+    domains = on_ranks(2, lambda comm: (lambda s: (s.domain, s.body))(build(case, path.parent, comm)))
+    owned = [
+        d.global_ids[body.node_sets["listed"][body.node_sets["listed"] < d.n_owned]] for d, body in domains
+    ]
+    assert sorted(np.concatenate(owned).tolist()) == [0, 7, 100]
