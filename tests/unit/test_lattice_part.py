@@ -20,6 +20,7 @@ from peridyn.setup import build as build_module
 from peridyn.setup import slab_body
 from peridyn.setup.build import build
 from peridyn.setup.grid_points import grid_points
+from peridyn.setup.solver_choice import time_stepper
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -227,3 +228,16 @@ def test_a_region_of_listed_points_makes_the_whole_body_first():
         d.global_ids[body.node_sets["listed"][body.node_sets["listed"] < d.n_owned]] for d, body in domains
     ]
     assert sorted(np.concatenate(owned).tolist()) == [0, 7, 100]
+
+
+@pytest.mark.parametrize("name", sorted(CASES))
+def test_a_ranks_float64_lattice_force_is_written_into_its_acceleration(name):
+    """As in one process, a rank's float64 lattice force needs no array of its own (24 B a
+    point, ``ExplicitSolver``): the lattice force overwrites every row of the part, ghosts
+    included (with and without the overlap of the ghost exchange: bar_pulse, no damage, and
+    plate2d_stretch, bonds breaking). The runs stay bit for bit (tests/mpi/test_mpi_lattice.py)."""
+    path = ROOT / "cases" / f"{name}.yaml"
+    case = load_case(path, CASES[name])
+    solvers = on_ranks(2, lambda comm: time_stepper(case, build(case, path.parent, comm)))
+    assert [s._force is None for s in solvers] == [True, True]
+    assert [s.overlap for s in solvers] == [name == "bar_pulse"] * 2

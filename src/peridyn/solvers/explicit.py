@@ -126,12 +126,12 @@ class ExplicitSolver:
         n = model.body.n_points
         #: the force's own array (n_points, 3), N/m^3, or None: the force is written into the
         #: state's acceleration, which ``kernels.verlet.acceleration`` turns into a in place
-        #: (24 bytes a point less: one process, a float64 model whose force overwrites its
-        #: output, no contact, Peridigm order or differenced velocity reading the force after)
+        #: (24 bytes a point less: a float64 model whose force overwrites its output, every
+        #: row of a rank's part included, no contact, Peridigm order or differenced velocity
+        #: reading the force after)
         into_acceleration = (
             model.force_overwrites_out
             and np.dtype(model.dtype) == np.float64
-            and self.domain.halo is None
             and contact is None
             and arithmetic == "peridyn"
             and prescribed_velocity == "rate"
@@ -195,7 +195,8 @@ class ExplicitSolver:
                 f = f.copy()  # self._force keeps the material's own (``internal_force``)
         elif overlapped:
             d = self.domain
-            f = self.model.force_overlapped(state.u, self._force, d.clear_rows, d.n_owned, d.finish_exchange)
+            out = state.a if self._force is None else self._force
+            f = self.model.force_overlapped(state.u, out, d.clear_rows, d.n_owned, d.finish_exchange)
         else:
             f = self.model.force(state.u, out=state.a if self._force is None else self._force)
         if self.contact is not None:  # Peridigm's order: at its deformed positions
