@@ -117,20 +117,18 @@ def run_explicit(ctx: RunContext, setup: Setup, solver, spec) -> dict:
         prepare = [*prepare, (spec.exodus_due, collect)]
     damage_due = [spec.snapshot_due, spec.exodus_due, *([cracks.due] if cracks is not None else [])]
     record = recorder.record_series if recorder is not None else None
-    # the series and a snapshot read u and v: under MPI, rank 0 gathers a and the damage index
-    # for an Exodus record only
+    # a record without an Exodus one reads the probe points and u: under MPI rank 0 gathers
+    # those only (``RootObservers.record``), not the whole state
     lean = not (spec.exodus or spec.exodus_more)
     try:
         if resume is None:
             if pieces is not None:
                 pieces.write(state)
             collect(state)
-            gathered.call(
-                state,
-                lambda whole: (recorder.record_series(whole), recorder.snapshot(whole)),
-                damage=not lean,
-                accelerations=not lean,
-            )
+            if lean:
+                gathered.record(state, recorder, probes)
+            else:
+                gathered.call(state, lambda whole: (recorder.record_series(whole), recorder.snapshot(whole)))
         observers = [gathered]
         if checkpoint_every and d.size == 1:
             observers.append(checkpointer)
@@ -171,9 +169,10 @@ def run_explicit(ctx: RunContext, setup: Setup, solver, spec) -> dict:
         if not spec.snapshot_due(state.step):
             if pieces is not None:
                 pieces.write(state)
-            gathered.call(
-                state, lambda whole: recorder.snapshot(whole), damage=not lean, accelerations=not lean
-            )
+            if lean:
+                gathered.snapshot(state, recorder)
+            else:
+                gathered.call(state, lambda whole: recorder.snapshot(whole))
     except BaseException as exc:  # e.g. a full disk: the records held are written, the file closed
         if recorder is not None:
             recorder.close(end_status(exc))

@@ -247,14 +247,11 @@ class Domain:
             error.every_rank = True
             raise error
 
-    def gather_state(self, state: State, accelerations: bool = True) -> State | None:
-        """The state of the whole body in global order on rank 0 (None elsewhere), its ``a``
-        None unless ``accelerations``; in one process ``state`` itself."""
+    def gather_state(self, state: State) -> State | None:
+        """The state of the whole body in global order on rank 0 (None elsewhere); in one
+        process ``state`` itself."""
         if self.size == 1:
             return state
-        if not accelerations:
-            whole = self.gather_many(state.u, state.v)
-            return State(*whole, None, state.time, state.step) if self.is_root else None
         whole = self.gather_many(state.u, state.v, state.a)
         return State(*whole, state.time, state.step) if self.is_root else None
 

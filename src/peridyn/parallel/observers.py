@@ -160,13 +160,43 @@ class RootObservers:
             )
         self.domain.on_root(lambda: recorder.finished())
 
-    def call(self, state: State, fn, tensors: bool = False, damage: bool = True, accelerations: bool = True):
+    def record(self, state: State, recorder, probes) -> None:
+        """The series record and the snapshot of ``state`` by ``recorder`` (rank 0's
+        ``Recorder``, None elsewhere; a run's first record, without an Exodus record), its
+        series at ``probes``' points (``Probes``): under MPI the ranks check the state together
+        (``Domain.check_state``), gather the probe points' values for the series and u alone
+        for the snapshot (collective); in one process from ``state`` itself."""
+        d = self.domain
+        if d.size == 1:
+            recorder.record_series(state)
+            recorder.snapshot(state)
+            return
+        d.check_state(state, d.runaway_limit(self.model.body.points))
+        values = PointGather(d, probes.u_points, probes.v_points)(state.u, state.v)
+        probe = None if values is None else ProbeState(*values, state.time, state.step)
+        d.on_root(lambda: recorder.record_series(probe))
+        self.snapshot(state, recorder, checked=True)
+
+    def snapshot(self, state: State, recorder, checked: bool = False) -> None:
+        """``recorder.snapshot`` of ``state`` without an Exodus record: under MPI the ranks check
+        the state together (unless ``checked``) and gather u alone, so that rank 0 holds one
+        field of the whole body (a VTU snapshot is written by the ranks:
+        ``peridyn.io.vtu_pieces``); in one process from ``state`` itself (collective)."""
+        d = self.domain
+        if d.size == 1:
+            recorder.snapshot(state)
+            return
+        if not checked:
+            d.check_state(state, d.runaway_limit(self.model.body.points))
+        u = d.gather(state.u)
+        d.on_root(lambda: recorder.snapshot(State(u, None, None, state.time, state.step), checked=True))
+
+    def call(self, state: State, fn, tensors: bool = False, damage: bool = True):
         """``fn(state of the whole body)`` on rank 0 after gathering (collective); its result on
         rank 0, None elsewhere. ``tensors``: gather the tensor fields too (for ``fn`` to read
         through ``tensor_fields``); ``damage``: gather the damage index (else ``damage()`` gives
-        None until the next call that gathers it); ``accelerations``: gather ``a`` (else the
-        whole state's ``a`` is None: for an ``fn`` that reads u and v only)."""
-        whole = self.domain.gather_state(state, accelerations)
+        None until the next call that gathers it)."""
+        whole = self.domain.gather_state(state)
         if self.domain.size > 1:
             self._damage = self.domain.gather(damage_field(self.model)) if damage else None
             if tensors and self.tensors is not None:
