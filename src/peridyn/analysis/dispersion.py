@@ -72,7 +72,6 @@ import itertools
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.optimize import brentq
 
 from peridyn.discretization import geometry
 from peridyn.discretization.body import in_sphere
@@ -744,6 +743,9 @@ def _branch(
             def shifted_group(kk: float) -> float:
                 lam_k, slope_k = eigen(np.array([kk]))
                 return slope_k[0, b] / (2.0 * np.sqrt(rho * max(lam_k[0, b], 1e-300))) + tol
+
+            # imported here: scipy.optimize costs a process 15 MB (an explicit run solves for no root)
+            from scipy.optimize import brentq
 
             onset = float(brentq(shifted_group, k[i - 1], k[i], xtol=1e-10 * k[i]))
     return Branch(name, polarisation, k, omega, omega / k, group, float(limit), onset)

@@ -40,7 +40,6 @@ from dataclasses import asdict, dataclass
 from typing import NamedTuple
 
 import numpy as np
-from scipy.optimize import brentq, minimize_scalar
 
 from peridyn.discretization import geometry
 from peridyn.errors import InputError
@@ -193,6 +192,9 @@ def rayleigh_speed(E: float, nu: float, rho: float) -> float:
     float
         Rayleigh speed, m/s.
     """
+    # imported here: scipy.optimize costs a process 15 MB (an explicit run solves for no root)
+    from scipy.optimize import brentq
+
     cl, ct = bulk_speeds(E, nu, rho)
     kappa2 = (ct / cl) ** 2
 
@@ -626,6 +628,9 @@ def _brackets(grid, values, f) -> list[tuple[float, float]]:
     (near crossings of branches of one symmetry): the minimum of ``|f|`` around
     it is found, and where ``f`` changes sign there, both halves are kept.
     """
+    # imported here: scipy.optimize costs a process 15 MB (an explicit run solves for no root)
+    from scipy.optimize import minimize_scalar
+
     sign, size = np.signbit(values), np.abs(values)
     brackets = [(grid[i], grid[i + 1]) for i in np.flatnonzero(sign[:-1] != sign[1:])]
     same = (sign[:-2] == sign[1:-1]) & (sign[1:-1] == sign[2:])

@@ -110,30 +110,34 @@ class Body:
             f"node_sets={sorted(self.node_sets)})"
         )
 
-    def node_set(self, name: str) -> np.ndarray:
-        """Indices of the named node set; a clear error when it does not exist or is empty."""
+    def node_set(self, name: str, empty: bool = False) -> np.ndarray:
+        """Indices of the named node set; a clear error when it does not exist or, unless
+        ``empty`` (a rank's part, which may hold none of a set's points), is empty."""
         if name not in self.node_sets:
             raise InputError(
                 f"unknown node set {name!r}{did_you_mean(name, self.node_sets)}; "
                 f"defined sets: {sorted(self.node_sets)}"
             )
         idx = self.node_sets[name]
-        if len(idx) == 0:
+        if len(idx) == 0 and not empty:
             raise InputError(f"node set {name!r} is empty: its region contains no point")
         return idx
 
-    def with_node_set(self, name: str, selection) -> Body:
+    def with_node_set(self, name: str, selection, empty: bool = False) -> Body:
         """A copy with one more named node set.
 
         Parameters
         ----------
         selection : (n_points,) bool mask, index array, or callable
             A callable receives ``points`` (n_points, 3) and returns a mask.
+        empty : bool
+            Allow a set without points (a rank's part that holds none of a set's points: the
+            whole set is checked over the ranks).
         """
         if callable(selection):
             selection = selection(self.points)
         idx = _as_index_array(name, selection, self.n_points)
-        if len(idx) == 0:
+        if len(idx) == 0 and not empty:
             raise InputError(f"node set {name!r} is empty: its region contains no point")
         return replace(self, node_sets={**self.node_sets, name: idx})
 
@@ -168,6 +172,23 @@ class Body:
         if mask.all():
             raise InputError("the removal takes away every point of the body")
         return self.subset(np.flatnonzero(~mask))
+
+
+@dataclass(frozen=True)
+class BodySize:
+    """What a rank that does not hold the whole body knows of it (lattice storage under MPI,
+    where rank 0 alone makes the whole body, for the recorder): its size.
+
+    Attributes
+    ----------
+    n_points : int
+    dim : {2, 3}
+    spacing : float, m
+    """
+
+    n_points: int
+    dim: int
+    spacing: float
 
 
 def _as_index_array(name: str, selection, n: int) -> np.ndarray:

@@ -81,13 +81,28 @@ def check_grid_fits(n_points: float, what: str) -> None:
         )
 
 
-def _grid(counts, spacing, origin) -> np.ndarray:
-    axes = [origin[a] + (np.arange(counts[a]) + 0.5) * spacing[a] for a in range(len(counts))]
+def _grid(counts, spacing, origin, planes=None) -> np.ndarray:
+    """The cell centres of a grid of ``counts`` cells, x slowest; with ``planes`` = (first,
+    stop), only the planes across x ``first .. stop - 1``, with the values the whole grid has."""
+    ranges = [(0, int(n)) for n in counts]
+    if planes is not None:
+        ranges[0] = planes
+    axes = [origin[a] + (np.arange(*ranges[a]) + 0.5) * spacing[a] for a in range(len(counts))]
     mesh = np.meshgrid(*axes, indexing="ij")
     return np.stack([m.ravel() for m in mesh], axis=1)
 
 
-def box(lengths, spacing, origin=(0.0, 0.0, 0.0)) -> Body:
+def planes_of(counts, planes) -> tuple[int, int]:
+    """(first, stop): the planes across x of a grid of ``counts`` cells that a generator makes,
+    all of them (``planes`` None) or ``planes`` = (first, stop) (a rank's slab of the grid)."""
+    n = int(counts[0])
+    first, stop = (0, n) if planes is None else (int(planes[0]), int(planes[1]))
+    if not 0 <= first < stop <= n:
+        raise InputError(f"planes {first} to {stop - 1} across x: the grid has planes 0 to {n - 1}")
+    return first, stop
+
+
+def box(lengths, spacing, origin=(0.0, 0.0, 0.0), planes=None) -> Body:
     """A 3D box of cubic (or box) cells.
 
     Parameters
@@ -98,17 +113,27 @@ def box(lengths, spacing, origin=(0.0, 0.0, 0.0)) -> Body:
         Cell size per axis.
     origin : 3 floats, m
         Lower corner of the box.
+    planes : (first, stop) or None
+        Make only the planes of cells across x ``first .. stop - 1`` (``planes_of``).
     """
     h = _positive_triplet("spacing", spacing)
     lengths = _positive_triplet("lengths", lengths)
     counts = cell_counts(lengths, h)
-    check_grid_fits(np.prod(counts.astype(float)), "a box")
-    points = _grid(counts, h, np.asarray(origin, dtype=float))
+    first, stop = planes_of(counts, planes)
+    check_grid_fits(np.prod(counts[1:].astype(float)) * (stop - first), "a box")
+    points = _grid(counts, h, np.asarray(origin, dtype=float), (first, stop))
     return Body(points=points, volumes=np.full(len(points), h.prod()), cells=h, dim=3, spacing=float(h.max()))
 
 
 def plate(
-    length, width, thickness, spacing, layers, origin=(0.0, 0.0, 0.0), layer_placement: str = "cell"
+    length,
+    width,
+    thickness,
+    spacing,
+    layers,
+    origin=(0.0, 0.0, 0.0),
+    layer_placement: str = "cell",
+    planes=None,
 ) -> Body:
     """A 3D plate in the x-y plane with ``layers`` layers of points through its thickness.
 
@@ -125,6 +150,8 @@ def plate(
         volumes add up to the plate volume. ``"surface"``: the first and last layers
         lie on the faces (dz = t / (layers - 1)) and every point has volume
         dx dy dz, as in Patra et al. 2018 (3 layers 1 mm apart in a 2 mm plate).
+    planes : (first, stop) or None
+        Make only the planes of cells across x ``first .. stop - 1`` (``planes_of``).
 
     Notes
     -----
@@ -146,7 +173,8 @@ def plate(
     h = float(_positive_triplet("spacing", spacing, 1)[0])
     length, width, thickness = _positive_triplet("plate size", (length, width, thickness))
     counts_xy = cell_counts(np.array([length, width]), np.array([h, h]))
-    check_grid_fits(np.prod(counts_xy.astype(float)) * layers, "a plate")
+    first, stop = planes_of(counts_xy, planes)
+    check_grid_fits(float(counts_xy[1]) * (stop - first) * layers, "a plate")
     if layer_placement == "cell":
         dz = thickness / layers
         z = (np.arange(layers) + 0.5) * dz
@@ -157,7 +185,7 @@ def plate(
         z = np.arange(layers) * dz
     else:
         raise InputError(f"layer_placement must be 'cell' or 'surface', got {layer_placement!r}")
-    xy = _grid(counts_xy, np.array([h, h]), np.asarray(origin[:2], dtype=float))
+    xy = _grid(counts_xy, np.array([h, h]), np.asarray(origin[:2], dtype=float), (first, stop))
     n_xy = len(xy)
     points = np.empty((n_xy * layers, 3))
     points[:, :2] = np.repeat(xy, layers, axis=0)
@@ -174,7 +202,9 @@ def plate(
     )
 
 
-def rectangle(length, width, spacing, thickness, plane: str = "stress", origin=(0.0, 0.0)) -> Body:
+def rectangle(
+    length, width, spacing, thickness, plane: str = "stress", origin=(0.0, 0.0), planes=None
+) -> Body:
     """A 2D rectangle (plane stress or plane strain) of square cells.
 
     Parameters
@@ -186,12 +216,15 @@ def rectangle(length, width, spacing, thickness, plane: str = "stress", origin=(
     thickness : float, m
         Out-of-plane thickness (volumes are cell area times thickness).
     plane : {"stress", "strain"}
+    planes : (first, stop) or None
+        Make only the planes of cells across x ``first .. stop - 1`` (``planes_of``).
     """
     h = float(_positive_triplet("spacing", spacing, 1)[0])
     t = float(_positive_triplet("thickness", thickness, 1)[0])
     counts = cell_counts(_positive_triplet("rectangle size", (length, width), 2), np.array([h, h]))
-    check_grid_fits(np.prod(counts.astype(float)), "a rectangle")
-    xy = _grid(counts, np.array([h, h]), np.asarray(origin, dtype=float))
+    first, stop = planes_of(counts, planes)
+    check_grid_fits(float(counts[1]) * (stop - first), "a rectangle")
+    xy = _grid(counts, np.array([h, h]), np.asarray(origin, dtype=float), (first, stop))
     points = np.zeros((len(xy), 3))
     points[:, :2] = xy
     return Body(
@@ -205,7 +238,7 @@ def rectangle(length, width, spacing, thickness, plane: str = "stress", origin=(
     )
 
 
-def face(body: Body, which: str, depth: float | None = None) -> np.ndarray:
+def face(body: Body, which: str, depth: float | None = None, bounds=None) -> np.ndarray:
     """Mask of the points within ``depth`` (default: half a cell) of a bounding-box face.
 
     Parameters
@@ -213,15 +246,19 @@ def face(body: Body, which: str, depth: float | None = None) -> np.ndarray:
     which : {"x-", "x+", "y-", "y+", "z-", "z+"}
     depth : float, m
         Thickness of the selected slab, measured from the outermost points.
+    bounds : (2, 3) float64 or None, m
+        The lowest and highest coordinates of the whole body of which ``body`` is a part (a
+        rank's slab); None: ``body``'s own.
     """
     if which not in {"x-", "x+", "y-", "y+", "z-", "z+"}:
         raise InputError(f"face must be one of x-, x+, y-, y+, z-, z+, got {which!r}")
     axis = "xyz".index(which[0])
     coord = body.points[:, axis]
     tol = 0.5 * float(np.min(body.cells[:, axis])) if depth is None else depth
+    low, high = (coord.min(), coord.max()) if bounds is None else (bounds[0][axis], bounds[1][axis])
     if which[1] == "-":
-        return coord <= coord.min() + tol
-    return coord >= coord.max() - tol
+        return coord <= low + tol
+    return coord >= high - tol
 
 
 def layer(body: Body, index: int) -> np.ndarray:

@@ -160,9 +160,11 @@ class Lattice:
         )
 
 
-def grid_layout(body: Body) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+def grid_layout(body: Body, whole=None) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """(shape, spacing, origin, grid_index) of a body whose points sit on a regular grid of its
-    cells (every cell the same box, each point at a grid position); see :class:`Lattice`.
+    cells (every cell the same box, each point at a grid position); see :class:`Lattice`. With
+    ``whole`` = (origin (3,) m, shape (3,)) of a whole grid's, of which ``body`` is a part (a
+    rank's slab), those of that grid, and each point's index in it.
 
     Raises
     ------
@@ -173,7 +175,7 @@ def grid_layout(body: Body) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndar
     if not np.all(cells == cells[0]):
         raise InputError("the body is not a grid: its cells are not all the same size")
     spacing = cells[0].copy()
-    origin = body.points.min(axis=0)
+    origin = body.points.min(axis=0) if whole is None else np.asarray(whole[0], dtype=np.float64)
     if body.dim == 2:
         spacing[2] = body.thickness
     index = np.rint((body.points - origin) / spacing).astype(np.int64)
@@ -183,7 +185,7 @@ def grid_layout(body: Body) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndar
         raise InputError(
             f"the body is not a grid: a point lies {off.max():.3g} spacings off the grid along {axis}"
         )
-    shape = index.max(axis=0) + 1
+    shape = index.max(axis=0) + 1 if whole is None else np.asarray(whole[1], dtype=np.int64)
     grid_index = (index[:, 2] * shape[1] + index[:, 1]) * shape[0] + index[:, 0]
     if len(np.unique(grid_index)) != body.n_points:
         raise InputError("the body is not a grid: two points share a grid position")

@@ -468,10 +468,12 @@ class Recorder:
             ]
             h5.append("pzt_signal", step, t, np.array(signals))
 
-    def snapshot(self, state: State) -> None:
+    def snapshot(self, state: State, checked: bool = False) -> None:
         """Write the whole displacement field (HDF5, and VTU when enabled); raises
-        InstabilityError, writing nothing, for a non-finite or runaway state."""
-        check_state(state, self.max_displacement)
+        InstabilityError, writing nothing, for a non-finite or runaway state (unless
+        ``checked``: the ranks of an MPI run checked it together, and ``state`` holds u alone)."""
+        if not checked:
+            check_state(state, self.max_displacement)
         self.series.append("field_u", state.step, state.time, state.u)
         if self.exodus is not None and (self.spec.exodus_every is None or self.spec.exodus_due(state.step)):
             self.write_exodus(state, at_snapshot=True)
@@ -531,14 +533,44 @@ class Recorder:
         closed as by :meth:`close` with the failure's status). The reserve stays until the
         run's owner deletes it (the summary is written after)."""
         try:
-            self.flush()
-            vector = ("point", "component")
-            self.h5.write_array("final/u", state.u, {"units": "m", "long_name": "displacement"}, vector)
-            self.h5.write_array("final/v", state.v, {"units": "m/s", "long_name": "velocity"}, vector)
+            fields = {"u": state.u, "v": state.v}
             if self.damage is not None:
+                fields["damage"] = self.damage()
+            fields.update(self._tensor_fields(state.u))
+        except Exception as exc:
+            self.close(end_status(exc))
+            raise
+        for key, value in fields.items():
+            self.write_final(key, value)
+        self.finished()
+
+    def final_keys(self) -> list[str]:
+        """The fields ``finish`` writes when no tensor field is asked for: ``u``, ``v`` and,
+        with a damage index, ``damage``."""
+        return ["u", "v", *(["damage"] if self.damage is not None else [])]
+
+    def finished(self) -> None:
+        """Close the file after the final state (``finish``, or ``write_final`` field by field);
+        the reserve stays until the run's owner deletes it."""
+        self.h5.close()
+
+    def write_final(self, key: str, value: np.ndarray) -> None:
+        """Write one field of the final state, ``final/<key>`` (the whole body's ``u``, ``v``,
+        ``damage`` or a tensor field), after the held records; on a failure, close the file
+        as :meth:`close` does, with the failure's status. ``finish`` writes every field; under
+        MPI they may come one at a time (``RootObservers.finish``), and :meth:`finished`
+        closes the file after them."""
+        try:
+            self.flush()
+            if key in ("u", "v"):
+                about = {"u": ("m", "displacement"), "v": ("m/s", "velocity")}[key]
+                self.h5.write_array(
+                    f"final/{key}", value, {"units": about[0], "long_name": about[1]}, ("point", "component")
+                )
+            elif key == "damage":
                 about = {"units": "1", "long_name": "damage: share of the point's bonds broken"}
-                self.h5.write_array("final/damage", self.damage(), about, ("point",))
-            for key, value in self._tensor_fields(state.u).items():
+                self.h5.write_array("final/damage", value, about, ("point",))
+            else:
                 units, long_name = FINAL_TENSORS.get(key, ("1", key))
                 dims = ("point", "row", "column")[: np.ndim(value)]
                 labels = COMPONENTS[: np.shape(value)[-1]]
@@ -549,7 +581,6 @@ class Recorder:
         except Exception as exc:
             self.close(end_status(exc))
             raise
-        self.h5.close()
 
     def _tensor_fields(self, u: np.ndarray) -> dict:
         """The per-point tensor fields asked for (``tensors``), or none."""

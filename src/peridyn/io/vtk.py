@@ -9,7 +9,6 @@ import os
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
-import meshio
 import numpy as np
 
 from peridyn.errors import InputError
@@ -57,6 +56,8 @@ def write_vtu(
         _write_streamed_vtu(Path(path), points, fields, time)
         return
     cells = [("vertex", np.arange(n, dtype=np.int64).reshape(-1, 1))]
+    import meshio  # here: meshio and the rich console it loads cost 20 MB a process that writes no VTU
+
     mesh = meshio.Mesh(points, cells, point_data=fields)
     meshio.vtu.write(os.fspath(path), mesh, compression=VTU_COMPRESSIONS[compression])
     if time is not None:  # meshio writes no field data: the time goes in after it

@@ -81,7 +81,7 @@ def run_explicit(ctx: RunContext, setup: Setup, solver, spec) -> dict:
         tensors = gathered.tensor_fields
     # the explicit solver's own force (Peridigm's order: from its deformed positions); Newmark's: None
     fields = exodus_values(case, setup, spec, getattr(solver, "internal_force", None))
-    probes = Probes.of(setup.whole_body, spec)  # every rank: under MPI, gathered at a series record
+    probes = d.from_root(Probes.of, setup.whole_body, spec)  # every rank's: gathered at a series record
     recorder = d.on_root(
         Recorder,
         setup.whole_body,
@@ -117,12 +117,18 @@ def run_explicit(ctx: RunContext, setup: Setup, solver, spec) -> dict:
         prepare = [*prepare, (spec.exodus_due, collect)]
     damage_due = [spec.snapshot_due, spec.exodus_due, *([cracks.due] if cracks is not None else [])]
     record = recorder.record_series if recorder is not None else None
+    # a record without an Exodus one reads the probe points and u: under MPI rank 0 gathers
+    # those only (``RootObservers.record``), not the whole state
+    lean = not (spec.exodus or spec.exodus_more)
     try:
         if resume is None:
             if pieces is not None:
                 pieces.write(state)
             collect(state)
-            gathered.call(state, lambda whole: (recorder.record_series(whole), recorder.snapshot(whole)))
+            if lean:
+                gathered.record(state, recorder, probes)
+            else:
+                gathered.call(state, lambda whole: (recorder.record_series(whole), recorder.snapshot(whole)))
         observers = [gathered]
         if checkpoint_every and d.size == 1:
             observers.append(checkpointer)
@@ -163,7 +169,10 @@ def run_explicit(ctx: RunContext, setup: Setup, solver, spec) -> dict:
         if not spec.snapshot_due(state.step):
             if pieces is not None:
                 pieces.write(state)
-            gathered.call(state, lambda whole: recorder.snapshot(whole))
+            if lean:
+                gathered.snapshot(state, recorder)
+            else:
+                gathered.call(state, lambda whole: recorder.snapshot(whole))
     except BaseException as exc:  # e.g. a full disk: the records held are written, the file closed
         if recorder is not None:
             recorder.close(end_status(exc))
@@ -193,7 +202,7 @@ def run_explicit(ctx: RunContext, setup: Setup, solver, spec) -> dict:
         summary["contact_rebuilds"] = setup.contact.rebuilds
     if cracks is not None:
         summary["crack_length_history"] = cracks.history()  # rank 0's is the one returned
-    gathered.call(state, lambda whole: recorder.finish(whole), True)
+    gathered.finish(state, recorder)
     return summary
 
 

@@ -132,7 +132,7 @@ def run_case(
         domain = setup.domain
         solver = time_stepper(case, setup) if stepping else None
         out = output_directory(case, output_dir)
-        spec = recorder_spec(case, setup.whole_body, solver.dt) if stepping else None
+        spec = domain.from_root(recorder_spec, case, setup.whole_body, solver.dt) if stepping else None
         if stepping:
             n_steps = step_count(case, solver)
             check_run_plan(case, solver.dt, n_steps)

@@ -25,7 +25,6 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
-import pyamg
 import scipy.sparse as sp
 from scipy.sparse.linalg import LinearOperator, cg
 
@@ -139,6 +138,8 @@ def solve_spd(
     elif preconditioner not in PRECONDITIONERS:
         raise InputError(f"unknown preconditioner {preconditioner!r}; choose one of {PRECONDITIONERS}")
     elif preconditioner == "amg":
+        import pyamg  # here: 30 MB a process that runs no AMG-preconditioned solve
+
         m = pyamg.smoothed_aggregation_solver(sp.csr_matrix(a), symmetry="symmetric").aspreconditioner(
             cycle="V"
         )

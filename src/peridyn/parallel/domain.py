@@ -71,13 +71,19 @@ class Domain:
         self.halo = halo
         self.partition = partition
         owned_ids = self.global_ids[: self.n_owned]
-        #: on rank 0: every rank's owned global indices (None elsewhere)
-        self._rank_ids = comm.gather(owned_ids) if comm.size > 1 else [owned_ids]
-        gathering = comm.size > 1 and self._rank_ids is not None  # rank 0 of several
-        #: on rank 0 of several: the global indices of the owned points of rank 0, then rank 1, ...
-        self._rank_order = np.concatenate(self._rank_ids) if gathering else None
-        #: on rank 0 of several: whether that order is the global one (``gather_many`` then places nothing)
+        rank_ids = comm.gather(owned_ids) if comm.size > 1 else [owned_ids]
+        gathering = comm.size > 1 and rank_ids is not None  # rank 0 of several
+        #: on rank 0: every rank's number of owned points (None elsewhere)
+        self._rank_counts = None if rank_ids is None else [len(ids) for ids in rank_ids]
+        #: on rank 0 of several: the global indices of the owned points of rank 0, then rank 1,
+        #: ..., or None where that order is the global one (slabs of a grid: ``gather_many``
+        #: then places nothing, and rank 0 keeps no whole-body index)
+        self._rank_order = np.concatenate(rank_ids) if gathering else None
+        del rank_ids
+        #: on rank 0 of several: whether the ranks own the global order's consecutive ranges
         self._in_rank_order = gathering and bool(np.array_equal(self._rank_order, np.arange(self.n_global)))
+        if self._in_rank_order:
+            self._rank_order = None
 
     @classmethod
     def serial(cls, n_points: int) -> Domain:
@@ -159,7 +165,7 @@ class Domain:
             row = int(np.prod(a.shape[1:], dtype=np.int64))
             whole = np.empty((self.n_global, *a.shape[1:]), dtype=a.dtype) if root else None
             by_rank = whole if root and self._in_rank_order else np.empty_like(whole) if root else None
-            counts = [row * len(ids) for ids in self._rank_ids] if root else None
+            counts = [row * count for count in self._rank_counts] if root else None
             self.comm.gatherv(np.ascontiguousarray(a[: self.n_owned]), by_rank, counts)
             if root and not self._in_rank_order:
                 whole[self._rank_order] = by_rank
@@ -217,6 +223,12 @@ class Domain:
                 error = exc
         _raise_any([self.comm.bcast(None if error is None else _portable(error))], error)
         return result
+
+    def from_root(self, fn, *args):
+        """``fn(*args)`` on rank 0, its result on every rank (``on_root``, then broadcast): what
+        needs the whole body, which only rank 0 may hold (lattice storage's slabs)."""
+        result = self.on_root(fn, *args)
+        return result if self.size == 1 else self.comm.bcast(result)
 
     def check_state(self, state: State, max_displacement: float) -> None:
         """``check_state`` of the whole body, each rank checking its owned points, then one

@@ -143,6 +143,54 @@ class RootObservers:
         probe = None if values is None else ProbeState(*values, state.time, state.step)
         self.domain.on_root(record, probe)
 
+    def finish(self, state: State, recorder) -> None:
+        """``recorder.finish`` (rank 0's ``Recorder``, None elsewhere) at the final ``state``,
+        without the whole state on rank 0: under MPI each field (``Recorder.final_keys``) is
+        gathered, written and dropped before the next, so that rank 0 holds one field of the
+        whole body at a time, not u, v, a and the damage index together (collective). With
+        tensor fields asked for, or in one process, ``recorder.finish`` with the whole state."""
+        if self.domain.size == 1 or self.tensors is not None:
+            self.call(state, lambda whole: recorder.finish(whole), True)
+            return
+        keys = self.domain.from_root(lambda: recorder.final_keys())
+        local = {"u": lambda: state.u, "v": lambda: state.v, "damage": lambda: damage_field(self.model)}
+        for key in keys:
+            self.domain.on_root(
+                lambda key, whole: recorder.write_final(key, whole), key, self.domain.gather(local[key]())
+            )
+        self.domain.on_root(lambda: recorder.finished())
+
+    def record(self, state: State, recorder, probes) -> None:
+        """The series record and the snapshot of ``state`` by ``recorder`` (rank 0's
+        ``Recorder``, None elsewhere; a run's first record, without an Exodus record), its
+        series at ``probes``' points (``Probes``): under MPI the ranks check the state together
+        (``Domain.check_state``), gather the probe points' values for the series and u alone
+        for the snapshot (collective); in one process from ``state`` itself."""
+        d = self.domain
+        if d.size == 1:
+            recorder.record_series(state)
+            recorder.snapshot(state)
+            return
+        d.check_state(state, d.runaway_limit(self.model.body.points))
+        values = PointGather(d, probes.u_points, probes.v_points)(state.u, state.v)
+        probe = None if values is None else ProbeState(*values, state.time, state.step)
+        d.on_root(lambda: recorder.record_series(probe))
+        self.snapshot(state, recorder, checked=True)
+
+    def snapshot(self, state: State, recorder, checked: bool = False) -> None:
+        """``recorder.snapshot`` of ``state`` without an Exodus record: under MPI the ranks check
+        the state together (unless ``checked``) and gather u alone, so that rank 0 holds one
+        field of the whole body (a VTU snapshot is written by the ranks:
+        ``peridyn.io.vtu_pieces``); in one process from ``state`` itself (collective)."""
+        d = self.domain
+        if d.size == 1:
+            recorder.snapshot(state)
+            return
+        if not checked:
+            d.check_state(state, d.runaway_limit(self.model.body.points))
+        u = d.gather(state.u)
+        d.on_root(lambda: recorder.snapshot(State(u, None, None, state.time, state.step), checked=True))
+
     def call(self, state: State, fn, tensors: bool = False, damage: bool = True):
         """``fn(state of the whole body)`` on rank 0 after gathering (collective); its result on
         rank 0, None elsewhere. ``tensors``: gather the tensor fields too (for ``fn`` to read

@@ -57,11 +57,12 @@ def stretch_from_bond_stress(critical_bond_stress: float, E):
     return float(critical_bond_stress) / np.asarray(E, dtype=float)
 
 
-def protected_points(body, names) -> np.ndarray:
-    """(n_points,) bool: the points of the node sets ``names`` (whose bonds never break)."""
+def protected_points(body, names, empty: bool = False) -> np.ndarray:
+    """(n_points,) bool: the points of the node sets ``names`` (whose bonds never break);
+    ``empty``: a set may hold none of them (``body`` a rank's part)."""
     protected = np.zeros(body.n_points, dtype=bool)
     for name in names:
-        protected[body.node_set(name)] = True
+        protected[body.node_set(name, empty)] = True
     return protected
 
 

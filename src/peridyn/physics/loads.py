@@ -114,14 +114,24 @@ class _Bound:
 class Loading:
     """Boundary conditions bound to a body, checked for conflicts.
 
+    Parameters
+    ----------
+    body : Body
+    conditions, initial : sequences of BoundaryCondition and InitialCondition
+    set_volume : callable or None
+        ``body`` is a rank's part (``peridyn.parallel``): ``set_volume(name, idx)`` is the volume
+        (m^3) of the whole set ``name`` of which the part holds the points ``idx`` (a force's
+        spread), and a set may hold none of the part's points. None: ``body`` is whole.
+
     Attributes
     ----------
     constrained : (n_points, 3) bool
         DOFs whose motion is prescribed (displacement or velocity).
     """
 
-    def __init__(self, body: Body, conditions=(), initial=()):
+    def __init__(self, body: Body, conditions=(), initial=(), set_volume=None):
         self.body = body
+        self._set_volume = set_volume
         self.displacement: list[_Bound] = []
         self.velocity: list[_Bound] = []
         self.body_force: list[_Bound] = []
@@ -147,7 +157,8 @@ class Loading:
                 if bc.where_prescribed == "error":
                     forced[np.ix_(idx, comps)] = True
                 if bc.kind == "force":
-                    bound.amplitude = bound.amplitude / body.volumes[idx].sum()
+                    whole = body.volumes[idx].sum() if set_volume is None else set_volume(bc.node_set, idx)
+                    bound.amplitude = bound.amplitude / whole
                 self.body_force.append(bound)
         self.constrained = owner >= 0
         self._initial = [(ic.kind, self._bind_initial(ic)) for ic in self.initial]
@@ -159,14 +170,18 @@ class Loading:
                 "component: the force would be ignored"
             )
 
+    def _points(self, name: str) -> np.ndarray:
+        """The indices of set ``name``: on a part (``set_volume`` given) possibly none."""
+        return self.body.node_set(name, self._set_volume is not None)
+
     def _bind(self, bc: BoundaryCondition) -> _Bound:
-        idx = self.body.node_set(bc.node_set)
+        idx = self._points(bc.node_set)
         amplitude = _amplitude(bc.profile, len(idx), len(bc.components), bc.node_set)
         points = self.body.points[idx] if isinstance(bc.function, SpaceTime) else None
         return _Bound(idx, bc.components, bc.function, amplitude, points)
 
     def _bind_initial(self, ic: InitialCondition) -> _Bound:
-        idx = self.body.node_set(ic.node_set)
+        idx = self._points(ic.node_set)
         amp = _amplitude(ic.value, len(idx), len(ic.components), ic.node_set)
         return _Bound(idx, ic.components, Constant(1.0), amp)
 

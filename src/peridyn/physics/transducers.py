@@ -78,6 +78,7 @@ def pzt_radial_actuator(
     layer: int | None = -1,
     amplitude: float = 1e-6,
     name: str = "pzt",
+    part: bool = False,
 ) -> tuple[Body, list[BoundaryCondition]]:
     """Radial in-plane displacement of a PZT patch (Patra et al. 2018), see the module docstring.
 
@@ -102,6 +103,9 @@ def pzt_radial_actuator(
         Radial displacement of the perimeter points at ``function = 1``.
     name : str
         Name of the node set holding the patch's points.
+    part : bool
+        ``body`` is a rank's part of the plate (``peridyn.parallel``), which may hold none of
+        the patch's points: the caller checks the whole patch over the ranks.
 
     Returns
     -------
@@ -116,9 +120,9 @@ def pzt_radial_actuator(
     InputError
         Bad shape, size or layer, or no point under the patch.
     """
-    mask = _footprint(body, center, size, shape, layer)
-    body = body.with_node_set(name, mask)
-    d = _offsets(body.points[body.node_set(name)], center)
+    mask = _footprint(body, center, size, shape, layer, part)
+    body = body.with_node_set(name, mask, empty=part)
+    d = _offsets(body.points[body.node_set(name, part)], center)
     profile = amplitude * d * _radius_over_distance(d, shape) / (0.5 * size)
     return body, [BoundaryCondition(name, "displacement", "xy", function, profile)]
 
@@ -278,13 +282,16 @@ def _radius_over_distance(d: np.ndarray, shape: str) -> np.ndarray:
     return ratio[:, None]
 
 
-def _footprint(body: Body, center, size: float, shape: str, layer: int | None) -> np.ndarray:
-    """Mask of the points under the patch (perimeter included) on ``layer``."""
+def _footprint(
+    body: Body, center, size: float, shape: str, layer: int | None, part: bool = False
+) -> np.ndarray:
+    """Mask of the points under the patch (perimeter included) on ``layer`` (of a rank's part:
+    ``part``, which may hold none)."""
     _check_patch(size, shape)
     on_layer = np.ones(body.n_points, bool) if layer is None else geometry.layer(body, layer)
     rho = _patch_radius(_offsets(body.points, center), shape)
     mask = on_layer & (rho <= 0.5 * size + _ON_PERIMETER * body.spacing)
-    if not mask.any():
+    if not mask.any() and not part:
         raise InputError(
             f"no point of the body lies under the {shape} patch of size {size} m "
             f"at {list(center)} (layer {layer})"

@@ -12,8 +12,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from peridyn import interrupts
-from peridyn.discretization import geometry
-from peridyn.discretization.body import Body, in_box, in_cylinder, in_sphere
+from peridyn.discretization.body import Body, BodySize
 from peridyn.discretization.bonds import (
     HORIZON_RTOL,
     Bonds,
@@ -56,6 +55,8 @@ from peridyn.physics.materials.blocks import BlockMaterial, assign_blocks, make_
 from peridyn.physics.materials.lattice import make_lattice_model
 from peridyn.physics.timefunctions import from_spec
 from peridyn.physics.transducers import pin_force_actuator, pzt_radial_actuator
+from peridyn.setup.grid_points import grid_points, pad3, region_mask
+from peridyn.setup.slab_body import grid_plan, slab_points, slab_refusals
 from peridyn.setup.storage import choose_storage
 
 #: What ``Interrupted`` says a job was doing when it stopped during ``build``.
@@ -79,7 +80,8 @@ class Setup:
     damage: BondDamage | None
     contact: Contact | None = None
     domain: Domain | None = None
-    whole_body: Body | None = None
+    #: rank 0's whole body; a ``BodySize`` on the other ranks of a run made slab by slab
+    whole_body: Body | BodySize | None = None
     #: ``bonds`` (``bonds`` a ``Bonds``) or ``lattice`` (``bonds`` a ``discretization.lattice.Lattice``)
     storage: str = "bonds"
 
@@ -97,12 +99,7 @@ def build_body(case: Case, base_dir=".") -> Body:
     for name, region in case.node_sets.items():
         mask = region_mask(body, region, f"node_sets.{name}")
         if not mask.any():
-            raise CaseFileError(
-                case.name,
-                f"node_sets.{name}",
-                region.model_dump(exclude_none=True),
-                "a region that contains at least one point",
-            )
+            raise _empty_set(case, name, region)
         body = body.with_node_set(name, mask)
     if case.geometry.is_mesh:
         check_mesh_sets(case, body)
@@ -124,26 +121,7 @@ def build_points(case: Case, base_dir=".", removals: bool = True) -> Body:
     g, d = case.geometry, case.discretization
     if not g.is_mesh and d.spacing is None:
         raise CaseFileError(case.name, "discretization.spacing", None, "a positive spacing (m)")
-    if g.type == "box":
-        body = geometry.box(g.size, d.spacing, g.origin or (0.0, 0.0, 0.0))
-    elif g.type == "plate":
-        body = geometry.plate(
-            *g.size,
-            spacing=d.spacing,
-            layers=g.layers,
-            origin=g.origin or (0.0, 0.0, 0.0),
-            layer_placement=g.layer_placement,
-        )
-    elif g.type == "rectangle":
-        body = geometry.rectangle(
-            *g.size,
-            spacing=d.spacing,
-            thickness=g.thickness,
-            plane=g.plane,
-            origin=(g.origin or (0.0, 0.0))[:2],
-        )
-    else:
-        body = mesh_body(g, base_dir)
+    body = mesh_body(g, base_dir) if g.is_mesh else grid_points(case)
     for k, region in enumerate(case.removals if removals else []):
         body = body.remove(region_mask(body, region, f"removals[{k}]"))
     return body
@@ -174,44 +152,6 @@ def check_distinct_points(points: np.ndarray, source: str) -> None:
             f"{source}: points {i} and {j} are at the same place {points[i].tolist()} m "
             f"({same.size} duplicate point{'s' if same.size > 1 else ''}): a mesh needs distinct points"
         )
-
-
-def region_mask(body: Body, region: Region, where: str) -> np.ndarray:
-    """(n_points,) bool mask of a case-file region."""
-    pad = pad3
-    if region.type == "all":
-        return np.ones(body.n_points, dtype=bool)
-    if region.type == "box":
-        return in_box(pad(region.min), pad(region.max))(body.points)
-    if region.type == "sphere":
-        return in_sphere(pad(region.center), region.radius)(body.points)
-    if region.type == "cylinder":
-        return in_cylinder(pad(region.center), region.radius, region.axis)(body.points)
-    if region.type == "face":
-        return geometry.face(body, region.face, region.depth)
-    if region.type == "points":
-        return point_mask(body, region.indices, where)
-    try:
-        return geometry.layer(body, region.index)
-    except InputError as exc:
-        raise InputError(f"{where}: {exc}") from None
-
-
-def point_mask(body: Body, indices: list[int], where: str) -> np.ndarray:
-    """(n_points,) bool mask of 0-based point ``indices``; an index past the body is refused."""
-    idx = np.asarray(indices, dtype=np.int64)
-    if idx.max() >= body.n_points:
-        raise InputError(
-            f"{where}.indices: point {int(idx.max())} does not exist (the body has {body.n_points} points)"
-        )
-    mask = np.zeros(body.n_points, dtype=bool)
-    mask[idx] = True
-    return mask
-
-
-def pad3(v) -> list:
-    """A 2- or 3-component coordinate as 3 components (z = 0 for 2D input)."""
-    return list(v) + [0.0] * (3 - len(v))
 
 
 def case_horizon(case: Case, body: Body) -> float:
@@ -307,14 +247,24 @@ def filtered(case: Case, body: Body, bonds: Bonds, of_block=None) -> Bonds:
     return without_bonds(bonds, mask) if mask.any() else bonds
 
 
-def add_actuators(case: Case, body: Body) -> tuple[Body, list[BoundaryCondition]]:
-    """The body with a node set per actuator, and the actuators' boundary conditions."""
+def add_actuators(case: Case, body: Body, part: bool = False) -> tuple[Body, list[BoundaryCondition]]:
+    """The body with a node set per actuator, and the actuators' boundary conditions; ``part``:
+    ``body`` is a rank's part, which may hold none of a PZT patch's points (``slab_refusals``:
+    no pin-force actuator)."""
     conditions = []
     for name, a in case.actuators.items():
         signal = from_spec(a.signal, f"actuators.{name}.signal")
         if a.type == "pzt_radial":
             body, bcs = pzt_radial_actuator(
-                body, a.center, a.size, signal, shape=a.shape, layer=a.layer, amplitude=a.amplitude, name=name
+                body,
+                a.center,
+                a.size,
+                signal,
+                shape=a.shape,
+                layer=a.layer,
+                amplitude=a.amplitude,
+                name=name,
+                part=part,
             )
         else:
             body, bcs = pin_force_actuator(
@@ -331,8 +281,9 @@ def add_actuators(case: Case, body: Body) -> tuple[Body, list[BoundaryCondition]
     return body, conditions
 
 
-def build_loading(case: Case, body: Body, extra=()) -> Loading:
-    """Boundary and initial conditions of the case (plus ``extra`` ones), checked for conflicts."""
+def build_loading(case: Case, body: Body, extra=(), set_volume=None) -> Loading:
+    """Boundary and initial conditions of the case (plus ``extra`` ones), checked for conflicts;
+    ``set_volume``: ``body`` is a rank's part (``Loading``)."""
     bcs = [
         BoundaryCondition(
             bc.set,
@@ -350,11 +301,11 @@ def build_loading(case: Case, body: Body, extra=()) -> Loading:
             where = f"initial_conditions[{k}].value"
             if value.get("type") != "expression":
                 raise InputError(f"{where}: a number or {{type: expression, text: ...}}, got {value!r}")
-            at = body.points[body.node_set(ic.set)]
+            at = body.points[body.node_set(ic.set, set_volume is not None)]
             values = value_function(value, f"initial_conditions[{k}]").at(at, 0.0)
             value = np.repeat(values[:, None], len(ic.components), axis=1)
         ics.append(InitialCondition(ic.set, ic.kind, ic.components, value))
-    return Loading(body, [*extra, *bcs], ics)
+    return Loading(body, [*extra, *bcs], ics, set_volume)
 
 
 def value_function(spec, where: str):
@@ -370,12 +321,14 @@ def value_function(spec, where: str):
         raise InputError(f"{where}.value: {exc}") from None
 
 
-def check_placements(case: Case, body: Body) -> None:
+def check_placements(case: Case, body: Body, nearest=None, bounds=None) -> None:
     """Refuse sensors, line-probe ends, PZT sensors and actuators outside the body, and
     pre-cracks that do not meet it (``check_precracks``).
 
     A position is outside when it lies more than half a spacing outside the cell of every
-    point near it (an in-plane ``center`` is compared with the x-y cells only).
+    point near it (an in-plane ``center`` is compared with the x-y cells only). On a rank's
+    part, ``nearest`` takes the least of the ranks' distances ((m,) m) and ``bounds`` ((2, 3)
+    m) are the whole body's lowest and highest coordinates.
 
     Raises
     ------
@@ -388,14 +341,16 @@ def check_placements(case: Case, body: Body) -> None:
         spots += [(f"output.lines.{k}.start", line.start), (f"output.lines.{k}.end", line.end)]
     spots += [(f"output.pzt_sensors.{k}.center", v.center) for k, v in out.pzt_sensors.items()]
     spots += [(f"actuators.{k}.center", v.center) for k, v in case.actuators.items()]
-    check_precracks(case, body)
+    check_precracks(case, body, nearest, bounds)
     if not spots:
         return
+    nearest = nearest or (lambda gaps: gaps)
+    low, high = (body.points.min(axis=0), body.points.max(axis=0)) if bounds is None else bounds
     in_plane = [len(v) == 2 and body.dim == 3 for _, v in spots]
     for axes, chosen in ((3, [not p for p in in_plane]), (2, in_plane)):
         items = [spot for spot, c in zip(spots, chosen, strict=True) if c]
         if items:
-            far = distance_outside(body, np.array([pad3(v)[:axes] for _, v in items]), axes)
+            far = nearest(distance_outside(body, np.array([pad3(v)[:axes] for _, v in items]), axes))
             for (key, value), d in zip(items, far, strict=True):
                 if d > 0.5 * body.spacing:
                     raise CaseFileError(
@@ -404,7 +359,7 @@ def check_placements(case: Case, body: Body) -> None:
                         value,
                         f"a position inside the body: it is {d:.3g} m outside "
                         f"(spacing {body.spacing:g} m; the body spans "
-                        f"{body.points.min(axis=0).tolist()} to {body.points.max(axis=0).tolist()} m)",
+                        f"{low.tolist()} to {high.tolist()} m)",
                     )
 
 
@@ -412,10 +367,10 @@ def check_placements(case: Case, body: Body) -> None:
 MAX_CRACK_SAMPLES = 200
 
 
-def check_precracks(case: Case, body: Body) -> None:
+def check_precracks(case: Case, body: Body, nearest=None, bounds=None) -> None:
     """Refuse a pre-crack that lies wholly outside the body (it would cut no bond): none of its
     sample points (every half spacing along it, at most ``MAX_CRACK_SAMPLES`` an edge) within
-    half a spacing of a point's cell.
+    half a spacing of a point's cell (``nearest`` and ``bounds``: ``check_placements``').
 
     Raises
     ------
@@ -423,6 +378,7 @@ def check_precracks(case: Case, body: Body) -> None:
         Naming ``precracks[i]`` and how far outside it lies (m).
     """
     axes = 3 if body.dim == 3 else 2
+    nearest = nearest or (lambda gaps: gaps)
     for i, crack in enumerate(case.precracks):
         if crack.type == "rectangle":
             o, u, v = (np.asarray(pad3(p)) for p in (crack.origin, crack.edge_u, crack.edge_v))
@@ -438,15 +394,15 @@ def check_precracks(case: Case, body: Body) -> None:
             samples = start + _samples(end - start, body.spacing)[:, None] * (end - start)
         within = samples.shape[-1] if crack.type == "bonds" else axes
         samples = samples.reshape(-1, samples.shape[-1])[:, :within]
-        gap = float(distance_outside(body, samples, within).min())
-        low, high = body.points.min(axis=0).tolist(), body.points.max(axis=0).tolist()
+        gap = float(nearest(distance_outside(body, samples, within)).min())
+        low, high = (body.points.min(axis=0), body.points.max(axis=0)) if bounds is None else bounds
         if gap > 0.5 * body.spacing:
             raise CaseFileError(
                 case.name,
                 f"precracks[{i}]",
                 crack.model_dump(exclude_none=True),
                 f"a pre-crack that meets the body: it lies {gap:.3g} m outside and would cut no bond "
-                f"(the body spans {low} to {high} m)",
+                f"(the body spans {low.tolist()} to {high.tolist()} m)",
             )
 
 
@@ -548,8 +504,11 @@ def build_lattice_part(case: Case, comm, base_dir=".") -> Setup:
     """This rank's part of a case on lattice storage (``peridyn.parallel.lattice_domain``): a
     slab of grid planes across x and the ghost planes either side, its lattice with the whole
     grid's stencil, the pre-cracks, model, damage and loading on it. Collective: every rank
-    calls it, and an error on one rank is raised on all."""
-    setup, owned, ghosts, ghost_owner, slab = agree(comm, _build_lattice_part, case, comm, base_dir)
+    calls it, and an error on one rank is raised on all. A case ``slab_refusals`` names is
+    made whole on every rank first; others slab by slab (``setup.slab_body``), rank 0 making
+    the whole body for the recorder."""
+    part = _build_lattice_part if slab_refusals(case) else _build_lattice_slab
+    setup, owned, ghosts, ghost_owner, slab = agree(comm, part, case, comm, base_dir)
     halo = Halo(comm, plan_halo(comm, owned, ghosts, ghost_owner))
     local_ids = np.concatenate([owned, ghosts])
     n_words = setup.bonds.broken.shape[0]
@@ -588,6 +547,89 @@ def _build_lattice_part(case: Case, comm, base_dir):
     loading = loading.restricted(part, local_ids)
     setup = Setup(part, lattice, model, loading, damage, None, None, body, "lattice")
     return setup, owned, ghosts, ghost_owner, slab
+
+
+def _build_lattice_slab(case: Case, comm, base_dir):
+    """``_build_lattice_part`` from the rank's planes alone (``setup.slab_body``): the node sets,
+    actuators, placement checks and force spreads of the whole body by reductions over the
+    ranks; the whole body on rank 0 only (``BodySize`` elsewhere)."""
+    d = case.discretization
+    plan = grid_plan(case, comm)
+    plane = grid_points(case, (plan.first, plan.first + 1))  # the grid's cells, dim and spacing
+    horizon = case_horizon(case, plane)
+    spacing = grid_layout(plane)[1]
+    stencil = grid_stencil(plane, plan.shape, spacing, horizon, d.influence, d.partial_volumes)
+    bounds = slab_bounds(int(plan.shape[0]), comm.size)
+    slab = Slab.of_rank(plan.shape, bounds, comm.rank, ghost_planes(stencil.offsets))
+    part, ids = slab_points(case, plan, slab.first, slab.stop)
+    grid_index = grid_layout(part, (plan.origin, plan.shape))[3]
+    owned, ghosts = slab.points(grid_index)  # planes ascending: the ghosts by owner rank
+    if not len(owned):
+        raise InputError(
+            f"lattice storage: rank {comm.rank}'s planes across x ({slab.lo} to {slab.hi - 1}) "
+            "hold no point: use fewer ranks, or discretization.storage: bonds"
+        )
+    local = np.concatenate([owned, ghosts])
+    part, ids, grid_index, n_owned = part.subset(local), ids[local], grid_index[local], len(owned)
+    part = _slab_node_sets(case, part, plan, comm, n_owned)
+    check_placements(case, part, lambda gaps: comm.allreduce(gaps, "min"), plan.bounds)
+    part, actuation = add_actuators(case, part, part=True)
+    for name in case.actuators:
+        if not comm.allreduce(int(np.count_nonzero(part.node_sets[name] < n_owned))):
+            add_actuators(case, part)  # no rank holds a point of the patch: the serial error
+    volumes = _set_volumes(case, part, comm, n_owned)
+    loading = build_loading(case, part, actuation, lambda name, idx: volumes[name])
+    check_loading(case, loading)
+    layout = slab.layout(spacing, plan.origin, grid_index)
+    lattice = lattice_on_grid(part, layout, stencil, horizon, d.influence)
+    check_families(lattice, part, np.arange(n_owned), ids)
+    no_damage = case.material.damage.no_damage_sets if case.material.damage is not None else []
+    model, damage = lattice_model(case, part, lattice, protected_points(part, no_damage, empty=True))
+    ghost_owner = slab.owners(bounds, grid_index[n_owned:])
+    whole = _whole_body(case, base_dir) if comm.rank == 0 else BodySize(plan.n_points, part.dim, part.spacing)
+    setup = Setup(part, lattice, model, loading, damage, None, None, whole, "lattice")
+    return setup, ids[:n_owned], ids[n_owned:], ghost_owner, slab
+
+
+def _whole_body(case: Case, base_dir) -> Body:
+    """The whole body with its node sets and actuators' sets (rank 0's, for the recorder)."""
+    return add_actuators(case, build_body(case, base_dir))[0]
+
+
+def _slab_node_sets(case: Case, part: Body, plan, comm, n_owned: int) -> Body:
+    """``part`` (a rank's points, the first ``n_owned`` its own) with the case's node sets and
+    ``all``, as ``build_body`` makes them on the whole body (faces by its bounds), a set no
+    rank holds a point of refused as there."""
+    part = part.with_node_set("all", np.ones(part.n_points, dtype=bool))
+    for name, region in case.node_sets.items():
+        mask = region_mask(part, region, f"node_sets.{name}", plan.bounds)
+        if not comm.allreduce(int(np.count_nonzero(mask[:n_owned]))):
+            raise _empty_set(case, name, region)
+        part = part.with_node_set(name, mask, empty=True)
+    return part
+
+
+def _empty_set(case: Case, name: str, region: Region) -> CaseFileError:
+    """The error of a node set whose region holds no point of the body."""
+    return CaseFileError(
+        case.name,
+        f"node_sets.{name}",
+        region.model_dump(exclude_none=True),
+        "a region that contains at least one point",
+    )
+
+
+def _set_volumes(case: Case, part: Body, comm, n_owned: int) -> dict:
+    """The volume (m^3) of each set a ``force`` condition spreads over, summed over the whole
+    set in the whole body's point order (the ranks' owned points in rank order), as a serial
+    run sums it."""
+    volumes = {}
+    for bc in case.boundary_conditions:
+        if bc.kind == "force" and bc.set not in volumes:
+            idx = part.node_set(bc.set, empty=True)
+            mine = part.volumes[idx[idx < n_owned]]
+            volumes[bc.set] = np.concatenate(comm.allgather(mine)).sum()
+    return volumes
 
 
 def precrack_crossing(crack):

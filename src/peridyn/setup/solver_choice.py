@@ -63,7 +63,7 @@ def time_stepper(case, setup):
     if case.solver.type == "newmark":
         return newmark_solver(case, setup)
     s = case.solver
-    damping = explicit_damping(case, setup.whole_body)
+    damping = setup.domain.from_root(explicit_damping, case, setup.whole_body)
     if np.ndim(damping):  # per point: the rank's points
         damping = damping[setup.domain.global_ids]
     peridigm_dt = s.dt is None and s.step_rule == "peridigm"

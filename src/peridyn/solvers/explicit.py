@@ -126,12 +126,11 @@ class ExplicitSolver:
         n = model.body.n_points
         #: the force's own array (n_points, 3), N/m^3, or None: the force is written into the
         #: state's acceleration, which ``kernels.verlet.acceleration`` turns into a in place
-        #: (a model that can, ``Model.force_fills_acceleration``, called as ``model.force`` (one
-        #: process, peridyn's order) with nothing reading the force after: no contact, no
-        #: differenced velocity)
+        #: (a model that can, ``Model.force_fills_acceleration``, every row of a rank's part
+        #: included, called as ``model.force`` (peridyn's order) with nothing reading the force
+        #: after: no contact, no differenced velocity)
         into_acceleration = (
             model.force_fills_acceleration
-            and self.domain.halo is None
             and arithmetic == "peridyn"
             and contact is None
             and prescribed_velocity == "rate"
@@ -195,7 +194,8 @@ class ExplicitSolver:
                 f = f.copy()  # self._force keeps the material's own (``internal_force``)
         elif overlapped:
             d = self.domain
-            f = self.model.force_overlapped(state.u, self._force, d.clear_rows, d.n_owned, d.finish_exchange)
+            out = state.a if self._force is None else self._force
+            f = self.model.force_overlapped(state.u, out, d.clear_rows, d.n_owned, d.finish_exchange)
         else:
             f = self.model.force(state.u, out=state.a if self._force is None else self._force)
         if self.contact is not None:  # Peridigm's order: at its deformed positions

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import numpy as np
-from scipy.integrate import quad
 
 from peridyn.discretization.bonds import influence_function
 from peridyn.errors import InputError
@@ -61,6 +60,8 @@ def dilatational_modulus(E, nu, dim: int, plane: str | None = None):
 def radial_moment(influence: str, horizon: float, power: int) -> float:
     """Integral of omega(r) r^power over [0, horizon] (m^(power+1))."""
     omega = influence_function(influence)
+    from scipy.integrate import quad  # here: scipy.integrate loads scipy.optimize, 15 MB
+
     value, _ = quad(lambda r: float(omega(np.array(r), horizon)) * r**power, 0.0, horizon, limit=200)
     return value
 
