@@ -13,7 +13,8 @@ the two layers of bond reach of the bond-list path (``peridyn.parallel.halo``). 
 the first ``r`` ghost planes then has its whole family on the rank, so its per-point values
 (the LPS weighted volume, dilatation and shear factor) come out as in a serial run from the
 exchanged displacement, and every owned force is the serial one: the lattice kernels add each
-point's bonds in stencil order, whatever the grid around it. A bond whose ends lie on two
+point's pairs in an order set by the grid's y and z planes and the stencil alone, whatever the
+grid's extent across x (``peridyn.kernels.lattice``). A bond whose ends lie on two
 ranks is tested for breaking on both, from the same exchanged displacements, so its two bits
 are set in the same step.
 
