@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from conftest import peridyn_process, results_datasets
+from lamb_probes import LAMB_PROBES
 from test_mpi_runs import _assert_same_snapshots
 
 pytestmark = pytest.mark.mpi
@@ -33,21 +34,7 @@ CASES = {
     "kalthoff_winkler": ("kalthoff_winkler.yaml", ["discretization.spacing=1e-3", "solver.time=30e-6"]),
     "bar_pulse": ("bar_pulse.yaml", ["solver.time=3e-6"]),
     "bar_pulse_float32": ("bar_pulse.yaml", ["solver.time=3e-6", "solver.dtype=float32"]),
-    "lamb_probes": (
-        "lamb_plate.yaml",
-        [
-            "geometry.size=[0.06, 0.0396, 0.002]",
-            "actuators.pzt.center=[0.0306, 0.0198]",
-            "output.sensors={top: [0.0426, 0.0198, 0.002], mid: [0.0426, 0.0198, 0.001], "
-            "centre: [0.0306, 0.0198, 0.002]}",
-            "output.lines={x_axis: {start: [0.0006, 0.0198, 0.002], end: [0.0594, 0.0198, 0.002], "
-            "points: 50}}",
-            "output.pzt_sensors={p: {center: [0.0426, 0.0198], size: 2.4e-3}}",
-            "output.snapshot_times=[1.0e-6]",
-            "analysis={}",
-            "solver.time=2e-6",
-        ],
-    ),
+    "lamb_probes": ("lamb_plate.yaml", [*LAMB_PROBES, "output.snapshot_times=[1.0e-6]", "solver.time=2e-6"]),
 }
 
 #: The cases whose bonds break during the run.

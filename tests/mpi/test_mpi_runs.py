@@ -30,6 +30,7 @@ import meshio
 import numpy as np
 import pytest
 from conftest import peridyn_process, results_datasets
+from lamb_probes import LAMB_PROBES
 
 import peridyn
 from peridyn.io.vtk import read_pvtu_pieces
@@ -55,21 +56,7 @@ CASES = {
     ),
     # the seed Lamb plate cut to 60 x 39.6 mm: every kind of probe (sensors, a line, the top
     # plane, a PZT sensor) recorded at every step, gathered as probe values only under MPI
-    "lamb_probes": (
-        "lamb_plate.yaml",
-        [
-            "geometry.size=[0.06, 0.0396, 0.002]",
-            "actuators.pzt.center=[0.0306, 0.0198]",
-            "output.sensors={top: [0.0426, 0.0198, 0.002], mid: [0.0426, 0.0198, 0.001], "
-            "centre: [0.0306, 0.0198, 0.002]}",
-            "output.lines={x_axis: {start: [0.0006, 0.0198, 0.002], end: [0.0594, 0.0198, 0.002], "
-            "points: 50}}",
-            "output.pzt_sensors={p: {center: [0.0426, 0.0198], size: 2.4e-3}}",
-            "output.snapshot_times=[2.0e-6]",
-            "analysis={}",
-            "solver.time=4e-6",
-        ],
-    ),
+    "lamb_probes": ("lamb_plate.yaml", [*LAMB_PROBES, "output.snapshot_times=[2.0e-6]", "solver.time=4e-6"]),
 }
 
 
