@@ -120,6 +120,7 @@ def test_on_a_clean_crack_the_bonds_route_reaches_past_the_cut_and_gives_the_hig
 
 
 @pytest.mark.slow
+@pytest.mark.xdist_group("monitor_transfer_fine")  # one worker makes the fine job
 def test_on_a_clean_crack_the_two_transfers_agree_within_ten_percent_on_half_the_spacing(fine_job):
     """The monitoring acceptance's line (docs/monitoring.md, "Where they must agree, and how far
     they do"): the two damage-transfer routes agree on the crossed paths' indices within 10% at
@@ -134,6 +135,7 @@ def test_on_a_clean_crack_the_two_transfers_agree_within_ten_percent_on_half_the
 
 
 @pytest.mark.slow
+@pytest.mark.xdist_group("monitor_transfer_fine")  # one worker makes the fine job
 def test_the_two_transfers_converge_as_the_grid_is_refined(job, fine_job):
     """The routes' difference is the fatigue model's process zone, a few spacings long
     (docs/monitoring.md, "Where they must agree, and how far they do"): on half the spacing the
