@@ -254,29 +254,13 @@ def add_actuators(case: Case, body: Body, part: bool = False) -> tuple[Body, lis
     conditions = []
     for name, a in case.actuators.items():
         signal = from_spec(a.signal, f"actuators.{name}.signal")
+        patch = dict(shape=a.shape, layer=a.layer, name=name)
         if a.type == "pzt_radial":
             body, bcs = pzt_radial_actuator(
-                body,
-                a.center,
-                a.size,
-                signal,
-                shape=a.shape,
-                layer=a.layer,
-                amplitude=a.amplitude,
-                name=name,
-                part=part,
+                body, a.center, a.size, signal, amplitude=a.amplitude, part=part, **patch
             )
         else:
-            body, bcs = pin_force_actuator(
-                body,
-                a.center,
-                a.size,
-                signal,
-                shape=a.shape,
-                layer=a.layer,
-                line_force=a.line_force,
-                name=name,
-            )
+            body, bcs = pin_force_actuator(body, a.center, a.size, signal, line_force=a.line_force, **patch)
         conditions += bcs
     return body, conditions
 
